@@ -1,0 +1,143 @@
+//! Hand-off from the main world to the renderer: synchronously on the caller's thread, or
+//! pipelined over a bounded crossbeam channel to a render thread (the simulation of frame N+1
+//! overlaps the rendering of frame N; the channel holds one frame, so the simulation never runs
+//! more than one frame ahead).
+
+use bevy_ecs::prelude::*;
+use crossbeam_channel::{Receiver, Sender, bounded, unbounded};
+use manylight_render::{FrameReport, FrameSnapshot, RenderError};
+use std::thread::JoinHandle;
+
+/// What a rendered frame gives back: its report and, if asked, its image.
+pub type FrameResult = Result<(FrameReport, Option<image::RgbaImage>), String>;
+
+/// Something that renders snapshots: the headless renderer or a window surface.
+pub trait FrameSink: Send + Sync + 'static {
+    /// Renders one snapshot; reads the image back when `readback` is set.
+    fn render_frame(
+        &mut self,
+        snapshot: FrameSnapshot,
+        readback: bool,
+    ) -> Result<(FrameReport, Option<image::RgbaImage>), RenderError>;
+}
+
+impl FrameSink for crate::render_world::HeadlessRenderer {
+    fn render_frame(
+        &mut self,
+        snapshot: FrameSnapshot,
+        readback: bool,
+    ) -> Result<(FrameReport, Option<image::RgbaImage>), RenderError> {
+        self.render(snapshot, readback)
+    }
+}
+
+enum Message {
+    Frame(Box<FrameSnapshot>, bool),
+}
+
+/// The render thread: receives snapshots, renders them, sends results back.
+pub struct RenderThread {
+    frames: Option<Sender<Message>>,
+    results: Receiver<FrameResult>,
+    handle: Option<JoinHandle<()>>,
+}
+
+impl RenderThread {
+    /// Starts a render thread around `sink`.
+    pub fn spawn(mut sink: Box<dyn FrameSink>) -> std::io::Result<RenderThread> {
+        let (frame_tx, frame_rx) = bounded::<Message>(1);
+        let (result_tx, result_rx) = unbounded::<FrameResult>();
+        let handle = std::thread::Builder::new().name("manylight-render".into()).spawn(move || {
+            // Ends when the sender is dropped (app shut down) or a frame fails.
+            while let Ok(Message::Frame(snapshot, readback)) = frame_rx.recv() {
+                let result = sink.render_frame(*snapshot, readback).map_err(|e| e.to_string());
+                let failed = result.is_err();
+                if result_tx.send(result).is_err() || failed {
+                    break;
+                }
+            }
+            tracing::debug!("render thread finished");
+        })?;
+        Ok(RenderThread { frames: Some(frame_tx), results: result_rx, handle: Some(handle) })
+    }
+
+    /// Stops the thread after the frame in flight and waits for it.
+    pub fn shutdown(&mut self) {
+        self.frames.take();
+        if let Some(h) = self.handle.take()
+            && h.join().is_err()
+        {
+            tracing::error!("the render thread panicked");
+        }
+    }
+}
+
+impl Drop for RenderThread {
+    fn drop(&mut self) {
+        self.shutdown();
+    }
+}
+
+/// How the main world reaches the renderer.
+#[derive(Resource)]
+pub enum RenderBackend {
+    /// No renderer yet (a window backend is created when the window exists).
+    Pending,
+    /// Render on the calling thread.
+    Sync {
+        /// The renderer.
+        sink: Box<dyn FrameSink>,
+        /// Results not yet collected.
+        pending: Vec<FrameResult>,
+    },
+    /// Render on a render thread.
+    Pipelined(RenderThread),
+    /// Creating the renderer failed; the message says why.
+    Failed(String),
+}
+
+impl RenderBackend {
+    /// Hands a snapshot over (renders it now in sync mode).
+    pub fn submit(&mut self, snapshot: FrameSnapshot, readback: bool) {
+        match self {
+            RenderBackend::Pending => {}
+            RenderBackend::Sync { sink, pending } => {
+                pending.push(sink.render_frame(snapshot, readback).map_err(|e| e.to_string()));
+            }
+            RenderBackend::Pipelined(thread) => {
+                let sent = thread
+                    .frames
+                    .as_ref()
+                    .is_some_and(|tx| tx.send(Message::Frame(Box::new(snapshot), readback)).is_ok());
+                if !sent {
+                    tracing::debug!("render thread has stopped; frame dropped");
+                }
+            }
+            RenderBackend::Failed(_) => {}
+        }
+    }
+
+    /// Results that arrived since the last call.
+    pub fn drain(&mut self) -> Vec<FrameResult> {
+        match self {
+            RenderBackend::Sync { pending, .. } => std::mem::take(pending),
+            RenderBackend::Pipelined(thread) => thread.results.try_iter().collect(),
+            RenderBackend::Failed(message) => {
+                let m = std::mem::take(message);
+                if m.is_empty() { Vec::new() } else { vec![Err(m)] }
+            }
+            RenderBackend::Pending => Vec::new(),
+        }
+    }
+
+    /// Waits for every frame in flight (pipelined mode) and returns their results.
+    pub fn flush(&mut self) -> Vec<FrameResult> {
+        if let RenderBackend::Pipelined(thread) = self {
+            thread.frames.take();
+            if let Some(h) = thread.handle.take() {
+                let _ = h.join();
+            }
+        }
+        self.drain()
+    }
+}

@@ -1,0 +1,113 @@
+//! The components a user spawns: where things are, what is drawn, what emits light.
+
+use bevy_ecs::prelude::*;
+use glam::{Mat4, Quat, Vec3};
+use manylight_core::{MaterialData, MeshData, Projection};
+use std::sync::Arc;
+
+/// Position, rotation and scale of an entity in world space.
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct Transform {
+    /// Position.
+    pub translation: Vec3,
+    /// Orientation.
+    pub rotation: Quat,
+    /// Scale per axis.
+    pub scale: Vec3,
+}
+
+impl Default for Transform {
+    fn default() -> Self {
+        Self::IDENTITY
+    }
+}
+
+impl Transform {
+    /// No translation, rotation or scale.
+    pub const IDENTITY: Transform =
+        Transform { translation: Vec3::ZERO, rotation: Quat::IDENTITY, scale: Vec3::ONE };
+
+    /// A transform at `(x, y, z)`.
+    pub fn from_xyz(x: f32, y: f32, z: f32) -> Transform {
+        Transform { translation: Vec3::new(x, y, z), ..Self::IDENTITY }
+    }
+
+    /// A transform at `translation`.
+    pub fn from_translation(translation: Vec3) -> Transform {
+        Transform { translation, ..Self::IDENTITY }
+    }
+
+    /// Decomposes a matrix (e.g. from a glTF node).
+    pub fn from_matrix(m: Mat4) -> Transform {
+        let (scale, rotation, translation) = m.to_scale_rotation_translation();
+        Transform { translation, rotation, scale }
+    }
+
+    /// Turns the entity so its -Z axis points at `target`, with +Y as close to `up` as possible.
+    pub fn looking_at(mut self, target: Vec3, up: Vec3) -> Transform {
+        let forward = (target - self.translation).try_normalize().unwrap_or(Vec3::NEG_Z);
+        let right = forward.cross(up).try_normalize().unwrap_or_else(|| forward.any_orthonormal_vector());
+        let up = right.cross(forward);
+        self.rotation = Quat::from_mat3(&glam::Mat3::from_cols(right, up, -forward));
+        self
+    }
+
+    /// World-from-local matrix.
+    pub fn to_matrix(&self) -> Mat4 {
+        Mat4::from_scale_rotation_translation(self.scale, self.rotation, self.translation)
+    }
+}
+
+/// A perspective camera; the entity's [`Transform`] places it (looking down its -Z).
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct Camera3d {
+    /// Vertical field of view in radians.
+    pub fov_y: f32,
+    /// Near plane distance.
+    pub near: f32,
+    /// Far plane distance.
+    pub far: f32,
+}
+
+impl Default for Camera3d {
+    fn default() -> Self {
+        let p = Projection::default();
+        Self { fov_y: p.fov_y, near: p.near, far: p.far }
+    }
+}
+
+impl Camera3d {
+    /// The projection parameters.
+    pub fn projection(&self) -> Projection {
+        Projection { fov_y: self.fov_y, near: self.near, far: self.far }
+    }
+}
+
+/// A point light at the entity's [`Transform`] translation.
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct PointLight {
+    /// Linear RGB colour.
+    pub color: Vec3,
+    /// Multiplier of `color`.
+    pub intensity: f32,
+    /// Distance at which the contribution reaches exactly zero.
+    pub radius: f32,
+}
+
+impl Default for PointLight {
+    fn default() -> Self {
+        Self { color: Vec3::ONE, intensity: 10.0, radius: 10.0 }
+    }
+}
+
+/// The geometry drawn at the entity's [`Transform`] (shared; uploaded once per `Arc`).
+#[derive(Component, Clone, Debug)]
+pub struct Mesh3d(pub Arc<MeshData>);
+
+/// The material of a [`Mesh3d`] entity (shared; one GPU binding per `Arc`).
+#[derive(Component, Clone, Debug)]
+pub struct Material(pub Arc<MaterialData>);
+
+/// Animates a light: the plugin moves its [`Transform`] and tints its [`PointLight`] each frame.
+#[derive(Component, Clone, Copy, Debug)]
+pub struct LightAnimation(pub manylight_scene::AnimatedLight);

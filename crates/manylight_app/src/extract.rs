@@ -1,0 +1,130 @@
+//! Extract: copy what rendering needs out of the ECS world into a [`FrameSnapshot`] and hand
+//! it to the render side. Mesh and material data travel as `Arc`s (no copy of the data).
+
+use crate::backend::RenderBackend;
+use crate::components::{Camera3d, LightAnimation, Material, Mesh3d, PointLight, Transform};
+use crate::resources::{
+    FrameClock, FrameStats, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize,
+};
+use bevy_app::AppExit;
+use bevy_ecs::prelude::*;
+use glam::Mat4;
+use manylight_core::MaterialData;
+use manylight_render::{ExtractedCamera, ExtractedInstance, ExtractedPointLight, FrameSnapshot};
+use std::sync::Arc;
+
+/// State the extract system keeps between frames.
+#[derive(Default)]
+pub struct ExtractState {
+    prev_clip_from_world: Option<Mat4>,
+    frame_index: u64,
+    default_material: Option<Arc<MaterialData>>,
+    warned_cameras: bool,
+}
+
+/// Builds the frame's snapshot from the world.
+#[allow(clippy::too_many_arguments)]
+pub fn build_snapshot(
+    state: &mut ExtractState,
+    viewport: glam::UVec2,
+    settings: &RenderSettings,
+    cameras: &Query<(&Transform, &Camera3d)>,
+    meshes: &Query<(&Transform, &Mesh3d, Option<&Material>)>,
+    lights: &Query<(&Transform, &PointLight)>,
+) -> FrameSnapshot {
+    let mut camera_iter = cameras.iter();
+    let camera = camera_iter.next().map(|(t, c)| ExtractedCamera {
+        world_from_view: Mat4::from_rotation_translation(t.rotation, t.translation),
+        projection: c.projection(),
+        prev_clip_from_world: state.prev_clip_from_world,
+    });
+    if camera_iter.next().is_some() && !state.warned_cameras {
+        tracing::warn!("more than one Camera3d: rendering the first one only");
+        state.warned_cameras = true;
+    }
+    state.prev_clip_from_world = camera.map(|c| c.clip_from_world(viewport));
+    let default_material =
+        state.default_material.get_or_insert_with(|| Arc::new(MaterialData::default())).clone();
+    let instances = meshes
+        .iter()
+        .map(|(t, mesh, material)| ExtractedInstance {
+            mesh: mesh.0.clone(),
+            material: material.map_or_else(|| default_material.clone(), |m| m.0.clone()),
+            world_from_local: t.to_matrix(),
+        })
+        .collect();
+    let lights = lights
+        .iter()
+        .map(|(t, l)| ExtractedPointLight {
+            position: t.translation,
+            color: l.color,
+            intensity: l.intensity,
+            radius: l.radius,
+        })
+        .collect();
+    let snapshot = FrameSnapshot {
+        frame_index: state.frame_index,
+        viewport,
+        camera,
+        instances,
+        lights,
+        settings: settings.frame_settings(),
+    };
+    state.frame_index += 1;
+    snapshot
+}
+
+/// The extract system (runs in `Last`, in [`crate::ManyLightSet::Extract`]).
+#[allow(clippy::too_many_arguments)]
+pub fn extract_and_render(
+    mut state: Local<ExtractState>,
+    viewport: Res<ViewportSize>,
+    settings: Res<RenderSettings>,
+    cameras: Query<(&Transform, &Camera3d)>,
+    meshes: Query<(&Transform, &Mesh3d, Option<&Material>)>,
+    lights: Query<(&Transform, &PointLight)>,
+    mut backend: ResMut<RenderBackend>,
+    mut stats: ResMut<FrameStats>,
+    mut capture: ResMut<HeadlessCapture>,
+    mut failure: ResMut<RenderFailure>,
+    mut exit: MessageWriter<AppExit>,
+) {
+    if failure.0.is_some() {
+        return;
+    }
+    let snapshot = build_snapshot(&mut state, viewport.0, &settings, &cameras, &meshes, &lights);
+    backend.submit(snapshot, capture.enabled);
+    for result in backend.drain() {
+        match result {
+            Ok((report, image)) => {
+                stats.last = Some(report);
+                stats.frames_rendered += 1;
+                if image.is_some() {
+                    capture.image = image;
+                }
+            }
+            Err(message) => {
+                tracing::error!("rendering failed: {message}");
+                failure.0 = Some(message);
+                exit.write(AppExit::error());
+            }
+        }
+    }
+}
+
+/// Advances the clock (first system of `First`).
+pub fn tick_clock(mut clock: ResMut<FrameClock>) {
+    clock.tick();
+}
+
+/// Moves and tints lights that carry a [`LightAnimation`].
+pub fn animate_lights(
+    clock: Res<FrameClock>,
+    mut lights: Query<(&LightAnimation, &mut Transform, &mut PointLight)>,
+) {
+    let t = clock.elapsed;
+    for (anim, mut transform, mut light) in &mut lights {
+        transform.translation = anim.0.position_at(t);
+        light.color = anim.0.color_at(t);
+    }
+}

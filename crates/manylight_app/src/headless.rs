@@ -1,0 +1,61 @@
+//! The headless runner: renders a number of frames and writes the last one as PNG.
+
+use crate::backend::RenderBackend;
+use crate::plugin::HeadlessConfig;
+use crate::resources::{FrameStats, HeadlessCapture, RenderFailure};
+use bevy_app::{App, AppExit};
+
+/// Runs `config.frames` updates (or until a system exits), then writes the last frame to
+/// `config.output` if set.
+pub fn run_headless(mut app: App, config: HeadlessConfig) -> AppExit {
+    for _ in 0..config.frames {
+        app.update();
+        if let Some(exit) = app.should_exit() {
+            return exit;
+        }
+    }
+    finish_frames(&mut app);
+    if let Some(message) = app.world().get_resource::<RenderFailure>().and_then(|f| f.0.clone()) {
+        tracing::error!("{message}");
+        return AppExit::error();
+    }
+    if let Some(path) = &config.output {
+        let Some(image) = app.world().get_resource::<HeadlessCapture>().and_then(|c| c.image.clone()) else {
+            tracing::error!("no frame was captured, nothing written to {}", path.display());
+            return AppExit::error();
+        };
+        if let Err(e) = save_png(&image, path) {
+            tracing::error!("{e}");
+            return AppExit::error();
+        }
+        tracing::info!("wrote {}", path.display());
+    }
+    AppExit::Success
+}
+
+/// Waits for frames still in flight (pipelined mode) and stores their results.
+pub fn finish_frames(app: &mut App) {
+    let world = app.world_mut();
+    let results = world.resource_mut::<RenderBackend>().flush();
+    for result in results {
+        match result {
+            Ok((report, image)) => {
+                let mut stats = world.resource_mut::<FrameStats>();
+                stats.last = Some(report);
+                stats.frames_rendered += 1;
+                if image.is_some() {
+                    world.resource_mut::<HeadlessCapture>().image = image;
+                }
+            }
+            Err(e) => world.resource_mut::<RenderFailure>().0 = Some(e),
+        }
+    }
+}
+
+/// Writes an image as PNG, creating parent folders.
+pub fn save_png(image: &image::RgbaImage, path: &std::path::Path) -> Result<(), String> {
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent).map_err(|e| format!("cannot create {}: {e}", parent.display()))?;
+    }
+    image.save(path).map_err(|e| format!("cannot write {}: {e}", path.display()))
+}

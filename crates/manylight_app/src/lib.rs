@@ -1,0 +1,42 @@
+//! The bevy_app side of manylight: components, resources, the extract step, the render thread,
+//! the window and the headless runner.
+//!
+//! ```no_run
+//! use manylight_app::prelude::*;
+//! App::new()
+//!     .add_plugins(ManyLightPlugin::headless(UVec2::new(256, 256)))
+//!     .add_systems(Startup, |mut commands: Commands| {
+//!         commands.spawn((Transform::from_xyz(0.0, 1.0, 5.0), Camera3d::default()));
+//!         commands.spawn((Transform::from_xyz(0.0, 2.0, 0.0), PointLight::default()));
+//!     })
+//!     .run();
+//! ```
+
+pub mod backend;
+pub mod components;
+pub mod extract;
+pub mod headless;
+pub mod plugin;
+pub mod render_world;
+pub mod resources;
+pub mod scene;
+pub mod window;
+
+pub use components::{Camera3d, LightAnimation, Material, Mesh3d, PointLight, Transform};
+pub use plugin::{HeadlessConfig, ManyLightPlugin, ManyLightSet, OutputMode};
+pub use resources::{FrameClock, FrameStats, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize};
+pub use window::WindowConfig;
+
+/// What an app needs in scope to use manylight.
+pub mod prelude {
+    pub use crate::components::{Camera3d, LightAnimation, Material, Mesh3d, PointLight, Transform};
+    pub use crate::plugin::{ManyLightPlugin, ManyLightSet};
+    pub use crate::resources::{FrameClock, FrameStats, HeadlessCapture, RenderSettings};
+    pub use crate::scene::{spawn_light_rig, spawn_scene};
+    pub use crate::window::WindowConfig;
+    pub use bevy_app::prelude::*;
+    pub use bevy_ecs::prelude::*;
+    pub use glam::{Quat, UVec2, Vec3};
+    pub use manylight_core::{MaterialData, MeshData, ShadingModel};
+    pub use manylight_render::PipelineKind;
+}

@@ -1,0 +1,137 @@
+//! `ManyLightPlugin`: adds the components' systems, the extract step and the renderer.
+
+use crate::backend::{RenderBackend, RenderThread};
+use crate::extract::{animate_lights, extract_and_render, tick_clock};
+use crate::render_world::HeadlessRenderer;
+use crate::resources::{
+    FrameClock, FrameStats, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize,
+};
+use crate::window::WindowConfig;
+use bevy_app::prelude::*;
+use bevy_ecs::prelude::*;
+use glam::UVec2;
+use std::path::PathBuf;
+
+/// Public system sets, so user systems can be ordered around the plugin's.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ManyLightSet {
+    /// `Update`: the plugin's own animation (light rigs). User systems that move things can
+    /// run before or after it.
+    Animate,
+    /// `Last`: the snapshot of the world is taken and handed to the renderer. Anything that
+    /// should show in this frame must run before it (any `Update` system does).
+    Extract,
+}
+
+/// Headless parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeadlessConfig {
+    /// Target size in pixels.
+    pub size: UVec2,
+    /// With `App::run`: how many frames to render before exiting (default 1).
+    pub frames: u32,
+    /// With `App::run`: where to write the last frame as PNG.
+    pub output: Option<PathBuf>,
+}
+
+/// Where frames go.
+#[derive(Clone, Debug, PartialEq)]
+pub enum OutputMode {
+    /// A window (winit); `App::run` runs its event loop.
+    Window(WindowConfig),
+    /// An offscreen image.
+    Headless(HeadlessConfig),
+}
+
+/// The manylight plugin: windowed by default, or headless with a size.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ManyLightPlugin {
+    /// Window or headless.
+    pub mode: OutputMode,
+    /// Render on a separate thread (frame N+1 simulates while N renders). Default: true for
+    /// windows, false headless (deterministic, results available right after `update`).
+    pub pipelined: bool,
+}
+
+impl Default for ManyLightPlugin {
+    fn default() -> Self {
+        Self { mode: OutputMode::Window(WindowConfig::default()), pipelined: true }
+    }
+}
+
+impl ManyLightPlugin {
+    /// A window with the given configuration.
+    pub fn window(config: WindowConfig) -> Self {
+        Self { mode: OutputMode::Window(config), pipelined: true }
+    }
+
+    /// Headless rendering at `size` (synchronous, one frame per `App::update`).
+    pub fn headless(size: UVec2) -> Self {
+        Self {
+            mode: OutputMode::Headless(HeadlessConfig { size, frames: 1, output: None }),
+            pipelined: false,
+        }
+    }
+
+    /// Headless: frames `App::run` renders before it exits.
+    pub fn with_frames(mut self, frames: u32) -> Self {
+        if let OutputMode::Headless(h) = &mut self.mode {
+            h.frames = frames.max(1);
+        }
+        self
+    }
+
+    /// Headless: the PNG `App::run` writes the last frame to.
+    pub fn with_output(mut self, path: impl Into<PathBuf>) -> Self {
+        if let OutputMode::Headless(h) = &mut self.mode {
+            h.output = Some(path.into());
+        }
+        self
+    }
+
+    /// Chooses pipelined (render thread) or synchronous rendering.
+    pub fn with_pipelined(mut self, pipelined: bool) -> Self {
+        self.pipelined = pipelined;
+        self
+    }
+}
+
+impl Plugin for ManyLightPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<RenderSettings>()
+            .init_resource::<FrameStats>()
+            .init_resource::<RenderFailure>()
+            .configure_sets(Update, ManyLightSet::Animate)
+            .configure_sets(Last, ManyLightSet::Extract)
+            .add_systems(First, tick_clock)
+            .add_systems(Update, animate_lights.in_set(ManyLightSet::Animate))
+            .add_systems(Last, extract_and_render.in_set(ManyLightSet::Extract));
+        match &self.mode {
+            OutputMode::Window(config) => {
+                let config = config.clone();
+                let pipelined = self.pipelined;
+                app.insert_resource(FrameClock::real_time())
+                    .insert_resource(ViewportSize(UVec2::new(config.width, config.height)))
+                    .insert_resource(HeadlessCapture::default())
+                    .insert_resource(RenderBackend::Pending)
+                    .set_runner(move |app| crate::window::run_window(app, config, pipelined));
+            }
+            OutputMode::Headless(config) => {
+                let backend = match HeadlessRenderer::new() {
+                    Ok(r) if self.pipelined => match RenderThread::spawn(Box::new(r)) {
+                        Ok(t) => RenderBackend::Pipelined(t),
+                        Err(e) => RenderBackend::Failed(format!("could not start the render thread: {e}")),
+                    },
+                    Ok(r) => RenderBackend::Sync { sink: Box::new(r), pending: Vec::new() },
+                    Err(e) => RenderBackend::Failed(e.to_string()),
+                };
+                let config = config.clone();
+                app.insert_resource(FrameClock::fixed(1.0 / 60.0))
+                    .insert_resource(ViewportSize(config.size))
+                    .insert_resource(HeadlessCapture { enabled: true, image: None })
+                    .insert_resource(backend)
+                    .set_runner(move |app| crate::headless::run_headless(app, config));
+            }
+        }
+    }
+}

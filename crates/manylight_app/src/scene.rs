@@ -1,0 +1,49 @@
+//! Turning a [`Scene`] (loaded glTF or the embedded default) into entities.
+
+use crate::components::{Camera3d, LightAnimation, Material, Mesh3d, PointLight, Transform};
+use bevy_ecs::prelude::*;
+use manylight_core::Aabb;
+use manylight_scene::Scene;
+use manylight_scene::light_rig;
+
+/// Spawns the scene's instances and lights, and its camera (or one framing it) when
+/// `spawn_camera` is set. `aspect` is the viewport's width / height.
+pub fn spawn_scene(commands: &mut Commands, scene: &Scene, spawn_camera: bool, aspect: f32) {
+    for inst in &scene.instances {
+        let (Some(mesh), Some(material)) = (scene.meshes.get(inst.mesh), scene.materials.get(inst.material))
+        else {
+            tracing::warn!("scene `{}`: instance refers to a missing mesh or material", scene.name);
+            continue;
+        };
+        commands.spawn((
+            Transform::from_matrix(inst.transform),
+            Mesh3d(mesh.clone()),
+            Material(material.clone()),
+        ));
+    }
+    for light in &scene.lights {
+        commands.spawn((
+            Transform::from_translation(light.position),
+            PointLight { color: light.color, intensity: light.intensity, radius: light.radius },
+        ));
+    }
+    if spawn_camera {
+        let cam = scene.camera_or_fit(aspect);
+        let p = cam.projection;
+        commands.spawn((
+            Transform::from_matrix(cam.transform),
+            Camera3d { fov_y: p.fov_y, near: p.near, far: p.far },
+        ));
+    }
+}
+
+/// Spawns `count` animated lights inside `bounds` (deterministic for a `seed`).
+pub fn spawn_light_rig(commands: &mut Commands, count: usize, bounds: Aabb, seed: u64) {
+    for anim in light_rig(count, bounds, seed) {
+        commands.spawn((
+            Transform::from_translation(anim.position_at(0.0)),
+            PointLight { color: anim.color_at(0.0), intensity: anim.intensity, radius: anim.radius },
+            LightAnimation(anim),
+        ));
+    }
+}

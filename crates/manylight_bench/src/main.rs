@@ -1,0 +1,231 @@
+//! `manylight`: render a scene to PNG, check a glTF file, and (later) benchmark pipelines.
+
+use anyhow::{Context, Result, bail};
+use bevy_app::{App, Startup};
+use bevy_ecs::system::Commands;
+use clap::{Parser, Subcommand};
+use glam::UVec2;
+use manylight_app::headless::save_png;
+use manylight_app::scene::{spawn_light_rig, spawn_scene};
+use manylight_app::{FrameStats, HeadlessCapture, RenderFailure};
+use manylight_app::{ManyLightPlugin, RenderSettings};
+use manylight_core::ShadingModel;
+use manylight_render::PipelineKind;
+use manylight_scene::{LoadOptions, Scene, load_scene};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "manylight", version, about = "Many-light rendering with wgpu: render, check, bench")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene headless and write the last frame as PNG.
+    Render(RenderArgs),
+    /// Load a glTF/GLB file and render one frame headless; exit 1 with the error on bad input.
+    Check {
+        /// The .gltf or .glb file.
+        path: PathBuf,
+    },
+}
+
+#[derive(clap::Args)]
+struct RenderArgs {
+    /// `default` (embedded hall), `sphere-shell`, or a path to a .gltf/.glb file.
+    #[arg(long, default_value = "default")]
+    scene: String,
+    /// Pipeline: naive.
+    #[arg(long, default_value = "naive", value_parser = parse_pipeline)]
+    pipeline: PipelineKind,
+    /// Shading model for materials without their own: lambert or blinn-phong.
+    #[arg(long, default_value = "blinn-phong", value_parser = parse_shading)]
+    shading: ShadingModel,
+    /// Animated lights added to the scene's own lights.
+    #[arg(long, default_value_t = 0)]
+    lights: usize,
+    /// Image size, WxH.
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    size: UVec2,
+    /// Frames to render (animation advances 1/60 s per frame); the last one is written.
+    #[arg(long, default_value_t = 1)]
+    frames: u32,
+    /// Exposure multiplier before tone mapping.
+    #[arg(long, default_value_t = 1.0)]
+    exposure: f32,
+    /// Seed of the light placement.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Camera: `scene` (the file's first camera, else a fitted one), `fit` (frame the whole
+    /// scene), or the index of one of the file's cameras.
+    #[arg(long, default_value = "scene")]
+    camera: String,
+    /// Output PNG.
+    #[arg(long)]
+    out: PathBuf,
+    /// Write the last frame's statistics as JSON here.
+    #[arg(long)]
+    stats_json: Option<PathBuf>,
+}
+
+fn parse_pipeline(s: &str) -> Result<PipelineKind, String> {
+    PipelineKind::from_name(s).ok_or_else(|| {
+        let names: Vec<_> = PipelineKind::ALL.iter().map(|p| p.name()).collect();
+        format!("unknown pipeline `{s}` (expected one of: {})", names.join(", "))
+    })
+}
+
+fn parse_shading(s: &str) -> Result<ShadingModel, String> {
+    ShadingModel::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
+        let names: Vec<_> = ShadingModel::ALL.iter().map(|m| m.name()).collect();
+        format!("unknown shading model `{s}` (expected one of: {})", names.join(", "))
+    })
+}
+
+fn parse_size(s: &str) -> Result<UVec2, String> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("size `{s}` is not WxH"))?;
+    let parse = |v: &str| v.trim().parse::<u32>().map_err(|e| format!("size `{s}`: {e}"));
+    let (w, h) = (parse(w)?, parse(h)?);
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err(format!("size `{s}`: each side must be in 1..=16384"));
+    }
+    Ok(UVec2::new(w, h))
+}
+
+/// Renders `scene` headless through the plugin and returns the last frame and its stats.
+fn render_scene(
+    scene: Scene,
+    size: UVec2,
+    frames: u32,
+    lights: usize,
+    seed: u64,
+    settings: RenderSettings,
+) -> Result<(image::RgbaImage, FrameStats)> {
+    let mut app = App::new();
+    app.add_plugins(ManyLightPlugin::headless(size)).insert_resource(settings);
+    let aspect = size.x as f32 / size.y as f32;
+    let bounds = scene.bounds();
+    app.add_systems(Startup, move |mut commands: Commands| {
+        spawn_scene(&mut commands, &scene, true, aspect);
+        if lights > 0 {
+            spawn_light_rig(&mut commands, lights, bounds, seed);
+        }
+    });
+    for _ in 0..frames.max(1) {
+        app.update();
+        if let Some(message) = app.world().resource::<RenderFailure>().0.clone() {
+            bail!("{message}");
+        }
+    }
+    manylight_app::headless::finish_frames(&mut app);
+    if let Some(message) = app.world().resource::<RenderFailure>().0.clone() {
+        bail!("{message}");
+    }
+    let image = app.world().resource::<HeadlessCapture>().image.clone().context("no frame was rendered")?;
+    Ok((image, app.world().resource::<FrameStats>().clone()))
+}
+
+/// Reorders or clears the scene's cameras so the chosen one comes first.
+fn select_camera(scene: &mut Scene, choice: &str) -> Result<()> {
+    match choice {
+        "scene" => {}
+        "fit" => scene.cameras.clear(),
+        index => {
+            let i: usize = index
+                .parse()
+                .with_context(|| format!("--camera `{index}`: expected scene, fit or a number"))?;
+            if i >= scene.cameras.len() {
+                bail!("--camera {i}: the scene has {} cameras", scene.cameras.len());
+            }
+            scene.cameras.swap(0, i);
+        }
+    }
+    Ok(())
+}
+
+fn stats_json(stats: &FrameStats) -> serde_json::Value {
+    serde_json::json!({
+        "frames_rendered": stats.frames_rendered,
+        "last_frame": stats.last,
+    })
+}
+
+fn render(args: RenderArgs) -> Result<()> {
+    let mut scene = load_scene(&args.scene, &LoadOptions::default())?;
+    select_camera(&mut scene, &args.camera)?;
+    let settings = RenderSettings {
+        pipeline: args.pipeline,
+        shading: args.shading,
+        exposure: args.exposure,
+        ..RenderSettings::default()
+    };
+    let (image, stats) = render_scene(scene, args.size, args.frames, args.lights, args.seed, settings)?;
+    save_png(&image, &args.out).map_err(anyhow::Error::msg)?;
+    if let Some(path) = &args.stats_json {
+        let text = serde_json::to_string_pretty(&stats_json(&stats))?;
+        std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    if let Some(r) = &stats.last {
+        let passes: Vec<String> = r
+            .passes
+            .iter()
+            .map(|p| match p.gpu_ms {
+                Some(g) => format!("{} {:.2} ms", p.name, g),
+                None => format!("{} (cpu {:.2} ms)", p.name, p.cpu_ms),
+            })
+            .collect();
+        println!(
+            "wrote {} ({}x{}, {} lights, {} instances): {}",
+            args.out.display(),
+            r.width,
+            r.height,
+            r.light_count,
+            r.instance_count,
+            passes.join(", ")
+        );
+    }
+    Ok(())
+}
+
+fn check(path: PathBuf) -> Result<()> {
+    let spec = path.to_string_lossy().to_string();
+    let scene = manylight_scene::load_gltf(&path, &LoadOptions::default())?;
+    let summary = format!(
+        "{}: {} meshes, {} materials, {} instances, {} lights, {} cameras",
+        path.display(),
+        scene.meshes.len(),
+        scene.materials.len(),
+        scene.instances.len(),
+        scene.lights.len(),
+        scene.cameras.len()
+    );
+    render_scene(scene, UVec2::new(64, 64), 1, 0, 1, RenderSettings::default())
+        .with_context(|| format!("`{spec}` loaded but did not render"))?;
+    println!("ok: {summary}");
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| "warn,manylight=info".into()),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Render(args) => render(args),
+        Command::Check { path } => check(path),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}

@@ -1,0 +1,14 @@
+//! Pure math and plain data for manylight: no GPU, no ECS.
+//!
+//! Everything here is unit- and property-tested without a device; the WGSL in `shaders/`
+//! mirrors these functions and GPU tests compare the two.
+
+pub mod attenuation;
+pub mod camera;
+pub mod material;
+pub mod mesh;
+
+pub use attenuation::{attenuation, radius_for_intensity};
+pub use camera::{Projection, linearize_depth_reverse_z};
+pub use material::{MaterialData, ShadingModel, TextureData};
+pub use mesh::{Aabb, MeshData, MeshError, Vertex};

@@ -1,0 +1,214 @@
+//! Triangle meshes as plain data.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec2, Vec3};
+use thiserror::Error;
+
+/// Interleaved vertex as the GPU reads it (`shaders/common/vertex.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Vertex {
+    /// Object-space position.
+    pub position: [f32; 3],
+    /// Object-space unit normal.
+    pub normal: [f32; 3],
+    /// Texture coordinate.
+    pub uv: [f32; 2],
+}
+
+/// A mesh whose data is not usable.
+#[derive(Debug, Error, PartialEq)]
+pub enum MeshError {
+    /// An index points past the vertex array.
+    #[error("index {index} at position {at} is out of range (mesh has {vertices} vertices)")]
+    IndexOutOfRange { index: u32, at: usize, vertices: usize },
+    /// The index count is not a multiple of three.
+    #[error("index count {0} is not a multiple of 3")]
+    NotTriangles(usize),
+    /// A position, normal or uv is NaN or infinite.
+    #[error("vertex {0} has a non-finite attribute")]
+    NonFinite(usize),
+}
+
+/// Axis-aligned bounding box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    /// Minimum corner.
+    pub min: Vec3,
+    /// Maximum corner.
+    pub max: Vec3,
+}
+
+impl Aabb {
+    /// The empty box (min = +inf, max = -inf); `extend` grows it.
+    pub const EMPTY: Aabb = Aabb { min: Vec3::INFINITY, max: Vec3::NEG_INFINITY };
+
+    /// Grows the box to contain `p`.
+    pub fn extend(&mut self, p: Vec3) {
+        self.min = self.min.min(p);
+        self.max = self.max.max(p);
+    }
+
+    /// True when nothing was added.
+    pub fn is_empty(&self) -> bool {
+        self.min.x > self.max.x
+    }
+
+    /// Centre of the box.
+    pub fn center(&self) -> Vec3 {
+        (self.min + self.max) * 0.5
+    }
+
+    /// Full size along each axis.
+    pub fn size(&self) -> Vec3 {
+        self.max - self.min
+    }
+
+    /// The box that contains this one after `m` is applied.
+    pub fn transformed(&self, m: &Mat4) -> Aabb {
+        let mut out = Aabb::EMPTY;
+        if self.is_empty() {
+            return out;
+        }
+        for i in 0..8 {
+            let c = Vec3::new(
+                if i & 1 == 0 { self.min.x } else { self.max.x },
+                if i & 2 == 0 { self.min.y } else { self.max.y },
+                if i & 4 == 0 { self.min.z } else { self.max.z },
+            );
+            out.extend(m.transform_point3(c));
+        }
+        out
+    }
+
+    /// Union of two boxes.
+    pub fn union(&self, o: &Aabb) -> Aabb {
+        Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
+    }
+}
+
+/// An indexed triangle list (non-indexed input gets sequential indices).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MeshData {
+    /// Name for logs and GPU labels.
+    pub label: String,
+    /// Vertices.
+    pub vertices: Vec<Vertex>,
+    /// Triangle list indices into `vertices`.
+    pub indices: Vec<u32>,
+}
+
+impl MeshData {
+    /// Builds a mesh from separate attribute arrays; missing normals are generated from the
+    /// triangles (area-weighted smooth normals), missing uvs are zero.
+    pub fn from_attributes(
+        label: impl Into<String>,
+        positions: &[Vec3],
+        normals: Option<&[Vec3]>,
+        uvs: Option<&[Vec2]>,
+        indices: Option<Vec<u32>>,
+    ) -> Result<MeshData, MeshError> {
+        let indices = indices.unwrap_or_else(|| (0..positions.len() as u32).collect());
+        let mut mesh = MeshData {
+            label: label.into(),
+            vertices: positions
+                .iter()
+                .enumerate()
+                .map(|(i, p)| Vertex {
+                    position: p.to_array(),
+                    normal: normals.and_then(|n| n.get(i)).map_or([0.0; 3], |n| n.to_array()),
+                    uv: uvs.and_then(|u| u.get(i)).map_or([0.0; 2], |u| u.to_array()),
+                })
+                .collect(),
+            indices,
+        };
+        mesh.validate()?;
+        if normals.is_none() {
+            mesh.generate_normals();
+        } else {
+            mesh.normalize_normals();
+        }
+        Ok(mesh)
+    }
+
+    /// Checks indices and attributes.
+    pub fn validate(&self) -> Result<(), MeshError> {
+        if !self.indices.len().is_multiple_of(3) {
+            return Err(MeshError::NotTriangles(self.indices.len()));
+        }
+        if let Some((at, &index)) =
+            self.indices.iter().enumerate().find(|&(_, &i)| i as usize >= self.vertices.len())
+        {
+            return Err(MeshError::IndexOutOfRange { index, at, vertices: self.vertices.len() });
+        }
+        if let Some(i) = self
+            .vertices
+            .iter()
+            .position(|v| !v.position.iter().chain(&v.normal).chain(&v.uv).all(|x| x.is_finite()))
+        {
+            return Err(MeshError::NonFinite(i));
+        }
+        Ok(())
+    }
+
+    /// Replaces the normals by area-weighted smooth normals of the triangles.
+    pub fn generate_normals(&mut self) {
+        let mut acc = vec![Vec3::ZERO; self.vertices.len()];
+        for tri in self.indices.chunks_exact(3) {
+            let [a, b, c] = [tri[0], tri[1], tri[2]].map(|i| Vec3::from(self.vertices[i as usize].position));
+            let n = (b - a).cross(c - a); // length = 2 * area: area weighting for free
+            for &i in tri {
+                acc[i as usize] += n;
+            }
+        }
+        for (v, n) in self.vertices.iter_mut().zip(acc) {
+            v.normal = n.try_normalize().unwrap_or(Vec3::Y).to_array();
+        }
+    }
+
+    /// Makes every normal unit length (zero or non-finite normals become +Y).
+    pub fn normalize_normals(&mut self) {
+        for v in &mut self.vertices {
+            v.normal = Vec3::from(v.normal).try_normalize().unwrap_or(Vec3::Y).to_array();
+        }
+    }
+
+    /// Object-space bounds.
+    pub fn bounds(&self) -> Aabb {
+        let mut b = Aabb::EMPTY;
+        for v in &self.vertices {
+            b.extend(Vec3::from(v.position));
+        }
+        b
+    }
+
+    /// Number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn generated_normals_point_out_of_a_ccw_triangle() {
+        let m = MeshData::from_attributes("tri", &[Vec3::ZERO, Vec3::X, Vec3::Y], None, None, None).unwrap();
+        for v in &m.vertices {
+            assert_eq!(v.normal, [0.0, 0.0, 1.0]);
+        }
+    }
+
+    #[test]
+    fn out_of_range_index_is_an_error() {
+        let e = MeshData::from_attributes("bad", &[Vec3::ZERO; 3], None, None, Some(vec![0, 1, 7]));
+        assert_eq!(e, Err(MeshError::IndexOutOfRange { index: 7, at: 2, vertices: 3 }));
+    }
+
+    #[test]
+    fn degenerate_triangles_give_finite_normals() {
+        let m = MeshData::from_attributes("deg", &[Vec3::ZERO; 3], None, None, None).unwrap();
+        assert!(m.vertices.iter().all(|v| v.normal.iter().all(|x| x.is_finite())));
+    }
+}

@@ -1,0 +1,150 @@
+//! The GPU context: instance, adapter, device and queue, for headless rendering or a surface.
+
+use std::sync::Arc;
+use thiserror::Error;
+
+/// What to tell a user whose machine has no usable GPU adapter.
+pub const NO_ADAPTER_HELP: &str = "no GPU adapter found. manylight needs Vulkan, Metal, DX12 or \
+OpenGL. On Debian/Ubuntu without a GPU install the software Vulkan driver (lavapipe): \
+`sudo apt-get install -y mesa-vulkan-drivers`; with a GPU, install its vendor driver";
+
+/// Errors of the GPU side.
+#[derive(Debug, Error)]
+pub enum RenderError {
+    /// No adapter could be found.
+    #[error("{NO_ADAPTER_HELP} ({0})")]
+    NoAdapter(String),
+    /// The adapter refused to create a device.
+    #[error("could not create a GPU device on `{adapter}`: {message}")]
+    NoDevice {
+        /// Adapter name.
+        adapter: String,
+        /// Driver's message.
+        message: String,
+    },
+    /// The window surface could not be created.
+    #[error("could not create a window surface: {0}")]
+    Surface(String),
+    /// A shader was not embedded.
+    #[error(transparent)]
+    Shader(#[from] crate::shaders::ShaderError),
+    /// Reading back a texture or query buffer failed.
+    #[error("GPU readback failed: {0}")]
+    Readback(String),
+    /// A texture of the scene exceeds what the device supports.
+    #[error("texture `{label}` is {width}x{height}, larger than this device's limit of {limit}")]
+    TextureTooLarge {
+        /// Texture label (file name).
+        label: String,
+        /// Width in pixels.
+        width: u32,
+        /// Height in pixels.
+        height: u32,
+        /// Device limit.
+        limit: u32,
+    },
+    /// The render graph is inconsistent (a pass reads what nobody writes, or a cycle).
+    #[error("render graph: {0}")]
+    Graph(String),
+    /// The device reported a validation or out-of-memory error.
+    #[error("GPU error: {0}")]
+    Device(String),
+}
+
+/// Instance, adapter, device and queue, shared by every part of the renderer.
+#[derive(Clone)]
+pub struct GpuContext {
+    /// The wgpu instance (needed to create surfaces).
+    pub instance: wgpu::Instance,
+    /// The chosen adapter.
+    pub adapter: wgpu::Adapter,
+    /// The logical device.
+    pub device: wgpu::Device,
+    /// Its queue.
+    pub queue: wgpu::Queue,
+    /// Adapter name, driver and backend, for logs and reports.
+    pub info: wgpu::AdapterInfo,
+    /// True when render-pass timestamp queries are available.
+    pub timestamps: bool,
+    /// Device-lost or uncaptured errors, recorded by the error callback.
+    pub errors: Arc<std::sync::Mutex<Vec<String>>>,
+}
+
+impl GpuContext {
+    /// Creates a context without a surface (headless rendering, tests, benchmarks).
+    pub fn headless() -> Result<GpuContext, RenderError> {
+        let instance = new_instance();
+        Self::with_instance(instance, None)
+    }
+
+    /// Creates a context on `instance` whose adapter can present to `surface` (if given).
+    pub fn with_instance(
+        instance: wgpu::Instance,
+        surface: Option<&wgpu::Surface<'_>>,
+    ) -> Result<GpuContext, RenderError> {
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: surface,
+            apply_limit_buckets: false,
+        }))
+        .map_err(|e| RenderError::NoAdapter(e.to_string()))?;
+        let info = adapter.get_info();
+        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let mut required_features = wgpu::Features::empty();
+        if timestamps {
+            required_features |= wgpu::Features::TIMESTAMP_QUERY;
+        }
+        let adapter_limits = adapter.limits();
+        let required_limits = wgpu::Limits {
+            max_texture_dimension_2d: adapter_limits.max_texture_dimension_2d,
+            max_storage_buffer_binding_size: adapter_limits.max_storage_buffer_binding_size,
+            max_buffer_size: adapter_limits.max_buffer_size,
+            max_compute_workgroup_storage_size: adapter_limits.max_compute_workgroup_storage_size,
+            max_compute_invocations_per_workgroup: adapter_limits.max_compute_invocations_per_workgroup,
+            max_compute_workgroup_size_x: adapter_limits.max_compute_workgroup_size_x,
+            ..wgpu::Limits::default()
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("manylight"),
+            required_features,
+            required_limits,
+            ..Default::default()
+        }))
+        .map_err(|e| RenderError::NoDevice { adapter: info.name.clone(), message: e.to_string() })?;
+        let errors = Arc::new(std::sync::Mutex::new(Vec::new()));
+        let sink = errors.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            tracing::error!("wgpu: {e}");
+            if let Ok(mut v) = sink.lock() {
+                v.push(e.to_string());
+            }
+        }));
+        tracing::info!(
+            "GPU adapter: {} ({:?}, {:?}, driver {}), timestamps: {timestamps}",
+            info.name,
+            info.device_type,
+            info.backend,
+            info.driver_info
+        );
+        Ok(GpuContext { instance, adapter, device, queue, info, timestamps, errors })
+    }
+
+    /// Largest 2D texture side this device accepts.
+    pub fn max_texture_size(&self) -> u32 {
+        self.device.limits().max_texture_dimension_2d
+    }
+
+    /// Takes the device errors recorded since the last call.
+    pub fn take_errors(&self) -> Vec<String> {
+        self.errors.lock().map(|mut v| std::mem::take(&mut *v)).unwrap_or_default()
+    }
+}
+
+/// A wgpu instance on the backends from `WGPU_BACKEND` (default: Vulkan, Metal, DX12; set
+/// `WGPU_BACKEND=gl` for OpenGL).
+pub fn new_instance() -> wgpu::Instance {
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+    desc.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY);
+    wgpu::Instance::new(desc)
+}

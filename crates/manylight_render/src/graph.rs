@@ -1,0 +1,245 @@
+//! The render graph: passes declare what they read and write; the graph orders them, drops
+//! the ones whose outputs nobody reads, and lists what it built.
+//!
+//! Building a frame happens in three steps:
+//! 1. systems add passes ([`RenderGraph::add`]) for the effects the frame calls for;
+//! 2. [`RenderGraph::compile`] keeps the passes that contribute to [`OUTPUT`] and orders them
+//!    so that every reader comes after the writers of what it reads (ties keep insertion order);
+//! 3. the [`crate::executor::GraphExecutor`] allocates transient textures from its pool, records
+//!    each pass inside timestamp queries, and submits.
+
+use crate::context::{GpuContext, RenderError};
+use crate::pipelines::PipelineCache;
+use crate::resources::SceneResources;
+use std::collections::HashMap;
+
+/// Name of a graph resource (a texture or buffer slot).
+pub type ResourceName = &'static str;
+
+/// The external resource every frame ends in: the swapchain image or the headless target.
+pub const OUTPUT: ResourceName = "output";
+
+/// A transient texture a pass creates: sized relative to the viewport.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TextureSpec {
+    /// Resource name.
+    pub name: ResourceName,
+    /// Format.
+    pub format: wgpu::TextureFormat,
+    /// Usages.
+    pub usage: wgpu::TextureUsages,
+    /// Size as a fraction of the viewport (1.0 = full resolution).
+    pub scale: f32,
+}
+
+/// One pass of the graph.
+pub trait Pass: Send + Sync {
+    /// Name, also the wgpu label (snake_case).
+    fn name(&self) -> &'static str;
+    /// Resources read.
+    fn reads(&self) -> Vec<ResourceName>;
+    /// Resources written.
+    fn writes(&self) -> Vec<ResourceName>;
+    /// Transient textures this pass creates (it must also list them in `writes`).
+    fn creates(&self) -> Vec<TextureSpec> {
+        Vec::new()
+    }
+    /// True for compute passes (their GPU timings are flagged as untrusted on CPU adapters).
+    fn is_compute(&self) -> bool {
+        false
+    }
+    /// Records the pass.
+    fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError>;
+}
+
+/// What a pass sees while it records.
+pub struct PassContext<'a> {
+    /// Device and queue.
+    pub gpu: &'a GpuContext,
+    /// The frame's uploaded scene data (view, lights, meshes, materials).
+    pub scene: &'a SceneResources,
+    /// Pipelines, created on first use.
+    pub pipelines: &'a PipelineCache,
+    /// The frame's command encoder.
+    pub encoder: &'a mut wgpu::CommandEncoder,
+    /// Format of [`OUTPUT`].
+    pub output_format: wgpu::TextureFormat,
+    pub(crate) textures: &'a HashMap<ResourceName, wgpu::TextureView>,
+    pub(crate) timer: Option<&'a wgpu::QuerySet>,
+    pub(crate) pass_index: u32,
+    pub(crate) stamps: (bool, bool),
+}
+
+impl<'a> PassContext<'a> {
+    /// The view of a graph texture (transient or [`OUTPUT`]).
+    pub fn texture(&self, name: ResourceName) -> Result<&'a wgpu::TextureView, RenderError> {
+        self.textures
+            .get(name)
+            .ok_or_else(|| RenderError::Graph(format!("texture `{name}` was not allocated")))
+    }
+
+    /// Timestamp writes for a render pass; `first`/`last` say whether this wgpu pass opens or
+    /// closes the graph pass (a graph pass may record several wgpu passes).
+    pub fn render_timestamps(
+        &mut self,
+        first: bool,
+        last: bool,
+    ) -> Option<wgpu::RenderPassTimestampWrites<'a>> {
+        let qs = self.timer?;
+        self.stamps.0 |= first;
+        self.stamps.1 |= last;
+        Some(wgpu::RenderPassTimestampWrites {
+            query_set: qs,
+            beginning_of_pass_write_index: first.then_some(self.pass_index * 2),
+            end_of_pass_write_index: last.then_some(self.pass_index * 2 + 1),
+        })
+    }
+
+    /// Timestamp writes for a compute pass (see [`Self::render_timestamps`]).
+    pub fn compute_timestamps(
+        &mut self,
+        first: bool,
+        last: bool,
+    ) -> Option<wgpu::ComputePassTimestampWrites<'a>> {
+        let qs = self.timer?;
+        self.stamps.0 |= first;
+        self.stamps.1 |= last;
+        Some(wgpu::ComputePassTimestampWrites {
+            query_set: qs,
+            beginning_of_pass_write_index: first.then_some(self.pass_index * 2),
+            end_of_pass_write_index: last.then_some(self.pass_index * 2 + 1),
+        })
+    }
+}
+
+/// The passes of one frame.
+#[derive(Default)]
+pub struct RenderGraph {
+    passes: Vec<Box<dyn Pass>>,
+}
+
+impl RenderGraph {
+    /// An empty graph.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds a pass.
+    pub fn add(&mut self, pass: impl Pass + 'static) {
+        self.passes.push(Box::new(pass));
+    }
+
+    /// Removes every pass (the graph is rebuilt each frame).
+    pub fn clear(&mut self) {
+        self.passes.clear();
+    }
+
+    /// Names of the passes as added (before culling).
+    pub fn added_names(&self) -> Vec<&'static str> {
+        self.passes.iter().map(|p| p.name()).collect()
+    }
+
+    /// Names of the passes that will run, in order.
+    pub fn pass_names(&self) -> Result<Vec<&'static str>, RenderError> {
+        Ok(self.compile()?.into_iter().map(|i| self.passes[i].name()).collect())
+    }
+
+    /// The pass at `index` (as returned by [`Self::compile`]).
+    pub fn pass(&self, index: usize) -> &dyn Pass {
+        self.passes[index].as_ref()
+    }
+
+    /// Indices of the passes that contribute to [`OUTPUT`], in execution order.
+    pub fn compile(&self) -> Result<Vec<usize>, RenderError> {
+        let n = self.passes.len();
+        let reads: Vec<Vec<ResourceName>> = self.passes.iter().map(|p| p.reads()).collect();
+        let writes: Vec<Vec<ResourceName>> = self.passes.iter().map(|p| p.writes()).collect();
+        // Dependencies: for each resource a pass reads, the other passes that write it earlier
+        // in insertion order, or, when there are none, every other writer (a system may add a
+        // consumer before its producer). A pass that only writes a resource starts it afresh
+        // and depends on nothing for it.
+        let mut deps: Vec<Vec<usize>> = vec![Vec::new(); n];
+        for i in 0..n {
+            for r in &reads[i] {
+                let writers: Vec<usize> = (0..n).filter(|&j| j != i && writes[j].contains(r)).collect();
+                let earlier: Vec<usize> = writers.iter().copied().filter(|&j| j < i).collect();
+                if !earlier.is_empty() {
+                    deps[i].extend(earlier);
+                } else if !writers.is_empty() {
+                    deps[i].extend(writers);
+                } else if !writes[i].contains(r) {
+                    return Err(RenderError::Graph(format!(
+                        "pass `{}` reads `{r}` but no pass writes it",
+                        self.passes[i].name()
+                    )));
+                }
+            }
+        }
+        // Live passes: those writing OUTPUT and, transitively, what they depend on.
+        let mut live = vec![false; n];
+        let mut stack: Vec<usize> = (0..n).filter(|&i| writes[i].contains(&OUTPUT)).collect();
+        while let Some(i) = stack.pop() {
+            if !std::mem::replace(&mut live[i], true) {
+                stack.extend(deps[i].iter().copied());
+            }
+        }
+        // Topological order (Kahn), lowest insertion index first among the ready ones.
+        let mut order = Vec::new();
+        let mut done = vec![false; n];
+        let live_count = live.iter().filter(|&&l| l).count();
+        while order.len() < live_count {
+            let next = (0..n).find(|&i| live[i] && !done[i] && deps[i].iter().all(|&d| done[d] || !live[d]));
+            match next {
+                Some(i) => {
+                    done[i] = true;
+                    order.push(i);
+                }
+                None => return Err(RenderError::Graph("the passes' reads and writes form a cycle".into())),
+            }
+        }
+        Ok(order)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    struct Fake(&'static str, Vec<ResourceName>, Vec<ResourceName>);
+    impl Pass for Fake {
+        fn name(&self) -> &'static str {
+            self.0
+        }
+        fn reads(&self) -> Vec<ResourceName> {
+            self.1.clone()
+        }
+        fn writes(&self) -> Vec<ResourceName> {
+            self.2.clone()
+        }
+        fn record(&self, _: &mut PassContext<'_>) -> Result<(), RenderError> {
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn orders_by_dependencies_and_drops_unread_passes() {
+        let mut g = RenderGraph::new();
+        g.add(Fake("tonemap", vec!["hdr"], vec![OUTPUT]));
+        g.add(Fake("unused", vec![], vec!["scratch"]));
+        g.add(Fake("bloom", vec!["hdr"], vec!["hdr"]));
+        g.add(Fake("forward", vec![], vec!["hdr", "depth"]));
+        assert_eq!(g.pass_names().unwrap(), vec!["forward", "bloom", "tonemap"]);
+    }
+
+    #[test]
+    fn missing_writer_is_an_error() {
+        let mut g = RenderGraph::new();
+        g.add(Fake("tonemap", vec!["hdr"], vec![OUTPUT]));
+        assert!(matches!(g.compile(), Err(RenderError::Graph(_))));
+    }
+
+    #[test]
+    fn empty_graph_runs_nothing() {
+        assert!(RenderGraph::new().pass_names().unwrap().is_empty());
+    }
+}

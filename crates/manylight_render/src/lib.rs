@@ -1,0 +1,27 @@
+//! The wgpu side of manylight: GPU context, render graph, passes, timing and readback.
+//!
+//! It consumes a plain [`FrameSnapshot`] and knows nothing of bevy: tests and benchmarks can
+//! drive it directly. The app crate decides which passes a frame needs.
+
+pub mod context;
+pub mod gpu_types;
+pub mod graph;
+pub mod passes;
+pub mod pipelines;
+pub mod pool;
+pub mod readback;
+pub mod renderer;
+pub mod resources;
+pub mod shaders;
+pub mod snapshot;
+pub mod stats;
+pub mod timing;
+
+pub use context::{GpuContext, NO_ADAPTER_HELP, RenderError};
+pub use graph::{OUTPUT, Pass, PassContext, RenderGraph, ResourceName, TextureSpec};
+pub use readback::{HEADLESS_FORMAT, HeadlessTarget};
+pub use renderer::Renderer;
+pub use snapshot::{
+    ExtractedCamera, ExtractedInstance, ExtractedPointLight, FrameSettings, FrameSnapshot, PipelineKind,
+};
+pub use stats::{FrameReport, PassTiming};

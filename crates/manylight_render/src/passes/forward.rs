@@ -1,0 +1,153 @@
+//! Naive forward pass: draws every instance, evaluating every light per fragment, into the
+//! HDR target with a reverse-Z depth test.
+
+use super::{DEPTH, HDR};
+use crate::context::RenderError;
+use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::resources::{DEPTH_FORMAT, HDR_FORMAT, SceneResources};
+use manylight_core::Vertex;
+
+/// The pipeline of [`ForwardPass`].
+pub struct ForwardPipeline {
+    pipeline: wgpu::RenderPipeline,
+}
+
+impl ForwardPipeline {
+    fn new(device: &wgpu::Device, scene: &SceneResources) -> Result<Self, RenderError> {
+        let module = crate::shaders::create_module(device, "forward.wgsl")?;
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("forward"),
+            bind_group_layouts: &[Some(&scene.view_layout), Some(&scene.material_layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("forward"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[Some(vertex_layout())],
+            },
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                // Two-sided: glTF double-sided materials and negative scales need no special case.
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Greater),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: HDR_FORMAT,
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        Ok(ForwardPipeline { pipeline })
+    }
+}
+
+/// The vertex buffer layout of [`Vertex`].
+pub fn vertex_layout() -> wgpu::VertexBufferLayout<'static> {
+    const ATTRIBUTES: [wgpu::VertexAttribute; 3] =
+        wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2];
+    wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<Vertex>() as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &ATTRIBUTES,
+    }
+}
+
+/// Draws the scene with every light evaluated per fragment.
+pub struct ForwardPass {
+    /// Linear clear colour of the HDR target.
+    pub clear_color: [f32; 3],
+}
+
+impl Pass for ForwardPass {
+    fn name(&self) -> &'static str {
+        "forward"
+    }
+    fn reads(&self) -> Vec<ResourceName> {
+        Vec::new()
+    }
+    fn writes(&self) -> Vec<ResourceName> {
+        vec![HDR, DEPTH]
+    }
+    fn creates(&self) -> Vec<TextureSpec> {
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        vec![
+            TextureSpec { name: HDR, format: HDR_FORMAT, usage, scale: 1.0 },
+            TextureSpec { name: DEPTH, format: DEPTH_FORMAT, usage, scale: 1.0 },
+        ]
+    }
+    fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
+        let scene = ctx.scene;
+        let pipeline = ctx.pipelines.get_or_create(0, || ForwardPipeline::new(&ctx.gpu.device, scene))?;
+        let hdr = ctx.texture(HDR)?;
+        let depth = ctx.texture(DEPTH)?;
+        let timestamps = ctx.render_timestamps(true, true);
+        let [r, g, b] = self.clear_color.map(f64::from);
+        let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("forward"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: hdr,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a: 1.0 }),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(0.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: timestamps,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&pipeline.pipeline);
+        pass.set_bind_group(0, &scene.view_bind_group, &[]);
+        draw_scene(&mut pass, scene);
+        Ok(())
+    }
+}
+
+/// Issues one indexed draw per scene draw, switching material bind groups (group 1) and
+/// vertex/index buffers only when they change.
+pub fn draw_scene(pass: &mut wgpu::RenderPass<'_>, scene: &SceneResources) {
+    let (mut bound_material, mut bound_mesh) = (usize::MAX, usize::MAX);
+    for d in &scene.draws {
+        let (Some(mesh), Some(material)) = (scene.mesh(d.mesh), scene.material(d.material)) else {
+            continue;
+        };
+        if d.material != bound_material {
+            pass.set_bind_group(1, &material.bind_group, &[]);
+            bound_material = d.material;
+        }
+        if d.mesh != bound_mesh {
+            pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+            pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+            bound_mesh = d.mesh;
+        }
+        pass.draw_indexed(0..mesh.index_count, 0, d.instance..d.instance + 1);
+    }
+}

@@ -1,0 +1,165 @@
+//! Transient textures, pooled by descriptor and reused across frames.
+
+/// What a transient texture is: the pool's key.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct TextureKey {
+    /// Size in pixels.
+    pub width: u32,
+    /// Size in pixels.
+    pub height: u32,
+    /// Format.
+    pub format: wgpu::TextureFormat,
+    /// Usages.
+    pub usage: wgpu::TextureUsages,
+}
+
+struct Entry {
+    key: TextureKey,
+    texture: wgpu::Texture,
+    view: wgpu::TextureView,
+    last_used: u64,
+    in_use: bool,
+}
+
+/// Frames a texture may stay unused before it is freed.
+pub const TRANSIENT_KEEP_FRAMES: u64 = 3;
+
+/// A pool of textures keyed by descriptor.
+#[derive(Default)]
+pub struct TransientPool {
+    entries: Vec<Entry>,
+    frame: u64,
+    allocations: u64,
+}
+
+impl TransientPool {
+    /// Starts a frame: every texture becomes available again; textures unused for more than
+    /// [`TRANSIENT_KEEP_FRAMES`] frames are freed.
+    pub fn begin_frame(&mut self) {
+        self.frame += 1;
+        let frame = self.frame;
+        self.entries.retain(|e| frame - e.last_used <= TRANSIENT_KEEP_FRAMES);
+        for e in &mut self.entries {
+            e.in_use = false;
+        }
+    }
+
+    /// A texture for `key` not yet handed out this frame, created if needed.
+    pub fn acquire(&mut self, device: &wgpu::Device, key: TextureKey, label: &str) -> wgpu::TextureView {
+        let frame = self.frame;
+        if let Some(e) = self.entries.iter_mut().find(|e| e.key == key && !e.in_use) {
+            e.in_use = true;
+            e.last_used = frame;
+            return e.view.clone();
+        }
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width: key.width.max(1),
+                height: key.height.max(1),
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: key.format,
+            usage: key.usage,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+        self.allocations += 1;
+        self.entries.push(Entry { key, texture, view: view.clone(), last_used: frame, in_use: true });
+        view
+    }
+
+    /// Textures alive now.
+    pub fn live(&self) -> usize {
+        self.entries.len()
+    }
+
+    /// Bytes held by live textures (approximate: block size × pixels).
+    pub fn live_bytes(&self) -> u64 {
+        self.entries
+            .iter()
+            .map(|e| {
+                let bpp = e.key.format.block_copy_size(None).unwrap_or(4) as u64;
+                bpp * e.key.width as u64 * e.key.height as u64
+            })
+            .sum()
+    }
+
+    /// Textures created since start-up.
+    pub fn allocations(&self) -> u64 {
+        self.allocations
+    }
+
+    /// The textures handed out (for debugging).
+    pub fn textures(&self) -> impl Iterator<Item = &wgpu::Texture> {
+        self.entries.iter().map(|e| &e.texture)
+    }
+}
+
+/// A growable GPU buffer (storage or uniform) that is re-created larger when data outgrows it.
+pub struct GrowableBuffer {
+    label: &'static str,
+    usage: wgpu::BufferUsages,
+    buffer: wgpu::Buffer,
+    capacity: u64,
+    generation: u64,
+}
+
+impl GrowableBuffer {
+    /// Creates a buffer of at least `min_bytes`.
+    pub fn new(
+        device: &wgpu::Device,
+        label: &'static str,
+        usage: wgpu::BufferUsages,
+        min_bytes: u64,
+    ) -> Self {
+        let capacity = min_bytes.max(16).next_power_of_two();
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: capacity,
+            usage: usage | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Self { label, usage, buffer, capacity, generation: 0 }
+    }
+
+    /// Uploads `data`, growing the buffer (to the next power of two) when it does not fit.
+    /// Returns true when the buffer was re-created (bind groups that use it must be rebuilt).
+    pub fn write(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, data: &[u8]) -> bool {
+        let grew = self.reserve(device, data.len() as u64);
+        if !data.is_empty() {
+            queue.write_buffer(&self.buffer, 0, data);
+        }
+        grew
+    }
+
+    /// Makes room for `bytes`; returns true when the buffer was re-created.
+    pub fn reserve(&mut self, device: &wgpu::Device, bytes: u64) -> bool {
+        if bytes <= self.capacity {
+            return false;
+        }
+        *self = GrowableBuffer {
+            generation: self.generation + 1,
+            ..Self::new(device, self.label, self.usage, bytes)
+        };
+        true
+    }
+
+    /// The buffer.
+    pub fn buffer(&self) -> &wgpu::Buffer {
+        &self.buffer
+    }
+
+    /// Capacity in bytes.
+    pub fn capacity(&self) -> u64 {
+        self.capacity
+    }
+
+    /// Incremented each time the buffer is re-created.
+    pub fn generation(&self) -> u64 {
+        self.generation
+    }
+}

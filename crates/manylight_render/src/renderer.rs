@@ -1,0 +1,139 @@
+//! The renderer: scene resources, the transient pool, pipelines and the GPU timer, and the
+//! execution of one frame's graph.
+
+use crate::context::{GpuContext, RenderError};
+use crate::graph::{OUTPUT, PassContext, RenderGraph};
+use crate::pipelines::PipelineCache;
+use crate::pool::{TextureKey, TransientPool};
+use crate::resources::SceneResources;
+use crate::snapshot::FrameSnapshot;
+use crate::stats::{FrameReport, PassTiming};
+use crate::timing::{GpuTimer, MAX_TIMED_PASSES};
+use std::collections::HashMap;
+use std::time::Instant;
+
+/// Everything that lives across frames on the render side.
+pub struct Renderer {
+    /// Device and queue.
+    pub gpu: GpuContext,
+    /// Uploaded scene data.
+    pub scene: SceneResources,
+    /// Pipelines created so far.
+    pub pipelines: PipelineCache,
+    pool: TransientPool,
+    timer: Option<GpuTimer>,
+    cpu_adapter: bool,
+}
+
+impl Renderer {
+    /// Creates the renderer on a context.
+    pub fn new(gpu: GpuContext) -> Renderer {
+        let timer = GpuTimer::new(&gpu.device, &gpu.queue, gpu.timestamps);
+        let cpu_adapter = gpu.info.device_type == wgpu::DeviceType::Cpu;
+        Renderer {
+            scene: SceneResources::new(&gpu),
+            pipelines: PipelineCache::default(),
+            pool: TransientPool::default(),
+            timer,
+            cpu_adapter,
+            gpu,
+        }
+    }
+
+    /// Uploads the snapshot's data (the `Prepare` step).
+    pub fn prepare(&mut self, snapshot: &FrameSnapshot) -> Result<(), RenderError> {
+        self.scene.prepare(&self.gpu, snapshot)
+    }
+
+    /// The transient pool (tests read its allocation counts).
+    pub fn pool(&self) -> &TransientPool {
+        &self.pool
+    }
+
+    /// Runs `graph` into `output` (the `Execute` step) and waits for the GPU to finish.
+    pub fn execute(
+        &mut self,
+        graph: &RenderGraph,
+        snapshot: &FrameSnapshot,
+        output: &wgpu::TextureView,
+        output_format: wgpu::TextureFormat,
+    ) -> Result<FrameReport, RenderError> {
+        let frame_start = Instant::now();
+        let order = graph.compile()?;
+        self.pool.begin_frame();
+        let size = snapshot.viewport;
+        let mut textures = HashMap::new();
+        textures.insert(OUTPUT, output.clone());
+        for &i in &order {
+            for spec in graph.pass(i).creates() {
+                let scaled = |v: u32| ((v as f32 * spec.scale).round() as u32).max(1);
+                let key = TextureKey {
+                    width: scaled(size.x),
+                    height: scaled(size.y),
+                    format: spec.format,
+                    usage: spec.usage,
+                };
+                textures.insert(spec.name, self.pool.acquire(&self.gpu.device, key, spec.name));
+            }
+        }
+
+        let mut encoder =
+            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        let mut passes = Vec::with_capacity(order.len());
+        let mut written = Vec::with_capacity(order.len());
+        for (slot, &i) in order.iter().enumerate() {
+            let pass = graph.pass(i);
+            let timed = self.timer.as_ref().filter(|_| (slot as u32) < MAX_TIMED_PASSES);
+            let mut ctx = PassContext {
+                gpu: &self.gpu,
+                scene: &self.scene,
+                pipelines: &self.pipelines,
+                encoder: &mut encoder,
+                output_format,
+                textures: &textures,
+                timer: timed.map(|t| t.query_set()),
+                pass_index: slot as u32,
+                stamps: (false, false),
+            };
+            let start = Instant::now();
+            pass.record(&mut ctx)?;
+            let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
+            written.push(ctx.stamps.0 && ctx.stamps.1);
+            passes.push(PassTiming {
+                name: pass.name().to_string(),
+                gpu_ms: None,
+                gpu_trusted: !(pass.is_compute() && self.cpu_adapter),
+                cpu_ms,
+            });
+        }
+        if let Some(t) = &self.timer {
+            t.resolve(&mut encoder, order.len() as u32);
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+        if let Some(t) = &self.timer {
+            for (p, ms) in passes.iter_mut().zip(t.read(&self.gpu.device, &written)) {
+                p.gpu_ms = ms;
+            }
+        }
+        let _ = self.gpu.device.poll(wgpu::PollType::wait_indefinitely());
+        let errors = self.gpu.take_errors();
+        if !errors.is_empty() {
+            return Err(RenderError::Device(errors.join("; ")));
+        }
+        let gpu_times: Vec<f64> = passes.iter().filter_map(|p| p.gpu_ms).collect();
+        Ok(FrameReport {
+            frame_index: snapshot.frame_index,
+            width: size.x,
+            height: size.y,
+            pipeline: snapshot.settings.pipeline.name().to_string(),
+            frame_gpu_ms: (!gpu_times.is_empty()).then(|| gpu_times.iter().sum()),
+            passes,
+            frame_cpu_ms: frame_start.elapsed().as_secs_f64() * 1e3,
+            light_count: self.scene.light_count,
+            invalid_lights: self.scene.invalid_lights,
+            instance_count: self.scene.draws.len() as u32,
+            transient_textures: self.pool.live() as u32,
+            transient_allocations: self.pool.allocations(),
+        })
+    }
+}

@@ -1,0 +1,510 @@
+//! Scene data on the GPU: view constants, lights, instances, meshes, materials and textures.
+//!
+//! `prepare` uploads what changed for a frame: meshes and textures once per distinct `Arc`
+//! (and freed a few frames after the last instance using them disappears), light and instance
+//! buffers every frame, grown when the counts outgrow them.
+
+use crate::context::{GpuContext, RenderError};
+use crate::gpu_types::{GpuInstance, GpuMaterial, GpuPointLight, SHADING_GLOBAL, ViewUniform};
+use crate::pool::GrowableBuffer;
+use crate::snapshot::{FrameSnapshot, aspect};
+use glam::{Mat4, Vec4};
+use manylight_core::{MaterialData, MeshData, TextureData, Vertex};
+use std::collections::HashMap;
+use std::sync::Arc;
+use wgpu::util::DeviceExt;
+
+/// Frames a mesh/material/texture stays on the GPU after its last use.
+const KEEP_FRAMES: u64 = 60;
+
+/// Depth format of every pass (reverse-Z: cleared to 0, compare `Greater`).
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// HDR colour format of the lighting target.
+pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// A mesh on the GPU.
+pub struct GpuMesh {
+    _source: Arc<MeshData>,
+    /// Interleaved [`Vertex`] buffer.
+    pub vertices: wgpu::Buffer,
+    /// u32 index buffer.
+    pub indices: wgpu::Buffer,
+    /// Number of indices.
+    pub index_count: u32,
+    last_used: u64,
+}
+
+struct CachedTexture {
+    _source: Arc<TextureData>,
+    view: wgpu::TextureView,
+    last_used: u64,
+}
+
+/// A material's bind group (group 1 of mesh pipelines).
+pub struct GpuMaterialBinding {
+    _source: Arc<MaterialData>,
+    /// The bind group.
+    pub bind_group: wgpu::BindGroup,
+    last_used: u64,
+}
+
+/// One draw: an instance of a mesh with a material.
+#[derive(Clone, Copy, Debug)]
+pub struct Draw {
+    /// Key into [`SceneResources::mesh`].
+    pub mesh: usize,
+    /// Key into [`SceneResources::material`].
+    pub material: usize,
+    /// Index into the instance buffer (the draw's `first_instance`).
+    pub instance: u32,
+}
+
+/// Scene data on the GPU for the current frame.
+pub struct SceneResources {
+    /// Layout of group 0: view uniform, lights, instances.
+    pub view_layout: wgpu::BindGroupLayout,
+    /// Layout of group 1: material uniform, base colour texture, sampler.
+    pub material_layout: wgpu::BindGroupLayout,
+    /// Group 0 for this frame.
+    pub view_bind_group: wgpu::BindGroup,
+    /// The view uniform buffer.
+    pub view_buffer: wgpu::Buffer,
+    /// Point lights (storage; at least one element).
+    pub lights: GrowableBuffer,
+    /// Instance transforms (storage).
+    pub instances: GrowableBuffer,
+    /// Draws sorted by material then mesh.
+    pub draws: Vec<Draw>,
+    /// The frame's view constants as uploaded.
+    pub view: ViewUniform,
+    /// Lights uploaded this frame.
+    pub light_count: u32,
+    /// Lights dropped for invalid parameters this frame.
+    pub invalid_lights: u32,
+    meshes: HashMap<usize, GpuMesh>,
+    materials: HashMap<usize, GpuMaterialBinding>,
+    textures: HashMap<usize, CachedTexture>,
+    white: wgpu::TextureView,
+    sampler: wgpu::Sampler,
+    frame: u64,
+    bound_generations: (u64, u64),
+    max_texture_size: u32,
+}
+
+fn key<T>(a: &Arc<T>) -> usize {
+    Arc::as_ptr(a) as *const u8 as usize
+}
+
+impl SceneResources {
+    /// Creates the layouts and empty buffers.
+    pub fn new(gpu: &GpuContext) -> SceneResources {
+        let device = &gpu.device;
+        let storage = |binding, visibility| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: true },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let all = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
+        let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("view_layout"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: all,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<ViewUniform>() as u64),
+                    },
+                    count: None,
+                },
+                storage(1, wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE),
+                storage(2, wgpu::ShaderStages::VERTEX),
+            ],
+        });
+        let material_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("material_layout"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+            ],
+        });
+        let view_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("view_uniform"),
+            size: std::mem::size_of::<ViewUniform>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let storage_usage = wgpu::BufferUsages::STORAGE;
+        let lights = GrowableBuffer::new(device, "point_lights", storage_usage, 64 * 32);
+        let instances = GrowableBuffer::new(device, "instances", storage_usage, 64 * 128);
+        let view_bind_group =
+            Self::make_view_bind_group(device, &view_layout, &view_buffer, &lights, &instances);
+        let white = upload_texture(
+            gpu,
+            &TextureData { label: "white".into(), width: 1, height: 1, rgba8: vec![255; 4], srgb: true },
+        );
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("material_sampler"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::Repeat,
+            address_mode_w: wgpu::AddressMode::Repeat,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        SceneResources {
+            view_layout,
+            material_layout,
+            view_bind_group,
+            view_buffer,
+            lights,
+            instances,
+            draws: Vec::new(),
+            view: ViewUniform::zeroed_default(),
+            light_count: 0,
+            invalid_lights: 0,
+            meshes: HashMap::new(),
+            materials: HashMap::new(),
+            textures: HashMap::new(),
+            white,
+            sampler,
+            frame: 0,
+            bound_generations: (0, 0),
+            max_texture_size: gpu.max_texture_size(),
+        }
+    }
+
+    fn make_view_bind_group(
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        view: &wgpu::Buffer,
+        lights: &GrowableBuffer,
+        instances: &GrowableBuffer,
+    ) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("view_bind_group"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: view.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: lights.buffer().as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: instances.buffer().as_entire_binding() },
+            ],
+        })
+    }
+
+    /// Uploads the frame's view, lights, instances and any new meshes/materials/textures.
+    pub fn prepare(&mut self, gpu: &GpuContext, snapshot: &FrameSnapshot) -> Result<(), RenderError> {
+        self.frame += 1;
+        let device = &gpu.device;
+        let queue = &gpu.queue;
+
+        // View constants.
+        let size = snapshot.viewport;
+        let settings = &snapshot.settings;
+        self.view = match &snapshot.camera {
+            Some(cam) => {
+                let clip_from_view = cam.projection.matrix(aspect(size));
+                let view_from_world = cam.view_from_world();
+                let clip_from_world = clip_from_view * view_from_world;
+                let p = cam.projection.sanitized();
+                ViewUniform {
+                    clip_from_world,
+                    view_from_world,
+                    clip_from_view,
+                    world_from_clip: clip_from_world.inverse(),
+                    prev_clip_from_world: cam.prev_clip_from_world.unwrap_or(clip_from_world),
+                    camera_position: cam.position().extend(1.0),
+                    viewport: viewport_vec(size),
+                    params: Vec4::new(p.near, p.far, settings.exposure, settings.ambient),
+                    light_count: 0,
+                    shading_model: settings.shading.gpu_id(),
+                    _pad: [0; 2],
+                }
+            }
+            None => ViewUniform { viewport: viewport_vec(size), ..ViewUniform::zeroed_default() },
+        };
+
+        // Lights: invalid ones (NaN, inf, negative) are dropped and counted, never uploaded.
+        let gpu_lights: Vec<GpuPointLight> = snapshot
+            .lights
+            .iter()
+            .filter(|l| l.is_valid())
+            .map(|l| GpuPointLight {
+                position_radius: l.position.extend(l.radius).to_array(),
+                color: (l.color * l.intensity).extend(0.0).to_array(),
+            })
+            .collect();
+        self.invalid_lights = (snapshot.lights.len() - gpu_lights.len()) as u32;
+        self.light_count = gpu_lights.len() as u32;
+        self.view.light_count = self.light_count;
+        let light_bytes: &[u8] =
+            if gpu_lights.is_empty() { &[0u8; 32] } else { bytemuck::cast_slice(&gpu_lights) };
+        self.lights.write(device, queue, light_bytes);
+        queue.write_buffer(&self.view_buffer, 0, bytemuck::bytes_of(&self.view));
+
+        // Meshes, materials, instances.
+        let mut instance_data = Vec::with_capacity(snapshot.instances.len());
+        self.draws.clear();
+        for inst in &snapshot.instances {
+            if !inst.world_from_local.is_finite() {
+                tracing::warn!("skipping instance of `{}`: non-finite transform", inst.mesh.label);
+                continue;
+            }
+            if inst.mesh.indices.is_empty() {
+                continue;
+            }
+            let mesh = self.mesh_entry(device, &inst.mesh);
+            let material = self.material_entry(gpu, &inst.material)?;
+            self.draws.push(Draw { mesh, material, instance: instance_data.len() as u32 });
+            instance_data.push(GpuInstance::new(inst.world_from_local));
+        }
+        self.draws.sort_by_key(|d| (d.material, d.mesh));
+        if instance_data.is_empty() {
+            instance_data.push(GpuInstance::new(Mat4::IDENTITY));
+        }
+        self.instances.write(device, queue, bytemuck::cast_slice(&instance_data));
+
+        let generations = (self.lights.generation(), self.instances.generation());
+        if generations != self.bound_generations {
+            self.view_bind_group = Self::make_view_bind_group(
+                device,
+                &self.view_layout,
+                &self.view_buffer,
+                &self.lights,
+                &self.instances,
+            );
+            self.bound_generations = generations;
+        }
+
+        let frame = self.frame;
+        self.meshes.retain(|_, m| frame - m.last_used <= KEEP_FRAMES);
+        self.materials.retain(|_, m| frame - m.last_used <= KEEP_FRAMES);
+        self.textures.retain(|_, t| frame - t.last_used <= KEEP_FRAMES);
+        Ok(())
+    }
+
+    fn mesh_entry(&mut self, device: &wgpu::Device, mesh: &Arc<MeshData>) -> usize {
+        let k = key(mesh);
+        let frame = self.frame;
+        self.meshes
+            .entry(k)
+            .or_insert_with(|| GpuMesh {
+                _source: mesh.clone(),
+                vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(&mesh.label),
+                    contents: bytemuck::cast_slice::<Vertex, u8>(&mesh.vertices),
+                    usage: wgpu::BufferUsages::VERTEX,
+                }),
+                indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(&mesh.label),
+                    contents: bytemuck::cast_slice(&mesh.indices),
+                    usage: wgpu::BufferUsages::INDEX,
+                }),
+                index_count: mesh.indices.len() as u32,
+                last_used: frame,
+            })
+            .last_used = frame;
+        k
+    }
+
+    fn material_entry(
+        &mut self,
+        gpu: &GpuContext,
+        material: &Arc<MaterialData>,
+    ) -> Result<usize, RenderError> {
+        let k = key(material);
+        let frame = self.frame;
+        if let Some(m) = self.materials.get_mut(&k) {
+            m.last_used = frame;
+            if let Some(t) = material.base_color_texture.as_ref().and_then(|t| self.textures.get_mut(&key(t)))
+            {
+                t.last_used = frame;
+            }
+            return Ok(k);
+        }
+        let view = match &material.base_color_texture {
+            Some(tex) => {
+                if tex.width > self.max_texture_size || tex.height > self.max_texture_size {
+                    return Err(RenderError::TextureTooLarge {
+                        label: tex.label.clone(),
+                        width: tex.width,
+                        height: tex.height,
+                        limit: self.max_texture_size,
+                    });
+                }
+                let entry = self.textures.entry(key(tex)).or_insert_with(|| CachedTexture {
+                    _source: tex.clone(),
+                    view: upload_texture(gpu, tex),
+                    last_used: frame,
+                });
+                entry.last_used = frame;
+                entry.view.clone()
+            }
+            None => self.white.clone(),
+        };
+        let uniform = GpuMaterial {
+            base_color: material.base_color,
+            shininess: material.shininess.clamp(1.0, 4096.0),
+            specular: material.specular.max(0.0),
+            shading_model: material.shading.map_or(SHADING_GLOBAL, |s| s.gpu_id()),
+            has_texture: material.base_color_texture.is_some() as u32,
+        };
+        let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(&material.label),
+            contents: bytemuck::bytes_of(&uniform),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(&material.label),
+            layout: &self.material_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&view) },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+            ],
+        });
+        self.materials
+            .insert(k, GpuMaterialBinding { _source: material.clone(), bind_group, last_used: frame });
+        Ok(k)
+    }
+
+    /// The GPU mesh of a draw.
+    pub fn mesh(&self, key: usize) -> Option<&GpuMesh> {
+        self.meshes.get(&key)
+    }
+
+    /// The material bind group of a draw.
+    pub fn material(&self, key: usize) -> Option<&GpuMaterialBinding> {
+        self.materials.get(&key)
+    }
+
+    /// Meshes, materials and textures resident on the GPU.
+    pub fn resident_counts(&self) -> (usize, usize, usize) {
+        (self.meshes.len(), self.materials.len(), self.textures.len())
+    }
+}
+
+fn viewport_vec(size: glam::UVec2) -> Vec4 {
+    let (w, h) = (size.x.max(1) as f32, size.y.max(1) as f32);
+    Vec4::new(w, h, 1.0 / w, 1.0 / h)
+}
+
+impl ViewUniform {
+    /// Identity matrices, zero lights.
+    pub fn zeroed_default() -> ViewUniform {
+        ViewUniform {
+            clip_from_world: Mat4::IDENTITY,
+            view_from_world: Mat4::IDENTITY,
+            clip_from_view: Mat4::IDENTITY,
+            world_from_clip: Mat4::IDENTITY,
+            prev_clip_from_world: Mat4::IDENTITY,
+            camera_position: Vec4::W,
+            viewport: Vec4::ONE,
+            params: Vec4::new(0.1, 1000.0, 1.0, 0.0),
+            light_count: 0,
+            shading_model: 0,
+            _pad: [0; 2],
+        }
+    }
+}
+
+/// Uploads an RGBA8 texture with a full mip chain (box-filtered on the CPU).
+fn upload_texture(gpu: &GpuContext, tex: &TextureData) -> wgpu::TextureView {
+    let format = if tex.srgb { wgpu::TextureFormat::Rgba8UnormSrgb } else { wgpu::TextureFormat::Rgba8Unorm };
+    let levels = 32 - tex.width.max(tex.height).max(1).leading_zeros();
+    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(&tex.label),
+        size: wgpu::Extent3d { width: tex.width, height: tex.height, depth_or_array_layers: 1 },
+        mip_level_count: levels,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    let (mut w, mut h) = (tex.width, tex.height);
+    let mut level: std::borrow::Cow<[u8]> = std::borrow::Cow::Borrowed(&tex.rgba8);
+    for mip in 0..levels {
+        gpu.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &texture,
+                mip_level: mip,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            &level,
+            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(4 * w), rows_per_image: Some(h) },
+            wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        );
+        if mip + 1 < levels {
+            let next = downsample(&level, w, h, tex.srgb);
+            w = (w / 2).max(1);
+            h = (h / 2).max(1);
+            level = std::borrow::Cow::Owned(next);
+        }
+    }
+    texture.create_view(&wgpu::TextureViewDescriptor::default())
+}
+
+/// 2×2 box filter (in linear light for sRGB data).
+fn downsample(src: &[u8], w: u32, h: u32, srgb: bool) -> Vec<u8> {
+    let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
+    let to_lin = |v: u8| {
+        let c = v as f32 / 255.0;
+        if srgb { if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) } } else { c }
+    };
+    let from_lin = |c: f32| {
+        let v =
+            if srgb { if c <= 0.0031308 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 } } else { c };
+        (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
+    };
+    let mut out = vec![0u8; (nw * nh * 4) as usize];
+    for y in 0..nh {
+        for x in 0..nw {
+            for c in 0..4 {
+                let mut sum = 0.0;
+                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                    let sx = (2 * x + dx).min(w - 1);
+                    let sy = (2 * y + dy).min(h - 1);
+                    let v = src[((sy * w + sx) * 4 + c) as usize];
+                    sum += if c == 3 { v as f32 / 255.0 } else { to_lin(v) };
+                }
+                let avg = sum / 4.0;
+                out[((y * nw + x) * 4 + c) as usize] =
+                    if c == 3 { (avg.clamp(0.0, 1.0) * 255.0 + 0.5) as u8 } else { from_lin(avg) };
+            }
+        }
+    }
+    out
+}

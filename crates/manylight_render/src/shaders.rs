@@ -1,0 +1,77 @@
+//! The WGSL sources, embedded at compile time, and the small include step that combines them.
+//!
+//! A shader names shared code with a line `//!include common/file.wgsl`; each file is pasted
+//! once, in order of first mention. Every shader starts with the constants preamble generated
+//! from [`crate::gpu_types::shared_u32_constants`].
+
+use crate::gpu_types::shared_u32_constants;
+use std::fmt::Write as _;
+
+/// Every WGSL file under `shaders/`, by path relative to that folder.
+pub const SOURCES: &[(&str, &str)] = &[
+    ("common/view.wgsl", include_str!("../../../shaders/common/view.wgsl")),
+    ("common/lights.wgsl", include_str!("../../../shaders/common/lights.wgsl")),
+    ("common/brdf.wgsl", include_str!("../../../shaders/common/brdf.wgsl")),
+    ("common/mesh.wgsl", include_str!("../../../shaders/common/mesh.wgsl")),
+    ("common/fullscreen.wgsl", include_str!("../../../shaders/common/fullscreen.wgsl")),
+    ("forward.wgsl", include_str!("../../../shaders/forward.wgsl")),
+    ("tonemap.wgsl", include_str!("../../../shaders/tonemap.wgsl")),
+];
+
+/// A shader could not be composed.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum ShaderError {
+    /// The named file is not in [`SOURCES`].
+    #[error("shader `{0}` is not embedded (add it to manylight_render::shaders::SOURCES)")]
+    Unknown(String),
+}
+
+/// `const NAME: u32 = VALUE;` lines for every shared constant.
+pub fn constants_preamble() -> String {
+    let mut s = String::from("// generated from manylight_render::gpu_types\n");
+    for (name, value) in shared_u32_constants() {
+        let _ = writeln!(s, "const {name}: u32 = {value}u;");
+    }
+    s
+}
+
+fn source(path: &str) -> Result<&'static str, ShaderError> {
+    SOURCES
+        .iter()
+        .find(|(p, _)| *p == path)
+        .map(|(_, s)| *s)
+        .ok_or_else(|| ShaderError::Unknown(path.to_string()))
+}
+
+/// The full WGSL of `path`: preamble, then its includes, then its own body.
+pub fn compose(path: &str) -> Result<String, ShaderError> {
+    let mut out = constants_preamble();
+    let mut seen = Vec::new();
+    append(path, &mut out, &mut seen)?;
+    Ok(out)
+}
+
+fn append(path: &str, out: &mut String, seen: &mut Vec<String>) -> Result<(), ShaderError> {
+    if seen.iter().any(|s| s == path) {
+        return Ok(());
+    }
+    seen.push(path.to_string());
+    for line in source(path)?.lines() {
+        if let Some(include) = line.trim().strip_prefix("//!include ") {
+            append(include.trim(), out, seen)?;
+        } else {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    Ok(())
+}
+
+/// Creates a shader module from the composed source of `path`.
+pub fn create_module(device: &wgpu::Device, path: &str) -> Result<wgpu::ShaderModule, ShaderError> {
+    let code = compose(path)?;
+    Ok(device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(path),
+        source: wgpu::ShaderSource::Wgsl(code.into()),
+    }))
+}

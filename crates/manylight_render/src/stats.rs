@@ -1,0 +1,52 @@
+//! What one rendered frame reports: passes in order with their GPU and CPU times.
+
+use serde::Serialize;
+
+/// Timing of one pass.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct PassTiming {
+    /// The pass name (also its wgpu label).
+    pub name: String,
+    /// GPU time from timestamp queries, when the adapter supports them.
+    pub gpu_ms: Option<f64>,
+    /// False when the figure is known to be unreliable (compute passes on lavapipe).
+    pub gpu_trusted: bool,
+    /// CPU time spent recording the pass.
+    pub cpu_ms: f64,
+}
+
+/// The report of one frame.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct FrameReport {
+    /// Frame counter.
+    pub frame_index: u64,
+    /// Viewport size.
+    pub width: u32,
+    /// Viewport size.
+    pub height: u32,
+    /// Pipeline name.
+    pub pipeline: String,
+    /// Passes that ran, in order.
+    pub passes: Vec<PassTiming>,
+    /// CPU time of the whole frame on the render side (prepare, record, submit, wait).
+    pub frame_cpu_ms: f64,
+    /// Sum of the passes' GPU times, when known.
+    pub frame_gpu_ms: Option<f64>,
+    /// Lights rendered.
+    pub light_count: u32,
+    /// Lights dropped because a parameter was NaN, infinite or negative.
+    pub invalid_lights: u32,
+    /// Mesh instances drawn.
+    pub instance_count: u32,
+    /// Transient textures alive in the pool after the frame.
+    pub transient_textures: u32,
+    /// Transient textures created since start-up (reuse keeps this flat).
+    pub transient_allocations: u64,
+}
+
+impl FrameReport {
+    /// Names of the passes in the order they ran.
+    pub fn pass_names(&self) -> Vec<&str> {
+        self.passes.iter().map(|p| p.name.as_str()).collect()
+    }
+}

@@ -1,0 +1,134 @@
+//! Every WGSL file parses and validates with naga, and the structs shared with Rust have the
+//! same size and field offsets on both sides. No GPU needed.
+
+use manylight_render::gpu_types::{GpuInstance, GpuMaterial, GpuPointLight, ViewUniform};
+use manylight_render::shaders::{SOURCES, compose};
+use std::mem::{offset_of, size_of};
+
+fn parse(path: &str) -> naga::Module {
+    let code = compose(path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    naga::front::wgsl::parse_str(&code).unwrap_or_else(|e| panic!("{path}: {}", e.emit_to_string(&code)))
+}
+
+fn validate(path: &str) -> naga::Module {
+    let module = parse(path);
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{path}: {}", e.emit_to_string(&compose(path).unwrap())));
+    module
+}
+
+#[test]
+fn every_embedded_shader_validates() {
+    for (path, _) in SOURCES {
+        validate(path);
+    }
+}
+
+#[test]
+fn every_wgsl_file_on_disk_is_embedded() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shaders");
+    let mut stack = vec![std::path::PathBuf::from(root)];
+    let mut found = Vec::new();
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+            } else if path.extension().is_some_and(|e| e == "wgsl") {
+                let rel = path.strip_prefix(root).unwrap().to_string_lossy().replace('\\', "/");
+                found.push(rel);
+            }
+        }
+    }
+    assert!(!found.is_empty());
+    for rel in found {
+        let embedded = SOURCES.iter().find(|(p, _)| *p == rel);
+        let on_disk = std::fs::read_to_string(format!("{root}/{rel}")).unwrap();
+        assert_eq!(embedded.map(|(_, s)| *s), Some(on_disk.as_str()), "{rel} is not embedded or differs");
+    }
+}
+
+/// Size and member offsets of a WGSL struct.
+fn wgsl_layout(module: &naga::Module, name: &str) -> (u32, Vec<(String, u32)>) {
+    for (_, ty) in module.types.iter() {
+        if ty.name.as_deref() == Some(name)
+            && let naga::TypeInner::Struct { members, span } = &ty.inner
+        {
+            return (*span, members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset)).collect());
+        }
+    }
+    panic!("struct {name} not found");
+}
+
+fn offsets(module: &naga::Module, name: &str, size: usize, rust: &[(&str, usize)]) {
+    let (span, members) = wgsl_layout(module, name);
+    assert_eq!(span as usize, size, "size of {name}");
+    for (field, offset) in rust {
+        let wgsl = members
+            .iter()
+            .find(|(n, _)| n == field)
+            .unwrap_or_else(|| panic!("{name}.{field} missing in WGSL"));
+        assert_eq!(wgsl.1 as usize, *offset, "offset of {name}.{field}");
+    }
+}
+
+#[test]
+fn shared_structs_match_rust() {
+    let forward = validate("forward.wgsl");
+    offsets(
+        &forward,
+        "ViewUniform",
+        size_of::<ViewUniform>(),
+        &[
+            ("clip_from_world", offset_of!(ViewUniform, clip_from_world)),
+            ("view_from_world", offset_of!(ViewUniform, view_from_world)),
+            ("clip_from_view", offset_of!(ViewUniform, clip_from_view)),
+            ("world_from_clip", offset_of!(ViewUniform, world_from_clip)),
+            ("prev_clip_from_world", offset_of!(ViewUniform, prev_clip_from_world)),
+            ("camera_position", offset_of!(ViewUniform, camera_position)),
+            ("viewport", offset_of!(ViewUniform, viewport)),
+            ("params", offset_of!(ViewUniform, params)),
+            ("light_count", offset_of!(ViewUniform, light_count)),
+            ("shading_model", offset_of!(ViewUniform, shading_model)),
+        ],
+    );
+    offsets(
+        &forward,
+        "GpuPointLight",
+        size_of::<GpuPointLight>(),
+        &[
+            ("position_radius", offset_of!(GpuPointLight, position_radius)),
+            ("color", offset_of!(GpuPointLight, color)),
+        ],
+    );
+    offsets(
+        &forward,
+        "GpuInstance",
+        size_of::<GpuInstance>(),
+        &[
+            ("world_from_local", offset_of!(GpuInstance, world_from_local)),
+            ("normal_from_local", offset_of!(GpuInstance, normal_from_local)),
+        ],
+    );
+    offsets(
+        &forward,
+        "GpuMaterial",
+        size_of::<GpuMaterial>(),
+        &[
+            ("base_color", offset_of!(GpuMaterial, base_color)),
+            ("shininess", offset_of!(GpuMaterial, shininess)),
+            ("specular", offset_of!(GpuMaterial, specular)),
+            ("shading_model", offset_of!(GpuMaterial, shading_model)),
+            ("has_texture", offset_of!(GpuMaterial, has_texture)),
+        ],
+    );
+}
+
+#[test]
+fn constants_come_from_rust() {
+    let code = compose("forward.wgsl").unwrap();
+    for (name, value) in manylight_render::gpu_types::shared_u32_constants() {
+        assert!(code.contains(&format!("const {name}: u32 = {value}u;")), "{name}");
+    }
+}

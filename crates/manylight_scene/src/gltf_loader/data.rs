@@ -1,0 +1,438 @@
+//! Binary data of a glTF file: buffers (GLB chunk, `data:` URIs, files next to the glTF),
+//! buffer views and accessors, each range-checked before a byte is read.
+
+use super::Ctx;
+use crate::SceneError;
+use base64::Engine as _;
+use gltf::json::accessor::{ComponentType, Type};
+use gltf::json::validation::Checked;
+use std::borrow::Cow;
+use std::path::{Path, PathBuf};
+
+/// Largest accessor (in bytes) that is materialised without backing data (all zeros or sparse).
+const MAX_SYNTHETIC_ACCESSOR_BYTES: u64 = 256 << 20;
+
+/// Where the bytes named by a `uri` come from.
+pub(super) enum UriSource {
+    /// Decoded `data:` URI payload, with its media type.
+    Data { bytes: Vec<u8>, media_type: String },
+    /// A local file, resolved against the glTF file's folder.
+    File(PathBuf),
+}
+
+/// Shortens long URIs (e.g. `data:` URIs) for error messages.
+fn short_uri(uri: &str) -> String {
+    if uri.len() <= 80 {
+        return uri.to_owned();
+    }
+    let cut = (0..=77).rev().find(|&i| uri.is_char_boundary(i)).unwrap_or(0);
+    format!("{}...", &uri[..cut])
+}
+
+/// Decodes `%XX` escapes of a relative URI reference.
+fn percent_decode(uri: &str) -> Option<String> {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%' {
+            let hex = std::str::from_utf8(bytes.get(i + 1..i + 3)?).ok()?;
+            out.push(u8::from_str_radix(hex, 16).ok()?);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(out).ok()
+}
+
+/// Interprets a buffer or image URI: `data:` URIs are decoded, `http(s)://` and other schemes
+/// are refused (nothing is ever fetched), anything else is a path relative to `base_dir`.
+pub(super) fn resolve_uri(
+    path: &Path,
+    base_dir: &Path,
+    what: &str,
+    uri: &str,
+) -> Result<UriSource, SceneError> {
+    let bad = |reason: &str| SceneError::BadUri {
+        path: path.to_owned(),
+        what: what.to_owned(),
+        uri: short_uri(uri),
+        reason: reason.to_owned(),
+    };
+    let lower = uri.get(..8).unwrap_or(uri).to_ascii_lowercase();
+    if lower.starts_with("http://") || lower.starts_with("https://") || uri.starts_with("//") {
+        return Err(SceneError::ExternalUri {
+            path: path.to_owned(),
+            what: what.to_owned(),
+            uri: short_uri(uri),
+        });
+    }
+    if lower.starts_with("data:") {
+        let rest = &uri[5..];
+        let (header, payload) = rest.split_once(',').ok_or_else(|| bad("data URI without ','"))?;
+        let Some(media_type) = header.strip_suffix(";base64") else {
+            return Err(bad("only base64 data URIs are supported"));
+        };
+        let bytes = base64::engine::general_purpose::STANDARD
+            .decode(payload.trim_end())
+            .map_err(|e| bad(&format!("invalid base64: {e}")))?;
+        return Ok(UriSource::Data { bytes, media_type: media_type.to_ascii_lowercase() });
+    }
+    // A scheme is letters/digits/+/-/. before the first ':' that comes before any '/'.
+    if let Some(colon) = uri.find(':') {
+        let scheme = &uri[..colon];
+        let looks_like_scheme =
+            scheme.len() > 1 && scheme.chars().all(|c| c.is_ascii_alphanumeric() || "+-.".contains(c));
+        if looks_like_scheme {
+            return Err(bad(&format!("unsupported URI scheme `{scheme}:`")));
+        }
+    }
+    if uri.is_empty() {
+        return Err(bad("empty URI"));
+    }
+    let decoded = percent_decode(uri).ok_or_else(|| bad("invalid percent escape"))?;
+    Ok(UriSource::File(base_dir.join(decoded)))
+}
+
+/// Reads a file named by a URI.
+pub(super) fn read_referenced(path: &Path, what: &str, file: &Path) -> Result<Vec<u8>, SceneError> {
+    std::fs::read(file).map_err(|source| SceneError::ReferencedFile {
+        path: path.to_owned(),
+        what: what.to_owned(),
+        file: file.to_owned(),
+        source,
+    })
+}
+
+/// Loads every buffer of the file; each is cut to its declared `byteLength`.
+pub(super) fn load_buffers<'a>(
+    path: &Path,
+    base_dir: &Path,
+    root: &gltf::json::Root,
+    glb_bin: Option<&'a [u8]>,
+) -> Result<Vec<Cow<'a, [u8]>>, SceneError> {
+    let mut out = Vec::with_capacity(root.buffers.len());
+    for (i, buffer) in root.buffers.iter().enumerate() {
+        let what = format!("buffer {i}");
+        let declared = buffer.byte_length.0;
+        let data: Cow<'a, [u8]> = match &buffer.uri {
+            Some(uri) => match resolve_uri(path, base_dir, &what, uri)? {
+                UriSource::Data { bytes, .. } => Cow::Owned(bytes),
+                UriSource::File(file) => Cow::Owned(read_referenced(path, &what, &file)?),
+            },
+            None if i == 0 => Cow::Borrowed(glb_bin.ok_or_else(|| SceneError::BadBuffer {
+                path: path.to_owned(),
+                buffer: i,
+                problem: "has no uri and the file has no GLB binary chunk".into(),
+            })?),
+            None => {
+                return Err(SceneError::BadBuffer {
+                    path: path.to_owned(),
+                    buffer: i,
+                    problem: "has no uri (only buffer 0 may use the GLB binary chunk)".into(),
+                });
+            }
+        };
+        if (data.len() as u64) < declared {
+            return Err(SceneError::BadBuffer {
+                path: path.to_owned(),
+                buffer: i,
+                problem: format!("has {} bytes but its byteLength is {declared}", data.len()),
+            });
+        }
+        // `declared <= data.len()`, so it fits in usize.
+        let data = match data {
+            Cow::Borrowed(b) => Cow::Borrowed(&b[..declared as usize]),
+            Cow::Owned(mut v) => {
+                v.truncate(declared as usize);
+                Cow::Owned(v)
+            }
+        };
+        out.push(data);
+    }
+    Ok(out)
+}
+
+/// Name of a component type for messages.
+fn component_name(c: ComponentType) -> &'static str {
+    match c {
+        ComponentType::I8 => "BYTE",
+        ComponentType::U8 => "UNSIGNED_BYTE",
+        ComponentType::I16 => "SHORT",
+        ComponentType::U16 => "UNSIGNED_SHORT",
+        ComponentType::U32 => "UNSIGNED_INT",
+        ComponentType::F32 => "FLOAT",
+    }
+}
+
+/// Name of an accessor type for messages.
+fn type_name(t: Type) -> &'static str {
+    match t {
+        Type::Scalar => "SCALAR",
+        Type::Vec2 => "VEC2",
+        Type::Vec3 => "VEC3",
+        Type::Vec4 => "VEC4",
+        Type::Mat2 => "MAT2",
+        Type::Mat3 => "MAT3",
+        Type::Mat4 => "MAT4",
+    }
+}
+
+/// Shape of one accessor after its type was checked.
+#[derive(Clone, Copy)]
+struct Layout {
+    count: usize,
+    components: usize,
+    component: ComponentType,
+    normalized: bool,
+}
+
+impl Layout {
+    fn element_size(&self) -> usize {
+        self.components * self.component.size()
+    }
+}
+
+impl Ctx<'_> {
+    /// The bytes of buffer view `view`, after checking that it lies inside its buffer.
+    pub(super) fn view_bytes(&self, view: usize, what: &str) -> Result<&[u8], SceneError> {
+        let v = self.lookup(&self.root.buffer_views, view, what, "buffer view")?;
+        let buffer = v.buffer.value();
+        let data = self.lookup(&self.buffers, buffer, &format!("buffer view {view}"), "buffer")?;
+        let offset = v.byte_offset.map_or(0, |o| o.0);
+        let length = v.byte_length.0;
+        match offset.checked_add(length) {
+            Some(end) if end <= data.len() as u64 => Ok(&data[offset as usize..end as usize]),
+            _ => Err(SceneError::ViewOutOfRange {
+                path: self.path.to_owned(),
+                view,
+                offset,
+                length,
+                buffer,
+                buffer_len: data.len() as u64,
+            }),
+        }
+    }
+
+    /// Checks accessor `index`'s type against `usage` and returns its shape.
+    fn layout(
+        &self,
+        index: usize,
+        what: &str,
+        usage: &str,
+        accept: &dyn Fn(Type, ComponentType, bool) -> bool,
+        expected: &'static str,
+    ) -> Result<Layout, SceneError> {
+        let a = self.lookup(&self.root.accessors, index, what, "accessor")?;
+        let wrong = |found: String| SceneError::AccessorType {
+            path: self.path.to_owned(),
+            accessor: index,
+            usage: usage.to_owned(),
+            found,
+            expected,
+        };
+        let (Checked::Valid(ty), Checked::Valid(ct)) = (&a.type_, &a.component_type) else {
+            return Err(wrong("of an invalid type or component type".into()));
+        };
+        let (ty, ct) = (*ty, ct.0);
+        if !accept(ty, ct, a.normalized) {
+            let norm = if a.normalized { "normalized " } else { "" };
+            return Err(wrong(format!("{} of {norm}{}", type_name(ty), component_name(ct))));
+        }
+        let count = usize::try_from(a.count.0).map_err(|_| self.bad_accessor(index, "count is too large"))?;
+        Ok(Layout { count, components: ty.multiplicity(), component: ct, normalized: a.normalized })
+    }
+
+    fn bad_accessor(&self, accessor: usize, problem: &str) -> SceneError {
+        SceneError::BadAccessor { path: self.path.to_owned(), accessor, problem: problem.to_owned() }
+    }
+
+    /// The accessor's elements, tightly packed (`count * element_size` bytes), with sparse
+    /// substitutions applied. Every range is checked before reading.
+    fn packed(&self, index: usize, layout: Layout) -> Result<Vec<u8>, SceneError> {
+        let a = &self.root.accessors[index]; // `layout` checked the index
+        let elem = layout.element_size() as u64;
+        let count = layout.count as u64;
+        let total = count.checked_mul(elem).ok_or_else(|| self.bad_accessor(index, "count is too large"))?;
+        let mut out;
+        if let Some(view_index) = a.buffer_view {
+            let view_index = view_index.value();
+            let view = self.view_bytes(view_index, &format!("accessor {index}"))?;
+            let stride = match self.root.buffer_views[view_index].byte_stride {
+                Some(s) => s.0 as u64,
+                None => elem,
+            };
+            if stride < elem {
+                return Err(self.bad_accessor(
+                    index,
+                    &format!("byteStride {stride} of buffer view {view_index} is smaller than the element size {elem}"),
+                ));
+            }
+            let offset = a.byte_offset.map_or(0, |o| o.0);
+            let needed = if count == 0 {
+                Some(offset)
+            } else {
+                stride
+                    .checked_mul(count - 1)
+                    .and_then(|x| x.checked_add(offset))
+                    .and_then(|x| x.checked_add(elem))
+            };
+            match needed {
+                Some(n) if n <= view.len() as u64 => {}
+                _ => {
+                    return Err(SceneError::AccessorOutOfRange {
+                        path: self.path.to_owned(),
+                        accessor: index,
+                        view: view_index,
+                        needed: needed.unwrap_or(u64::MAX),
+                        length: view.len() as u64,
+                    });
+                }
+            }
+            // All of these fit in usize: they are bounded by the view length.
+            let (offset, stride, elem) = (offset as usize, stride as usize, elem as usize);
+            if stride == elem {
+                out = view[offset..offset + total as usize].to_vec();
+            } else {
+                out = Vec::with_capacity(total as usize);
+                for i in 0..layout.count {
+                    let start = offset + i * stride;
+                    out.extend_from_slice(&view[start..start + elem]);
+                }
+            }
+        } else {
+            if total > MAX_SYNTHETIC_ACCESSOR_BYTES {
+                return Err(self.bad_accessor(index, "has no buffer view and is too large"));
+            }
+            out = vec![0; total as usize];
+        }
+        if let Some(sparse) = &a.sparse {
+            self.apply_sparse(index, sparse, layout, &mut out)?;
+        }
+        Ok(out)
+    }
+
+    /// Writes the sparse substitutions of accessor `index` into `out`.
+    fn apply_sparse(
+        &self,
+        index: usize,
+        sparse: &gltf::json::accessor::sparse::Sparse,
+        layout: Layout,
+        out: &mut [u8],
+    ) -> Result<(), SceneError> {
+        let what = format!("accessor {index} (sparse)");
+        let n = sparse.count.0;
+        if n > layout.count as u64 {
+            return Err(self.bad_accessor(index, "sparse count exceeds the accessor count"));
+        }
+        let n = n as usize;
+        let Checked::Valid(ict) = &sparse.indices.component_type else {
+            return Err(self.bad_accessor(index, "sparse indices have an invalid component type"));
+        };
+        let isize_ = ict.0.size();
+        let elem = layout.element_size();
+        let slice = |view: usize, offset: u64, len: usize| -> Result<&[u8], SceneError> {
+            let bytes = self.view_bytes(view, &what)?;
+            let end = offset.checked_add(len as u64);
+            match end {
+                Some(end) if end <= bytes.len() as u64 => Ok(&bytes[offset as usize..end as usize]),
+                _ => Err(SceneError::AccessorOutOfRange {
+                    path: self.path.to_owned(),
+                    accessor: index,
+                    view,
+                    needed: end.unwrap_or(u64::MAX),
+                    length: bytes.len() as u64,
+                }),
+            }
+        };
+        let idx = slice(sparse.indices.buffer_view.value(), sparse.indices.byte_offset.0, n * isize_)?;
+        let vals = slice(sparse.values.buffer_view.value(), sparse.values.byte_offset.0, n * elem)?;
+        for i in 0..n {
+            let target = read_uint(ict.0, &idx[i * isize_..]) as usize;
+            if target >= layout.count {
+                return Err(self.bad_accessor(
+                    index,
+                    &format!("sparse index {target} is out of range (count {})", layout.count),
+                ));
+            }
+            out[target * elem..(target + 1) * elem].copy_from_slice(&vals[i * elem..(i + 1) * elem]);
+        }
+        Ok(())
+    }
+
+    /// Reads a `VEC3` `FLOAT` accessor (positions, normals).
+    pub(super) fn read_vec3(
+        &self,
+        index: usize,
+        what: &str,
+        usage: &str,
+    ) -> Result<Vec<glam::Vec3>, SceneError> {
+        let layout = self.layout(
+            index,
+            what,
+            usage,
+            &|t, c, _| t == Type::Vec3 && c == ComponentType::F32,
+            "VEC3 of FLOAT",
+        )?;
+        let bytes = self.packed(index, layout)?;
+        Ok(bytes
+            .chunks_exact(12)
+            .map(|c| glam::Vec3::new(f32_at(c, 0), f32_at(c, 4), f32_at(c, 8)))
+            .collect())
+    }
+
+    /// Reads a texture-coordinate accessor (`VEC2` of `FLOAT` or normalized unsigned ints).
+    pub(super) fn read_uv(&self, index: usize, what: &str) -> Result<Vec<glam::Vec2>, SceneError> {
+        let layout = self.layout(
+            index,
+            what,
+            "TEXCOORD_0",
+            &|t, c, n| {
+                t == Type::Vec2
+                    && (c == ComponentType::F32 || (n && matches!(c, ComponentType::U8 | ComponentType::U16)))
+            },
+            "VEC2 of FLOAT, normalized UNSIGNED_BYTE or normalized UNSIGNED_SHORT",
+        )?;
+        let bytes = self.packed(index, layout)?;
+        let cs = layout.component.size();
+        let read = |b: &[u8]| match layout.component {
+            ComponentType::F32 => f32_at(b, 0),
+            ComponentType::U8 => b[0] as f32 / 255.0,
+            _ => u16::from_le_bytes([b[0], b[1]]) as f32 / 65535.0,
+        };
+        debug_assert!(layout.normalized || layout.component == ComponentType::F32);
+        Ok(bytes.chunks_exact(2 * cs).map(|c| glam::Vec2::new(read(c), read(&c[cs..]))).collect())
+    }
+
+    /// Reads an index accessor (`SCALAR` of unsigned ints).
+    pub(super) fn read_indices(&self, index: usize, what: &str) -> Result<Vec<u32>, SceneError> {
+        let layout = self.layout(
+            index,
+            what,
+            "indices",
+            &|t, c, _| {
+                t == Type::Scalar && matches!(c, ComponentType::U8 | ComponentType::U16 | ComponentType::U32)
+            },
+            "SCALAR of UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT",
+        )?;
+        let bytes = self.packed(index, layout)?;
+        let cs = layout.component.size();
+        Ok(bytes.chunks_exact(cs).map(|c| read_uint(layout.component, c)).collect())
+    }
+}
+
+/// Little-endian f32 at `at`; callers pass slices of at least `at + 4` bytes.
+fn f32_at(b: &[u8], at: usize) -> f32 {
+    f32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]])
+}
+
+/// Little-endian unsigned int of component type `c` at the start of `b`.
+fn read_uint(c: ComponentType, b: &[u8]) -> u32 {
+    match c {
+        ComponentType::U8 | ComponentType::I8 => b[0] as u32,
+        ComponentType::U16 | ComponentType::I16 => u16::from_le_bytes([b[0], b[1]]) as u32,
+        _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+    }
+}

@@ -1,0 +1,74 @@
+//! Scenes for manylight: glTF loading, the embedded procedural default scene, light rigs.
+//!
+//! A [`Scene`] is plain data (meshes, materials, instances, lights, cameras) that the app turns
+//! into ECS entities; mesh and texture data are `Arc`s so they travel to the render thread once.
+
+mod default_scene;
+mod error;
+mod gltf_loader;
+mod light_rig;
+mod scene_ops;
+mod shapes;
+mod textures;
+
+pub use default_scene::default_scene;
+pub use error::SceneError;
+pub use gltf_loader::{LoadOptions, blinn_phong_from_pbr, load_gltf};
+pub use light_rig::{
+    AnimatedLight, RIG_RADIUS_K, intensity_for_radius, light_rig, sphere_shell_lights, sphere_shell_scene,
+};
+pub use scene_ops::{camera_looking_at, load_scene};
+
+use glam::{Mat4, Vec3};
+use manylight_core::{MaterialData, MeshData, Projection};
+use std::sync::Arc;
+
+/// A loaded or generated scene.
+#[derive(Clone, Debug, Default)]
+pub struct Scene {
+    /// Name for logs (file name or generator name).
+    pub name: String,
+    /// Mesh data, referenced by index from `instances`.
+    pub meshes: Vec<Arc<MeshData>>,
+    /// Materials, referenced by index from `instances`.
+    pub materials: Vec<Arc<MaterialData>>,
+    /// Drawn objects.
+    pub instances: Vec<SceneInstance>,
+    /// Point lights that come with the scene.
+    pub lights: Vec<SceneLight>,
+    /// Cameras that come with the scene (glTF cameras); may be empty.
+    pub cameras: Vec<SceneCamera>,
+}
+
+/// One drawn object: a mesh with a material at a world transform.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneInstance {
+    /// Index into `Scene::meshes`.
+    pub mesh: usize,
+    /// Index into `Scene::materials`.
+    pub material: usize,
+    /// World-from-object transform.
+    pub transform: Mat4,
+}
+
+/// A point light in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneLight {
+    /// World position.
+    pub position: Vec3,
+    /// Linear RGB colour.
+    pub color: Vec3,
+    /// Scalar multiplier of `color`.
+    pub intensity: f32,
+    /// Distance at which the light's contribution reaches exactly zero.
+    pub radius: f32,
+}
+
+/// A camera placement.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneCamera {
+    /// World-from-camera transform; the camera looks down its local -Z with +Y up.
+    pub transform: Mat4,
+    /// Perspective parameters.
+    pub projection: Projection,
+}

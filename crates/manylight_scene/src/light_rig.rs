@@ -1,0 +1,292 @@
+//! Generated lights: an animated rig for filling a scene with many moving coloured lights, and
+//! the sphere-shell stress scene (thousands of small lights just inside a large sphere).
+//!
+//! Everything is deterministic for a seed (a splitmix64 generator, no `rand`), and every
+//! position and colour is finite for every finite or non-finite time.
+
+use crate::shapes::{cuboid, uv_sphere};
+use crate::{Scene, SceneCamera, SceneInstance, SceneLight};
+use glam::{Mat4, Vec3};
+use manylight_core::{Aabb, MaterialData, Projection};
+use std::f64::consts::TAU;
+use std::sync::Arc;
+
+/// Scale of the light radius relative to the mean spacing of the lights (see [`light_rig`]).
+/// With `K = 1` a point of the volume lies inside `4/3 π K³ ≈ 4.2` light spheres on average.
+pub const RIG_RADIUS_K: f32 = 1.0;
+
+/// A point light that orbits a centre in XZ, bobs in Y and slowly shifts hue and flickers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AnimatedLight {
+    /// Centre of the orbit.
+    pub center: Vec3,
+    /// Orbit radius in the XZ plane.
+    pub orbit_radius: f32,
+    /// Orbit angular speed in radians per second (sign = direction).
+    pub orbit_speed: f32,
+    /// Phase offset in radians (orbit, bob and flicker).
+    pub phase: f32,
+    /// Vertical bobbing amplitude.
+    pub bob_amplitude: f32,
+    /// Bobbing angular speed in radians per second.
+    pub bob_speed: f32,
+    /// Base linear RGB colour.
+    pub color: Vec3,
+    /// Flicker angular speed in radians per second (hue drift is ten times slower).
+    pub flicker_speed: f32,
+    /// Intensity multiplier of the colour.
+    pub intensity: f32,
+    /// Distance at which the light's contribution reaches zero.
+    pub radius: f32,
+}
+
+/// `(phase + speed * t) mod 2π`, computed in f64 so large `t` keeps its precision and never
+/// overflows; non-finite inputs give 0.
+fn angle(phase: f32, speed: f32, t: f32) -> f32 {
+    let a = (phase as f64 + speed as f64 * t as f64).rem_euclid(TAU);
+    if a.is_finite() { a as f32 } else { 0.0 }
+}
+
+/// Rotates an RGB colour around the grey axis by `theta` (a hue shift), clamped to >= 0.
+fn hue_rotate(c: Vec3, theta: f32) -> Vec3 {
+    let k = Vec3::ONE.normalize();
+    let (s, co) = theta.sin_cos();
+    (c * co + k.cross(c) * s + k * k.dot(c) * (1.0 - co)).max(Vec3::ZERO)
+}
+
+impl AnimatedLight {
+    /// World position at time `t` seconds: orbit in XZ around `center`, bob in Y.
+    pub fn position_at(&self, t: f32) -> Vec3 {
+        let a = angle(self.phase, self.orbit_speed, t);
+        let b = angle(self.phase, self.bob_speed, t);
+        let p = self.center
+            + Vec3::new(
+                self.orbit_radius * a.cos(),
+                self.bob_amplitude * b.sin(),
+                self.orbit_radius * a.sin(),
+            );
+        if p.is_finite() {
+            p
+        } else if self.center.is_finite() {
+            self.center
+        } else {
+            Vec3::ZERO
+        }
+    }
+
+    /// Colour at time `t` (to be scaled by `intensity`): the base colour
+    /// with a slow hue drift of ±20° and a ±15 % flicker. Finite and non-negative.
+    pub fn color_at(&self, t: f32) -> Vec3 {
+        let drift = angle(self.phase, 0.1 * self.flicker_speed, t).sin() * 0.35;
+        let f1 = angle(3.0 * self.phase, self.flicker_speed, t).sin();
+        let f2 = angle(self.phase, 2.7 * self.flicker_speed, t).sin();
+        let flicker = 0.85 + 0.15 * (0.6 * f1 + 0.4 * f2);
+        let c = hue_rotate(self.color.max(Vec3::ZERO), drift) * flicker;
+        if c.is_finite() { c } else { Vec3::ZERO }
+    }
+
+    /// The light at time `t` as a scene light.
+    pub fn at(&self, t: f32) -> SceneLight {
+        SceneLight {
+            position: self.position_at(t),
+            color: self.color_at(t),
+            intensity: self.intensity,
+            radius: self.radius,
+        }
+    }
+}
+
+/// splitmix64: a tiny, well-mixed deterministic generator.
+struct SplitMix64(u64);
+
+impl SplitMix64 {
+    fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [0, 1).
+    fn f32(&mut self) -> f32 {
+        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
+    }
+
+    /// Uniform in [lo, hi).
+    fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.f32()
+    }
+}
+
+/// Fully saturated-ish colour of hue `h` in [0, 1), saturation `s`, value 1.
+fn hsv(h: f32, s: f32) -> Vec3 {
+    let h6 = (h.fract() * 6.0).clamp(0.0, 5.999_999);
+    let f = h6.fract();
+    let (p, q, t) = (1.0 - s, 1.0 - s * f, 1.0 - s * (1.0 - f));
+    match h6 as u32 {
+        0 => Vec3::new(1.0, t, p),
+        1 => Vec3::new(q, 1.0, p),
+        2 => Vec3::new(p, 1.0, t),
+        3 => Vec3::new(p, q, 1.0),
+        4 => Vec3::new(t, p, 1.0),
+        _ => Vec3::new(1.0, p, q),
+    }
+}
+
+/// Intensity for a light of radius `r`: `(0.36 r² + 1) / 3`.
+///
+/// A point sees about 4 lights (see [`RIG_RADIUS_K`]) at a typical distance of 0.6 r, where
+/// the windowed falloff is about `0.76 / (0.36 r² + 1)`; this intensity makes their sum about 1
+/// whatever the radius, so 16 big lights and 4096 small ones light a scene similarly.
+pub fn intensity_for_radius(r: f32) -> f32 {
+    (0.36 * r * r + 1.0) / 3.0
+}
+
+/// `count` animated lights placed deterministically (for `seed`) inside `bounds`.
+///
+/// Centres are uniform in `bounds` shrunk by 5 % of its size on each side, and orbit and bob
+/// amplitudes are limited so every position stays inside that shrunk box at all times. Hues
+/// are random and saturated. The radius is
+/// `r = clamp(K · (V / count)^(1/3), 0.5, 8)` with `V` the volume of `bounds` and
+/// `K` = [`RIG_RADIUS_K`], so the expected number of lights touching a point stays about 4 as
+/// `count` grows (until the clamp); the intensity is [`intensity_for_radius`]. An empty or
+/// non-finite `bounds` is replaced by the cube [-1, 1]³.
+pub fn light_rig(count: usize, bounds: Aabb, seed: u64) -> Vec<AnimatedLight> {
+    let usable =
+        !bounds.is_empty() && bounds.min.is_finite() && bounds.max.is_finite() && bounds.size().is_finite();
+    let bounds = if usable { bounds } else { Aabb { min: Vec3::splat(-1.0), max: Vec3::ONE } };
+    let size = bounds.size();
+    let inner = Aabb { min: bounds.min + size * 0.05, max: bounds.max - size * 0.05 };
+    let volume = (size.x * size.y * size.z).max(1e-6);
+    let radius = (RIG_RADIUS_K * (volume / count.max(1) as f32).cbrt()).clamp(0.5, 8.0);
+    let intensity = intensity_for_radius(radius);
+    let mut rng = SplitMix64(seed ^ 0x6c69_6768_7472_6967);
+    (0..count)
+        .map(|_| {
+            let u = Vec3::new(rng.f32(), rng.f32(), rng.f32());
+            let center = inner.min + (inner.max - inner.min) * u;
+            let room_xz = (center.x - inner.min.x)
+                .min(inner.max.x - center.x)
+                .min(center.z - inner.min.z)
+                .min(inner.max.z - center.z)
+                .max(0.0);
+            let room_y = (center.y - inner.min.y).min(inner.max.y - center.y).max(0.0);
+            let dir = if rng.f32() < 0.5 { -1.0 } else { 1.0 };
+            AnimatedLight {
+                center,
+                orbit_radius: rng.range(0.2, 1.0) * room_xz.min(3.0),
+                orbit_speed: dir * rng.range(0.2, 0.8),
+                phase: rng.range(0.0, std::f32::consts::TAU),
+                bob_amplitude: rng.f32() * room_y.min(0.5),
+                bob_speed: rng.range(0.5, 2.0),
+                color: hsv(rng.f32(), rng.range(0.7, 1.0)),
+                flicker_speed: rng.range(0.5, 3.0),
+                intensity,
+                radius,
+            }
+        })
+        .collect()
+}
+
+/// `count` static lights of range `light_range` on a Fibonacci (golden-angle) lattice just
+/// inside a sphere of radius `shell_radius` centred on the origin, with random hues.
+///
+/// Each light sits `min(0.8 · light_range, 1)` inside the sphere: inside the flat faces of the
+/// tessellated shell of [`sphere_shell_scene`] (whose faces sag up to ~0.21 below the sphere at
+/// r = 50), while its sphere of influence still reaches the shell (for range 0.3 the light is
+/// 0.24 inside).
+pub fn sphere_shell_lights(count: usize, shell_radius: f32, light_range: f32, seed: u64) -> Vec<SceneLight> {
+    let shell = if shell_radius.is_finite() { shell_radius.max(0.0) } else { 0.0 };
+    let range = if light_range.is_finite() { light_range.max(0.0) } else { 0.0 };
+    let r = shell - (0.8 * range).min(1.0).min(shell);
+    let golden_angle = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    let mut rng = SplitMix64(seed ^ 0x7368_656c_6c5f_6c74);
+    (0..count)
+        .map(|i| {
+            let y = 1.0 - 2.0 * (i as f64 + 0.5) / count as f64;
+            let ring = (1.0 - y * y).max(0.0).sqrt();
+            let theta = (golden_angle * i as f64).rem_euclid(TAU);
+            let dir = Vec3::new((theta.cos() * ring) as f32, y as f32, (theta.sin() * ring) as f32);
+            SceneLight {
+                position: dir * r,
+                color: hsv(rng.f32(), rng.range(0.7, 1.0)),
+                intensity: intensity_for_radius(range),
+                radius: range,
+            }
+        })
+        .collect()
+}
+
+/// The sphere-shell stress scene: an inward-facing white sphere of radius 50 (~2200
+/// triangles), a 5 × 5 × 5 box at (0, 50, 0), a camera at the origin (45° vertical fov,
+/// near 0.1, far 1000) and no lights (add [`sphere_shell_lights`]).
+pub fn sphere_shell_scene() -> Scene {
+    let white = MaterialData {
+        label: "sphere_shell/white".into(),
+        base_color: glam::Vec4::ONE,
+        ..MaterialData::default()
+    };
+    Scene {
+        name: "sphere-shell".into(),
+        meshes: vec![
+            Arc::new(uv_sphere("sphere_shell/shell", 50.0, 24, 48, true)),
+            Arc::new(cuboid("sphere_shell/box", Vec3::splat(5.0), 1.0)),
+        ],
+        materials: vec![Arc::new(white)],
+        instances: vec![
+            SceneInstance { mesh: 0, material: 0, transform: Mat4::IDENTITY },
+            SceneInstance {
+                mesh: 1,
+                material: 0,
+                transform: Mat4::from_translation(Vec3::new(0.0, 50.0, 0.0)),
+            },
+        ],
+        lights: Vec::new(),
+        cameras: vec![SceneCamera {
+            transform: Mat4::IDENTITY,
+            projection: Projection { fov_y: 45f32.to_radians(), near: 0.1, far: 1000.0 },
+        }],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hsv_is_in_unit_range_and_saturated() {
+        for i in 0..100 {
+            let c = hsv(i as f32 / 100.0, 1.0);
+            assert!(c.min_element() >= 0.0 && c.max_element() <= 1.0);
+            assert_eq!(c.max_element(), 1.0);
+        }
+    }
+
+    #[test]
+    fn shell_lights_sit_inside_the_tessellated_shell() {
+        let scene = sphere_shell_scene();
+        let shell = &scene.meshes[0];
+        // The smallest distance of a shell triangle's plane from the centre.
+        let mut inscribed = f32::MAX;
+        for t in shell.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| Vec3::from(shell.vertices[i as usize].position));
+            if let Some(n) = (b - a).cross(c - a).try_normalize() {
+                inscribed = inscribed.min(n.dot(a).abs());
+            }
+        }
+        for l in sphere_shell_lights(500, 50.0, 0.3, 1) {
+            let d = l.position.length();
+            assert!(d < inscribed, "{d} >= {inscribed}");
+            assert!(d + l.radius > inscribed);
+        }
+    }
+
+    #[test]
+    fn shell_scene_is_valid() {
+        let s = sphere_shell_scene();
+        s.validate().expect("valid");
+        let tris = s.meshes[0].triangle_count();
+        assert!((1500..3000).contains(&tris), "{tris}");
+    }
+}
