@@ -59,3 +59,36 @@ pub fn save_png(image: &image::RgbaImage, path: &std::path::Path) -> Result<(), 
     }
     image.save(path).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
+
+/// The last frame of a headless run.
+#[derive(Clone, Debug)]
+pub struct HeadlessFrame {
+    /// The tone-mapped image.
+    pub image: image::RgbaImage,
+    /// Statistics of the run (the report is the last frame's).
+    pub stats: FrameStats,
+}
+
+/// Builds a headless app of `size`, lets `setup` add systems and resources (spawn the scene in
+/// a `Startup` system), renders `frames` frames synchronously and returns the last one.
+pub fn render_headless(
+    size: glam::UVec2,
+    frames: u32,
+    setup: impl FnOnce(&mut App),
+) -> Result<HeadlessFrame, String> {
+    let mut app = App::new();
+    app.add_plugins(crate::ManyLightPlugin::headless(size));
+    setup(&mut app);
+    for _ in 0..frames.max(1) {
+        app.update();
+        if let Some(message) = app.world().resource::<RenderFailure>().0.clone() {
+            return Err(message);
+        }
+    }
+    finish_frames(&mut app);
+    if let Some(message) = app.world().resource::<RenderFailure>().0.clone() {
+        return Err(message);
+    }
+    let image = app.world().resource::<HeadlessCapture>().image.clone().ok_or("no frame was rendered")?;
+    Ok(HeadlessFrame { image, stats: app.world().resource::<FrameStats>().clone() })
+}

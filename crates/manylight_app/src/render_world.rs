@@ -171,8 +171,8 @@ impl HeadlessRenderer {
         readback: bool,
     ) -> Result<(FrameReport, Option<image::RgbaImage>), RenderError> {
         let size = snapshot.viewport;
-        if size.x == 0 || size.y == 0 {
-            return Ok((empty_report(&snapshot), None));
+        if size.x == 0 || size.y == 0 || snapshot.camera.is_none() {
+            return Ok((empty_report(&snapshot), None)); // nothing to look through or at
         }
         let gpu = self.render_world.gpu().clone();
         if self.target.as_ref().map(|t| t.size()) != Some((size.x, size.y)) {

@@ -1,18 +1,37 @@
 //! The window: a winit event loop that drives the app, and a surface sink on the render thread
 //! that survives resizes, minimising to 0×0 and lost or outdated surfaces.
+//!
+//! How the runner goes about a frame:
+//! 1. Window events update what the runner knows of the window: its inner size (`Resized`) and
+//!    whether it is minimised (at the app's request, or reported as a 0×0 size).
+//! 2. On `RedrawRequested` it publishes [`ViewportSize`] (0×0 while minimised), runs
+//!    `App::update`, checks for `AppExit`, then applies the [`WindowRequests`] systems made.
+//!    While the viewport is 0×0 the window may get no redraws at all, so the runner updates
+//!    the app from a timer instead, about 60 times a second, and nothing is rendered.
+//! 3. The extract system hands the snapshot to [`SurfaceSink`] (on the render thread when
+//!    pipelined). The sink configures the surface to the snapshot's size; an outdated surface
+//!    is configured again and a lost one recreated, and the frame is retried once.
+//! 4. On exit, the runner waits for the frames in flight, records their results, drops the
+//!    surface (joining the render thread) and only then the window.
 
 use crate::backend::{FrameSink, RenderBackend, RenderThread};
 use crate::render_world::{RenderWorld, empty_report};
-use crate::resources::{RenderFailure, ViewportSize};
-use bevy_app::{App, AppExit};
+use crate::resources::{FrameStats, HeadlessCapture, RenderFailure, ViewportSize};
+use bevy_app::{App, AppExit, PluginsState};
+use bevy_ecs::prelude::*;
 use glam::UVec2;
 use manylight_render::{FrameReport, FrameSnapshot, GpuContext, RenderError};
 use std::sync::Arc;
+use std::time::{Duration, Instant};
 use winit::application::ApplicationHandler;
+use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, KeyEvent, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::keyboard::{Key, NamedKey};
 use winit::window::{Window, WindowId};
+
+/// How often the app updates while the viewport is 0×0 (minimised): nothing is drawn then.
+const IDLE_UPDATE_INTERVAL: Duration = Duration::from_millis(16);
 
 /// Window parameters.
 #[derive(Clone, Debug, PartialEq)]
@@ -25,11 +44,58 @@ pub struct WindowConfig {
     pub height: u32,
     /// Wait for vertical sync when presenting.
     pub vsync: bool,
+    /// Allow the event loop on a thread other than the main one (X11, Wayland and Windows;
+    /// ignored elsewhere). Off by default because macOS cannot do it; tests turn it on, since
+    /// the test harness runs each test on a thread of its own.
+    pub any_thread: bool,
 }
 
 impl Default for WindowConfig {
     fn default() -> Self {
-        Self { title: "manylight".into(), width: 1280, height: 720, vsync: true }
+        Self { title: "manylight".into(), width: 1280, height: 720, vsync: true, any_thread: false }
+    }
+}
+
+/// Changes to the window that systems ask for; the window runner applies them after each
+/// update (the runner inserts this resource when it starts).
+///
+/// ```no_run
+/// # use manylight_app::window::WindowRequests;
+/// # use bevy_ecs::prelude::*;
+/// fn shrink(mut requests: ResMut<WindowRequests>) {
+///     requests.request_resize(glam::UVec2::new(640, 360));
+/// }
+/// ```
+#[derive(Resource, Clone, Debug, Default, PartialEq, Eq)]
+pub struct WindowRequests {
+    resize: Option<UVec2>,
+    minimize: Option<bool>,
+    close: bool,
+}
+
+impl WindowRequests {
+    /// Asks for a new inner size in physical pixels (each side at least 1; the last request of
+    /// an update wins). The window system may adjust it: [`ViewportSize`] follows the size the
+    /// window really gets.
+    pub fn request_resize(&mut self, size: UVec2) {
+        self.resize = Some(size.max(UVec2::ONE));
+    }
+
+    /// Asks to minimise (`true`) or restore (`false`) the window. From the next update until
+    /// it is restored (by a request, or by the user where the window system reports it),
+    /// [`ViewportSize`] is 0×0, nothing is rendered and the app updates about 60 times a second.
+    pub fn request_minimize(&mut self, minimized: bool) {
+        self.minimize = Some(minimized);
+    }
+
+    /// Asks to close the window: the app exits with `AppExit::Success` after this update.
+    pub fn request_close(&mut self) {
+        self.close = true;
+    }
+
+    /// True when nothing is asked for.
+    pub fn is_empty(&self) -> bool {
+        *self == WindowRequests::default()
     }
 }
 
@@ -40,6 +106,7 @@ pub struct SurfaceSink {
     config: Option<wgpu::SurfaceConfiguration>,
     render_world: RenderWorld,
     vsync: bool,
+    warned_too_large: bool,
 }
 
 impl SurfaceSink {
@@ -49,16 +116,26 @@ impl SurfaceSink {
         let surface =
             instance.create_surface(window.clone()).map_err(|e| RenderError::Surface(e.to_string()))?;
         let gpu = GpuContext::with_instance(instance, Some(&surface))?;
-        Ok(SurfaceSink { window, surface, config: None, render_world: RenderWorld::new(gpu), vsync })
+        Ok(SurfaceSink {
+            window,
+            surface,
+            config: None,
+            render_world: RenderWorld::new(gpu),
+            vsync,
+            warned_too_large: false,
+        })
     }
 
-    fn configure(&mut self, size: UVec2) {
+    /// Configures the surface for `size` (both sides non-zero).
+    fn configure(&mut self, size: UVec2) -> Result<(), RenderError> {
         let gpu = self.render_world.gpu();
         let caps = self.surface.get_capabilities(&gpu.adapter);
         let format = caps.formats.iter().copied().find(|f| f.is_srgb()).or(caps.formats.first().copied());
         let Some(format) = format else {
-            tracing::error!("the surface supports no format");
-            return;
+            return Err(RenderError::Surface(format!(
+                "the window surface supports no format on adapter `{}`",
+                gpu.info.name
+            )));
         };
         let present_mode =
             if self.vsync { wgpu::PresentMode::AutoVsync } else { wgpu::PresentMode::AutoNoVsync };
@@ -73,18 +150,58 @@ impl SurfaceSink {
             view_formats: vec![],
             color_space: wgpu::SurfaceColorSpace::Auto,
         };
+        tracing::debug!("configuring the window surface: {}x{} {format:?}", size.x, size.y);
         self.surface.configure(&gpu.device, &config);
         self.config = Some(config);
+        Ok(())
     }
 
     fn recreate_surface(&mut self) -> Result<(), RenderError> {
         let gpu = self.render_world.gpu();
-        self.surface = gpu
+        let surface = gpu
             .instance
             .create_surface(self.window.clone())
             .map_err(|e| RenderError::Surface(e.to_string()))?;
+        self.surface = surface;
         self.config = None;
         Ok(())
+    }
+
+    /// The next surface texture at `size`, configuring or recreating the surface as needed.
+    /// An outdated or lost surface is fixed and tried once more; `None` skips the frame.
+    fn acquire(&mut self, size: UVec2) -> Result<Option<wgpu::SurfaceTexture>, RenderError> {
+        for _attempt in 0..2 {
+            if self.config.as_ref().map(|c| (c.width, c.height)) != Some((size.x, size.y)) {
+                self.configure(size)?;
+            }
+            match self.surface.get_current_texture() {
+                wgpu::CurrentSurfaceTexture::Success(frame) => return Ok(Some(frame)),
+                wgpu::CurrentSurfaceTexture::Suboptimal(frame) => {
+                    self.config = None; // configure again next frame
+                    return Ok(Some(frame));
+                }
+                wgpu::CurrentSurfaceTexture::Outdated => {
+                    tracing::debug!("surface outdated: configuring it again");
+                    self.config = None;
+                }
+                wgpu::CurrentSurfaceTexture::Lost => {
+                    tracing::warn!("surface lost: recreating it");
+                    self.recreate_surface()?;
+                }
+                wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
+                    tracing::debug!("no surface texture this frame (timeout or occluded)");
+                    return Ok(None);
+                }
+                wgpu::CurrentSurfaceTexture::Validation => {
+                    // The error itself went to the device's error handler and fails the next
+                    // frame with its message; configure from scratch in case that was the cause.
+                    tracing::warn!("acquiring the surface texture raised a validation error");
+                    self.config = None;
+                    return Ok(None);
+                }
+            }
+        }
+        Ok(None)
     }
 }
 
@@ -98,31 +215,19 @@ impl FrameSink for SurfaceSink {
         if size.x == 0 || size.y == 0 {
             return Ok((empty_report(&snapshot), None)); // minimised: nothing to draw
         }
-        if self.config.as_ref().map(|c| (c.width, c.height)) != Some((size.x, size.y)) {
-            self.configure(size);
+        let max = self.render_world.gpu().device.limits().max_texture_dimension_2d;
+        if size.x > max || size.y > max {
+            if !self.warned_too_large {
+                tracing::warn!("window is {}x{}, larger than this GPU's {max}: not drawing", size.x, size.y);
+                self.warned_too_large = true;
+            }
+            return Ok((empty_report(&snapshot), None));
         }
-        let Some(format) = self.config.as_ref().map(|c| c.format) else {
+        let Some(frame) = self.acquire(size)? else {
             return Ok((empty_report(&snapshot), None));
         };
-        let frame = match self.surface.get_current_texture() {
-            wgpu::CurrentSurfaceTexture::Success(f) => f,
-            wgpu::CurrentSurfaceTexture::Suboptimal(f) => {
-                self.config = None; // reconfigure next frame
-                f
-            }
-            wgpu::CurrentSurfaceTexture::Outdated => {
-                self.config = None;
-                return Ok((empty_report(&snapshot), None));
-            }
-            wgpu::CurrentSurfaceTexture::Lost => {
-                tracing::warn!("surface lost: recreating it");
-                self.recreate_surface()?;
-                return Ok((empty_report(&snapshot), None));
-            }
-            other => {
-                tracing::debug!("no surface texture this frame: {other:?}");
-                return Ok((empty_report(&snapshot), None));
-            }
+        let Some(format) = self.config.as_ref().map(|c| c.format).or(Some(frame.texture.format())) else {
+            return Ok((empty_report(&snapshot), None));
         };
         let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
         let report = self.render_world.render(snapshot, &view, format)?;
@@ -132,34 +237,164 @@ impl FrameSink for SurfaceSink {
     }
 }
 
+/// The winit application: owns the app and the window, and turns window events into updates.
 struct WinitRunner {
     app: App,
     config: WindowConfig,
-    window: Option<Arc<Window>>,
     pipelined: bool,
+    window: Option<Arc<Window>>,
+    /// The inner size the window system last reported (0×0 when it minimises the window).
+    window_size: UVec2,
+    /// The app asked for the window to be minimised and has not seen it restored. The window
+    /// system may not report minimising (X11 without a window manager ignores it), so this
+    /// alone makes the viewport 0×0.
+    minimize_requested: bool,
+    /// The window system has reported the window hidden since the app asked to minimise it.
+    seen_hidden: bool,
+    next_idle_update: Instant,
     exit: Option<AppExit>,
 }
 
 impl WinitRunner {
-    fn set_viewport(&mut self, size: winit::dpi::PhysicalSize<u32>) {
-        self.app.world_mut().insert_resource(ViewportSize(UVec2::new(size.width, size.height)));
+    /// The size the app renders at: 0×0 while minimised.
+    fn viewport(&self) -> UVec2 {
+        if self.minimize_requested { UVec2::ZERO } else { self.window_size }
+    }
+
+    fn idle(&self) -> bool {
+        let v = self.viewport();
+        v.x == 0 || v.y == 0
+    }
+
+    fn publish_viewport(&mut self) {
+        let size = self.viewport();
+        let world = self.app.world_mut();
+        if world.get_resource::<ViewportSize>().map(|v| v.0) != Some(size) {
+            world.insert_resource(ViewportSize(size));
+        }
+    }
+
+    fn exit_with(&mut self, event_loop: &ActiveEventLoop, exit: AppExit) {
+        self.exit.get_or_insert(exit);
+        event_loop.exit();
     }
 
     fn fail(&mut self, event_loop: &ActiveEventLoop, message: String) {
         tracing::error!("{message}");
         self.app.world_mut().insert_resource(RenderFailure(Some(message)));
-        self.exit = Some(AppExit::error());
-        event_loop.exit();
+        self.exit_with(event_loop, AppExit::error());
+    }
+
+    /// One frame: update the app, then act on `AppExit` and on the window requests.
+    fn update(&mut self, event_loop: &ActiveEventLoop) {
+        if self.exit.is_some() {
+            return;
+        }
+        self.publish_viewport();
+        self.app.update();
+        if let Some(exit) = self.app.should_exit() {
+            return self.exit_with(event_loop, exit);
+        }
+        self.apply_requests(event_loop);
+    }
+
+    fn apply_requests(&mut self, event_loop: &ActiveEventLoop) {
+        let Some(window) = self.window.clone() else {
+            return;
+        };
+        let requests = match self.app.world_mut().get_resource_mut::<WindowRequests>() {
+            Some(mut r) if !r.is_empty() => std::mem::take(&mut *r),
+            _ => return,
+        };
+        if requests.close {
+            tracing::debug!("window close requested by the app");
+            return self.exit_with(event_loop, AppExit::Success);
+        }
+        if let Some(size) = requests.resize {
+            tracing::debug!("window resize to {}x{} requested by the app", size.x, size.y);
+            if let Some(applied) = window.request_inner_size(PhysicalSize::new(size.x, size.y)) {
+                self.window_size = UVec2::new(applied.width, applied.height);
+            }
+        }
+        match requests.minimize {
+            Some(true) => {
+                tracing::debug!("window minimise requested by the app");
+                window.set_minimized(true);
+                self.minimize_requested = true;
+                self.seen_hidden = false;
+            }
+            Some(false) => {
+                tracing::debug!("window restore requested by the app");
+                let hidden = self.minimize_requested
+                    || window.is_minimized() == Some(true)
+                    || self.window_size.min_element() == 0;
+                if hidden {
+                    // Only when hidden: on X11 restoring also activates (focuses) the window.
+                    window.set_minimized(false);
+                }
+                self.minimize_requested = false;
+            }
+            None => {}
+        }
+    }
+
+    /// While minimised at the app's request: notices the user restoring the window, where the
+    /// window system says so.
+    fn poll_restored(&mut self, window: &Window) {
+        if !self.minimize_requested {
+            return;
+        }
+        match window.is_minimized() {
+            Some(true) => self.seen_hidden = true,
+            Some(false) if self.seen_hidden => {
+                tracing::debug!("window restored by the window system");
+                self.minimize_requested = false;
+            }
+            _ => {}
+        }
+    }
+
+    /// Waits for the frames in flight, records their results, then drops the surface (and the
+    /// render thread) before the window goes.
+    fn shut_down_renderer(&mut self) {
+        let world = self.app.world_mut();
+        let Some(mut backend) = world.remove_resource::<RenderBackend>() else {
+            return;
+        };
+        let results = backend.flush();
+        drop(backend);
+        world.insert_resource(RenderBackend::Pending);
+        for result in results {
+            match result {
+                Ok((report, image)) => {
+                    if let Some(mut stats) = world.get_resource_mut::<FrameStats>() {
+                        stats.last = Some(report);
+                        stats.frames_rendered += 1;
+                    }
+                    if let (Some(image), Some(mut capture)) = (image, world.get_resource_mut::<HeadlessCapture>())
+                    {
+                        capture.image = Some(image);
+                    }
+                }
+                Err(message) => {
+                    tracing::error!("rendering failed: {message}");
+                    world.insert_resource(RenderFailure(Some(message)));
+                    if self.exit.as_ref().is_none_or(|e| e.is_success()) {
+                        self.exit = Some(AppExit::error());
+                    }
+                }
+            }
+        }
     }
 }
 
 impl ApplicationHandler for WinitRunner {
     fn resumed(&mut self, event_loop: &ActiveEventLoop) {
-        if self.window.is_some() {
+        if self.window.is_some() || self.exit.is_some() {
             return;
         }
         let attributes = Window::default_attributes().with_title(self.config.title.clone()).with_inner_size(
-            winit::dpi::PhysicalSize::new(self.config.width.max(1), self.config.height.max(1)),
+            PhysicalSize::new(self.config.width.max(1), self.config.height.max(1)),
         );
         let window = match event_loop.create_window(attributes) {
             Ok(w) => Arc::new(w),
@@ -178,47 +413,114 @@ impl ApplicationHandler for WinitRunner {
             RenderBackend::Sync { sink: Box::new(sink), pending: Vec::new() }
         };
         self.app.world_mut().insert_resource(backend);
-        self.set_viewport(window.inner_size());
+        let size = window.inner_size();
+        self.window_size = UVec2::new(size.width, size.height);
         window.request_redraw();
         self.window = Some(window);
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
         match event {
-            WindowEvent::CloseRequested => {
-                self.exit.get_or_insert(AppExit::Success);
-                event_loop.exit();
+            WindowEvent::CloseRequested | WindowEvent::Destroyed => {
+                self.exit_with(event_loop, AppExit::Success);
             }
             WindowEvent::KeyboardInput {
                 event:
                     KeyEvent { logical_key: Key::Named(NamedKey::Escape), state: ElementState::Pressed, .. },
                 ..
-            } => {
-                self.exit.get_or_insert(AppExit::Success);
-                event_loop.exit();
+            } => self.exit_with(event_loop, AppExit::Success),
+            WindowEvent::Resized(size) => {
+                tracing::trace!("window resized to {}x{}", size.width, size.height);
+                self.window_size = UVec2::new(size.width, size.height);
             }
-            WindowEvent::Resized(size) => self.set_viewport(size),
-            WindowEvent::RedrawRequested => {
-                self.app.update();
-                if let Some(exit) = self.app.should_exit() {
-                    self.exit = Some(exit);
-                    event_loop.exit();
+            WindowEvent::Focused(true) if self.minimize_requested => {
+                // Focus comes back when the user restores the window. Trust it only where the
+                // window system cannot say whether the window is minimised (Wayland) or has
+                // said it was.
+                let unknown = self.window.as_ref().is_some_and(|w| w.is_minimized().is_none());
+                if unknown || self.seen_hidden {
+                    tracing::debug!("window focused again: treating it as restored");
+                    self.minimize_requested = false;
                 }
             }
+            // While idle the timer in `about_to_wait` drives updates.
+            WindowEvent::RedrawRequested if !self.idle() => self.update(event_loop),
             _ => {}
         }
     }
 
-    fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
-        if let Some(w) = &self.window {
-            w.request_redraw();
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        if self.exit.is_some() {
+            return;
         }
+        let Some(window) = self.window.clone() else {
+            return;
+        };
+        if self.idle() {
+            self.poll_restored(&window);
+            let now = Instant::now();
+            if self.idle() && now >= self.next_idle_update {
+                self.next_idle_update = now + IDLE_UPDATE_INTERVAL;
+                self.update(event_loop);
+            }
+        }
+        if self.exit.is_some() {
+            return;
+        }
+        if self.idle() {
+            event_loop.set_control_flow(ControlFlow::WaitUntil(self.next_idle_update));
+        } else {
+            event_loop.set_control_flow(ControlFlow::Poll);
+            window.request_redraw();
+        }
+    }
+
+    fn exiting(&mut self, _event_loop: &ActiveEventLoop) {
+        self.shut_down_renderer();
+        self.window = None;
     }
 }
 
-/// Runs `app` in a window until it is closed, Esc is pressed or a system sends `AppExit`.
-pub fn run_window(app: App, config: WindowConfig, pipelined: bool) -> AppExit {
-    let event_loop = match EventLoop::new() {
+fn build_event_loop(config: &WindowConfig) -> Result<EventLoop<()>, winit::error::EventLoopError> {
+    let mut builder = EventLoop::builder();
+    #[cfg(all(
+        unix,
+        not(any(target_os = "macos", target_os = "ios", target_os = "android", target_os = "emscripten"))
+    ))]
+    {
+        // Sets the same flag for X11 and Wayland.
+        use winit::platform::x11::EventLoopBuilderExtX11;
+        builder.with_any_thread(config.any_thread);
+    }
+    #[cfg(windows)]
+    {
+        use winit::platform::windows::EventLoopBuilderExtWindows;
+        builder.with_any_thread(config.any_thread);
+    }
+    #[cfg(not(any(
+        windows,
+        all(
+            unix,
+            not(any(target_os = "macos", target_os = "ios", target_os = "android", target_os = "emscripten"))
+        )
+    )))]
+    let _ = config;
+    builder.build()
+}
+
+/// Runs `app` in a window until it is closed, Esc is pressed, a system sends `AppExit` or
+/// calls [`WindowRequests::request_close`]. Returns the app's exit status (an error when
+/// rendering failed, also in a frame that was still in flight at the close).
+pub fn run_window(mut app: App, config: WindowConfig, pipelined: bool) -> AppExit {
+    if app.plugins_state() != PluginsState::Cleaned {
+        while app.plugins_state() == PluginsState::Adding {
+            std::thread::yield_now();
+        }
+        app.finish();
+        app.cleanup();
+    }
+    app.init_resource::<WindowRequests>();
+    let event_loop = match build_event_loop(&config) {
         Ok(l) => l,
         Err(e) => {
             tracing::error!("could not start the window event loop (is a display available?): {e}");
@@ -226,13 +528,25 @@ pub fn run_window(app: App, config: WindowConfig, pipelined: bool) -> AppExit {
         }
     };
     event_loop.set_control_flow(ControlFlow::Poll);
-    let mut runner = WinitRunner { app, config, window: None, pipelined, exit: None };
-    if let Err(e) = event_loop.run_app(&mut runner) {
+    let size = UVec2::new(config.width, config.height);
+    let mut runner = WinitRunner {
+        app,
+        config,
+        pipelined,
+        window: None,
+        window_size: size,
+        minimize_requested: false,
+        seen_hidden: false,
+        next_idle_update: Instant::now(),
+        exit: None,
+    };
+    let result = event_loop.run_app(&mut runner);
+    // `exiting` has already stopped the renderer; this covers a loop that ended without it.
+    runner.shut_down_renderer();
+    runner.window = None;
+    if let Err(e) = result {
         tracing::error!("window event loop failed: {e}");
         return AppExit::error();
     }
-    let exit = runner.exit.take().unwrap_or(AppExit::Success);
-    // Dropping the app drops the render backend, which joins the render thread.
-    drop(runner);
-    exit
+    runner.exit.take().unwrap_or(AppExit::Success)
 }

@@ -1,14 +1,14 @@
 //! `manylight`: render a scene to PNG, check a glTF file, and (later) benchmark pipelines.
 
 use anyhow::{Context, Result, bail};
-use bevy_app::{App, Startup};
+use bevy_app::Startup;
 use bevy_ecs::system::Commands;
 use clap::{Parser, Subcommand};
 use glam::UVec2;
-use manylight_app::headless::save_png;
+use manylight_app::headless::{render_headless, save_png};
 use manylight_app::scene::{spawn_light_rig, spawn_scene};
-use manylight_app::{FrameStats, HeadlessCapture, RenderFailure};
-use manylight_app::{ManyLightPlugin, RenderSettings};
+use manylight_app::FrameStats;
+use manylight_app::RenderSettings;
 use manylight_core::ShadingModel;
 use manylight_render::PipelineKind;
 use manylight_scene::{LoadOptions, Scene, load_scene};
@@ -104,28 +104,18 @@ fn render_scene(
     seed: u64,
     settings: RenderSettings,
 ) -> Result<(image::RgbaImage, FrameStats)> {
-    let mut app = App::new();
-    app.add_plugins(ManyLightPlugin::headless(size)).insert_resource(settings);
     let aspect = size.x as f32 / size.y as f32;
     let bounds = scene.bounds();
-    app.add_systems(Startup, move |mut commands: Commands| {
-        spawn_scene(&mut commands, &scene, true, aspect);
-        if lights > 0 {
-            spawn_light_rig(&mut commands, lights, bounds, seed);
-        }
-    });
-    for _ in 0..frames.max(1) {
-        app.update();
-        if let Some(message) = app.world().resource::<RenderFailure>().0.clone() {
-            bail!("{message}");
-        }
-    }
-    manylight_app::headless::finish_frames(&mut app);
-    if let Some(message) = app.world().resource::<RenderFailure>().0.clone() {
-        bail!("{message}");
-    }
-    let image = app.world().resource::<HeadlessCapture>().image.clone().context("no frame was rendered")?;
-    Ok((image, app.world().resource::<FrameStats>().clone()))
+    let frame = render_headless(size, frames, move |app| {
+        app.insert_resource(settings).add_systems(Startup, move |mut commands: Commands| {
+            spawn_scene(&mut commands, &scene, true, aspect);
+            if lights > 0 {
+                spawn_light_rig(&mut commands, lights, bounds, seed);
+            }
+        });
+    })
+    .map_err(anyhow::Error::msg)?;
+    Ok((frame.image, frame.stats))
 }
 
 /// Reorders or clears the scene's cameras so the chosen one comes first.

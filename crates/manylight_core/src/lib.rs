@@ -5,6 +5,7 @@
 
 pub mod attenuation;
 pub mod camera;
+pub mod image_metrics;
 pub mod material;
 pub mod mesh;
 

@@ -1,0 +1,109 @@
+//! The `manylight` binary as a user runs it: `check` on every malformed file exits 1 with one
+//! typed error naming the file (never a panic), on real assets exits 0; `render` writes the PNG
+//! and the stats JSON. Runs on a real device (lavapipe in CI), one command at a time.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::Mutex;
+
+static GPU: Mutex<()> = Mutex::new(());
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn manylight(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_manylight")).args(args).output().expect("the binary runs")
+}
+
+fn bad_files() -> Vec<PathBuf> {
+    let dir = root().join("tests/data/bad_gltf");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.expect("dir entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "gltf" || e == "glb"))
+        .collect();
+    files.sort();
+    files
+}
+
+#[test]
+fn check_rejects_every_malformed_file_with_a_typed_error() {
+    let _gpu = GPU.lock().unwrap_or_else(|e| e.into_inner());
+    let files = bad_files();
+    assert!(files.len() >= 20, "expected the malformed-glTF corpus, found {}", files.len());
+    for file in files {
+        let out = manylight(&["check", file.to_str().expect("utf-8 path")]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{}: exit {:?}\n{stderr}", file.display(), out.status);
+        let name = file.file_name().and_then(|n| n.to_str()).expect("name");
+        let line = stderr.lines().find(|l| l.starts_with("error: ")).unwrap_or_else(|| {
+            panic!("{}: no `error:` line in\n{stderr}", file.display());
+        });
+        assert!(line.contains(name), "{}: the error does not name the file: {line}", file.display());
+        assert!(!stderr.contains("panicked"), "{}: panicked\n{stderr}", file.display());
+    }
+}
+
+#[test]
+fn check_accepts_real_assets() {
+    let _gpu = GPU.lock().unwrap_or_else(|e| e.into_inner());
+    let assets = root().join("../shared/assets");
+    for rel in ["DamagedHelmet/DamagedHelmet.glb", "CornellBox/CornellBox.gltf", "BoxTextured/BoxTextured.gltf"] {
+        let path = assets.join(rel);
+        let out = manylight(&["check", path.to_str().expect("utf-8 path")]);
+        assert!(out.status.success(), "{rel}: {}", String::from_utf8_lossy(&out.stderr));
+        assert!(String::from_utf8_lossy(&out.stdout).starts_with("ok: "));
+    }
+}
+
+#[test]
+fn render_writes_png_and_stats_json() {
+    let _gpu = GPU.lock().unwrap_or_else(|e| e.into_inner());
+    let dir = root().join("target/cli-tests");
+    std::fs::create_dir_all(&dir).expect("mkdir");
+    let png = dir.join("render.png");
+    let json = dir.join("render.json");
+    let out = manylight(&[
+        "render",
+        "--scene",
+        "default",
+        "--lights",
+        "16",
+        "--size",
+        "96x64",
+        "--frames",
+        "2",
+        "--out",
+        png.to_str().expect("utf-8"),
+        "--stats-json",
+        json.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let img = image::open(&png).expect("png").to_rgba8();
+    assert_eq!(img.dimensions(), (96, 64));
+    let stats: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).expect("json")).expect("valid");
+    let last = &stats["last_frame"];
+    let names: Vec<&str> = last["passes"].as_array().expect("passes").iter().map(|p| p["name"].as_str().unwrap_or("")).collect();
+    assert_eq!(names, ["forward", "tonemap"]);
+    assert!(last["passes"][0]["gpu_ms"].is_number());
+    assert!(last["passes"][0]["cpu_ms"].is_number());
+    assert!(last["frame_cpu_ms"].is_number());
+    assert_eq!(last["light_count"].as_u64(), Some(16 + 6));
+    assert_eq!(stats["frames_rendered"].as_u64(), Some(2));
+}
+
+#[test]
+fn bad_arguments_are_refused_with_a_message() {
+    for args in [
+        &["render", "--out", "x.png", "--size", "0x10"][..],
+        &["render", "--out", "x.png", "--pipeline", "magic"],
+        &["render", "--out", "x.png", "--scene", "/nonexistent/scene.gltf"],
+        &["check", "/nonexistent/file.glb"],
+    ] {
+        let out = manylight(args);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        assert_ne!(out.status.code(), Some(101), "{args:?} panicked");
+        assert!(!out.stderr.is_empty(), "{args:?} said nothing");
+    }
+}

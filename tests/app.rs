@@ -1,0 +1,195 @@
+//! The plugin as an app uses it: build an `App` with the headless plugin, run frames, read
+//! `FrameStats`. Runs on a real device (lavapipe in CI).
+
+mod support;
+
+use manylight::app::headless::{finish_frames, render_headless};
+use manylight::app::{FrameStats, HeadlessCapture, RenderFailure, ViewportSize};
+use manylight::prelude::*;
+use std::time::Duration;
+use support::gpu;
+
+const SIZE: UVec2 = UVec2::new(96, 64);
+
+fn scene_app(plugin: ManyLightPlugin, lights: usize) -> App {
+    let mut app = App::new();
+    app.add_plugins(plugin).add_systems(Startup, move |mut commands: Commands| {
+        let scene = default_scene();
+        spawn_scene(&mut commands, &scene, true, 1.5);
+        spawn_light_rig(&mut commands, lights, scene.bounds(), 7);
+    });
+    app
+}
+
+fn stats(app: &App) -> FrameStats {
+    app.world().resource::<FrameStats>().clone()
+}
+
+#[test]
+fn frame_stats_list_the_passes_with_timings() {
+    let _gpu = gpu();
+    let mut app = scene_app(ManyLightPlugin::headless(SIZE), 8);
+    for _ in 0..3 {
+        app.update();
+    }
+    let s = stats(&app);
+    assert_eq!(s.frames_rendered, 3);
+    assert_eq!(s.pass_names(), ["forward", "tonemap"]);
+    let report = s.last.expect("a report");
+    assert_eq!(report.light_count as usize, default_scene().lights.len() + 8);
+    assert_eq!(report.instance_count as usize, default_scene().instances.len());
+    assert_eq!((report.width, report.height), (SIZE.x, SIZE.y));
+    for pass in &report.passes {
+        assert!(pass.cpu_ms >= 0.0 && pass.cpu_ms.is_finite());
+        // lavapipe and every real GPU we target support timestamp queries.
+        let gpu_ms = pass.gpu_ms.unwrap_or_else(|| panic!("{} has no GPU time", pass.name));
+        assert!(gpu_ms >= 0.0 && gpu_ms.is_finite());
+    }
+    assert!(report.frame_cpu_ms > 0.0);
+}
+
+#[test]
+fn transient_textures_are_reused_across_frames() {
+    let _gpu = gpu();
+    let mut app = scene_app(ManyLightPlugin::headless(SIZE), 4);
+    for _ in 0..5 {
+        app.update();
+    }
+    let report = stats(&app).last.expect("a report");
+    assert_eq!(report.transient_textures, 2, "hdr + depth");
+    assert_eq!(report.transient_allocations, 2, "no texture re-created after the first frame");
+}
+
+#[test]
+fn resizing_reallocates_and_frees_old_transients() {
+    let _gpu = gpu();
+    let mut app = scene_app(ManyLightPlugin::headless(SIZE), 4);
+    app.update();
+    app.world_mut().insert_resource(ViewportSize(UVec2::new(64, 48)));
+    for _ in 0..5 {
+        app.update();
+    }
+    let report = stats(&app).last.expect("a report");
+    assert_eq!((report.width, report.height), (64, 48));
+    assert_eq!(report.transient_allocations, 4);
+    assert_eq!(report.transient_textures, 2, "the old size's textures were freed");
+    let image = app.world().resource::<HeadlessCapture>().image.clone().expect("image");
+    assert_eq!(image.dimensions(), (64, 48));
+}
+
+#[test]
+fn zero_sized_viewport_and_missing_camera_render_nothing_and_do_not_fail() {
+    let _gpu = gpu();
+    let mut app = scene_app(ManyLightPlugin::headless(SIZE), 4);
+    app.world_mut().insert_resource(ViewportSize(UVec2::ZERO));
+    app.update();
+    assert!(stats(&app).pass_names().is_empty());
+    assert!(app.world().resource::<RenderFailure>().0.is_none());
+
+    let mut app = App::new();
+    app.add_plugins(ManyLightPlugin::headless(SIZE));
+    app.update();
+    assert!(stats(&app).pass_names().is_empty());
+    assert!(app.world().resource::<RenderFailure>().0.is_none());
+}
+
+#[test]
+fn invalid_lights_are_dropped_and_counted_and_the_image_stays_finite() {
+    let _gpu = gpu();
+    let frame = render_headless(SIZE, 1, |app| {
+        app.add_systems(Startup, |mut commands: Commands| {
+            spawn_scene(&mut commands, &default_scene(), true, 1.5);
+            commands.spawn((Transform::from_xyz(f32::NAN, 1.0, 0.0), PointLight::default()));
+            commands.spawn((
+                Transform::from_xyz(0.0, 1.0, 0.0),
+                PointLight { radius: f32::INFINITY, ..PointLight::default() },
+            ));
+            commands.spawn((Transform::from_xyz(0.0, 1.0, 0.0), PointLight { intensity: -1.0, ..PointLight::default() }));
+            // Valid edge cases: radius 0 (lights nothing) and a huge radius.
+            commands.spawn((Transform::from_xyz(0.0, 1.0, 0.0), PointLight { radius: 0.0, ..PointLight::default() }));
+            commands.spawn((Transform::from_xyz(0.0, 1.0, 0.0), PointLight { radius: 1e6, ..PointLight::default() }));
+        });
+    })
+    .expect("renders");
+    let report = frame.stats.last.expect("a report");
+    assert_eq!(report.invalid_lights, 3);
+    assert_eq!(report.light_count as usize, default_scene().lights.len() + 2);
+    assert!(frame.image.pixels().any(|p| p.0[0] > 10), "the frame is lit");
+}
+
+#[test]
+fn a_light_at_the_camera_position_is_finite() {
+    let _gpu = gpu();
+    let scene = default_scene();
+    let eye = scene.camera_or_fit(1.5).transform.w_axis.truncate();
+    let frame = render_headless(SIZE, 1, move |app| {
+        app.add_systems(Startup, move |mut commands: Commands| {
+            spawn_scene(&mut commands, &scene, true, 1.5);
+            commands.spawn((Transform::from_translation(eye), PointLight { radius: 30.0, ..PointLight::default() }));
+        });
+    })
+    .expect("renders");
+    assert!(frame.image.pixels().any(|p| p.0[1] > 200), "the light at the eye lights what it sees");
+}
+
+#[test]
+fn pipelined_mode_renders_every_frame_and_shuts_down_cleanly() {
+    let _gpu = gpu();
+    let mut app = scene_app(ManyLightPlugin::headless(SIZE).with_pipelined(true), 8);
+    for _ in 0..4 {
+        app.update();
+    }
+    finish_frames(&mut app);
+    let s = stats(&app);
+    assert_eq!(s.frames_rendered, 4);
+    assert_eq!(s.pass_names(), ["forward", "tonemap"]);
+    assert!(app.world().resource::<HeadlessCapture>().image.is_some());
+
+    // Dropping an app with a frame in flight joins the render thread without hanging.
+    let mut app = scene_app(ManyLightPlugin::headless(SIZE).with_pipelined(true), 8);
+    app.update();
+    app.update();
+    // (App is not Send, so a watchdog thread ends the process if the drop hangs.)
+    let (tx, rx) = std::sync::mpsc::channel::<()>();
+    let watchdog = std::thread::spawn(move || {
+        if rx.recv_timeout(Duration::from_secs(60)).is_err() {
+            eprintln!("dropping the app did not join the render thread within 60 s");
+            std::process::exit(1);
+        }
+    });
+    drop(app);
+    let _ = tx.send(());
+    watchdog.join().expect("watchdog");
+}
+
+#[test]
+fn app_run_writes_the_png() {
+    let _gpu = gpu();
+    let out = support::output_dir().join("app_run.png");
+    let _ = std::fs::remove_file(&out);
+    let exit = scene_app(ManyLightPlugin::headless(SIZE).with_frames(2).with_output(&out), 4).run();
+    assert_eq!(exit, AppExit::Success);
+    let img = image::open(&out).expect("the PNG was written").to_rgba8();
+    assert_eq!(img.dimensions(), (SIZE.x, SIZE.y));
+}
+
+#[test]
+fn user_systems_before_extract_show_in_the_same_frame() {
+    let _gpu = gpu();
+    #[derive(Component)]
+    struct Added;
+    let mut app = App::new();
+    app.add_plugins(ManyLightPlugin::headless(SIZE))
+        .add_systems(Startup, |mut commands: Commands| {
+            spawn_scene(&mut commands, &default_scene(), true, 1.5);
+        })
+        .add_systems(Last, (|mut commands: Commands, q: Query<&Added>| {
+            if q.is_empty() {
+                commands.spawn((Transform::from_xyz(0.0, 2.0, 0.0), PointLight::default(), Added));
+            }
+        })
+        .before(ManyLightSet::Extract));
+    app.update();
+    let report = stats(&app).last.expect("a report");
+    assert_eq!(report.light_count as usize, default_scene().lights.len() + 1);
+}

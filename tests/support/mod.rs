@@ -1,0 +1,113 @@
+//! Shared helpers of the GPU integration tests: one GPU test at a time (lavapipe is slow and
+//! single-queue), a hard failure when no adapter exists, and FLIP image comparison against
+//! stored references.
+#![allow(dead_code)]
+
+use image::RgbaImage;
+use manylight::core::image_metrics::{FlipStats, flip_compare};
+use std::path::PathBuf;
+use std::sync::{Mutex, MutexGuard, OnceLock};
+
+/// Serialises GPU tests within a test binary and checks once that an adapter exists.
+pub fn gpu() -> MutexGuard<'static, ()> {
+    static LOCK: Mutex<()> = Mutex::new(());
+    static CHECKED: OnceLock<Result<String, String>> = OnceLock::new();
+    let guard = LOCK.lock().unwrap_or_else(|e| e.into_inner());
+    let adapter = CHECKED.get_or_init(|| {
+        manylight::render::GpuContext::headless().map(|g| g.info.name.clone()).map_err(|e| e.to_string())
+    });
+    match adapter {
+        Ok(_) => guard,
+        // A GPU test never skips: without an adapter it fails with what to install.
+        Err(e) => panic!("GPU test needs an adapter: {e}"),
+    }
+}
+
+/// Tolerances of an image comparison.
+#[derive(Clone, Copy, Debug)]
+pub struct Tolerance {
+    /// Largest allowed mean FLIP error.
+    pub mean: f32,
+    /// Largest allowed 99th-percentile FLIP error.
+    pub p99: f32,
+}
+
+/// The tolerance the issues ask of pipelines compared with each other and of stored references.
+pub const STRICT: Tolerance = Tolerance { mean: 0.005, p99: 0.05 };
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Where failing comparisons write their images.
+pub fn output_dir() -> PathBuf {
+    let dir = root().join("target").join("image-tests");
+    let _ = std::fs::create_dir_all(&dir);
+    dir
+}
+
+/// Compares two images; on failure writes `<name>.actual.png`, `<name>.expected.png` and
+/// `<name>.diff.png` to `target/image-tests/` and panics with the statistics.
+pub fn assert_similar(name: &str, expected: &RgbaImage, actual: &RgbaImage, tol: Tolerance) -> FlipStats {
+    let result = flip_compare(expected.dimensions(), expected.as_raw(), actual.dimensions(), actual.as_raw());
+    let out = output_dir();
+    let write_pair = || {
+        let _ = actual.save(out.join(format!("{name}.actual.png")));
+        let _ = expected.save(out.join(format!("{name}.expected.png")));
+    };
+    let (stats, diff) = match result {
+        Ok(r) => r,
+        Err(e) => {
+            write_pair();
+            panic!("{name}: {e}");
+        }
+    };
+    if stats.mean > tol.mean || stats.p99 > tol.p99 {
+        write_pair();
+        let (w, h) = actual.dimensions();
+        if let Some(img) = image::RgbImage::from_raw(w, h, diff) {
+            let _ = img.save(out.join(format!("{name}.diff.png")));
+        }
+        panic!(
+            "{name}: FLIP mean {:.5} (max {}), p99 {:.5} (max {}); images written to {}",
+            stats.mean,
+            tol.mean,
+            stats.p99,
+            tol.p99,
+            out.display()
+        );
+    }
+    stats
+}
+
+/// Compares with the stored reference `tests/reference/<name>.png`. A missing reference fails
+/// (the actual image is written to `target/image-tests/` to be reviewed and copied);
+/// `MANYLIGHT_UPDATE_REFERENCES=1` rewrites the reference instead.
+pub fn assert_matches_reference(name: &str, actual: &RgbaImage, tol: Tolerance) -> FlipStats {
+    let path = root().join("tests").join("reference").join(format!("{name}.png"));
+    if std::env::var("MANYLIGHT_UPDATE_REFERENCES").is_ok_and(|v| v == "1") {
+        actual.save(&path).unwrap_or_else(|e| panic!("cannot write {}: {e}", path.display()));
+        eprintln!("updated reference {}", path.display());
+    }
+    let expected = match image::open(&path) {
+        Ok(img) => img.to_rgba8(),
+        Err(e) => {
+            let out = output_dir().join(format!("{name}.actual.png"));
+            let _ = actual.save(&out);
+            panic!(
+                "reference {} is missing or unreadable ({e}); the actual image is at {} \
+                 (run with MANYLIGHT_UPDATE_REFERENCES=1 to create it)",
+                path.display(),
+                out.display()
+            );
+        }
+    };
+    assert_similar(name, &expected, actual, tol)
+}
+
+/// The shared test assets (`../shared/assets` beside the checkout).
+pub fn shared_asset(rel: &str) -> PathBuf {
+    let p = root().join("..").join("shared").join("assets").join(rel);
+    assert!(p.exists(), "test asset {} is missing", p.display());
+    p
+}
