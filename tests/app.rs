@@ -34,14 +34,15 @@ fn frame_stats_list_the_passes_with_timings() {
     }
     let s = stats(&app);
     assert_eq!(s.frames_rendered, 3);
-    assert_eq!(s.pass_names(), ["forward", "tonemap"]);
+    assert_eq!(s.pass_names(), ["depth_prepass", "cluster_build", "clustered_forward", "tonemap"]);
     let report = s.last.expect("a report");
     assert_eq!(report.light_count as usize, default_scene().lights.len() + 8);
     assert_eq!(report.instance_count as usize, default_scene().instances.len());
     assert_eq!((report.width, report.height), (SIZE.x, SIZE.y));
     for pass in &report.passes {
         assert!(pass.cpu_ms >= 0.0 && pass.cpu_ms.is_finite());
-        // lavapipe and every real GPU we target support timestamp queries.
+        // lavapipe and every real GPU we target support timestamp queries (compute-pass figures
+        // are flagged untrusted on CPU adapters, but present).
         let gpu_ms = pass.gpu_ms.unwrap_or_else(|| panic!("{} has no GPU time", pass.name));
         assert!(gpu_ms >= 0.0 && gpu_ms.is_finite());
     }
@@ -57,6 +58,7 @@ fn transient_textures_are_reused_across_frames() {
     }
     let report = stats(&app).last.expect("a report");
     assert_eq!(report.transient_textures, 2, "hdr + depth");
+    assert!(report.clusters.is_some());
     assert_eq!(report.transient_allocations, 2, "no texture re-created after the first frame");
 }
 
@@ -104,10 +106,19 @@ fn invalid_lights_are_dropped_and_counted_and_the_image_stays_finite() {
                 Transform::from_xyz(0.0, 1.0, 0.0),
                 PointLight { radius: f32::INFINITY, ..PointLight::default() },
             ));
-            commands.spawn((Transform::from_xyz(0.0, 1.0, 0.0), PointLight { intensity: -1.0, ..PointLight::default() }));
+            commands.spawn((
+                Transform::from_xyz(0.0, 1.0, 0.0),
+                PointLight { intensity: -1.0, ..PointLight::default() },
+            ));
             // Valid edge cases: radius 0 (lights nothing) and a huge radius.
-            commands.spawn((Transform::from_xyz(0.0, 1.0, 0.0), PointLight { radius: 0.0, ..PointLight::default() }));
-            commands.spawn((Transform::from_xyz(0.0, 1.0, 0.0), PointLight { radius: 1e6, ..PointLight::default() }));
+            commands.spawn((
+                Transform::from_xyz(0.0, 1.0, 0.0),
+                PointLight { radius: 0.0, ..PointLight::default() },
+            ));
+            commands.spawn((
+                Transform::from_xyz(0.0, 1.0, 0.0),
+                PointLight { radius: 1e6, ..PointLight::default() },
+            ));
         });
     })
     .expect("renders");
@@ -125,7 +136,10 @@ fn a_light_at_the_camera_position_is_finite() {
     let frame = render_headless(SIZE, 1, move |app| {
         app.add_systems(Startup, move |mut commands: Commands| {
             spawn_scene(&mut commands, &scene, true, 1.5);
-            commands.spawn((Transform::from_translation(eye), PointLight { radius: 30.0, ..PointLight::default() }));
+            commands.spawn((
+                Transform::from_translation(eye),
+                PointLight { radius: 30.0, ..PointLight::default() },
+            ));
         });
     })
     .expect("renders");
@@ -142,7 +156,7 @@ fn pipelined_mode_renders_every_frame_and_shuts_down_cleanly() {
     finish_frames(&mut app);
     let s = stats(&app);
     assert_eq!(s.frames_rendered, 4);
-    assert_eq!(s.pass_names(), ["forward", "tonemap"]);
+    assert_eq!(s.pass_names(), ["depth_prepass", "cluster_build", "clustered_forward", "tonemap"]);
     assert!(app.world().resource::<HeadlessCapture>().image.is_some());
 
     // Dropping an app with a frame in flight joins the render thread without hanging.
@@ -183,13 +197,31 @@ fn user_systems_before_extract_show_in_the_same_frame() {
         .add_systems(Startup, |mut commands: Commands| {
             spawn_scene(&mut commands, &default_scene(), true, 1.5);
         })
-        .add_systems(Last, (|mut commands: Commands, q: Query<&Added>| {
-            if q.is_empty() {
-                commands.spawn((Transform::from_xyz(0.0, 2.0, 0.0), PointLight::default(), Added));
-            }
-        })
-        .before(ManyLightSet::Extract));
+        .add_systems(
+            Last,
+            (|mut commands: Commands, q: Query<&Added>| {
+                if q.is_empty() {
+                    commands.spawn((Transform::from_xyz(0.0, 2.0, 0.0), PointLight::default(), Added));
+                }
+            })
+            .before(ManyLightSet::Extract),
+        );
     app.update();
     let report = stats(&app).last.expect("a report");
     assert_eq!(report.light_count as usize, default_scene().lights.len() + 1);
+}
+
+#[test]
+fn a_scene_without_lights_builds_no_clusters() {
+    let _gpu = gpu();
+    let mut app = App::new();
+    app.add_plugins(ManyLightPlugin::headless(SIZE)).add_systems(Startup, |mut commands: Commands| {
+        let mut scene = default_scene();
+        scene.lights.clear();
+        spawn_scene(&mut commands, &scene, true, 1.5);
+    });
+    app.update();
+    let s = stats(&app);
+    assert_eq!(s.pass_names(), ["forward", "tonemap"]);
+    assert!(s.last.expect("a report").clusters.is_none());
 }

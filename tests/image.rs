@@ -5,7 +5,7 @@ mod support;
 use manylight::app::RenderSettings;
 use manylight::app::headless::{HeadlessFrame, render_headless};
 use manylight::prelude::*;
-use support::{STRICT, assert_matches_reference, gpu, shared_asset};
+use support::{STRICT, assert_matches_reference, assert_similar, gpu, shared_asset};
 
 /// Renders `scene` at `size` with `lights` rig lights (seed 1) through the headless plugin.
 fn render(scene: Scene, size: UVec2, lights: usize, settings: RenderSettings) -> HeadlessFrame {
@@ -23,7 +23,7 @@ fn render(scene: Scene, size: UVec2, lights: usize, settings: RenderSettings) ->
 #[test]
 fn default_scene_matches_reference() {
     let _gpu = gpu();
-    let frame = render(default_scene(), UVec2::new(256, 144), 32, RenderSettings::default());
+    let frame = render(default_scene(), UVec2::new(256, 144), 32, with_pipeline(PipelineKind::NaiveForward));
     assert_matches_reference("default_scene_naive", &frame.image, STRICT);
 }
 
@@ -32,7 +32,7 @@ fn gltf_scene_matches_reference() {
     let _gpu = gpu();
     let path = shared_asset("CornellBox/CornellBoxManyLights.gltf");
     let scene = load_gltf(&path, &LoadOptions::default()).expect("CornellBoxManyLights loads");
-    let settings = RenderSettings { exposure: 4.0, ..RenderSettings::default() };
+    let settings = RenderSettings { exposure: 4.0, ..with_pipeline(PipelineKind::NaiveForward) };
     let frame = render(scene, UVec2::new(128, 128), 0, settings);
     assert_matches_reference("cornell_box_many_lights_naive", &frame.image, STRICT);
 }
@@ -61,4 +61,110 @@ fn shading_models_give_different_images() {
     )
     .expect("same size");
     assert!(stats.max > 0.05, "Blinn-Phong adds specular highlights, so the images must differ: {stats:?}");
+}
+
+fn with_pipeline(pipeline: PipelineKind) -> RenderSettings {
+    RenderSettings { pipeline, ..RenderSettings::default() }
+}
+
+/// Forward+ and clustered forward (with and without depth pre-pass, both culling tests and
+/// both slicings) match naive forward on the default scene and a glTF scene.
+#[test]
+fn tiled_and_clustered_pipelines_match_naive_forward() {
+    use manylight::app::prelude::{ClusterSettings, CullTest, GridConfig, ZSlicing};
+    let _gpu = gpu();
+    let size = UVec2::new(256, 144);
+    let naive = render(default_scene(), size, 128, with_pipeline(PipelineKind::NaiveForward));
+    let cornell = || {
+        load_gltf(&shared_asset("CornellBox/CornellBoxManyLights.gltf"), &LoadOptions::default())
+            .expect("loads")
+    };
+    let small = UVec2::new(128, 128);
+    let bright = |p| RenderSettings { exposure: 4.0, ..with_pipeline(p) };
+    let naive_cornell = render(cornell(), small, 0, bright(PipelineKind::NaiveForward));
+    let variants = [
+        ("forward_plus", with_pipeline(PipelineKind::ForwardPlus)),
+        ("clustered", with_pipeline(PipelineKind::ClusteredForward)),
+        (
+            "clustered_no_prepass_aabb_linear",
+            RenderSettings {
+                clusters: ClusterSettings {
+                    cull: CullTest::Aabb,
+                    depth_prepass: false,
+                    grid: GridConfig { slicing: ZSlicing::Linear, ..GridConfig::default() },
+                    ..ClusterSettings::default()
+                },
+                ..with_pipeline(PipelineKind::ClusteredForward)
+            },
+        ),
+    ];
+    for (name, settings) in variants {
+        let frame = render(default_scene(), size, 128, settings);
+        let report = frame.stats.last.as_ref().expect("report");
+        assert!(report.pass_names().contains(&"cluster_build"), "{name}: {:?}", report.pass_names());
+        assert_similar(&format!("{name}_vs_naive"), &naive.image, &frame.image, STRICT);
+        let frame = render(cornell(), small, 0, RenderSettings { exposure: 4.0, ..settings });
+        assert_similar(&format!("{name}_vs_naive_cornell"), &naive_cornell.image, &frame.image, STRICT);
+    }
+}
+
+#[test]
+fn a_low_cluster_cap_changes_the_image_and_is_reported() {
+    use manylight::app::prelude::ClusterSettings;
+    let _gpu = gpu();
+    let size = UVec2::new(128, 72);
+    let exact = render(default_scene(), size, 128, with_pipeline(PipelineKind::ClusteredForward));
+    let capped = render(
+        default_scene(),
+        size,
+        128,
+        RenderSettings {
+            clusters: ClusterSettings { cap: Some(1), ..ClusterSettings::default() },
+            ..with_pipeline(PipelineKind::ClusteredForward)
+        },
+    );
+    let c = capped.stats.last.as_ref().and_then(|r| r.clusters.clone()).expect("cluster report");
+    assert!(c.dropped_pairs > 0, "{c:?}");
+    let e = exact.stats.last.as_ref().and_then(|r| r.clusters.clone()).expect("cluster report");
+    assert_eq!(e.dropped_pairs, 0);
+    let (stats, _) = manylight::core::image_metrics::flip_compare(
+        exact.image.dimensions(),
+        exact.image.as_raw(),
+        capped.image.dimensions(),
+        capped.image.as_raw(),
+    )
+    .expect("same size");
+    assert!(stats.mean > 0.005, "dropping lights must show: {stats:?}");
+}
+
+#[test]
+fn debug_views_render_cluster_data() {
+    use manylight::app::prelude::DebugView;
+    let _gpu = gpu();
+    let size = UVec2::new(128, 72);
+    for view in [DebugView::LightCount, DebugView::SliceX, DebugView::SliceY, DebugView::SliceZ] {
+        let frame = render(
+            default_scene(),
+            size,
+            64,
+            RenderSettings { debug_view: view, ..with_pipeline(PipelineKind::ClusteredForward) },
+        );
+        let names = frame
+            .stats
+            .last
+            .as_ref()
+            .expect("report")
+            .pass_names()
+            .iter()
+            .map(|s| s.to_string())
+            .collect::<Vec<_>>();
+        assert_eq!(names.last().map(String::as_str), Some("debug_view"), "{view:?}: {names:?}");
+        assert!(!names.iter().any(|n| n == "tonemap" || n == "clustered_forward"), "{view:?}: {names:?}");
+        let mut colors: Vec<[u8; 4]> = frame.image.pixels().map(|p| p.0).collect();
+        colors.sort_unstable();
+        colors.dedup();
+        // At least the background and two clusters (128 px is two 64-px tiles wide).
+        assert!(colors.len() >= 3, "{view:?} shows {} colours", colors.len());
+        assert_matches_reference(&format!("debug_{}", view.name().replace('-', "_")), &frame.image, STRICT);
+    }
 }

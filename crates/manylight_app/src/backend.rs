@@ -121,7 +121,17 @@ impl RenderBackend {
     pub fn drain(&mut self) -> Vec<FrameResult> {
         match self {
             RenderBackend::Sync { pending, .. } => std::mem::take(pending),
-            RenderBackend::Pipelined(thread) => thread.results.try_iter().collect(),
+            RenderBackend::Pipelined(thread) => {
+                let mut results: Vec<FrameResult> = thread.results.try_iter().collect();
+                // A render thread that ended while frames are still being sent has failed (it
+                // panicked, or it stopped after an error already reported above).
+                let ended = thread.handle.as_ref().is_some_and(|h| h.is_finished());
+                if ended && thread.frames.is_some() && !results.iter().any(|r| r.is_err()) {
+                    thread.frames.take();
+                    results.push(Err("the render thread stopped unexpectedly".into()));
+                }
+                results
+            }
             RenderBackend::Failed(message) => {
                 let m = std::mem::take(message);
                 if m.is_empty() { Vec::new() } else { vec![Err(m)] }

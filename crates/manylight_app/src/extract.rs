@@ -97,8 +97,9 @@ pub fn extract_and_render(
     for result in backend.drain() {
         match result {
             Ok((report, image)) => {
+                // Skipped frames (0×0 viewport, no camera, surface not ready) ran no pass.
+                stats.frames_rendered += u64::from(!report.passes.is_empty());
                 stats.last = Some(report);
-                stats.frames_rendered += 1;
                 if image.is_some() {
                     capture.image = image;
                 }

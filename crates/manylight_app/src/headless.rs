@@ -8,6 +8,7 @@ use bevy_app::{App, AppExit};
 /// Runs `config.frames` updates (or until a system exits), then writes the last frame to
 /// `config.output` if set.
 pub fn run_headless(mut app: App, config: HeadlessConfig) -> AppExit {
+    finish_plugins(&mut app);
     for _ in 0..config.frames {
         app.update();
         if let Some(exit) = app.should_exit() {
@@ -33,6 +34,14 @@ pub fn run_headless(mut app: App, config: HeadlessConfig) -> AppExit {
     AppExit::Success
 }
 
+/// Lets plugins finish building, as bevy's own runners do before the first update.
+pub fn finish_plugins(app: &mut App) {
+    if app.plugins_state() == bevy_app::PluginsState::Ready {
+        app.finish();
+        app.cleanup();
+    }
+}
+
 /// Waits for frames still in flight (pipelined mode) and stores their results.
 pub fn finish_frames(app: &mut App) {
     let world = app.world_mut();
@@ -41,8 +50,8 @@ pub fn finish_frames(app: &mut App) {
         match result {
             Ok((report, image)) => {
                 let mut stats = world.resource_mut::<FrameStats>();
+                stats.frames_rendered += u64::from(!report.passes.is_empty());
                 stats.last = Some(report);
-                stats.frames_rendered += 1;
                 if image.is_some() {
                     world.resource_mut::<HeadlessCapture>().image = image;
                 }
@@ -79,6 +88,7 @@ pub fn render_headless(
     let mut app = App::new();
     app.add_plugins(crate::ManyLightPlugin::headless(size));
     setup(&mut app);
+    finish_plugins(&mut app);
     for _ in 0..frames.max(1) {
         app.update();
         if let Some(message) = app.world().resource::<RenderFailure>().0.clone() {

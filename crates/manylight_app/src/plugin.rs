@@ -101,6 +101,7 @@ impl Plugin for ManyLightPlugin {
         app.init_resource::<RenderSettings>()
             .init_resource::<FrameStats>()
             .init_resource::<RenderFailure>()
+            .init_resource::<crate::window::WindowRequests>()
             .configure_sets(Update, ManyLightSet::Animate)
             .configure_sets(Last, ManyLightSet::Extract)
             .add_systems(First, tick_clock)

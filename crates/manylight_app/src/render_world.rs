@@ -5,9 +5,12 @@
 
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::ScheduleLabel;
-use manylight_render::passes::{ForwardPass, TonemapPass};
+use manylight_render::passes::{
+    ClusterBuildPass, ClusteredForwardPass, DebugViewPass, DepthPrepass, ForwardPass, TonemapPass,
+};
 use manylight_render::{
-    FrameReport, FrameSnapshot, GpuContext, HeadlessTarget, PipelineKind, RenderError, RenderGraph, Renderer,
+    DebugView, FrameReport, FrameSnapshot, GpuContext, HeadlessTarget, PipelineKind, RenderError,
+    RenderGraph, Renderer,
 };
 
 /// The ordered steps of one rendered frame.
@@ -73,7 +76,17 @@ impl RenderWorld {
         let mut schedule = Schedule::new(RenderSchedule);
         schedule.configure_sets((RenderSet::Prepare, RenderSet::Graph, RenderSet::Execute).chain());
         schedule.add_systems(prepare.in_set(RenderSet::Prepare));
-        schedule.add_systems((add_forward_pass, add_tonemap_pass).chain().in_set(RenderSet::Graph));
+        schedule.add_systems(
+            (
+                add_depth_prepass,
+                add_cluster_build,
+                add_forward_pass,
+                add_clustered_forward_pass,
+                add_output_pass,
+            )
+                .chain()
+                .in_set(RenderSet::Graph),
+        );
         schedule.add_systems(execute.in_set(RenderSet::Execute));
         RenderWorld { world, schedule }
     }
@@ -124,14 +137,53 @@ fn prepare(
     }
 }
 
+/// True when the frame shades with cluster lists (a tiled/clustered pipeline with lights).
+fn shades_with_clusters(snapshot: &FrameSnapshot) -> bool {
+    snapshot.settings.pipeline.uses_clusters() && snapshot.has_lights()
+}
+
+/// True when the frame runs a depth pre-pass.
+fn runs_depth_prepass(snapshot: &FrameSnapshot) -> bool {
+    let s = &snapshot.settings;
+    shades_with_clusters(snapshot) && (s.pipeline == PipelineKind::ForwardPlus || s.clusters.depth_prepass)
+}
+
+fn add_depth_prepass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
+    if runs_depth_prepass(&snapshot.0) {
+        graph.0.add(DepthPrepass);
+    }
+}
+
+fn add_cluster_build(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
+    if snapshot.0.needs_clusters() {
+        graph.0.add(ClusterBuildPass { workgroup_size: snapshot.0.settings.clusters.workgroup_size });
+    }
+}
+
 fn add_forward_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
-    if snapshot.0.settings.pipeline == PipelineKind::NaiveForward {
+    // Naive forward, and the tiled/clustered pipelines when there are no lights to assign.
+    if !shades_with_clusters(&snapshot.0) {
         graph.0.add(ForwardPass { clear_color: snapshot.0.settings.clear_color });
     }
 }
 
-fn add_tonemap_pass(mut graph: ResMut<FrameGraph>) {
-    graph.0.add(TonemapPass);
+fn add_clustered_forward_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
+    if shades_with_clusters(&snapshot.0) {
+        graph.0.add(ClusteredForwardPass {
+            clear_color: snapshot.0.settings.clear_color,
+            after_prepass: runs_depth_prepass(&snapshot.0),
+        });
+    }
+}
+
+/// Tone mapping, or the debug view that replaces it.
+fn add_output_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
+    let s = &snapshot.0.settings;
+    if s.debug_view == DebugView::None {
+        graph.0.add(TonemapPass);
+    } else {
+        graph.0.add(DebugViewPass { view: s.debug_view, heatmap_max: s.debug_heatmap_max });
+    }
 }
 
 fn execute(

@@ -3,7 +3,7 @@
 use bevy_ecs::prelude::*;
 use glam::UVec2;
 use manylight_core::ShadingModel;
-use manylight_render::{FrameReport, FrameSettings, PipelineKind};
+use manylight_render::{ClusterSettings, DebugView, FrameReport, FrameSettings, PipelineKind};
 
 /// How frames are rendered; changes apply from the next frame.
 #[derive(Resource, Clone, Copy, Debug, PartialEq)]
@@ -18,6 +18,13 @@ pub struct RenderSettings {
     pub ambient: f32,
     /// Linear colour behind everything.
     pub clear_color: [f32; 3],
+    /// Cluster grid, culling test, optional cap and depth pre-pass of the tiled and clustered
+    /// pipelines.
+    pub clusters: ClusterSettings,
+    /// Debug view shown instead of the image (`DebugView::None` for the image).
+    pub debug_view: DebugView,
+    /// Light count shown as the hottest colour of the light-count heatmap.
+    pub debug_heatmap_max: u32,
 }
 
 impl Default for RenderSettings {
@@ -29,6 +36,9 @@ impl Default for RenderSettings {
             exposure: f.exposure,
             ambient: f.ambient,
             clear_color: f.clear_color,
+            clusters: f.clusters,
+            debug_view: f.debug_view,
+            debug_heatmap_max: f.debug_heatmap_max,
         }
     }
 }
@@ -42,6 +52,9 @@ impl RenderSettings {
             exposure: self.exposure,
             ambient: self.ambient,
             clear_color: self.clear_color,
+            clusters: self.clusters,
+            debug_view: self.debug_view,
+            debug_heatmap_max: self.debug_heatmap_max,
         }
     }
 }

@@ -226,9 +226,7 @@ impl FrameSink for SurfaceSink {
         let Some(frame) = self.acquire(size)? else {
             return Ok((empty_report(&snapshot), None));
         };
-        let Some(format) = self.config.as_ref().map(|c| c.format).or(Some(frame.texture.format())) else {
-            return Ok((empty_report(&snapshot), None));
-        };
+        let format = frame.texture.format();
         let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
         let report = self.render_world.render(snapshot, &view, format)?;
         self.window.pre_present_notify();
@@ -368,10 +366,11 @@ impl WinitRunner {
             match result {
                 Ok((report, image)) => {
                     if let Some(mut stats) = world.get_resource_mut::<FrameStats>() {
+                        stats.frames_rendered += u64::from(!report.passes.is_empty());
                         stats.last = Some(report);
-                        stats.frames_rendered += 1;
                     }
-                    if let (Some(image), Some(mut capture)) = (image, world.get_resource_mut::<HeadlessCapture>())
+                    if let (Some(image), Some(mut capture)) =
+                        (image, world.get_resource_mut::<HeadlessCapture>())
                     {
                         capture.image = Some(image);
                     }
@@ -393,9 +392,9 @@ impl ApplicationHandler for WinitRunner {
         if self.window.is_some() || self.exit.is_some() {
             return;
         }
-        let attributes = Window::default_attributes().with_title(self.config.title.clone()).with_inner_size(
-            PhysicalSize::new(self.config.width.max(1), self.config.height.max(1)),
-        );
+        let attributes = Window::default_attributes()
+            .with_title(self.config.title.clone())
+            .with_inner_size(PhysicalSize::new(self.config.width.max(1), self.config.height.max(1)));
         let window = match event_loop.create_window(attributes) {
             Ok(w) => Arc::new(w),
             Err(e) => return self.fail(event_loop, format!("could not open a window: {e}")),
@@ -501,7 +500,12 @@ fn build_event_loop(config: &WindowConfig) -> Result<EventLoop<()>, winit::error
         windows,
         all(
             unix,
-            not(any(target_os = "macos", target_os = "ios", target_os = "android", target_os = "emscripten"))
+            not(any(
+                target_os = "macos",
+                target_os = "ios",
+                target_os = "android",
+                target_os = "emscripten"
+            ))
         )
     )))]
     let _ = config;

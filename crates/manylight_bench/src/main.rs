@@ -4,13 +4,14 @@ use anyhow::{Context, Result, bail};
 use bevy_app::Startup;
 use bevy_ecs::system::Commands;
 use clap::{Parser, Subcommand};
-use glam::UVec2;
-use manylight_app::headless::{render_headless, save_png};
-use manylight_app::scene::{spawn_light_rig, spawn_scene};
+use glam::{UVec2, UVec3};
 use manylight_app::FrameStats;
 use manylight_app::RenderSettings;
+use manylight_app::headless::{render_headless, save_png};
+use manylight_app::scene::{spawn_light_rig, spawn_scene};
 use manylight_core::ShadingModel;
-use manylight_render::PipelineKind;
+use manylight_core::cluster::{CullTest, GridConfig, MAX_GRID_DIM, ZSlicing};
+use manylight_render::{ClusterSettings, DebugView, PipelineKind};
 use manylight_scene::{LoadOptions, Scene, load_scene};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -38,9 +39,11 @@ struct RenderArgs {
     /// `default` (embedded hall), `sphere-shell`, or a path to a .gltf/.glb file.
     #[arg(long, default_value = "default")]
     scene: String,
-    /// Pipeline: naive.
-    #[arg(long, default_value = "naive", value_parser = parse_pipeline)]
+    /// Pipeline: naive, forward-plus or clustered-forward.
+    #[arg(long, default_value = "clustered-forward", value_parser = parse_pipeline)]
     pipeline: PipelineKind,
+    #[command(flatten)]
+    clusters: ClusterArgs,
     /// Shading model for materials without their own: lambert or blinn-phong.
     #[arg(long, default_value = "blinn-phong", value_parser = parse_shading)]
     shading: ShadingModel,
@@ -69,6 +72,72 @@ struct RenderArgs {
     /// Write the last frame's statistics as JSON here.
     #[arg(long)]
     stats_json: Option<PathBuf>,
+}
+
+/// Light-assignment options of the tiled and clustered pipelines.
+#[derive(clap::Args, Clone, Debug)]
+struct ClusterArgs {
+    /// Sphere–cluster test: aabb or planes.
+    #[arg(long, default_value = "planes", value_parser = parse_cull)]
+    cull: CullTest,
+    /// Depth slicing: linear or exponential.
+    #[arg(long, default_value = "exponential", value_parser = parse_slicing)]
+    z_slicing: ZSlicing,
+    /// Grid size XxYxZ (default: tiles of about 64 px, 24 slices; Forward+ uses Z = 1).
+    #[arg(long, value_parser = parse_grid)]
+    grid: Option<UVec3>,
+    /// Keep at most N lights per cluster (dropped pairs are counted in the stats).
+    #[arg(long)]
+    cluster_cap: Option<u32>,
+    /// Skip the depth pre-pass of clustered forward (Forward+ always runs it).
+    #[arg(long)]
+    no_depth_prepass: bool,
+    /// Workgroup size of the cluster-build compute shader.
+    #[arg(long, default_value_t = 64)]
+    workgroup_size: u32,
+    /// Debug view: none, light-count, slice-x, slice-y, slice-z.
+    #[arg(long, default_value = "none", value_parser = parse_debug_view)]
+    debug_view: DebugView,
+}
+
+impl ClusterArgs {
+    fn settings(&self) -> ClusterSettings {
+        ClusterSettings {
+            grid: GridConfig { dims: self.grid, slicing: self.z_slicing, ..GridConfig::default() },
+            cull: self.cull,
+            cap: self.cluster_cap,
+            depth_prepass: !self.no_depth_prepass,
+            workgroup_size: self.workgroup_size,
+        }
+    }
+}
+
+fn parse_cull(s: &str) -> Result<CullTest, String> {
+    CullTest::from_name(s).ok_or_else(|| format!("unknown culling test `{s}` (expected aabb or planes)"))
+}
+
+fn parse_slicing(s: &str) -> Result<ZSlicing, String> {
+    ZSlicing::from_name(s).ok_or_else(|| format!("unknown z slicing `{s}` (expected linear or exponential)"))
+}
+
+fn parse_debug_view(s: &str) -> Result<DebugView, String> {
+    DebugView::from_name(s).ok_or_else(|| {
+        let names: Vec<_> = DebugView::ALL.iter().map(|v| v.name()).collect();
+        format!("unknown debug view `{s}` (expected one of: {})", names.join(", "))
+    })
+}
+
+fn parse_grid(s: &str) -> Result<UVec3, String> {
+    let parts: Vec<&str> = s.split(['x', 'X']).collect();
+    let [x, y, z] = parts.as_slice() else {
+        return Err(format!("grid `{s}` is not XxYxZ"));
+    };
+    let parse = |v: &str| v.trim().parse::<u32>().map_err(|e| format!("grid `{s}`: {e}"));
+    let dims = UVec3::new(parse(x)?, parse(y)?, parse(z)?);
+    if dims.min_element() == 0 || dims.max_element() > MAX_GRID_DIM {
+        return Err(format!("grid `{s}`: each size must be in 1..={MAX_GRID_DIM}"));
+    }
+    Ok(dims)
 }
 
 fn parse_pipeline(s: &str) -> Result<PipelineKind, String> {
@@ -150,6 +219,8 @@ fn render(args: RenderArgs) -> Result<()> {
         pipeline: args.pipeline,
         shading: args.shading,
         exposure: args.exposure,
+        clusters: args.clusters.settings(),
+        debug_view: args.clusters.debug_view,
         ..RenderSettings::default()
     };
     let (image, stats) = render_scene(scene, args.size, args.frames, args.lights, args.seed, settings)?;

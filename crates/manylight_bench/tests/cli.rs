@@ -49,7 +49,9 @@ fn check_rejects_every_malformed_file_with_a_typed_error() {
 fn check_accepts_real_assets() {
     let _gpu = GPU.lock().unwrap_or_else(|e| e.into_inner());
     let assets = root().join("../shared/assets");
-    for rel in ["DamagedHelmet/DamagedHelmet.glb", "CornellBox/CornellBox.gltf", "BoxTextured/BoxTextured.gltf"] {
+    for rel in
+        ["DamagedHelmet/DamagedHelmet.glb", "CornellBox/CornellBox.gltf", "BoxTextured/BoxTextured.gltf"]
+    {
         let path = assets.join(rel);
         let out = manylight(&["check", path.to_str().expect("utf-8 path")]);
         assert!(out.status.success(), "{rel}: {}", String::from_utf8_lossy(&out.stderr));
@@ -82,10 +84,14 @@ fn render_writes_png_and_stats_json() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let img = image::open(&png).expect("png").to_rgba8();
     assert_eq!(img.dimensions(), (96, 64));
-    let stats: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).expect("json")).expect("valid");
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).expect("json")).expect("valid");
     let last = &stats["last_frame"];
-    let names: Vec<&str> = last["passes"].as_array().expect("passes").iter().map(|p| p["name"].as_str().unwrap_or("")).collect();
-    assert_eq!(names, ["forward", "tonemap"]);
+    let names: Vec<&str> =
+        last["passes"].as_array().expect("passes").iter().map(|p| p["name"].as_str().unwrap_or("")).collect();
+    assert_eq!(names, ["depth_prepass", "cluster_build", "clustered_forward", "tonemap"]);
+    assert!(last["clusters"]["total_entries"].as_u64().is_some_and(|n| n > 0));
+    assert_eq!(last["clusters"]["dropped_pairs"].as_u64(), Some(0));
     assert!(last["passes"][0]["gpu_ms"].is_number());
     assert!(last["passes"][0]["cpu_ms"].is_number());
     assert!(last["frame_cpu_ms"].is_number());

@@ -89,6 +89,9 @@ mod tests {
             flip_compare((2, 2), &[0; 16], (1, 1), &[0; 4]),
             Err(CompareError::SizeMismatch(2, 2, 1, 1))
         ));
-        assert!(matches!(flip_compare((2, 2), &[0; 15], (2, 2), &[0; 16]), Err(CompareError::BadBuffer(15, 2, 2))));
+        assert!(matches!(
+            flip_compare((2, 2), &[0; 15], (2, 2), &[0; 16]),
+            Err(CompareError::BadBuffer(15, 2, 2))
+        ));
     }
 }

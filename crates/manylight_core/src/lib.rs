@@ -5,6 +5,7 @@
 
 pub mod attenuation;
 pub mod camera;
+pub mod cluster;
 pub mod image_metrics;
 pub mod material;
 pub mod mesh;

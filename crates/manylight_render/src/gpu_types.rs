@@ -10,12 +10,33 @@ use manylight_core::ShadingModel;
 /// `GpuMaterial::shading_model` value meaning "use the view's global model".
 pub const SHADING_GLOBAL: u32 = 0xffff_ffff;
 
+/// `GpuClusterParams::cap` value meaning "no cap" (exact assignment).
+pub const CLUSTER_NO_CAP: u32 = 0xffff_ffff;
+/// Workgroup size of the prefix-sum step of the cluster build (one workgroup scans all).
+pub const SCAN_WORKGROUP_SIZE: u32 = 256;
+/// `GpuClusterParams::cull_test` values.
+pub const CULL_AABB: u32 = 0;
+/// See [`CULL_AABB`].
+pub const CULL_PLANES: u32 = 1;
+
 /// Constants emitted into WGSL as `const NAME: u32 = VALUE;`.
 pub fn shared_u32_constants() -> Vec<(&'static str, u32)> {
+    use crate::snapshot::DebugView;
+    use manylight_core::cluster::ZSlicing;
     vec![
         ("SHADING_LAMBERT", ShadingModel::Lambert.gpu_id()),
         ("SHADING_BLINN_PHONG", ShadingModel::BlinnPhong.gpu_id()),
         ("SHADING_GLOBAL", SHADING_GLOBAL),
+        ("CLUSTER_NO_CAP", CLUSTER_NO_CAP),
+        ("SCAN_WORKGROUP_SIZE", SCAN_WORKGROUP_SIZE),
+        ("CULL_AABB", CULL_AABB),
+        ("CULL_PLANES", CULL_PLANES),
+        ("Z_SLICING_LINEAR", ZSlicing::Linear.gpu_id()),
+        ("Z_SLICING_EXPONENTIAL", ZSlicing::Exponential.gpu_id()),
+        ("DEBUG_LIGHT_COUNT", DebugView::LightCount.gpu_id()),
+        ("DEBUG_SLICE_X", DebugView::SliceX.gpu_id()),
+        ("DEBUG_SLICE_Y", DebugView::SliceY.gpu_id()),
+        ("DEBUG_SLICE_Z", DebugView::SliceZ.gpu_id()),
     ]
 }
 
@@ -92,4 +113,63 @@ pub struct GpuMaterial {
     pub shading_model: u32,
     /// 1 when a base colour texture is bound.
     pub has_texture: u32,
+}
+
+/// Constants emitted into WGSL as `const NAME: f32 = VALUE;` (printed so they round-trip).
+pub fn shared_f32_constants() -> Vec<(&'static str, f32)> {
+    vec![("RADIUS_INFLATION", manylight_core::cluster::RADIUS_INFLATION)]
+}
+
+/// Cluster-grid constants (`ClusterParams` in `shaders/common/clusters.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuClusterParams {
+    /// Grid size x, y, z and the cluster count.
+    pub dims: [u32; 4],
+    /// Viewport width, height (pixels), near and far (view distances).
+    pub viewport: [f32; 4],
+    /// Lights in the light buffers.
+    pub light_count: u32,
+    /// Per-cluster cap or [`CLUSTER_NO_CAP`].
+    pub cap: u32,
+    /// [`CULL_AABB`] or [`CULL_PLANES`].
+    pub cull_test: u32,
+    /// Entries the index list can hold.
+    pub index_capacity: u32,
+    /// `ZSlicing::gpu_id`.
+    pub slicing: u32,
+    /// ln(far / near), precomputed for exponential slicing.
+    pub log_far_over_near: f32,
+    /// Padding to 16 bytes.
+    pub _pad: [u32; 2],
+}
+
+/// Bounds of one cluster in view space (`GpuClusterBounds` in `shaders/common/clusters.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuClusterBounds {
+    /// AABB minimum (xyz).
+    pub aabb_min: [f32; 4],
+    /// AABB maximum (xyz).
+    pub aabb_max: [f32; 4],
+    /// Six planes (n.xyz, w), inward normals.
+    pub planes: [[f32; 4]; 6],
+}
+
+/// Counters the cluster build writes (`ClusterCounters` in `shaders/cluster_build.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuClusterCounters {
+    /// Entries the index list needed (after the cap).
+    pub total_entries: u32,
+    /// Light–cluster pairs dropped by the cap.
+    pub dropped_pairs: u32,
+    /// Clusters that hit the cap.
+    pub clusters_overflowed: u32,
+    /// Largest per-cluster count before the cap.
+    pub max_count: u32,
+    /// Clusters with at least one light.
+    pub non_empty: u32,
+    /// Padding.
+    pub _pad: [u32; 3],
 }

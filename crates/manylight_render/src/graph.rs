@@ -60,6 +60,8 @@ pub struct PassContext<'a> {
     pub scene: &'a SceneResources,
     /// Pipelines, created on first use.
     pub pipelines: &'a PipelineCache,
+    /// Cluster buffers, when the frame uses clusters.
+    pub clusters: Option<&'a crate::clusters::ClusterResources>,
     /// The frame's command encoder.
     pub encoder: &'a mut wgpu::CommandEncoder,
     /// Format of [`OUTPUT`].

@@ -3,6 +3,7 @@
 //! It consumes a plain [`FrameSnapshot`] and knows nothing of bevy: tests and benchmarks can
 //! drive it directly. The app crate decides which passes a frame needs.
 
+pub mod clusters;
 pub mod context;
 pub mod gpu_types;
 pub mod graph;
@@ -22,6 +23,7 @@ pub use graph::{OUTPUT, Pass, PassContext, RenderGraph, ResourceName, TextureSpe
 pub use readback::{HEADLESS_FORMAT, HeadlessTarget};
 pub use renderer::Renderer;
 pub use snapshot::{
-    ExtractedCamera, ExtractedInstance, ExtractedPointLight, FrameSettings, FrameSnapshot, PipelineKind,
+    ClusterSettings, DebugView, ExtractedCamera, ExtractedInstance, ExtractedPointLight, FrameSettings,
+    FrameSnapshot, PipelineKind,
 };
 pub use stats::{FrameReport, PassTiming};

@@ -1,6 +1,7 @@
 //! The renderer: scene resources, the transient pool, pipelines and the GPU timer, and the
 //! execution of one frame's graph.
 
+use crate::clusters::ClusterResources;
 use crate::context::{GpuContext, RenderError};
 use crate::graph::{OUTPUT, PassContext, RenderGraph};
 use crate::pipelines::PipelineCache;
@@ -20,6 +21,8 @@ pub struct Renderer {
     pub scene: SceneResources,
     /// Pipelines created so far.
     pub pipelines: PipelineCache,
+    /// Cluster buffers, created the first time a frame needs them.
+    pub clusters: Option<ClusterResources>,
     pool: TransientPool,
     timer: Option<GpuTimer>,
     cpu_adapter: bool,
@@ -33,6 +36,7 @@ impl Renderer {
         Renderer {
             scene: SceneResources::new(&gpu),
             pipelines: PipelineCache::default(),
+            clusters: None,
             pool: TransientPool::default(),
             timer,
             cpu_adapter,
@@ -42,7 +46,14 @@ impl Renderer {
 
     /// Uploads the snapshot's data (the `Prepare` step).
     pub fn prepare(&mut self, snapshot: &FrameSnapshot) -> Result<(), RenderError> {
-        self.scene.prepare(&self.gpu, snapshot)
+        self.scene.prepare(&self.gpu, snapshot)?;
+        if snapshot.needs_clusters() {
+            let gpu = &self.gpu;
+            let clusters = self.clusters.get_or_insert_with(|| ClusterResources::new(gpu));
+            let view_from_world = snapshot.camera.map(|c| c.view_from_world()).unwrap_or_default();
+            clusters.prepare(gpu, snapshot, &view_from_world, &self.scene.light_spheres)?;
+        }
+        Ok(())
     }
 
     /// The transient pool (tests read its allocation counts).
@@ -50,8 +61,35 @@ impl Renderer {
         &self.pool
     }
 
-    /// Runs `graph` into `output` (the `Execute` step) and waits for the GPU to finish.
+    /// Runs `graph` into `output` (the `Execute` step) and waits for the GPU to finish. When the
+    /// cluster build finds its light-index list too small, the list grows and the frame is
+    /// rendered again, so no light is ever lost to a buffer size.
     pub fn execute(
+        &mut self,
+        graph: &RenderGraph,
+        snapshot: &FrameSnapshot,
+        output: &wgpu::TextureView,
+        output_format: wgpu::TextureFormat,
+    ) -> Result<FrameReport, RenderError> {
+        let builds_clusters = graph.pass_names()?.contains(&"cluster_build");
+        let mut regrows = 0;
+        loop {
+            let mut report = self.execute_once(graph, snapshot, output, output_format)?;
+            let Some(clusters) = self.clusters.as_mut().filter(|_| builds_clusters) else {
+                return Ok(report);
+            };
+            let counters = clusters.read_counters(&self.gpu)?;
+            if regrows < 4 && clusters.grow_if_needed(&self.gpu, counters.total_entries as u64) {
+                regrows += 1;
+                tracing::debug!("light-index list grew to {} entries", clusters.params.index_capacity);
+                continue;
+            }
+            report.clusters = Some(clusters.report(&counters, regrows));
+            return Ok(report);
+        }
+    }
+
+    fn execute_once(
         &mut self,
         graph: &RenderGraph,
         snapshot: &FrameSnapshot,
@@ -88,6 +126,7 @@ impl Renderer {
                 gpu: &self.gpu,
                 scene: &self.scene,
                 pipelines: &self.pipelines,
+                clusters: self.clusters.as_ref(),
                 encoder: &mut encoder,
                 output_format,
                 textures: &textures,
@@ -134,6 +173,7 @@ impl Renderer {
             instance_count: self.scene.draws.len() as u32,
             transient_textures: self.pool.live() as u32,
             transient_allocations: self.pool.allocations(),
+            clusters: None,
         })
     }
 }

@@ -81,6 +81,8 @@ pub struct SceneResources {
     pub light_count: u32,
     /// Lights dropped for invalid parameters this frame.
     pub invalid_lights: u32,
+    /// (position, radius) of the uploaded lights, in light-buffer order.
+    pub light_spheres: Vec<(glam::Vec3, f32)>,
     meshes: HashMap<usize, GpuMesh>,
     materials: HashMap<usize, GpuMaterialBinding>,
     textures: HashMap<usize, CachedTexture>,
@@ -194,6 +196,7 @@ impl SceneResources {
             view: ViewUniform::zeroed_default(),
             light_count: 0,
             invalid_lights: 0,
+            light_spheres: Vec::new(),
             meshes: HashMap::new(),
             materials: HashMap::new(),
             textures: HashMap::new(),
@@ -266,6 +269,8 @@ impl SceneResources {
             })
             .collect();
         self.invalid_lights = (snapshot.lights.len() - gpu_lights.len()) as u32;
+        self.light_spheres =
+            snapshot.lights.iter().filter(|l| l.is_valid()).map(|l| (l.position, l.radius)).collect();
         self.light_count = gpu_lights.len() as u32;
         self.view.light_count = self.light_count;
         let light_bytes: &[u8] =

@@ -4,7 +4,7 @@
 //! once, in order of first mention. Every shader starts with the constants preamble generated
 //! from [`crate::gpu_types::shared_u32_constants`].
 
-use crate::gpu_types::shared_u32_constants;
+use crate::gpu_types::{shared_f32_constants, shared_u32_constants};
 use std::fmt::Write as _;
 
 /// Every WGSL file under `shaders/`, by path relative to that folder.
@@ -14,7 +14,13 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("common/brdf.wgsl", include_str!("../../../shaders/common/brdf.wgsl")),
     ("common/mesh.wgsl", include_str!("../../../shaders/common/mesh.wgsl")),
     ("common/fullscreen.wgsl", include_str!("../../../shaders/common/fullscreen.wgsl")),
+    ("common/surface.wgsl", include_str!("../../../shaders/common/surface.wgsl")),
+    ("common/clusters.wgsl", include_str!("../../../shaders/common/clusters.wgsl")),
     ("forward.wgsl", include_str!("../../../shaders/forward.wgsl")),
+    ("depth_prepass.wgsl", include_str!("../../../shaders/depth_prepass.wgsl")),
+    ("cluster_build.wgsl", include_str!("../../../shaders/cluster_build.wgsl")),
+    ("clustered_forward.wgsl", include_str!("../../../shaders/clustered_forward.wgsl")),
+    ("debug_view.wgsl", include_str!("../../../shaders/debug_view.wgsl")),
     ("tonemap.wgsl", include_str!("../../../shaders/tonemap.wgsl")),
 ];
 
@@ -31,6 +37,9 @@ pub fn constants_preamble() -> String {
     let mut s = String::from("// generated from manylight_render::gpu_types\n");
     for (name, value) in shared_u32_constants() {
         let _ = writeln!(s, "const {name}: u32 = {value}u;");
+    }
+    for (name, value) in shared_f32_constants() {
+        let _ = writeln!(s, "const {name}: f32 = {value:?};");
     }
     s
 }

@@ -2,6 +2,7 @@
 //! world; the render side reads it and nothing else (it never reaches back into the ECS).
 
 use glam::{Mat4, UVec2, Vec3};
+use manylight_core::cluster::{CullTest, GridConfig};
 use manylight_core::{MaterialData, MeshData, Projection, ShadingModel};
 use std::sync::Arc;
 
@@ -9,24 +10,121 @@ use std::sync::Arc;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum PipelineKind {
     /// Forward shading that evaluates every light for every fragment (the reference).
-    #[default]
     NaiveForward,
+    /// Tiled forward (Forward+): 2D screen tiles, one depth range (Z = 1), depth pre-pass.
+    ForwardPlus,
+    /// Clustered forward: screen tiles × depth slices, optional depth pre-pass (the default).
+    #[default]
+    ClusteredForward,
 }
 
 impl PipelineKind {
     /// Every pipeline, in the order the CLI lists them.
-    pub const ALL: [PipelineKind; 1] = [PipelineKind::NaiveForward];
+    pub const ALL: [PipelineKind; 3] =
+        [PipelineKind::NaiveForward, PipelineKind::ForwardPlus, PipelineKind::ClusteredForward];
 
     /// Name used on the command line and in reports.
     pub fn name(self) -> &'static str {
         match self {
             PipelineKind::NaiveForward => "naive",
+            PipelineKind::ForwardPlus => "forward-plus",
+            PipelineKind::ClusteredForward => "clustered-forward",
         }
     }
 
     /// Parses a command-line name.
     pub fn from_name(name: &str) -> Option<PipelineKind> {
         Self::ALL.into_iter().find(|p| p.name() == name)
+    }
+
+    /// True for pipelines that build light lists per tile or cluster.
+    pub fn uses_clusters(self) -> bool {
+        matches!(self, PipelineKind::ForwardPlus | PipelineKind::ClusteredForward)
+    }
+}
+
+/// What the debug view shows instead of the tone-mapped image.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum DebugView {
+    /// The normal image.
+    #[default]
+    None,
+    /// Per-pixel number of lights in the pixel's cluster list, as a heatmap with a legend.
+    LightCount,
+    /// Cluster x index, as alternating colours.
+    SliceX,
+    /// Cluster y index.
+    SliceY,
+    /// Cluster z (depth slice) index.
+    SliceZ,
+}
+
+impl DebugView {
+    /// Every view, in CLI order.
+    pub const ALL: [DebugView; 5] =
+        [DebugView::None, DebugView::LightCount, DebugView::SliceX, DebugView::SliceY, DebugView::SliceZ];
+
+    /// Name used on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            DebugView::None => "none",
+            DebugView::LightCount => "light-count",
+            DebugView::SliceX => "slice-x",
+            DebugView::SliceY => "slice-y",
+            DebugView::SliceZ => "slice-z",
+        }
+    }
+
+    /// Parses a command-line name.
+    pub fn from_name(name: &str) -> Option<DebugView> {
+        Self::ALL.into_iter().find(|v| v.name() == name)
+    }
+
+    /// The id the debug shader switches on.
+    pub fn gpu_id(self) -> u32 {
+        self as u32
+    }
+}
+
+/// How lights are assigned to clusters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClusterSettings {
+    /// Grid sizing and z slicing (Forward+ forces Z = 1).
+    pub grid: GridConfig,
+    /// Sphere–cluster test.
+    pub cull: CullTest,
+    /// Optional per-cluster cap; lights beyond it are dropped deterministically and counted.
+    /// `None` (the default) is exact: no light is ever dropped.
+    pub cap: Option<u32>,
+    /// Run a depth pre-pass before clustered forward shading (Forward+ always does).
+    pub depth_prepass: bool,
+    /// Workgroup size of the cluster-build compute shader (pipeline-override constant).
+    pub workgroup_size: u32,
+}
+
+impl Default for ClusterSettings {
+    fn default() -> Self {
+        Self {
+            grid: GridConfig::default(),
+            cull: CullTest::default(),
+            cap: None,
+            depth_prepass: true,
+            workgroup_size: 64,
+        }
+    }
+}
+
+impl ClusterSettings {
+    /// The grid configuration a pipeline actually uses (Forward+ has one depth slice).
+    pub fn grid_for(&self, pipeline: PipelineKind) -> GridConfig {
+        let mut grid = self.grid;
+        if pipeline == PipelineKind::ForwardPlus {
+            grid.z_slices = 1;
+            if let Some(d) = &mut grid.dims {
+                d.z = 1;
+            }
+        }
+        grid
     }
 }
 
@@ -43,16 +141,25 @@ pub struct FrameSettings {
     pub ambient: f32,
     /// Colour the HDR target is cleared to (linear RGB).
     pub clear_color: [f32; 3],
+    /// Light assignment of the tiled and clustered pipelines.
+    pub clusters: ClusterSettings,
+    /// Debug view (replaces tone mapping when not `None`).
+    pub debug_view: DebugView,
+    /// Light count shown as the hottest colour of the light-count heatmap.
+    pub debug_heatmap_max: u32,
 }
 
 impl Default for FrameSettings {
     fn default() -> Self {
         Self {
-            pipeline: PipelineKind::NaiveForward,
+            pipeline: PipelineKind::ClusteredForward,
             shading: ShadingModel::BlinnPhong,
             exposure: 1.0,
             ambient: 0.03,
             clear_color: [0.005, 0.006, 0.01],
+            clusters: ClusterSettings::default(),
+            debug_view: DebugView::None,
+            debug_heatmap_max: 32,
         }
     }
 }
@@ -141,4 +248,19 @@ pub struct FrameSnapshot {
     pub lights: Vec<ExtractedPointLight>,
     /// Settings.
     pub settings: FrameSettings,
+}
+
+impl FrameSnapshot {
+    /// True when at least one light has valid parameters.
+    pub fn has_lights(&self) -> bool {
+        self.lights.iter().any(|l| l.is_valid())
+    }
+
+    /// True when the frame needs the cluster build: a tiled/clustered pipeline with lights, or
+    /// a debug view that shows cluster data.
+    pub fn needs_clusters(&self) -> bool {
+        self.camera.is_some()
+            && ((self.settings.pipeline.uses_clusters() && self.has_lights())
+                || self.settings.debug_view != DebugView::None)
+    }
 }

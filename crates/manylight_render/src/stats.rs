@@ -42,6 +42,8 @@ pub struct FrameReport {
     pub transient_textures: u32,
     /// Transient textures created since start-up (reuse keeps this flat).
     pub transient_allocations: u64,
+    /// Cluster statistics, when the frame built clusters.
+    pub clusters: Option<crate::clusters::ClusterReport>,
 }
 
 impl FrameReport {

@@ -1,9 +1,17 @@
 //! One module per pass. Each pass declares its reads and writes and records itself; its
 //! pipeline is created on first use through the [`crate::pipelines::PipelineCache`].
 
+pub mod cluster_build;
+pub mod clustered_forward;
+pub mod debug_view;
+pub mod depth_prepass;
 pub mod forward;
 pub mod tonemap;
 
+pub use cluster_build::ClusterBuildPass;
+pub use clustered_forward::ClusteredForwardPass;
+pub use debug_view::DebugViewPass;
+pub use depth_prepass::DepthPrepass;
 pub use forward::ForwardPass;
 pub use tonemap::TonemapPass;
 
@@ -11,3 +19,5 @@ pub use tonemap::TonemapPass;
 pub const HDR: crate::graph::ResourceName = "hdr";
 /// Graph resource: the depth buffer (reverse-Z).
 pub const DEPTH: crate::graph::ResourceName = "depth";
+/// Graph resource: the cluster light lists (persistent buffers, ordered through the graph).
+pub const CLUSTERS: crate::graph::ResourceName = "clusters";

@@ -1,0 +1,413 @@
+//! Cluster data on the GPU: the grid's per-cluster bounds, the lights' view-space spheres,
+//! the per-cluster `(offset, count)` ranges and the global light-index list, plus the
+//! counters the build writes and the renderer reads back each frame.
+//!
+//! The bounds come from `manylight_core::cluster` (the same numbers the CPU reference uses),
+//! so GPU and CPU assignments can be compared light for light.
+
+use crate::context::{GpuContext, RenderError};
+use crate::gpu_types::{
+    CLUSTER_NO_CAP, CULL_AABB, CULL_PLANES, GpuClusterBounds, GpuClusterCounters, GpuClusterParams,
+};
+use crate::pool::GrowableBuffer;
+use crate::snapshot::FrameSnapshot;
+use glam::Mat4;
+use manylight_core::cluster::{ClusterAssignment, ClusterGrid, CullTest, ViewSphere, view_spheres};
+use serde::Serialize;
+
+/// What the cluster build reported for a frame (in `FrameReport::clusters`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct ClusterReport {
+    /// Grid size x, y, z.
+    pub dims: [u32; 3],
+    /// Number of clusters.
+    pub clusters: u32,
+    /// Clusters with at least one light.
+    pub non_empty: u32,
+    /// Entries in the light-index list.
+    pub total_entries: u64,
+    /// Largest per-cluster count (before any cap).
+    pub max_per_cluster: u32,
+    /// Mean entries per cluster.
+    pub mean_per_cluster: f64,
+    /// Mean entries per non-empty cluster.
+    pub mean_per_non_empty: f64,
+    /// Light–cluster pairs dropped by the user's cap (0 without a cap).
+    pub dropped_pairs: u64,
+    /// Clusters that hit the cap.
+    pub clusters_overflowed: u32,
+    /// Capacity of the index list (entries).
+    pub index_capacity: u64,
+    /// Times the index list grew this frame (each re-renders the frame).
+    pub regrows: u32,
+    /// Culling test used.
+    pub cull_test: String,
+    /// Z slicing used.
+    pub z_slicing: String,
+}
+
+/// GPU buffers and bind groups of the cluster build and of clustered shading.
+pub struct ClusterResources {
+    /// The grid of the current frame.
+    pub grid: ClusterGrid,
+    /// The parameters uploaded this frame.
+    pub params: GpuClusterParams,
+    /// Layout of the build's group 0.
+    pub build_layout: wgpu::BindGroupLayout,
+    /// Layout of the shading passes' cluster group (params, ranges, indices; read-only).
+    pub shading_layout: wgpu::BindGroupLayout,
+    /// Group 0 of the build.
+    pub build_bind_group: wgpu::BindGroup,
+    /// The shading group.
+    pub shading_bind_group: wgpu::BindGroup,
+    /// The params uniform.
+    pub params_buffer: wgpu::Buffer,
+    /// Per-cluster `(offset, count)`.
+    pub ranges: GrowableBuffer,
+    /// The light-index list.
+    pub indices: GrowableBuffer,
+    bounds: GrowableBuffer,
+    spheres: GrowableBuffer,
+    counters: wgpu::Buffer,
+    counters_readback: wgpu::Buffer,
+    bounds_of: Option<ClusterGrid>,
+    generations: [u64; 4],
+    /// The view-space spheres uploaded this frame (for the CPU reference in tests and stats).
+    pub view_spheres: Vec<ViewSphere>,
+    cull: CullTest,
+}
+
+const INITIAL_INDEX_CAPACITY: u64 = 1 << 16;
+
+fn storage_entry(
+    binding: u32,
+    read_only: bool,
+    visibility: wgpu::ShaderStages,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+impl ClusterResources {
+    /// Creates the buffers (small; they grow with the grid and the lights).
+    pub fn new(gpu: &GpuContext) -> ClusterResources {
+        let device = &gpu.device;
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let build_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("cluster_build"),
+            entries: &[
+                uniform_entry(0, compute),
+                storage_entry(1, true, compute),
+                storage_entry(2, true, compute),
+                storage_entry(3, false, compute),
+                storage_entry(4, false, compute),
+                storage_entry(5, false, compute),
+            ],
+        });
+        let shade = wgpu::ShaderStages::FRAGMENT;
+        let shading_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("cluster_lists"),
+            entries: &[uniform_entry(0, shade), storage_entry(1, true, shade), storage_entry(2, true, shade)],
+        });
+        let params_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("cluster_params"),
+            size: std::mem::size_of::<GpuClusterParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let storage = wgpu::BufferUsages::STORAGE;
+        let copy = wgpu::BufferUsages::COPY_SRC;
+        let bounds = GrowableBuffer::new(device, "cluster_bounds", storage, 128 * 1024);
+        let spheres = GrowableBuffer::new(device, "light_view_spheres", storage, 16 * 1024);
+        let ranges = GrowableBuffer::new(device, "cluster_ranges", storage | copy, 8 * 8192);
+        let indices =
+            GrowableBuffer::new(device, "light_index_list", storage | copy, 4 * INITIAL_INDEX_CAPACITY);
+        let counters_size = std::mem::size_of::<GpuClusterCounters>() as u64;
+        let counters = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("cluster_counters"),
+            size: counters_size,
+            usage: storage | copy | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let counters_readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("cluster_counters_readback"),
+            size: counters_size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let (build_bind_group, shading_bind_group) = Self::bind_groups(
+            device,
+            &build_layout,
+            &shading_layout,
+            &params_buffer,
+            [&bounds, &spheres, &ranges, &indices],
+            &counters,
+        );
+        ClusterResources {
+            grid: ClusterGrid::new(glam::UVec2::ONE, &Default::default(), &Default::default()),
+            params: GpuClusterParams::default(),
+            build_layout,
+            shading_layout,
+            build_bind_group,
+            shading_bind_group,
+            params_buffer,
+            ranges,
+            indices,
+            bounds,
+            spheres,
+            counters,
+            counters_readback,
+            bounds_of: None,
+            generations: [0; 4],
+            view_spheres: Vec::new(),
+            cull: CullTest::default(),
+        }
+    }
+
+    fn bind_groups(
+        device: &wgpu::Device,
+        build_layout: &wgpu::BindGroupLayout,
+        shading_layout: &wgpu::BindGroupLayout,
+        params: &wgpu::Buffer,
+        [bounds, spheres, ranges, indices]: [&GrowableBuffer; 4],
+        counters: &wgpu::Buffer,
+    ) -> (wgpu::BindGroup, wgpu::BindGroup) {
+        fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+            wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() }
+        }
+        let build = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("cluster_build"),
+            layout: build_layout,
+            entries: &[
+                entry(0, params),
+                entry(1, bounds.buffer()),
+                entry(2, spheres.buffer()),
+                entry(3, ranges.buffer()),
+                entry(4, indices.buffer()),
+                entry(5, counters),
+            ],
+        });
+        let shading = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("cluster_lists"),
+            layout: shading_layout,
+            entries: &[entry(0, params), entry(1, ranges.buffer()), entry(2, indices.buffer())],
+        });
+        (build, shading)
+    }
+
+    fn rebind_if_grown(&mut self, device: &wgpu::Device) {
+        let generations = [
+            self.bounds.generation(),
+            self.spheres.generation(),
+            self.ranges.generation(),
+            self.indices.generation(),
+        ];
+        if generations != self.generations {
+            let (b, s) = Self::bind_groups(
+                device,
+                &self.build_layout,
+                &self.shading_layout,
+                &self.params_buffer,
+                [&self.bounds, &self.spheres, &self.ranges, &self.indices],
+                &self.counters,
+            );
+            self.build_bind_group = b;
+            self.shading_bind_group = s;
+            self.generations = generations;
+        }
+    }
+
+    /// Uploads the grid bounds (when the grid changed), the lights' view-space spheres and the
+    /// parameters, and zeroes the counters. `lights` are the (position, radius) pairs in the
+    /// order of the light buffer.
+    pub fn prepare(
+        &mut self,
+        gpu: &GpuContext,
+        snapshot: &FrameSnapshot,
+        view_from_world: &Mat4,
+        lights: &[(glam::Vec3, f32)],
+    ) -> Result<(), RenderError> {
+        let device = &gpu.device;
+        let queue = &gpu.queue;
+        let settings = &snapshot.settings.clusters;
+        let projection = snapshot.camera.map(|c| c.projection).unwrap_or_default();
+        let grid_config = settings.grid_for(snapshot.settings.pipeline);
+        self.grid = ClusterGrid::new(snapshot.viewport, &projection, &grid_config);
+        self.cull = settings.cull;
+        let count = self.grid.cluster_count();
+        if self.bounds_of != Some(self.grid) {
+            let dims = self.grid.dims;
+            let mut bounds = Vec::with_capacity(count as usize);
+            for z in 0..dims.z {
+                for y in 0..dims.y {
+                    for x in 0..dims.x {
+                        let (min, max) = self.grid.cluster_aabb(x, y, z);
+                        let planes = self.grid.cluster_planes(x, y, z);
+                        bounds.push(GpuClusterBounds {
+                            aabb_min: min.extend(0.0).to_array(),
+                            aabb_max: max.extend(0.0).to_array(),
+                            planes: planes.map(|p| p.to_array()),
+                        });
+                    }
+                }
+            }
+            self.bounds.write(device, queue, bytemuck::cast_slice(&bounds));
+            self.bounds_of = Some(self.grid);
+        }
+        self.view_spheres = view_spheres(view_from_world, lights.iter().copied());
+        let spheres: Vec<[f32; 4]> =
+            self.view_spheres.iter().map(|s| s.center.extend(s.radius).to_array()).collect();
+        if spheres.is_empty() {
+            self.spheres.write(device, queue, &[0u8; 16]);
+        } else {
+            self.spheres.write(device, queue, bytemuck::cast_slice(&spheres));
+        }
+        self.ranges.reserve(device, count as u64 * 8);
+        let p = projection.sanitized();
+        self.params = GpuClusterParams {
+            dims: [self.grid.dims.x, self.grid.dims.y, self.grid.dims.z, count],
+            viewport: [snapshot.viewport.x.max(1) as f32, snapshot.viewport.y.max(1) as f32, p.near, p.far],
+            light_count: spheres.len() as u32,
+            cap: settings.cap.unwrap_or(CLUSTER_NO_CAP),
+            cull_test: match settings.cull {
+                CullTest::Aabb => CULL_AABB,
+                CullTest::Planes => CULL_PLANES,
+            },
+            index_capacity: (self.indices.capacity() / 4).min(u32::MAX as u64) as u32,
+            slicing: self.grid.slicing.gpu_id(),
+            log_far_over_near: (p.far / p.near).ln(),
+            _pad: [0; 2],
+        };
+        queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
+        queue.write_buffer(&self.counters, 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
+        self.rebind_if_grown(device);
+        Ok(())
+    }
+
+    /// Records the copy of the counters to the readback buffer (after the build).
+    pub fn copy_counters(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.copy_buffer_to_buffer(&self.counters, 0, &self.counters_readback, 0, self.counters.size());
+    }
+
+    /// Reads the counters of the last submitted frame (waits for the GPU).
+    pub fn read_counters(&self, gpu: &GpuContext) -> Result<GpuClusterCounters, RenderError> {
+        let bytes = read_buffer(gpu, &self.counters_readback, 0, self.counters.size())?;
+        Ok(bytemuck::pod_read_unaligned(&bytes[..std::mem::size_of::<GpuClusterCounters>()]))
+    }
+
+    /// True when the index list is too small for `needed` entries; grows it (to the next power
+    /// of two) so the frame can be rendered again.
+    pub fn grow_if_needed(&mut self, gpu: &GpuContext, needed: u64) -> bool {
+        if needed <= self.params.index_capacity as u64 {
+            return false;
+        }
+        self.indices.reserve(&gpu.device, needed * 4);
+        self.params.index_capacity = (self.indices.capacity() / 4).min(u32::MAX as u64) as u32;
+        gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
+        gpu.queue.write_buffer(&self.counters, 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
+        self.rebind_if_grown(&gpu.device);
+        true
+    }
+
+    /// The report of a frame from its counters.
+    pub fn report(&self, c: &GpuClusterCounters, regrows: u32) -> ClusterReport {
+        let clusters = self.params.dims[3];
+        let total = c.total_entries as u64;
+        ClusterReport {
+            dims: [self.grid.dims.x, self.grid.dims.y, self.grid.dims.z],
+            clusters,
+            non_empty: c.non_empty,
+            total_entries: total,
+            max_per_cluster: c.max_count,
+            mean_per_cluster: total as f64 / clusters.max(1) as f64,
+            mean_per_non_empty: total as f64 / c.non_empty.max(1) as f64,
+            dropped_pairs: c.dropped_pairs as u64,
+            clusters_overflowed: c.clusters_overflowed,
+            index_capacity: self.params.index_capacity as u64,
+            regrows,
+            cull_test: self.cull.name().to_string(),
+            z_slicing: self.grid.slicing.name().to_string(),
+        }
+    }
+
+    /// Reads the GPU's assignment back into the CPU structure (tests compare it with
+    /// `manylight_core::cluster::assign_lights`).
+    pub fn read_assignment(&self, gpu: &GpuContext) -> Result<ClusterAssignment, RenderError> {
+        let count = self.params.dims[3] as u64;
+        let ranges_bytes = read_buffer(gpu, self.ranges.buffer(), 0, count * 8)?;
+        let ranges: Vec<[u32; 2]> = bytemuck::pod_collect_to_vec(&ranges_bytes);
+        let counters = self.read_counters(gpu)?;
+        let total = counters.total_entries as u64;
+        let indices: Vec<u32> = if total == 0 {
+            Vec::new()
+        } else {
+            bytemuck::pod_collect_to_vec(&read_buffer(gpu, self.indices.buffer(), 0, total * 4)?)
+        };
+        Ok(ClusterAssignment {
+            ranges,
+            indices,
+            dropped_pairs: counters.dropped_pairs as u64,
+            clusters_overflowed: counters.clusters_overflowed,
+        })
+    }
+}
+
+/// Copies `size` bytes of `buffer` from `offset` to the CPU (waits for the GPU).
+pub fn read_buffer(
+    gpu: &GpuContext,
+    buffer: &wgpu::Buffer,
+    offset: u64,
+    size: u64,
+) -> Result<Vec<u8>, RenderError> {
+    let size = size.max(4).div_ceil(4) * 4;
+    let staging_needed = !buffer.usage().contains(wgpu::BufferUsages::MAP_READ);
+    let staging;
+    let (source, start) = if staging_needed {
+        staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder =
+            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
+        encoder.copy_buffer_to_buffer(buffer, offset, &staging, 0, size);
+        gpu.queue.submit([encoder.finish()]);
+        (&staging, 0)
+    } else {
+        (buffer, offset)
+    };
+    let slice = source.slice(start..start + size);
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| RenderError::Readback(e.to_string()))?;
+    rx.recv()
+        .map_err(|e| RenderError::Readback(e.to_string()))?
+        .map_err(|e| RenderError::Readback(e.to_string()))?;
+    let data = slice.get_mapped_range().map_err(|e| RenderError::Readback(e.to_string()))?.to_vec();
+    source.unmap();
+    Ok(data)
+}

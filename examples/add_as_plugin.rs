@@ -1,0 +1,38 @@
+//! The smallest manylight app: the plugin, a scene, a few lights and a system that moves one.
+//!
+//! `cargo run --example add_as_plugin` opens a window (Esc closes it);
+//! `cargo run --example add_as_plugin -- --headless out.png` renders one frame to a PNG.
+
+use manylight::prelude::*;
+
+/// The light that `orbit` moves.
+#[derive(Component)]
+struct Orbiting;
+
+fn setup(mut commands: Commands) {
+    // The embedded hall: meshes, materials, six warm lights and a camera.
+    spawn_scene(&mut commands, &default_scene(), true, 16.0 / 9.0);
+    for (x, z, color) in [(-13.0, -2.5, Vec3::new(1.0, 0.1, 0.05)), (-9.0, 2.5, Vec3::new(0.1, 0.3, 1.0))] {
+        commands.spawn((Transform::from_xyz(x, 1.0, z), PointLight { color, intensity: 60.0, radius: 6.0 }));
+    }
+    let green = PointLight { color: Vec3::new(0.2, 1.0, 0.3), intensity: 60.0, radius: 6.0 };
+    commands.spawn((Transform::from_xyz(-6.0, 1.5, 0.0), green, Orbiting));
+}
+
+fn orbit(clock: Res<FrameClock>, mut lights: Query<&mut Transform, With<Orbiting>>) {
+    let t = clock.elapsed * 0.5;
+    for mut transform in &mut lights {
+        transform.translation = Vec3::new(-6.0 + 4.0 * t.cos(), 1.5, 3.0 * t.sin());
+    }
+}
+
+fn main() -> AppExit {
+    tracing_subscriber::fmt().with_env_filter("warn,winit=error,manylight_app=info").init();
+    let args: Vec<String> = std::env::args().collect();
+    let plugin = match args.iter().position(|a| a == "--headless") {
+        Some(i) => ManyLightPlugin::headless(UVec2::new(1280, 720))
+            .with_output(args.get(i + 1).map_or("add_as_plugin.png", |s| s.as_str())),
+        None => ManyLightPlugin::default(),
+    };
+    App::new().add_plugins(plugin).add_systems(Startup, setup).add_systems(Update, orbit).run()
+}

@@ -1,0 +1,100 @@
+//! Views a glTF/GLB file: its meshes and lights, seen through its first camera (or one that
+//! frames the whole scene), with an optional rig of animated lights.
+//!
+//! ```text
+//! cargo run --example gltf_viewer -- PATH [--lights N] [--fit] [--headless OUT.png]
+//! ```
+//!
+//! A file that cannot be loaded prints the loader's error (naming the file and the problem)
+//! and exits with code 1.
+
+use clap::Parser;
+use manylight::app::window::WindowConfig;
+use manylight::core::Aabb;
+use manylight::prelude::*;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Lights added when the file brings none and `--lights` is not given.
+const DEFAULT_RIG: usize = 32;
+
+#[derive(Parser)]
+#[command(about = "View a glTF/GLB file with manylight")]
+struct Args {
+    /// The .gltf or .glb file.
+    path: PathBuf,
+    /// Animated lights added to the file's own lights (default: 0, or 32 when the file has
+    /// no lights).
+    #[arg(long)]
+    lights: Option<usize>,
+    /// Frame the whole scene instead of looking through the file's first camera.
+    #[arg(long)]
+    fit: bool,
+    /// Render one 1280x720 frame to this PNG instead of opening a window.
+    #[arg(long, value_name = "OUT.png")]
+    headless: Option<PathBuf>,
+}
+
+/// The scene's bounds, thickened so that flat scenes (a single plane) get lights above them
+/// too: each side is at least a quarter of the diagonal.
+fn rig_bounds(bounds: Aabb) -> Aabb {
+    let pad = (Vec3::splat(bounds.size().length() * 0.25) - bounds.size()).max(Vec3::ZERO) * 0.5;
+    Aabb { min: bounds.min - pad, max: bounds.max + pad }
+}
+
+fn main() -> ExitCode {
+    tracing_subscriber::fmt().with_env_filter("warn,winit=error,manylight_app=info").init();
+    let args = Args::parse();
+    let mut scene = match load_gltf(&args.path, &LoadOptions::default()) {
+        Ok(scene) => scene,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    if args.fit {
+        scene.cameras.clear();
+    }
+    let lights = args.lights.unwrap_or(if scene.lights.is_empty() { DEFAULT_RIG } else { 0 });
+    println!(
+        "{}: {} meshes, {} instances, {} lights{}, {}",
+        args.path.display(),
+        scene.meshes.len(),
+        scene.instances.len(),
+        scene.lights.len(),
+        if lights > 0 { format!(" + {lights} animated") } else { String::new() },
+        if scene.cameras.is_empty() { "fitted camera" } else { "the file's camera" },
+    );
+
+    let size = UVec2::new(1280, 720);
+    let plugin = match &args.headless {
+        Some(out) => ManyLightPlugin::headless(size).with_output(out),
+        None => ManyLightPlugin::window(WindowConfig {
+            title: format!("manylight: {}", args.path.display()),
+            width: size.x,
+            height: size.y,
+            ..WindowConfig::default()
+        }),
+    };
+    let aspect = size.x as f32 / size.y as f32;
+    let exit = App::new()
+        .add_plugins(plugin)
+        .add_systems(Startup, move |mut commands: Commands| {
+            spawn_scene(&mut commands, &scene, true, aspect);
+            if lights > 0 {
+                spawn_light_rig(&mut commands, lights, rig_bounds(scene.bounds()), 1);
+            }
+        })
+        .run();
+    match (exit.is_success(), &args.headless) {
+        (true, Some(out)) => {
+            println!("wrote {}", out.display());
+            ExitCode::SUCCESS
+        }
+        (true, None) => ExitCode::SUCCESS,
+        (false, _) => {
+            eprintln!("error: rendering failed (see the log above)");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,40 @@
+// Clustered (and tiled, Z = 1) forward shading: each fragment finds its cluster and evaluates
+// only the lights in that cluster's list.
+//!include common/view.wgsl
+//!include common/lights.wgsl
+//!include common/brdf.wgsl
+//!include common/mesh.wgsl
+//!include common/clusters.wgsl
+//!include common/surface.wgsl
+
+@group(0) @binding(0) var<uniform> view: ViewUniform;
+@group(0) @binding(1) var<storage, read> lights: array<GpuPointLight>;
+@group(0) @binding(2) var<storage, read> instances: array<GpuInstance>;
+
+@group(1) @binding(0) var<uniform> material: GpuMaterial;
+@group(1) @binding(1) var base_color_texture: texture_2d<f32>;
+@group(1) @binding(2) var base_color_sampler: sampler;
+
+@group(2) @binding(0) var<uniform> cluster_params: ClusterParams;
+@group(2) @binding(1) var<storage, read> cluster_ranges: array<vec2<u32>>;
+@group(2) @binding(2) var<storage, read> cluster_indices: array<u32>;
+
+@vertex
+fn vs_main(v: VertexIn, @builtin(instance_index) instance_index: u32) -> SurfaceVertexOut {
+    return surface_vertex(v, instances[instance_index], view.clip_from_world);
+}
+
+@fragment
+fn fs_main(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    let albedo = surface_albedo(material, base_color_texture, base_color_sampler, in.uv);
+    let s = surface_params(material, view.shading_model, albedo.rgb, in.world_normal, front_facing);
+    let view_dir = normalize(view.camera_position.xyz - in.world_position);
+    let view_distance = -(view.view_from_world * vec4<f32>(in.world_position, 1.0)).z;
+    let cluster = cluster_index(cluster_params, in.clip_position.xy, view_distance);
+    let range = cluster_ranges[cluster];
+    var color = albedo.rgb * view.params.w;
+    for (var i = 0u; i < range.y; i++) {
+        color += shade_point_light(s, in.world_position, view_dir, lights[cluster_indices[range.x + i]]);
+    }
+    return vec4<f32>(color, 1.0);
+}

@@ -1,0 +1,72 @@
+// The cluster grid as the shaders see it (Rust: `GpuClusterParams`, `GpuClusterBounds`;
+// math mirrored from crates/manylight_core/src/cluster).
+struct ClusterParams {
+    // x, y, z: grid size; w: cluster count
+    dims: vec4<u32>,
+    // x, y: viewport size in pixels; z: near; w: far
+    viewport: vec4<f32>,
+    light_count: u32,
+    cap: u32,
+    cull_test: u32,
+    index_capacity: u32,
+    slicing: u32,
+    log_far_over_near: f32,
+    _pad0: u32,
+    _pad1: u32,
+};
+
+struct GpuClusterBounds {
+    aabb_min: vec4<f32>,
+    aabb_max: vec4<f32>,
+    planes: array<vec4<f32>, 6>,
+};
+
+// Depth slice of a positive view distance (ClusterGrid::slice_of_depth).
+fn cluster_slice(p: ClusterParams, d: f32) -> u32 {
+    let near = p.viewport.z;
+    let far = p.viewport.w;
+    var s = 0.0;
+    if p.slicing == Z_SLICING_LINEAR {
+        s = (d - near) / (far - near) * f32(p.dims.z);
+    } else {
+        s = log(max(d, near) / near) / p.log_far_over_near * f32(p.dims.z);
+    }
+    // `s >= 0.0` is false for NaN, which lands in slice 0.
+    let clamped = select(0.0, min(s, f32(p.dims.z - 1u)), s >= 0.0);
+    return u32(clamped);
+}
+
+// Cluster of a fragment at framebuffer position `frag` (pixels) and view distance `d`
+// (ClusterGrid::cluster_of).
+fn cluster_index(p: ClusterParams, frag: vec2<f32>, d: f32) -> u32 {
+    let tile_f = floor(frag * vec2<f32>(p.dims.xy) / p.viewport.xy);
+    let tile = vec2<u32>(clamp(tile_f, vec2<f32>(0.0), vec2<f32>(p.dims.xy - vec2<u32>(1u))));
+    let z = cluster_slice(p, d);
+    return tile.x + tile.y * p.dims.x + z * p.dims.x * p.dims.y;
+}
+
+// Conservative sphere–box test (manylight_core::cluster::sphere_intersects_aabb): spheres of
+// radius <= 0 touch nothing; the radius is inflated by RADIUS_INFLATION.
+fn sphere_intersects_aabb(c: vec3<f32>, radius: f32, mn: vec3<f32>, mx: vec3<f32>) -> bool {
+    if !(radius > 0.0) {
+        return false;
+    }
+    let r = radius * RADIUS_INFLATION;
+    let d = max(max(mn - c, c - mx), vec3<f32>(0.0));
+    return dot(d, d) <= r * r;
+}
+
+// Conservative sphere–planes test (manylight_core::cluster::sphere_intersects_planes).
+fn sphere_intersects_planes(c: vec3<f32>, radius: f32, b: GpuClusterBounds) -> bool {
+    if !(radius > 0.0) {
+        return false;
+    }
+    let r = radius * RADIUS_INFLATION;
+    for (var i = 0u; i < 6u; i++) {
+        let pl = b.planes[i];
+        if dot(pl.xyz, c) + pl.w < -r {
+            return false;
+        }
+    }
+    return true;
+}

@@ -1,0 +1,70 @@
+// Debug views that replace tone mapping: per-pixel light count of the pixel's cluster as a
+// heatmap (with a legend bar along the bottom edge), or the cluster x / y / z index as
+// alternating colours.
+//!include common/view.wgsl
+//!include common/clusters.wgsl
+//!include common/fullscreen.wgsl
+
+struct DebugParams {
+    mode: u32,
+    // light count shown as the hottest colour
+    scale_max: u32,
+    _pad0: u32,
+    _pad1: u32,
+};
+
+@group(0) @binding(0) var<uniform> view: ViewUniform;
+@group(0) @binding(1) var depth: texture_depth_2d;
+@group(0) @binding(2) var<uniform> cluster_params: ClusterParams;
+@group(0) @binding(3) var<storage, read> cluster_ranges: array<vec2<u32>>;
+@group(0) @binding(4) var<uniform> debug: DebugParams;
+
+// Blue -> cyan -> green -> yellow -> red, t in [0, 1].
+fn heat(t: f32) -> vec3<f32> {
+    let x = clamp(t, 0.0, 1.0) * 4.0;
+    let r = clamp(x - 2.0, 0.0, 1.0);
+    let g = select(clamp(x, 0.0, 1.0), clamp(4.0 - x, 0.0, 1.0), x > 3.0);
+    let b = clamp(2.0 - x, 0.0, 1.0);
+    return vec3<f32>(r, g, b);
+}
+
+fn index_color(i: u32) -> vec3<f32> {
+    let h = f32((i * 7u) % 12u) / 12.0;
+    let k = vec3<f32>(0.0, 2.0 / 3.0, 1.0 / 3.0);
+    return clamp(abs(fract(vec3<f32>(h) + k) * 6.0 - 3.0) - 1.0, vec3<f32>(0.0), vec3<f32>(1.0)) * select(0.55, 0.95, i % 2u == 0u);
+}
+
+@fragment
+fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
+    let px = vec2<i32>(in.position.xy);
+    let size = vec2<f32>(cluster_params.viewport.xy);
+    // Legend: a bar of the heat scale along the bottom 4% with ticks every 1/8 of the scale.
+    let legend_top = size.y * 0.96;
+    if debug.mode == DEBUG_LIGHT_COUNT && in.position.y >= legend_top {
+        let t = in.position.x / size.x;
+        let tick = abs(fract(t * 8.0 + 0.5) - 0.5) * size.x / 8.0 < 1.0;
+        return vec4<f32>(select(heat(t), vec3<f32>(1.0), tick), 1.0);
+    }
+    let z = textureLoad(depth, px, 0);
+    if z <= 0.0 {
+        return vec4<f32>(0.02, 0.02, 0.02, 1.0); // background (reverse-Z: cleared to 0)
+    }
+    let clip = vec4<f32>(in.uv.x * 2.0 - 1.0, 1.0 - in.uv.y * 2.0, z, 1.0);
+    let world = view.world_from_clip * clip;
+    let world_pos = world.xyz / world.w;
+    let view_distance = -(view.view_from_world * vec4<f32>(world_pos, 1.0)).z;
+    let cluster = cluster_index(cluster_params, in.position.xy, view_distance);
+    let dims = cluster_params.dims;
+    var color = vec3<f32>(0.0);
+    if debug.mode == DEBUG_LIGHT_COUNT {
+        let n = cluster_ranges[cluster].y;
+        color = select(heat(f32(n) / f32(max(debug.scale_max, 1u))), vec3<f32>(0.0), n == 0u);
+    } else if debug.mode == DEBUG_SLICE_X {
+        color = index_color(cluster % dims.x);
+    } else if debug.mode == DEBUG_SLICE_Y {
+        color = index_color((cluster / dims.x) % dims.y);
+    } else {
+        color = index_color(cluster / (dims.x * dims.y));
+    }
+    return vec4<f32>(color, 1.0);
+}

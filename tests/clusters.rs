@@ -1,0 +1,223 @@
+//! GPU light assignment against the CPU reference, light for light, on ordinary and hard
+//! scenes; the per-cluster cap; growth of the light-index list. Real device (lavapipe in CI).
+
+mod support;
+
+use glam::{Mat4, UVec2, Vec3};
+use manylight::app::render_world::HeadlessRenderer;
+use manylight::core::Projection;
+use manylight::core::cluster::{ClusterAssignment, CullTest, GridConfig, ZSlicing, assign_lights};
+use manylight::prelude::*;
+use manylight::render::{
+    ClusterSettings, ExtractedCamera, ExtractedInstance, ExtractedPointLight, FrameReport, FrameSettings,
+    FrameSnapshot,
+};
+use support::gpu;
+
+fn scene_snapshot(
+    scene: &Scene,
+    size: UVec2,
+    lights: Vec<ExtractedPointLight>,
+    settings: FrameSettings,
+) -> FrameSnapshot {
+    let cam = scene.camera_or_fit(size.x as f32 / size.y as f32);
+    FrameSnapshot {
+        frame_index: 0,
+        viewport: size,
+        camera: Some(ExtractedCamera {
+            world_from_view: cam.transform,
+            projection: cam.projection,
+            prev_clip_from_world: None,
+        }),
+        instances: scene
+            .instances
+            .iter()
+            .map(|i| ExtractedInstance {
+                mesh: scene.meshes[i.mesh].clone(),
+                material: scene.materials[i.material].clone(),
+                world_from_local: i.transform,
+            })
+            .collect(),
+        lights,
+        settings,
+    }
+}
+
+fn rig(scene: &Scene, count: usize, seed: u64) -> Vec<ExtractedPointLight> {
+    manylight::scene::light_rig(count, scene.bounds(), seed)
+        .iter()
+        .map(|a| {
+            let l = a.at(0.0);
+            ExtractedPointLight {
+                position: l.position,
+                color: l.color,
+                intensity: l.intensity,
+                radius: l.radius,
+            }
+        })
+        .collect()
+}
+
+fn light(position: Vec3, radius: f32) -> ExtractedPointLight {
+    ExtractedPointLight { position, color: Vec3::ONE, intensity: 1.0, radius }
+}
+
+fn clustered(cull: CullTest, slicing: ZSlicing, cap: Option<u32>) -> FrameSettings {
+    FrameSettings {
+        pipeline: PipelineKind::ClusteredForward,
+        clusters: ClusterSettings {
+            grid: GridConfig { slicing, ..GridConfig::default() },
+            cull,
+            cap,
+            ..ClusterSettings::default()
+        },
+        ..FrameSettings::default()
+    }
+}
+
+/// Renders the snapshot and returns the report, the GPU assignment and the CPU reference.
+fn gpu_and_cpu(
+    r: &mut HeadlessRenderer,
+    snapshot: FrameSnapshot,
+) -> (FrameReport, ClusterAssignment, ClusterAssignment) {
+    let settings = snapshot.settings;
+    let (report, _) = r.render(snapshot, false).expect("renders");
+    let renderer = r.render_world.renderer();
+    let clusters = renderer.clusters.as_ref().expect("the frame built clusters");
+    let gpu = clusters.read_assignment(&renderer.gpu).expect("readback");
+    let cpu =
+        assign_lights(&clusters.grid, &clusters.view_spheres, settings.clusters.cull, settings.clusters.cap);
+    (report, gpu, cpu)
+}
+
+fn assert_same_lists(what: &str, gpu: &ClusterAssignment, cpu: &ClusterAssignment) {
+    assert_eq!(gpu.ranges.len(), cpu.ranges.len(), "{what}: cluster count");
+    for c in 0..cpu.ranges.len() as u32 {
+        let mut g = gpu.lights_of(c).to_vec();
+        let mut e = cpu.lights_of(c).to_vec();
+        g.sort_unstable();
+        e.sort_unstable();
+        assert_eq!(g, e, "{what}: cluster {c} differs");
+    }
+    assert_eq!(gpu.dropped_pairs, cpu.dropped_pairs, "{what}: dropped pairs");
+    assert_eq!(gpu.clusters_overflowed, cpu.clusters_overflowed, "{what}: overflowed clusters");
+}
+
+#[test]
+fn gpu_lists_equal_the_cpu_reference_on_ordinary_scenes() {
+    let _gpu = gpu();
+    let mut r = HeadlessRenderer::new().expect("adapter");
+    let scene = default_scene();
+    let size = UVec2::new(200, 120);
+    for (cull, slicing) in [
+        (CullTest::Planes, ZSlicing::Exponential),
+        (CullTest::Aabb, ZSlicing::Exponential),
+        (CullTest::Planes, ZSlicing::Linear),
+        (CullTest::Aabb, ZSlicing::Linear),
+    ] {
+        let snap = scene_snapshot(&scene, size, rig(&scene, 300, 3), clustered(cull, slicing, None));
+        let (report, gpu, cpu) = gpu_and_cpu(&mut r, snap);
+        let what = format!("{cull:?}/{slicing:?}");
+        assert!(
+            report.clusters.as_ref().is_some_and(|c| c.total_entries > 0),
+            "{what}: lights were assigned"
+        );
+        assert_same_lists(&what, &gpu, &cpu);
+        assert_eq!(cpu.dropped_pairs, 0, "{what}: exact mode drops nothing");
+    }
+    // Forward+: one slice.
+    let mut settings = clustered(CullTest::Planes, ZSlicing::Exponential, None);
+    settings.pipeline = PipelineKind::ForwardPlus;
+    let (report, gpu, cpu) = gpu_and_cpu(&mut r, scene_snapshot(&scene, size, rig(&scene, 300, 4), settings));
+    assert_eq!(report.clusters.as_ref().map(|c| c.dims[2]), Some(1));
+    assert_same_lists("forward+", &gpu, &cpu);
+}
+
+#[test]
+fn gpu_lists_equal_the_cpu_reference_on_hard_cases() {
+    let _gpu = gpu();
+    let mut r = HeadlessRenderer::new().expect("adapter");
+    let scene = default_scene();
+    let size = UVec2::new(160, 96);
+    let cam = scene.camera_or_fit(size.x as f32 / size.y as f32);
+    let eye = cam.transform.w_axis.truncate();
+    let forward = -cam.transform.z_axis.truncate().normalize();
+    let right = cam.transform.x_axis.truncate().normalize();
+    let up = cam.transform.y_axis.truncate().normalize();
+    let at = |d: f32, x: f32, y: f32| eye + forward * d + right * x + up * y;
+    let hard = vec![
+        light(eye, 2.0),                 // contains the camera
+        light(eye - forward * 1.0, 1.5), // behind the camera, reaching forward
+        light(eye - forward * 5.0, 1.0), // behind the camera, touching nothing
+        light(at(0.1, 0.0, 0.0), 0.5),   // straddles the near plane
+        light(at(5.0, 0.0, 0.0), 0.0),   // radius 0
+        light(at(5.0, 0.0, 0.0), 1.0e4), // covers the whole view
+        light(at(8.0, 0.0, 0.0), 0.25),  // on the central tile planes
+        light(at(199.0, 0.0, 0.0), 3.0), // straddles the far plane
+        light(at(3.0, 1.0, 0.5), 1e-3),  // tiny
+    ];
+    for cull in [CullTest::Planes, CullTest::Aabb] {
+        let snap = scene_snapshot(&scene, size, hard.clone(), clustered(cull, ZSlicing::Exponential, None));
+        let (_, gpu, cpu) = gpu_and_cpu(&mut r, snap);
+        assert_same_lists(&format!("hard cases {cull:?}"), &gpu, &cpu);
+        // The covering light is in every cluster; the radius-0 light in none.
+        for c in 0..cpu.ranges.len() as u32 {
+            assert!(cpu.lights_of(c).contains(&5), "cluster {c} misses the covering light");
+            assert!(!cpu.lights_of(c).contains(&4), "cluster {c} has the radius-0 light");
+        }
+    }
+
+    // Extreme near/far with exponential slicing, lights on the slice boundaries.
+    let mut scene = default_scene();
+    scene.cameras = vec![manylight::scene::SceneCamera {
+        transform: cam.transform,
+        projection: Projection { fov_y: 1.0, near: 1e-4, far: 1e6 },
+    }];
+    let mut lights = Vec::new();
+    for k in 0..24 {
+        let d = 1e-4 * (1e10f32).powf(k as f32 / 24.0);
+        lights.push(light(at(d.min(5e5), 0.0, 0.0), d.min(5e5) * 0.01));
+    }
+    let snap = scene_snapshot(&scene, size, lights, clustered(CullTest::Planes, ZSlicing::Exponential, None));
+    let (report, gpu, cpu) = gpu_and_cpu(&mut r, snap);
+    assert_same_lists("near 1e-4, far 1e6", &gpu, &cpu);
+    assert!(report.clusters.is_some());
+}
+
+#[test]
+fn a_cap_drops_deterministically_and_is_counted() {
+    let _gpu = gpu();
+    let mut r = HeadlessRenderer::new().expect("adapter");
+    let scene = default_scene();
+    let size = UVec2::new(160, 96);
+    let snap = scene_snapshot(
+        &scene,
+        size,
+        rig(&scene, 400, 5),
+        clustered(CullTest::Planes, ZSlicing::Exponential, Some(2)),
+    );
+    let (report, gpu, cpu) = gpu_and_cpu(&mut r, snap);
+    assert_same_lists("cap 2", &gpu, &cpu);
+    let c = report.clusters.expect("cluster report");
+    assert!(c.dropped_pairs > 0 && c.clusters_overflowed > 0, "{c:?}");
+    assert_eq!(c.dropped_pairs, cpu.dropped_pairs);
+}
+
+#[test]
+fn the_index_list_grows_instead_of_truncating() {
+    let _gpu = gpu();
+    let mut r = HeadlessRenderer::new().expect("adapter");
+    let scene = default_scene();
+    let size = UVec2::new(640, 384);
+    // Large lights: tens of thousands of light-cluster pairs, beyond the initial capacity.
+    let lights: Vec<_> =
+        rig(&scene, 600, 6).into_iter().map(|l| ExtractedPointLight { radius: 12.0, ..l }).collect();
+    let snap = scene_snapshot(&scene, size, lights, clustered(CullTest::Aabb, ZSlicing::Exponential, None));
+    let (report, gpu, cpu) = gpu_and_cpu(&mut r, snap);
+    let c = report.clusters.expect("cluster report");
+    assert!(c.total_entries > 1 << 16, "the scene must outgrow the initial list: {c:?}");
+    assert!(c.regrows >= 1, "{c:?}");
+    assert_eq!(c.dropped_pairs, 0);
+    assert_same_lists("grown", &gpu, &cpu);
+    let _ = Mat4::IDENTITY;
+}

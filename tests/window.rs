@@ -1,0 +1,416 @@
+//! Opens a real window (on its own Xvfb server when no display is set) and drives it through
+//! [`WindowRequests`]: resizes, a storm of resizes, minimising (0×0), resizing while minimised,
+//! restoring, then closing while a frame is in flight. Checks that every size was really
+//! rendered, that the app exits with success, that nothing panicked and that the render thread
+//! is gone when `App::run` returns.
+//!
+//! winit allows one event loop per process, so everything is one `#[test]`: it drives a
+//! pipelined window (render thread) itself, then runs itself again in a child process for a
+//! synchronous one (surface on the main thread).
+//!
+//! Without a display and without `Xvfb` the test says so loudly and passes, unless `CI=true`,
+//! where it fails.
+
+use manylight::app::ViewportSize;
+use manylight::app::window::{WindowConfig, WindowRequests};
+use manylight::prelude::*;
+use std::path::PathBuf;
+use std::process::{Child, Command, Stdio};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// Seconds one step of the script may take before the test gives up.
+const STEP_TIMEOUT: Duration = Duration::from_secs(20);
+/// The whole test aborts after this (a hung event loop must not hang CI).
+const WATCHDOG: Duration = Duration::from_secs(150);
+/// Set in the child process that runs the synchronous mode.
+const MODE_VAR: &str = "MANYLIGHT_WINDOW_TEST_MODE";
+/// Updates the app must stay minimised with a 0×0 viewport.
+const MINIMISED_UPDATES: u32 = 10;
+
+/// An Xvfb server this test started; killed on drop.
+struct Xvfb {
+    child: Child,
+    display: u32,
+}
+
+impl Drop for Xvfb {
+    fn drop(&mut self) {
+        // SIGTERM lets Xvfb remove its socket and lock file; SIGKILL only if it does not stop.
+        let _ = Command::new("kill").args(["-TERM", &self.child.id().to_string()]).status();
+        let deadline = Instant::now() + Duration::from_secs(3);
+        while Instant::now() < deadline && !matches!(self.child.try_wait(), Ok(Some(_))) {
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+        let _ = std::fs::remove_file(format!("/tmp/.X11-unix/X{}", self.display));
+        let _ = std::fs::remove_file(format!("/tmp/.X{}-lock", self.display));
+    }
+}
+
+/// Starts `Xvfb :N` on the first free display number. `Err` when Xvfb cannot be run at all.
+fn start_xvfb() -> Result<Xvfb, String> {
+    for display in 90..140u32 {
+        let socket = PathBuf::from(format!("/tmp/.X11-unix/X{display}"));
+        let lock = PathBuf::from(format!("/tmp/.X{display}-lock"));
+        if socket.exists() || lock.exists() {
+            continue;
+        }
+        let child = Command::new("Xvfb")
+            .arg(format!(":{display}"))
+            .args(["-screen", "0", "1280x1024x24", "-nolisten", "tcp"])
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn();
+        let mut child = match child {
+            Ok(c) => c,
+            Err(e) => return Err(format!("cannot run Xvfb: {e}")),
+        };
+        let start = Instant::now();
+        while start.elapsed() < Duration::from_secs(10) {
+            if socket.exists() {
+                return Ok(Xvfb { child, display });
+            }
+            if let Ok(Some(_)) = child.try_wait() {
+                break; // lost a race for this display number: try the next one
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let _ = child.kill();
+        let _ = child.wait();
+    }
+    Err("Xvfb did not start on any display from :90 to :139".into())
+}
+
+/// A unit cube with flat normals (24 vertices).
+fn cube() -> MeshData {
+    let mut positions = Vec::new();
+    let mut normals = Vec::new();
+    let mut indices = Vec::new();
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            let mut n = Vec3::ZERO;
+            n[axis] = sign;
+            let u = Vec3::from_array(std::array::from_fn(|i| if i == (axis + 1) % 3 { 1.0 } else { 0.0 }));
+            let v = n.cross(u);
+            let base = positions.len() as u32;
+            for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                positions.push((n + u * a + v * b) * 0.5);
+                normals.push(n);
+            }
+            indices.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+        }
+    }
+    match MeshData::from_attributes("test_cube", &positions, Some(&normals), None, Some(indices)) {
+        Ok(m) => m,
+        Err(e) => panic!("the test cube is invalid: {e}"),
+    }
+}
+
+/// A floor, four boxes, eight coloured lights and a camera.
+fn spawn_small_scene(mut commands: Commands) {
+    let mesh = Arc::new(cube());
+    let material = Arc::new(MaterialData::default());
+    let mut floor = Transform::from_xyz(0.0, -0.05, 0.0);
+    floor.scale = Vec3::new(8.0, 0.1, 8.0);
+    commands.spawn((floor, Mesh3d(mesh.clone()), Material(material.clone())));
+    for (x, z) in [(-1.5, -1.5), (1.5, -1.5), (-1.5, 1.5), (1.5, 1.5)] {
+        commands.spawn((Transform::from_xyz(x, 0.5, z), Mesh3d(mesh.clone()), Material(material.clone())));
+    }
+    for i in 0..8 {
+        let a = i as f32 / 8.0 * std::f32::consts::TAU;
+        let color = Vec3::new(0.5 + 0.5 * a.cos(), 0.5 + 0.5 * a.sin(), 0.6);
+        commands.spawn((
+            Transform::from_xyz(3.0 * a.cos(), 1.5, 3.0 * a.sin()),
+            PointLight { color, intensity: 4.0, radius: 6.0 },
+        ));
+    }
+    commands.spawn((Transform::from_xyz(0.0, 4.0, 7.0).looking_at(Vec3::ZERO, Vec3::Y), Camera3d::default()));
+}
+
+/// One step of the script.
+#[derive(Clone, Copy, Debug)]
+enum Step {
+    /// Ask for a size (no waiting).
+    Resize(u32, u32),
+    /// Ask to minimise or restore (no waiting).
+    Minimize(bool),
+    /// Wait until a frame of this size was really rendered.
+    Rendered(u32, u32),
+    /// Wait until the viewport has been 0×0 for [`MINIMISED_UPDATES`] updates.
+    StayMinimised,
+    /// Ask to close.
+    Close,
+}
+
+const SCRIPT: &[Step] = &[
+    Step::Rendered(320, 240),
+    Step::Resize(400, 300),
+    Step::Rendered(400, 300),
+    // A storm: a new size every update, only the last one needs to show.
+    Step::Resize(200, 150),
+    Step::Resize(480, 360),
+    Step::Resize(256, 192),
+    Step::Resize(360, 270),
+    Step::Rendered(360, 270),
+    Step::Minimize(true),
+    Step::StayMinimised,
+    // Resize while minimised: the restore must configure the surface for the new size.
+    Step::Resize(300, 200),
+    Step::StayMinimised,
+    Step::Minimize(false),
+    Step::Rendered(300, 200),
+    Step::Minimize(true),
+    Step::StayMinimised,
+    Step::Minimize(false),
+    Step::Rendered(300, 200),
+    Step::Resize(320, 240),
+    Step::Rendered(320, 240),
+    Step::Close,
+];
+
+/// What the script saw, read by the test after `App::run` returns.
+#[derive(Debug, Default)]
+struct Log {
+    /// Index of the step reached.
+    step: usize,
+    /// `Some` when a step timed out.
+    failure: Option<String>,
+    /// Frames really rendered (with passes), by size.
+    rendered: Vec<(u32, u32)>,
+    /// Updates seen with a 0×0 viewport.
+    minimised_updates: u32,
+    /// Frames the sink got with a 0×0 viewport (and skipped).
+    zero_sized_frames: u32,
+    /// `FrameStats::frames_rendered` at the close request.
+    frames_rendered: u64,
+    /// When the close was requested.
+    close_requested: Option<Instant>,
+}
+
+#[derive(Default)]
+struct ScriptState {
+    step: usize,
+    step_started: Option<Instant>,
+    minimised_updates: u32,
+    last_seen_frame: Option<u64>,
+}
+
+fn run_script(
+    log: &Mutex<Log>,
+    state: &mut ScriptState,
+    viewport: &ViewportSize,
+    stats: &FrameStats,
+    requests: &mut WindowRequests,
+    exit: &mut MessageWriter<AppExit>,
+) {
+    let Ok(mut log) = log.lock() else {
+        exit.write(AppExit::error());
+        return;
+    };
+    // Record each newly finished frame once.
+    let minimised = viewport.0.min_element() == 0;
+    if let Some(report) = &stats.last
+        && state.last_seen_frame != Some(report.frame_index)
+    {
+        state.last_seen_frame = Some(report.frame_index);
+        if report.width == 0 || report.height == 0 {
+            log.zero_sized_frames += 1;
+            assert!(report.passes.is_empty(), "a 0×0 frame ran passes");
+        } else if !report.passes.is_empty() {
+            log.rendered.push((report.width, report.height));
+        }
+    }
+    if minimised {
+        log.minimised_updates += 1;
+    }
+    let Some(&step) = SCRIPT.get(state.step) else {
+        return;
+    };
+    let started = *state.step_started.get_or_insert_with(Instant::now);
+    let done = match step {
+        Step::Resize(w, h) => {
+            requests.request_resize(UVec2::new(w, h));
+            true
+        }
+        Step::Minimize(m) => {
+            requests.request_minimize(m);
+            state.minimised_updates = 0;
+            true
+        }
+        Step::Rendered(w, h) => stats.last.as_ref().is_some_and(|r| {
+            (r.width, r.height) == (w, h) && !r.passes.is_empty() && viewport.0 == UVec2::new(w, h)
+        }),
+        Step::StayMinimised => {
+            if minimised {
+                state.minimised_updates += 1;
+            }
+            let done = state.minimised_updates >= MINIMISED_UPDATES;
+            if done {
+                state.minimised_updates = 0;
+            }
+            done
+        }
+        Step::Close => {
+            requests.request_close();
+            log.frames_rendered = stats.frames_rendered;
+            log.close_requested = Some(Instant::now());
+            true
+        }
+    };
+    if done {
+        state.step += 1;
+        state.step_started = None;
+        log.step = state.step;
+    } else if started.elapsed() > STEP_TIMEOUT {
+        log.failure = Some(format!(
+            "step {} {step:?} did not finish in {STEP_TIMEOUT:?} (viewport {:?}, last frame {:?})",
+            state.step,
+            viewport.0,
+            stats.last.as_ref().map(|r| (r.width, r.height, r.passes.len()))
+        ));
+        exit.write(AppExit::error());
+    }
+}
+
+/// Names of this process's threads (Linux), to check the render thread is gone.
+fn thread_names() -> Vec<String> {
+    let Ok(dir) = std::fs::read_dir("/proc/self/task") else {
+        return Vec::new();
+    };
+    dir.filter_map(|e| e.ok())
+        .filter_map(|e| std::fs::read_to_string(e.path().join("comm")).ok())
+        .map(|s| s.trim().to_string())
+        .collect()
+}
+
+#[test]
+fn window_resize_minimise_close() {
+    let ci = std::env::var("CI").is_ok_and(|v| v == "true" || v == "1");
+    let has_display = std::env::var_os("DISPLAY").is_some_and(|d| !d.is_empty())
+        || std::env::var_os("WAYLAND_DISPLAY").is_some_and(|d| !d.is_empty());
+    let _xvfb = if has_display {
+        None
+    } else {
+        match start_xvfb() {
+            Ok(x) => {
+                // SAFETY: set before any other thread of this test binary reads the environment
+                // (the event loop and the renderer start below); this file has one test.
+                unsafe { std::env::set_var("DISPLAY", format!(":{}", x.display)) };
+                Some(x)
+            }
+            Err(e) if ci => panic!("CI=true but no display and {e}: install Xvfb (package xvfb)"),
+            Err(e) => {
+                eprintln!(
+                    "\n\n*** SKIPPING the window test: no DISPLAY and {e}. Install Xvfb to run it. ***\n"
+                );
+                return;
+            }
+        }
+    };
+    // Stops a hung event loop from hanging the test run (the Xvfb child dies with the guard
+    // only on a normal exit, so kill it here too).
+    let xvfb_pid = _xvfb.as_ref().map(|x| x.child.id());
+    std::thread::spawn(move || {
+        std::thread::sleep(WATCHDOG);
+        eprintln!("window test: still running after {WATCHDOG:?}, aborting");
+        if let Some(pid) = xvfb_pid {
+            let _ = Command::new("kill").arg(pid.to_string()).status();
+        }
+        std::process::exit(101);
+    });
+
+    // winit allows one event loop per process: the pipelined mode runs here, the synchronous
+    // one (surface on the main thread) in a child process running this test alone.
+    let child = std::env::var(MODE_VAR).is_ok_and(|m| m == "sync");
+    drive_window(!child);
+    if !child {
+        let exe = match std::env::current_exe() {
+            Ok(e) => e,
+            Err(e) => panic!("cannot find the test executable: {e}"),
+        };
+        let status = Command::new(exe)
+            .args(["--exact", "window_resize_minimise_close", "--nocapture", "--test-threads=1"])
+            .env(MODE_VAR, "sync")
+            .status();
+        assert!(status.as_ref().is_ok_and(|s| s.success()), "the synchronous run failed: {status:?}");
+    }
+}
+
+/// Runs the script in a window, rendering on a render thread (`pipelined`) or on the main
+/// thread, and checks what it saw.
+fn drive_window(pipelined: bool) {
+    let panics = Arc::new(AtomicUsize::new(0));
+    let default_hook = std::panic::take_hook();
+    let counter = panics.clone();
+    std::panic::set_hook(Box::new(move |info| {
+        counter.fetch_add(1, Ordering::SeqCst);
+        default_hook(info);
+    }));
+
+    let log = Arc::new(Mutex::new(Log::default()));
+    let script_log = log.clone();
+    let config = WindowConfig {
+        title: "manylight window test".into(),
+        width: 320,
+        height: 240,
+        vsync: false,
+        any_thread: true,
+    };
+    let started = Instant::now();
+    let exit = App::new()
+        .add_plugins(ManyLightPlugin::window(config).with_pipelined(pipelined))
+        .add_systems(Startup, spawn_small_scene)
+        .add_systems(
+            Update,
+            move |mut state: Local<ScriptState>,
+                  viewport: Res<ViewportSize>,
+                  stats: Res<FrameStats>,
+                  mut requests: ResMut<WindowRequests>,
+                  mut exit: MessageWriter<AppExit>| {
+                run_script(&script_log, &mut state, &viewport, &stats, &mut requests, &mut exit);
+            },
+        )
+        .run();
+    let returned = Instant::now();
+    let elapsed = started.elapsed();
+
+    let log = match log.lock() {
+        Ok(l) => l,
+        Err(e) => panic!("script log poisoned: {e}"),
+    };
+    eprintln!(
+        "window test ({}): {elapsed:.1?}, exit {exit:?}, {} frames, steps {}/{}, {} updates minimised, \
+         close took {:?}, {} zero-sized frames, rendered sizes {:?}",
+        if pipelined { "pipelined" } else { "synchronous" },
+        log.frames_rendered,
+        log.step,
+        SCRIPT.len(),
+        log.minimised_updates,
+        log.close_requested.map(|c| returned - c),
+        log.zero_sized_frames,
+        {
+            let mut sizes = log.rendered.clone();
+            sizes.dedup();
+            sizes
+        }
+    );
+    assert_eq!(log.failure, None, "the script failed");
+    assert!(exit.is_success(), "the app exited with {exit:?}");
+    assert_eq!(log.step, SCRIPT.len(), "the script did not finish");
+    assert!(log.frames_rendered > 0, "no frame was rendered");
+    for size in [(320, 240), (400, 300), (360, 270), (300, 200)] {
+        assert!(log.rendered.contains(&size), "no frame rendered at {size:?}: {:?}", log.rendered);
+    }
+    assert!(log.minimised_updates >= 3 * MINIMISED_UPDATES, "too few minimised updates");
+    assert!(log.zero_sized_frames > 0, "no 0×0 frame reached the renderer while minimised");
+    assert_eq!(panics.load(Ordering::SeqCst), 0, "a thread panicked");
+    let render_threads = thread_names().iter().filter(|n| n.starts_with("manylight-rend")).count();
+    assert_eq!(render_threads, 0, "the render thread outlived App::run");
+    if let Some(closing) = log.close_requested {
+        assert!(returned - closing < Duration::from_secs(10), "closing took {:?}", returned - closing);
+    }
+}
