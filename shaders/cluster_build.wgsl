@@ -35,7 +35,10 @@ fn touches(cluster: u32, light: u32) -> bool {
     if params.cull_test == CULL_AABB {
         return sphere_intersects_aabb(s.xyz, s.w, b.aabb_min.xyz, b.aabb_max.xyz);
     }
-    return sphere_intersects_planes(s.xyz, s.w, b);
+    if params.cull_test == CULL_PLANES {
+        return sphere_intersects_planes(s.xyz, s.w, b);
+    }
+    return sphere_intersects_aabb(s.xyz, s.w, b.aabb_min.xyz, b.aabb_max.xyz) && sphere_intersects_planes(s.xyz, s.w, b);
 }
 
 @compute @workgroup_size(WORKGROUP_SIZE)

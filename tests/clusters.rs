@@ -110,6 +110,7 @@ fn gpu_lists_equal_the_cpu_reference_on_ordinary_scenes() {
     let scene = default_scene();
     let size = UVec2::new(200, 120);
     for (cull, slicing) in [
+        (CullTest::Both, ZSlicing::Exponential),
         (CullTest::Planes, ZSlicing::Exponential),
         (CullTest::Aabb, ZSlicing::Exponential),
         (CullTest::Planes, ZSlicing::Linear),
@@ -156,7 +157,7 @@ fn gpu_lists_equal_the_cpu_reference_on_hard_cases() {
         light(at(199.0, 0.0, 0.0), 3.0), // straddles the far plane
         light(at(3.0, 1.0, 0.5), 1e-3),  // tiny
     ];
-    for cull in [CullTest::Planes, CullTest::Aabb] {
+    for cull in CullTest::ALL {
         let snap = scene_snapshot(&scene, size, hard.clone(), clustered(cull, ZSlicing::Exponential, None));
         let (_, gpu, cpu) = gpu_and_cpu(&mut r, snap);
         assert_same_lists(&format!("hard cases {cull:?}"), &gpu, &cpu);
@@ -220,4 +221,34 @@ fn the_index_list_grows_instead_of_truncating() {
     assert_eq!(c.dropped_pairs, 0);
     assert_same_lists("grown", &gpu, &cpu);
     let _ = Mat4::IDENTITY;
+}
+
+#[test]
+fn culling_efficiency_finds_no_missing_light_and_clusters_beat_tiles() {
+    use manylight::core::efficiency::culling_efficiency;
+    let _gpu = gpu();
+    let mut r = HeadlessRenderer::new().expect("adapter");
+    let scene = default_scene();
+    let size = UVec2::new(160, 96);
+    let mut ratios = Vec::new();
+    for pipeline in [PipelineKind::ClusteredForward, PipelineKind::ForwardPlus] {
+        let mut settings = clustered(CullTest::Both, ZSlicing::Exponential, None);
+        settings.pipeline = pipeline;
+        let snap = scene_snapshot(&scene, size, rig(&scene, 256, 9), settings);
+        let projection = snap.camera.expect("camera").projection;
+        r.render(snap, false).expect("renders");
+        let renderer = r.render_world.renderer();
+        let clusters = renderer.clusters.as_ref().expect("clusters");
+        let assignment = clusters.read_assignment(&renderer.gpu).expect("lists");
+        let (w, h, depth) = renderer.read_depth().expect("readback").expect("depth");
+        assert_eq!((w, h), (size.x, size.y));
+        // Check every pixel against every light: nothing that lights a pixel may be missing.
+        let e =
+            culling_efficiency(&clusters.grid, &projection, &assignment, &clusters.view_spheres, &depth, 1);
+        assert!(e.pixels > 0 && e.contributing_pairs > 0, "{e:?}");
+        assert_eq!(e.missed_pairs, 0, "{pipeline:?}: a contributing light is missing from a list: {e:?}");
+        assert!(e.ratio() >= 1.0);
+        ratios.push(e.ratio());
+    }
+    assert!(ratios[0] < ratios[1], "depth slices must cut evaluated pairs: {ratios:?}");
 }

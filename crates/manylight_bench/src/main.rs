@@ -16,6 +16,9 @@ use manylight_scene::{LoadOptions, Scene, load_scene};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+mod bench;
+mod direct;
+
 #[derive(Parser)]
 #[command(name = "manylight", version, about = "Many-light rendering with wgpu: render, check, bench")]
 struct Cli {
@@ -32,6 +35,41 @@ enum Command {
         /// The .gltf or .glb file.
         path: PathBuf,
     },
+    /// Sweep pipelines × light counts at one size and write the timings as CSV.
+    Bench(BenchArgs),
+}
+
+#[derive(clap::Args)]
+struct BenchArgs {
+    /// `default`, `sphere-shell` or a .gltf/.glb path.
+    #[arg(long, default_value = "default")]
+    scene: String,
+    /// Comma-separated pipelines.
+    #[arg(long, value_delimiter = ',', default_value = "naive,forward-plus,clustered-forward", value_parser = parse_pipeline)]
+    pipelines: Vec<PipelineKind>,
+    /// Comma-separated rig light counts.
+    #[arg(long, value_delimiter = ',', default_value = "16,64,256,1024,4096,16384")]
+    lights: Vec<usize>,
+    /// Image size, WxH.
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    size: UVec2,
+    /// Frames measured per configuration (the median is reported).
+    #[arg(long, default_value_t = 3)]
+    frames: u32,
+    /// Frames rendered first and not measured (pipeline creation, uploads).
+    #[arg(long, default_value_t = 1)]
+    warmup: u32,
+    /// Skip naive forward above this many lights (it costs seconds per frame on a CPU).
+    #[arg(long, default_value_t = 1024)]
+    naive_max_lights: usize,
+    /// Also measure each tiled/clustered configuration's culling efficiency.
+    #[arg(long)]
+    culling_efficiency: bool,
+    #[command(flatten)]
+    clusters: ClusterArgs,
+    /// CSV output.
+    #[arg(long)]
+    out: PathBuf,
 }
 
 #[derive(clap::Args)]
@@ -72,13 +110,17 @@ struct RenderArgs {
     /// Write the last frame's statistics as JSON here.
     #[arg(long)]
     stats_json: Option<PathBuf>,
+    /// Measure the culling efficiency of the last frame: light-pixel pairs evaluated ÷ pairs
+    /// with a non-zero contribution (CPU reference over the depth buffer read back).
+    #[arg(long)]
+    culling_efficiency: bool,
 }
 
 /// Light-assignment options of the tiled and clustered pipelines.
 #[derive(clap::Args, Clone, Debug)]
 struct ClusterArgs {
-    /// Sphere–cluster test: aabb or planes.
-    #[arg(long, default_value = "planes", value_parser = parse_cull)]
+    /// Sphere–cluster test: aabb, planes or both (both must accept; the tightest).
+    #[arg(long, default_value = "both", value_parser = parse_cull)]
     cull: CullTest,
     /// Depth slicing: linear or exponential.
     #[arg(long, default_value = "exponential", value_parser = parse_slicing)]
@@ -113,7 +155,8 @@ impl ClusterArgs {
 }
 
 fn parse_cull(s: &str) -> Result<CullTest, String> {
-    CullTest::from_name(s).ok_or_else(|| format!("unknown culling test `{s}` (expected aabb or planes)"))
+    CullTest::from_name(s)
+        .ok_or_else(|| format!("unknown culling test `{s}` (expected aabb, planes or both)"))
 }
 
 fn parse_slicing(s: &str) -> Result<ZSlicing, String> {
@@ -215,6 +258,31 @@ fn stats_json(stats: &FrameStats) -> serde_json::Value {
 fn render(args: RenderArgs) -> Result<()> {
     let mut scene = load_scene(&args.scene, &LoadOptions::default())?;
     select_camera(&mut scene, &args.camera)?;
+    let culling = if args.culling_efficiency {
+        let rig = manylight_scene::light_rig(args.lights, scene.bounds(), args.seed);
+        let t = args.frames.max(1).saturating_sub(1) as f32 / 60.0;
+        let settings = manylight_render::FrameSettings {
+            pipeline: args.pipeline,
+            shading: args.shading,
+            clusters: args.clusters.settings(),
+            ..Default::default()
+        };
+        let snap = direct::snapshot(&scene, &rig, t, args.size, settings, 0);
+        let mut renderer = manylight_app::render_world::HeadlessRenderer::new()?;
+        let (_, eff) = direct::measure_culling(&mut renderer, snap)?;
+        println!(
+            "culling efficiency: {} light-pixel pairs evaluated, {} contributing: {:.3}x \
+             ({} sampled pixels, {} contributing pairs missing from the lists)",
+            eff.evaluated_pairs,
+            eff.contributing_pairs,
+            eff.ratio(),
+            eff.sampled_pixels,
+            eff.missed_pairs
+        );
+        Some(eff)
+    } else {
+        None
+    };
     let settings = RenderSettings {
         pipeline: args.pipeline,
         shading: args.shading,
@@ -226,7 +294,18 @@ fn render(args: RenderArgs) -> Result<()> {
     let (image, stats) = render_scene(scene, args.size, args.frames, args.lights, args.seed, settings)?;
     save_png(&image, &args.out).map_err(anyhow::Error::msg)?;
     if let Some(path) = &args.stats_json {
-        let text = serde_json::to_string_pretty(&stats_json(&stats))?;
+        let mut json = stats_json(&stats);
+        if let Some(e) = culling {
+            json["culling_efficiency"] = serde_json::json!({
+                "pixels": e.pixels,
+                "evaluated_pairs": e.evaluated_pairs,
+                "contributing_pairs": e.contributing_pairs,
+                "ratio": e.ratio(),
+                "sampled_pixels": e.sampled_pixels,
+                "missed_pairs": e.missed_pairs,
+            });
+        }
+        let text = serde_json::to_string_pretty(&json)?;
         std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))?;
     }
     if let Some(r) = &stats.last {
@@ -269,6 +348,31 @@ fn check(path: PathBuf) -> Result<()> {
     Ok(())
 }
 
+fn bench_cmd(args: BenchArgs) -> Result<()> {
+    let scene = load_scene(&args.scene, &LoadOptions::default())?;
+    let sweep = bench::Sweep {
+        pipelines: args.pipelines,
+        lights: args.lights,
+        size: args.size,
+        warmup: args.warmup,
+        frames: args.frames.max(1),
+        naive_max_lights: args.naive_max_lights,
+        culling_efficiency: args.culling_efficiency,
+        settings: manylight_render::FrameSettings {
+            clusters: args.clusters.settings(),
+            ..Default::default()
+        },
+    };
+    let csv = bench::run(&scene, &sweep)?;
+    if let Some(parent) = args.out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent).with_context(|| format!("cannot create {}", parent.display()))?;
+    }
+    std::fs::write(&args.out, &csv).with_context(|| format!("cannot write {}", args.out.display()))?;
+    print!("{csv}");
+    eprintln!("wrote {}", args.out.display());
+    Ok(())
+}
+
 fn main() -> ExitCode {
     tracing_subscriber::fmt()
         .with_env_filter(
@@ -281,6 +385,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => render(args),
         Command::Check { path } => check(path),
+        Command::Bench(args) => bench_cmd(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -113,3 +113,32 @@ fn bad_arguments_are_refused_with_a_message() {
         assert!(!out.stderr.is_empty(), "{args:?} said nothing");
     }
 }
+
+#[test]
+fn bench_writes_a_csv_row_per_configuration() {
+    let _gpu = GPU.lock().unwrap_or_else(|e| e.into_inner());
+    let csv = root().join("target/cli-tests/bench.csv");
+    let out = manylight(&[
+        "bench",
+        "--lights",
+        "8,32",
+        "--size",
+        "96x64",
+        "--frames",
+        "1",
+        "--warmup",
+        "0",
+        "--culling-efficiency",
+        "--out",
+        csv.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(&csv).expect("csv");
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 1 + 6, "header + 3 pipelines x 2 light counts:\n{text}");
+    assert!(lines[0].starts_with("adapter,pipeline,lights,"));
+    assert!(lines.iter().any(|l| l.contains(",clustered-forward,32,")));
+    let clustered = lines.iter().find(|l| l.contains(",clustered-forward,32,")).expect("row");
+    let culling = clustered.rsplit(',').next().expect("last column");
+    assert!(culling.parse::<f64>().is_ok_and(|r| r >= 1.0), "culling ratio `{culling}`");
+}

@@ -7,7 +7,7 @@
 
 use crate::context::{GpuContext, RenderError};
 use crate::gpu_types::{
-    CLUSTER_NO_CAP, CULL_AABB, CULL_PLANES, GpuClusterBounds, GpuClusterCounters, GpuClusterParams,
+    CLUSTER_NO_CAP, CULL_AABB, CULL_BOTH, CULL_PLANES, GpuClusterBounds, GpuClusterCounters, GpuClusterParams,
 };
 use crate::pool::GrowableBuffer;
 use crate::snapshot::FrameSnapshot;
@@ -293,6 +293,7 @@ impl ClusterResources {
             cull_test: match settings.cull {
                 CullTest::Aabb => CULL_AABB,
                 CullTest::Planes => CULL_PLANES,
+                CullTest::Both => CULL_BOTH,
             },
             index_capacity: (self.indices.capacity() / 4).min(u32::MAX as u64) as u32,
             slicing: self.grid.slicing.gpu_id(),

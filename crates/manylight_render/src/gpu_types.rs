@@ -18,6 +18,8 @@ pub const SCAN_WORKGROUP_SIZE: u32 = 256;
 pub const CULL_AABB: u32 = 0;
 /// See [`CULL_AABB`].
 pub const CULL_PLANES: u32 = 1;
+/// See [`CULL_AABB`]: both tests must accept.
+pub const CULL_BOTH: u32 = 2;
 
 /// Constants emitted into WGSL as `const NAME: u32 = VALUE;`.
 pub fn shared_u32_constants() -> Vec<(&'static str, u32)> {
@@ -31,6 +33,7 @@ pub fn shared_u32_constants() -> Vec<(&'static str, u32)> {
         ("SCAN_WORKGROUP_SIZE", SCAN_WORKGROUP_SIZE),
         ("CULL_AABB", CULL_AABB),
         ("CULL_PLANES", CULL_PLANES),
+        ("CULL_BOTH", CULL_BOTH),
         ("Z_SLICING_LINEAR", ZSlicing::Linear.gpu_id()),
         ("Z_SLICING_EXPONENTIAL", ZSlicing::Exponential.gpu_id()),
         ("DEBUG_LIGHT_COUNT", DebugView::LightCount.gpu_id()),

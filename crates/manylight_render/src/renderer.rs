@@ -26,6 +26,7 @@ pub struct Renderer {
     pool: TransientPool,
     timer: Option<GpuTimer>,
     cpu_adapter: bool,
+    last_textures: HashMap<crate::graph::ResourceName, wgpu::TextureView>,
 }
 
 impl Renderer {
@@ -40,6 +41,7 @@ impl Renderer {
             pool: TransientPool::default(),
             timer,
             cpu_adapter,
+            last_textures: HashMap::new(),
             gpu,
         }
     }
@@ -54,6 +56,52 @@ impl Renderer {
             clusters.prepare(gpu, snapshot, &view_from_world, &self.scene.light_spheres)?;
         }
         Ok(())
+    }
+
+    /// The last frame's depth buffer (reverse-Z, row-major), if the frame had one.
+    pub fn read_depth(&self) -> Result<Option<(u32, u32, Vec<f32>)>, RenderError> {
+        let Some(view) = self.last_textures.get(crate::passes::DEPTH) else {
+            return Ok(None);
+        };
+        let texture = view.texture();
+        let (w, h) = (texture.width(), texture.height());
+        let row = w * 4;
+        let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let buffer = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("depth_readback"),
+            size: padded as u64 * h as u64,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("depth_readback") });
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::DepthOnly,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded),
+                    rows_per_image: Some(h),
+                },
+            },
+            wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        );
+        self.gpu.queue.submit([encoder.finish()]);
+        let bytes = crate::clusters::read_buffer(&self.gpu, &buffer, 0, padded as u64 * h as u64)?;
+        let mut depth = Vec::with_capacity((w * h) as usize);
+        for y in 0..h as usize {
+            let start = y * padded as usize;
+            depth.extend(bytemuck::pod_collect_to_vec::<u8, f32>(&bytes[start..start + row as usize]));
+        }
+        Ok(Some((w, h, depth)))
     }
 
     /// The transient pool (tests read its allocation counts).
@@ -155,6 +203,7 @@ impl Renderer {
             }
         }
         let _ = self.gpu.device.poll(wgpu::PollType::wait_indefinitely());
+        self.last_textures = textures;
         let errors = self.gpu.take_errors();
         if !errors.is_empty() {
             return Err(RenderError::Device(errors.join("; ")));

@@ -151,6 +151,10 @@ pub(crate) fn assign_lights_brute_force(
                     match test {
                         CullTest::Aabb => sphere_intersects_aabb(s.center, s.radius, aabb.0, aabb.1),
                         CullTest::Planes => sphere_intersects_planes(s.center, s.radius, &planes),
+                        CullTest::Both => {
+                            sphere_intersects_aabb(s.center, s.radius, aabb.0, aabb.1)
+                                && sphere_intersects_planes(s.center, s.radius, &planes)
+                        }
                     }
                 })
                 .collect()

@@ -93,31 +93,37 @@ impl ClusterTables {
     /// `grid.cluster_aabb` / `grid.cluster_planes`.
     #[inline]
     pub fn touches(&self, light: &ViewSphere, x: u32, y: u32, z: u32, test: CullTest) -> bool {
-        let (zu, dx, dy) = (z as usize, self.grid.dims.x as usize, self.grid.dims.y as usize);
         match test {
-            CullTest::Aabb => {
-                let xe = self.x_ext[zu * dx + x as usize];
-                let ye = self.y_ext[zu * dy + y as usize];
-                let ze = self.z_ext[zu];
-                let min = Vec3::new(xe.0, ye.0, ze.0);
-                let max = Vec3::new(xe.1, ye.1, ze.1);
-                sphere_intersects_aabb(light.center, light.radius, min, max)
-            }
-            CullTest::Planes => {
-                let m = self.margin[zu];
-                let (left, right) = self.x_normals[x as usize];
-                let (bottom, top) = self.y_normals[y as usize];
-                let planes = [
-                    left.extend(m),
-                    right.extend(m),
-                    bottom.extend(m),
-                    top.extend(m),
-                    Vec4::new(0.0, 0.0, -1.0, m - self.boundary[zu]),
-                    Vec4::new(0.0, 0.0, 1.0, m + self.boundary[zu + 1]),
-                ];
-                sphere_intersects_planes(light.center, light.radius, &planes)
-            }
+            CullTest::Aabb => self.touches_aabb(light, x, y, z),
+            CullTest::Planes => self.touches_planes(light, x, y, z),
+            CullTest::Both => self.touches_aabb(light, x, y, z) && self.touches_planes(light, x, y, z),
         }
+    }
+
+    fn touches_aabb(&self, light: &ViewSphere, x: u32, y: u32, z: u32) -> bool {
+        let (zu, dx, dy) = (z as usize, self.grid.dims.x as usize, self.grid.dims.y as usize);
+        let xe = self.x_ext[zu * dx + x as usize];
+        let ye = self.y_ext[zu * dy + y as usize];
+        let ze = self.z_ext[zu];
+        let min = Vec3::new(xe.0, ye.0, ze.0);
+        let max = Vec3::new(xe.1, ye.1, ze.1);
+        sphere_intersects_aabb(light.center, light.radius, min, max)
+    }
+
+    fn touches_planes(&self, light: &ViewSphere, x: u32, y: u32, z: u32) -> bool {
+        let zu = z as usize;
+        let m = self.margin[zu];
+        let (left, right) = self.x_normals[x as usize];
+        let (bottom, top) = self.y_normals[y as usize];
+        let planes = [
+            left.extend(m),
+            right.extend(m),
+            bottom.extend(m),
+            top.extend(m),
+            Vec4::new(0.0, 0.0, -1.0, m - self.boundary[zu]),
+            Vec4::new(0.0, 0.0, 1.0, m + self.boundary[zu + 1]),
+        ];
+        sphere_intersects_planes(light.center, light.radius, &planes)
     }
 
     /// Calls `f(cluster_index)` for every cluster `light` passes `test` for, in index order.
@@ -157,7 +163,8 @@ impl ClusterTables {
         // Step 3: tiles.
         let big_r = r + 2.0 * f64::from(self.margin[z_hi]) + slack;
         let (x, y) = match test {
-            CullTest::Aabb => {
+            // Both: the AABB test must accept, so its (tighter) search range suffices.
+            CullTest::Aabb | CullTest::Both => {
                 let (d0, d1) = (f64::from(self.boundary[z_lo]), f64::from(self.boundary[z_hi + 1]));
                 (box_ndc(c.x, big_r, d0, d1), box_ndc(c.y, big_r, d0, d1))
             }

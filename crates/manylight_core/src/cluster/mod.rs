@@ -82,19 +82,23 @@ pub enum CullTest {
     /// Sphere vs the cluster's view-space AABB ([`sphere_intersects_aabb`]).
     Aabb,
     /// Sphere vs the cluster's six planes ([`sphere_intersects_planes`]).
-    #[default]
     Planes,
+    /// Both tests must accept: the tightest, at the cost of both tests (the default; measured
+    /// false-positive rates are in `docs/benchmarks.md`).
+    #[default]
+    Both,
 }
 
 impl CullTest {
     /// All variants.
-    pub const ALL: [CullTest; 2] = [CullTest::Aabb, CullTest::Planes];
+    pub const ALL: [CullTest; 3] = [CullTest::Aabb, CullTest::Planes, CullTest::Both];
 
     /// Lower-case name used in configs and on the command line.
     pub fn name(self) -> &'static str {
         match self {
             CullTest::Aabb => "aabb",
             CullTest::Planes => "planes",
+            CullTest::Both => "both",
         }
     }
 

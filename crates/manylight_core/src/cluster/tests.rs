@@ -167,7 +167,7 @@ proptest! {
         let grid = random_grid(&mut rng);
         let count = 1 + rng.below(30) as usize;
         let lights = random_lights(&mut rng, &grid, count);
-        let test = CullTest::ALL[rng.below(2) as usize];
+        let test = CullTest::ALL[rng.below(3) as usize];
         let full = assign_lights(&grid, &lights, test, None);
         let capped = assign_lights(&grid, &lights, test, Some(cap));
         check_invariants(&grid, &capped, lights.len());

@@ -40,7 +40,7 @@ fn names_round_trip_and_defaults() {
     assert_eq!(CullTest::from_name("sphere"), None);
     assert_eq!((ZSlicing::Linear.gpu_id(), ZSlicing::Exponential.gpu_id()), (0, 1));
     assert_eq!(ZSlicing::default(), ZSlicing::Exponential);
-    assert_eq!(CullTest::default(), CullTest::Planes);
+    assert_eq!(CullTest::default(), CullTest::Both);
     let c = GridConfig::default();
     assert_eq!((c.tile_px, c.z_slices, c.dims), (64, 24, None));
 }

@@ -86,7 +86,12 @@ impl Pass for ClusteredForwardPass {
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
         let mut specs = vec![TextureSpec { name: HDR, format: HDR_FORMAT, usage, scale: 1.0 }];
         if !self.after_prepass {
-            specs.push(TextureSpec { name: DEPTH, format: DEPTH_FORMAT, usage, scale: 1.0 });
+            specs.push(TextureSpec {
+                name: DEPTH,
+                format: DEPTH_FORMAT,
+                usage: super::DEPTH_USAGE,
+                scale: 1.0,
+            });
         }
         specs
     }

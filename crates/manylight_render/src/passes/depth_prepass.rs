@@ -59,8 +59,7 @@ impl Pass for DepthPrepass {
         vec![DEPTH]
     }
     fn creates(&self) -> Vec<TextureSpec> {
-        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
-        vec![TextureSpec { name: DEPTH, format: DEPTH_FORMAT, usage, scale: 1.0 }]
+        vec![TextureSpec { name: DEPTH, format: DEPTH_FORMAT, usage: super::DEPTH_USAGE, scale: 1.0 }]
     }
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
         let scene = ctx.scene;

@@ -91,7 +91,7 @@ impl Pass for ForwardPass {
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
         vec![
             TextureSpec { name: HDR, format: HDR_FORMAT, usage, scale: 1.0 },
-            TextureSpec { name: DEPTH, format: DEPTH_FORMAT, usage, scale: 1.0 },
+            TextureSpec { name: DEPTH, format: DEPTH_FORMAT, usage: super::DEPTH_USAGE, scale: 1.0 },
         ]
     }
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {

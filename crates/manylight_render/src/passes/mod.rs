@@ -21,3 +21,8 @@ pub const HDR: crate::graph::ResourceName = "hdr";
 pub const DEPTH: crate::graph::ResourceName = "depth";
 /// Graph resource: the cluster light lists (persistent buffers, ordered through the graph).
 pub const CLUSTERS: crate::graph::ResourceName = "clusters";
+
+/// Usages of the depth buffer: attachment, sampled by debug views, copied for readback.
+pub const DEPTH_USAGE: wgpu::TextureUsages = wgpu::TextureUsages::RENDER_ATTACHMENT
+    .union(wgpu::TextureUsages::TEXTURE_BINDING)
+    .union(wgpu::TextureUsages::COPY_SRC);

@@ -1,0 +1,144 @@
+//! `manylight bench`: pipelines × light counts at one size, each frame rendered synchronously
+//! and timed end to end (prepare, record, submit, wait), written as CSV.
+
+use crate::direct::{measure_culling, snapshot};
+use anyhow::{Context, Result};
+use glam::UVec2;
+use indicatif::{ProgressBar, ProgressStyle};
+use manylight_app::render_world::HeadlessRenderer;
+use manylight_render::{FrameReport, FrameSettings, PipelineKind};
+use manylight_scene::{Scene, light_rig};
+use std::fmt::Write as _;
+use std::time::Instant;
+
+/// One benchmark configuration's measurements.
+pub struct Row {
+    pipeline: PipelineKind,
+    lights: usize,
+    frame_ms: Vec<f64>,
+    last: FrameReport,
+    culling: Option<f64>,
+}
+
+fn median(v: &[f64]) -> f64 {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    if s.is_empty() { f64::NAN } else { s[s.len() / 2] }
+}
+
+fn pass_ms(r: &FrameReport, name: &str) -> String {
+    r.passes
+        .iter()
+        .find(|p| p.name == name)
+        .and_then(|p| p.gpu_ms)
+        .map_or(String::new(), |ms| format!("{ms:.3}"))
+}
+
+/// What to sweep.
+pub struct Sweep {
+    /// Pipelines.
+    pub pipelines: Vec<PipelineKind>,
+    /// Rig light counts.
+    pub lights: Vec<usize>,
+    /// Image size.
+    pub size: UVec2,
+    /// Frames not measured.
+    pub warmup: u32,
+    /// Frames measured.
+    pub frames: u32,
+    /// Naive forward is skipped above this many lights (it costs seconds per frame on a CPU).
+    pub naive_max_lights: usize,
+    /// Also measure the culling efficiency of the tiled/clustered pipelines.
+    pub culling_efficiency: bool,
+    /// Settings other than the pipeline.
+    pub settings: FrameSettings,
+}
+
+/// Runs the sweep on `scene` and returns the CSV text.
+pub fn run(scene: &Scene, sweep: &Sweep) -> Result<String> {
+    let mut renderer = HeadlessRenderer::new()?;
+    let adapter = renderer.render_world.gpu().info.name.clone();
+    let configs: Vec<(PipelineKind, usize)> = sweep
+        .lights
+        .iter()
+        .flat_map(|&n| sweep.pipelines.iter().map(move |&p| (p, n)))
+        .filter(|&(p, n)| p != PipelineKind::NaiveForward || n <= sweep.naive_max_lights)
+        .collect();
+    let bar = ProgressBar::new(configs.len() as u64 * u64::from(sweep.warmup + sweep.frames));
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} frames, {elapsed} [{msg}]")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let mut rows = Vec::new();
+    for (pipeline, lights) in configs {
+        bar.set_message(format!("{} {lights}", pipeline.name()));
+        let rig = light_rig(lights, scene.bounds(), 1);
+        let settings = FrameSettings { pipeline, ..sweep.settings };
+        let mut frame_ms = Vec::new();
+        let mut last = None;
+        for f in 0..sweep.warmup + sweep.frames {
+            let snap = snapshot(scene, &rig, f as f32 / 60.0, sweep.size, settings, f as u64);
+            let start = Instant::now();
+            let (report, _) = renderer.render(snap, false)?;
+            let ms = start.elapsed().as_secs_f64() * 1e3;
+            if f >= sweep.warmup {
+                frame_ms.push(ms);
+            }
+            last = Some(report);
+            bar.inc(1);
+        }
+        let culling = if sweep.culling_efficiency && pipeline.uses_clusters() && lights > 0 {
+            let snap = snapshot(scene, &rig, 0.0, sweep.size, settings, 0);
+            Some(measure_culling(&mut renderer, snap)?.1.ratio())
+        } else {
+            None
+        };
+        rows.push(Row { pipeline, lights, frame_ms, last: last.context("no frame")?, culling });
+    }
+    bar.finish_and_clear();
+    Ok(csv(&rows, sweep.size, &adapter))
+}
+
+fn csv(rows: &[Row], size: UVec2, adapter: &str) -> String {
+    let mut out = String::from(
+        "adapter,pipeline,lights,width,height,frames,frame_ms_median,frame_ms_mean,\
+         depth_prepass_gpu_ms,cluster_build_gpu_ms,cluster_build_gpu_trusted,forward_gpu_ms,\
+         clustered_forward_gpu_ms,tonemap_gpu_ms,clusters,non_empty_clusters,list_entries,\
+         max_per_cluster,mean_per_non_empty,dropped_pairs,culling_ratio\n",
+    );
+    for r in rows {
+        let c = r.last.clusters.as_ref();
+        let trusted = r
+            .last
+            .passes
+            .iter()
+            .find(|p| p.name == "cluster_build")
+            .map_or(String::new(), |p| p.gpu_trusted.to_string());
+        let mean = r.frame_ms.iter().sum::<f64>() / r.frame_ms.len().max(1) as f64;
+        let _ = writeln!(
+            out,
+            "\"{adapter}\",{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            r.pipeline.name(),
+            r.lights,
+            size.x,
+            size.y,
+            r.frame_ms.len(),
+            median(&r.frame_ms),
+            mean,
+            pass_ms(&r.last, "depth_prepass"),
+            pass_ms(&r.last, "cluster_build"),
+            trusted,
+            pass_ms(&r.last, "forward"),
+            pass_ms(&r.last, "clustered_forward"),
+            pass_ms(&r.last, "tonemap"),
+            c.map_or(String::new(), |c| c.clusters.to_string()),
+            c.map_or(String::new(), |c| c.non_empty.to_string()),
+            c.map_or(String::new(), |c| c.total_entries.to_string()),
+            c.map_or(String::new(), |c| c.max_per_cluster.to_string()),
+            c.map_or(String::new(), |c| format!("{:.2}", c.mean_per_non_empty)),
+            c.map_or(String::new(), |c| c.dropped_pairs.to_string()),
+            r.culling.map_or(String::new(), |x| format!("{x:.3}")),
+        );
+    }
+    out
+}
