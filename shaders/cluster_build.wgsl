@@ -1,12 +1,20 @@
-// Cluster light assignment on the GPU, in three dispatches of one compute pass:
-// 1. `count`: one invocation per cluster tests every light's view-space sphere against the
-//    cluster's bounds, stores the count (capped if a cap is set) and updates the counters;
-// 2. `scan`: one workgroup turns the counts into offsets (exclusive prefix sum) and writes
-//    the total the index list needs;
-// 3. `fill`: one invocation per cluster tests the lights again in ascending order and writes
-//    the first `count` hits at its offset (skipped if the list is too small: the renderer
-//    reads the total back, grows the list and renders the frame again, so nothing is lost).
-// The result is the same compacted structure as manylight_core::cluster::assign_lights.
+// Cluster light assignment on the GPU, in two levels of three dispatches each, in one compute
+// pass. Level 1 builds a list per screen tile (the column of clusters behind it); level 2
+// builds each cluster's list from its tile's list instead of from every light:
+// 1. `tile_count`: one invocation per tile counts the lights whose sphere passes the chosen
+//    test against the tile's whole column, radius inflated a little more: the column's box
+//    contains each cluster's box and its planes are each cluster's side planes moved outwards,
+//    so this is a superset of what any cluster of the column accepts (checked on the CPU by
+//    crates/manylight_core/tests/tile_prefilter.rs);
+// 2. `tile_scan`: one workgroup turns the counts into offsets (exclusive prefix sum);
+// 3. `tile_fill`: writes each tile's lights in ascending order;
+// 4. `count`: one invocation per cluster tests its tile's lights against the cluster's bounds,
+//    stores the count (capped if a cap is set) and updates the counters;
+// 5. `scan`: prefix sum of the cluster counts, and the total the index list needs;
+// 6. `fill`: writes the first `count` hits, in ascending light order, at the cluster's offset.
+// A fill whose list is too small is skipped; the renderer reads the totals back, grows the
+// lists and renders the frame again, so nothing is lost. The result is the same compacted
+// structure as manylight_core::cluster::assign_lights.
 //!include common/clusters.wgsl
 
 struct ClusterCounters {
@@ -15,9 +23,9 @@ struct ClusterCounters {
     clusters_overflowed: atomic<u32>,
     max_count: atomic<u32>,
     non_empty: atomic<u32>,
+    tile_entries: atomic<u32>,
     _pad0: u32,
     _pad1: u32,
-    _pad2: u32,
 };
 
 @group(0) @binding(0) var<uniform> params: ClusterParams;
@@ -26,12 +34,23 @@ struct ClusterCounters {
 @group(0) @binding(3) var<storage, read_write> ranges: array<vec2<u32>>;
 @group(0) @binding(4) var<storage, read_write> indices: array<u32>;
 @group(0) @binding(5) var<storage, read_write> counters: ClusterCounters;
+@group(0) @binding(6) var<storage, read> tile_bounds: array<GpuClusterBounds>;
+@group(0) @binding(7) var<storage, read_write> tile_ranges: array<vec2<u32>>;
+@group(0) @binding(8) var<storage, read_write> tile_indices: array<u32>;
+
+// Extra inflation of the tile prefilter, so float rounding can never make it reject a light a
+// cluster of the column would accept.
+const TILE_PREFILTER_INFLATION: f32 = 1.001;
 
 override WORKGROUP_SIZE: u32 = 64u;
 
-fn touches(cluster: u32, light: u32) -> bool {
-    let s = spheres[light];
-    let b = bounds[cluster];
+// The cluster's bounds are loaded once per invocation (`b`), not once per light.
+fn touches(b: GpuClusterBounds, light: u32) -> bool {
+    return touches_sphere(b, spheres[light]);
+}
+
+// The chosen sphere test (CULL_AABB, CULL_PLANES or CULL_BOTH).
+fn touches_sphere(b: GpuClusterBounds, s: vec4<f32>) -> bool {
     if params.cull_test == CULL_AABB {
         return sphere_intersects_aabb(s.xyz, s.w, b.aabb_min.xyz, b.aabb_max.xyz);
     }
@@ -41,15 +60,69 @@ fn touches(cluster: u32, light: u32) -> bool {
     return sphere_intersects_aabb(s.xyz, s.w, b.aabb_min.xyz, b.aabb_max.xyz) && sphere_intersects_planes(s.xyz, s.w, b);
 }
 
+fn touches_tile(b: GpuClusterBounds, light: u32) -> bool {
+    let s = spheres[light];
+    return touches_sphere(b, vec4<f32>(s.xyz, s.w * TILE_PREFILTER_INFLATION));
+}
+
+fn tile_count_total() -> u32 {
+    return params.dims.x * params.dims.y;
+}
+
+@compute @workgroup_size(WORKGROUP_SIZE)
+fn tile_count(@builtin(global_invocation_id) id: vec3<u32>) {
+    let tile = id.x;
+    if tile >= tile_count_total() {
+        return;
+    }
+    let b = tile_bounds[tile];
+    var n = 0u;
+    for (var l = 0u; l < params.light_count; l++) {
+        if touches_tile(b, l) {
+            n += 1u;
+        }
+    }
+    tile_ranges[tile] = vec2<u32>(0u, n);
+}
+
+@compute @workgroup_size(WORKGROUP_SIZE)
+fn tile_fill(@builtin(global_invocation_id) id: vec3<u32>) {
+    let tile = id.x;
+    if tile >= tile_count_total() {
+        return;
+    }
+    let range = tile_ranges[tile];
+    if range.x + range.y > params.tile_index_capacity {
+        return;
+    }
+    let b = tile_bounds[tile];
+    var k = 0u;
+    for (var l = 0u; l < params.light_count && k < range.y; l++) {
+        if touches_tile(b, l) {
+            tile_indices[range.x + k] = l;
+            k += 1u;
+        }
+    }
+}
+
+// The lights of the cluster's tile: (offset, count) into `tile_indices`.
+fn tile_lights(cluster: u32) -> vec2<u32> {
+    let range = tile_ranges[cluster % tile_count_total()];
+    // A tile list that did not fit this frame is empty; the frame is rendered again.
+    return select(vec2<u32>(0u), range, range.x + range.y <= params.tile_index_capacity);
+}
+
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn count(@builtin(global_invocation_id) id: vec3<u32>) {
     let cluster = id.x;
     if cluster >= params.dims.w {
         return;
     }
+    let b = bounds[cluster];
+    let tile = tile_lights(cluster);
     var n = 0u;
-    for (var l = 0u; l < params.light_count; l++) {
-        if touches(cluster, l) {
+    for (var i = 0u; i < tile.y; i++) {
+        if touches(b, tile_indices[tile.x + i]) {
             n += 1u;
         }
     }
@@ -67,15 +140,17 @@ fn count(@builtin(global_invocation_id) id: vec3<u32>) {
 
 var<workgroup> partial_sums: array<u32, SCAN_WORKGROUP_SIZE>;
 
-@compute @workgroup_size(SCAN_WORKGROUP_SIZE)
-fn scan(@builtin(local_invocation_index) t: u32) {
-    let total_clusters = params.dims.w;
-    let chunk = (total_clusters + SCAN_WORKGROUP_SIZE - 1u) / SCAN_WORKGROUP_SIZE;
-    let begin = min(t * chunk, total_clusters);
-    let end = min(begin + chunk, total_clusters);
+// Exclusive prefix sum of the counts (`.y`) of `tiles ? tile_ranges : ranges` into their
+// offsets (`.x`); returns the total. One workgroup: each invocation sums a chunk, invocation
+// 0 scans the chunk sums, each invocation then writes its chunk's offsets.
+fn scan_ranges(tiles: bool, t: u32) -> u32 {
+    let total_entries = select(params.dims.w, tile_count_total(), tiles);
+    let chunk = (total_entries + SCAN_WORKGROUP_SIZE - 1u) / SCAN_WORKGROUP_SIZE;
+    let begin = min(t * chunk, total_entries);
+    let end = min(begin + chunk, total_entries);
     var sum = 0u;
     for (var c = begin; c < end; c++) {
-        sum += ranges[c].y;
+        sum += select(ranges[c].y, tile_ranges[c].y, tiles);
     }
     partial_sums[t] = sum;
     workgroupBarrier();
@@ -86,14 +161,40 @@ fn scan(@builtin(local_invocation_index) t: u32) {
             partial_sums[i] = running;
             running += v;
         }
-        atomicStore(&counters.total_entries, running);
+        // The total goes where every invocation can read it after the barrier.
+        scan_total = running;
     }
     workgroupBarrier();
     var offset = partial_sums[t];
     for (var c = begin; c < end; c++) {
-        let n = ranges[c].y;
-        ranges[c].x = offset;
-        offset += n;
+        if tiles {
+            let n = tile_ranges[c].y;
+            tile_ranges[c].x = offset;
+            offset += n;
+        } else {
+            let n = ranges[c].y;
+            ranges[c].x = offset;
+            offset += n;
+        }
+    }
+    return scan_total;
+}
+
+var<workgroup> scan_total: u32;
+
+@compute @workgroup_size(SCAN_WORKGROUP_SIZE)
+fn tile_scan(@builtin(local_invocation_index) t: u32) {
+    let total = scan_ranges(true, t);
+    if t == 0u {
+        atomicStore(&counters.tile_entries, total);
+    }
+}
+
+@compute @workgroup_size(SCAN_WORKGROUP_SIZE)
+fn scan(@builtin(local_invocation_index) t: u32) {
+    let total = scan_ranges(false, t);
+    if t == 0u {
+        atomicStore(&counters.total_entries, total);
     }
 }
 
@@ -107,9 +208,12 @@ fn fill(@builtin(global_invocation_id) id: vec3<u32>) {
     if range.x + range.y > params.index_capacity {
         return; // the list is too small this frame; the renderer grows it and renders again
     }
+    let b = bounds[cluster];
+    let tile = tile_lights(cluster);
     var k = 0u;
-    for (var l = 0u; l < params.light_count && k < range.y; l++) {
-        if touches(cluster, l) {
+    for (var i = 0u; i < tile.y && k < range.y; i++) {
+        let l = tile_indices[tile.x + i];
+        if touches(b, l) {
             indices[range.x + k] = l;
             k += 1u;
         }

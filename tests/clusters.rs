@@ -217,6 +217,8 @@ fn the_index_list_grows_instead_of_truncating() {
     let (report, gpu, cpu) = gpu_and_cpu(&mut r, snap);
     let c = report.clusters.expect("cluster report");
     assert!(c.total_entries > 1 << 16, "the scene must outgrow the initial list: {c:?}");
+    let initial_tiles = manylight::render::clusters::INITIAL_TILE_INDEX_CAPACITY;
+    assert!(c.tile_entries > initial_tiles, "the scene must outgrow the initial tile list: {c:?}");
     assert!(c.regrows >= 1, "{c:?}");
     assert_eq!(c.dropped_pairs, 0);
     assert_same_lists("grown", &gpu, &cpu);

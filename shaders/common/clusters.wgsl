@@ -11,8 +11,8 @@ struct ClusterParams {
     index_capacity: u32,
     slicing: u32,
     log_far_over_near: f32,
+    tile_index_capacity: u32,
     _pad0: u32,
-    _pad1: u32,
 };
 
 struct GpuClusterBounds {

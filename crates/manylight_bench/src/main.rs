@@ -85,9 +85,10 @@ struct RenderArgs {
     /// Shading model for materials without their own: lambert or blinn-phong.
     #[arg(long, default_value = "blinn-phong", value_parser = parse_shading)]
     shading: ShadingModel,
-    /// Animated lights added to the scene's own lights.
-    #[arg(long, default_value_t = 0)]
-    lights: usize,
+    /// Animated lights added to the scene's own lights (default: 64 for a scene that has no
+    /// lights of its own, so it is not black; 0 otherwise).
+    #[arg(long)]
+    lights: Option<usize>,
     /// Image size, WxH.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     size: UVec2,
@@ -258,8 +259,9 @@ fn stats_json(stats: &FrameStats) -> serde_json::Value {
 fn render(args: RenderArgs) -> Result<()> {
     let mut scene = load_scene(&args.scene, &LoadOptions::default())?;
     select_camera(&mut scene, &args.camera)?;
+    let lights = args.lights.unwrap_or(if scene.lights.is_empty() { 64 } else { 0 });
     let culling = if args.culling_efficiency {
-        let rig = manylight_scene::light_rig(args.lights, scene.bounds(), args.seed);
+        let rig = manylight_scene::light_rig(lights, scene.bounds(), args.seed);
         let t = args.frames.max(1).saturating_sub(1) as f32 / 60.0;
         let settings = manylight_render::FrameSettings {
             pipeline: args.pipeline,
@@ -291,7 +293,7 @@ fn render(args: RenderArgs) -> Result<()> {
         debug_view: args.clusters.debug_view,
         ..RenderSettings::default()
     };
-    let (image, stats) = render_scene(scene, args.size, args.frames, args.lights, args.seed, settings)?;
+    let (image, stats) = render_scene(scene, args.size, args.frames, lights, args.seed, settings)?;
     save_png(&image, &args.out).map_err(anyhow::Error::msg)?;
     if let Some(path) = &args.stats_json {
         let mut json = stats_json(&stats);

@@ -6,6 +6,7 @@
 pub mod attenuation;
 pub mod camera;
 pub mod cluster;
+pub mod codec;
 pub mod efficiency;
 pub mod image_metrics;
 pub mod material;

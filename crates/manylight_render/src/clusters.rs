@@ -38,6 +38,8 @@ pub struct ClusterReport {
     pub clusters_overflowed: u32,
     /// Capacity of the index list (entries).
     pub index_capacity: u64,
+    /// Entries of the per-tile lists the build filters clusters from.
+    pub tile_entries: u64,
     /// Times the index list grew this frame (each re-renders the frame).
     pub regrows: u32,
     /// Culling test used.
@@ -68,16 +70,22 @@ pub struct ClusterResources {
     pub indices: GrowableBuffer,
     bounds: GrowableBuffer,
     spheres: GrowableBuffer,
+    tile_bounds: GrowableBuffer,
+    tile_ranges: GrowableBuffer,
+    tile_indices: GrowableBuffer,
     counters: wgpu::Buffer,
     counters_readback: wgpu::Buffer,
     bounds_of: Option<ClusterGrid>,
-    generations: [u64; 4],
+    generations: [u64; 7],
     /// The view-space spheres uploaded this frame (for the CPU reference in tests and stats).
     pub view_spheres: Vec<ViewSphere>,
     cull: CullTest,
 }
 
-const INITIAL_INDEX_CAPACITY: u64 = 1 << 16;
+/// Initial entries of the cluster light-index list (it grows as frames need).
+pub const INITIAL_INDEX_CAPACITY: u64 = 1 << 16;
+/// Initial entries of the per-tile lists (they grow as frames need).
+pub const INITIAL_TILE_INDEX_CAPACITY: u64 = 1 << 12;
 
 fn storage_entry(
     binding: u32,
@@ -123,6 +131,9 @@ impl ClusterResources {
                 storage_entry(3, false, compute),
                 storage_entry(4, false, compute),
                 storage_entry(5, false, compute),
+                storage_entry(6, true, compute),
+                storage_entry(7, false, compute),
+                storage_entry(8, false, compute),
             ],
         });
         let shade = wgpu::ShaderStages::FRAGMENT;
@@ -143,6 +154,10 @@ impl ClusterResources {
         let ranges = GrowableBuffer::new(device, "cluster_ranges", storage | copy, 8 * 8192);
         let indices =
             GrowableBuffer::new(device, "light_index_list", storage | copy, 4 * INITIAL_INDEX_CAPACITY);
+        let tile_bounds = GrowableBuffer::new(device, "tile_bounds", storage, 128 * 256);
+        let tile_ranges = GrowableBuffer::new(device, "tile_ranges", storage, 8 * 256);
+        let tile_indices =
+            GrowableBuffer::new(device, "tile_light_index_list", storage, 4 * INITIAL_TILE_INDEX_CAPACITY);
         let counters_size = std::mem::size_of::<GpuClusterCounters>() as u64;
         let counters = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("cluster_counters"),
@@ -161,7 +176,7 @@ impl ClusterResources {
             &build_layout,
             &shading_layout,
             &params_buffer,
-            [&bounds, &spheres, &ranges, &indices],
+            [&bounds, &spheres, &ranges, &indices, &tile_bounds, &tile_ranges, &tile_indices],
             &counters,
         );
         ClusterResources {
@@ -176,10 +191,13 @@ impl ClusterResources {
             indices,
             bounds,
             spheres,
+            tile_bounds,
+            tile_ranges,
+            tile_indices,
             counters,
             counters_readback,
             bounds_of: None,
-            generations: [0; 4],
+            generations: [0; 7],
             view_spheres: Vec::new(),
             cull: CullTest::default(),
         }
@@ -190,7 +208,7 @@ impl ClusterResources {
         build_layout: &wgpu::BindGroupLayout,
         shading_layout: &wgpu::BindGroupLayout,
         params: &wgpu::Buffer,
-        [bounds, spheres, ranges, indices]: [&GrowableBuffer; 4],
+        [bounds, spheres, ranges, indices, tile_bounds, tile_ranges, tile_indices]: [&GrowableBuffer; 7],
         counters: &wgpu::Buffer,
     ) -> (wgpu::BindGroup, wgpu::BindGroup) {
         fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
@@ -206,6 +224,9 @@ impl ClusterResources {
                 entry(3, ranges.buffer()),
                 entry(4, indices.buffer()),
                 entry(5, counters),
+                entry(6, tile_bounds.buffer()),
+                entry(7, tile_ranges.buffer()),
+                entry(8, tile_indices.buffer()),
             ],
         });
         let shading = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -222,6 +243,9 @@ impl ClusterResources {
             self.spheres.generation(),
             self.ranges.generation(),
             self.indices.generation(),
+            self.tile_bounds.generation(),
+            self.tile_ranges.generation(),
+            self.tile_indices.generation(),
         ];
         if generations != self.generations {
             let (b, s) = Self::bind_groups(
@@ -229,7 +253,15 @@ impl ClusterResources {
                 &self.build_layout,
                 &self.shading_layout,
                 &self.params_buffer,
-                [&self.bounds, &self.spheres, &self.ranges, &self.indices],
+                [
+                    &self.bounds,
+                    &self.spheres,
+                    &self.ranges,
+                    &self.indices,
+                    &self.tile_bounds,
+                    &self.tile_ranges,
+                    &self.tile_indices,
+                ],
                 &self.counters,
             );
             self.build_bind_group = b;
@@ -273,6 +305,28 @@ impl ClusterResources {
                 }
             }
             self.bounds.write(device, queue, bytemuck::cast_slice(&bounds));
+            // Level 1 of the build: the same tiles with one slice from near to far.
+            let tile_grid = ClusterGrid::new(
+                snapshot.viewport,
+                &projection,
+                &manylight_core::cluster::GridConfig {
+                    dims: Some(glam::UVec3::new(dims.x, dims.y, 1)),
+                    ..grid_config
+                },
+            );
+            let mut tiles = Vec::with_capacity((dims.x * dims.y) as usize);
+            for y in 0..dims.y {
+                for x in 0..dims.x {
+                    let (min, max) = tile_grid.cluster_aabb(x, y, 0);
+                    tiles.push(GpuClusterBounds {
+                        aabb_min: min.extend(0.0).to_array(),
+                        aabb_max: max.extend(0.0).to_array(),
+                        planes: tile_grid.cluster_planes(x, y, 0).map(|p| p.to_array()),
+                    });
+                }
+            }
+            self.tile_bounds.write(device, queue, bytemuck::cast_slice(&tiles));
+            self.tile_ranges.reserve(device, tiles.len() as u64 * 8);
             self.bounds_of = Some(self.grid);
         }
         self.view_spheres = view_spheres(view_from_world, lights.iter().copied());
@@ -298,7 +352,8 @@ impl ClusterResources {
             index_capacity: (self.indices.capacity() / 4).min(u32::MAX as u64) as u32,
             slicing: self.grid.slicing.gpu_id(),
             log_far_over_near: (p.far / p.near).ln(),
-            _pad: [0; 2],
+            tile_index_capacity: (self.tile_indices.capacity() / 4).min(u32::MAX as u64) as u32,
+            _pad: 0,
         };
         queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
         queue.write_buffer(&self.counters, 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
@@ -317,14 +372,22 @@ impl ClusterResources {
         Ok(bytemuck::pod_read_unaligned(&bytes[..std::mem::size_of::<GpuClusterCounters>()]))
     }
 
-    /// True when the index list is too small for `needed` entries; grows it (to the next power
-    /// of two) so the frame can be rendered again.
-    pub fn grow_if_needed(&mut self, gpu: &GpuContext, needed: u64) -> bool {
-        if needed <= self.params.index_capacity as u64 {
+    /// True when the index lists are too small for what the frame needed (`counters`); grows
+    /// them (to the next power of two) so the frame can be rendered again.
+    pub fn grow_if_needed(&mut self, gpu: &GpuContext, counters: &GpuClusterCounters) -> bool {
+        let tiles_short = counters.tile_entries > self.params.tile_index_capacity;
+        let clusters_short = counters.total_entries > self.params.index_capacity;
+        if !tiles_short && !clusters_short {
             return false;
         }
-        self.indices.reserve(&gpu.device, needed * 4);
-        self.params.index_capacity = (self.indices.capacity() / 4).min(u32::MAX as u64) as u32;
+        if tiles_short {
+            self.tile_indices.reserve(&gpu.device, counters.tile_entries as u64 * 4);
+            self.params.tile_index_capacity = (self.tile_indices.capacity() / 4).min(u32::MAX as u64) as u32;
+        }
+        if clusters_short {
+            self.indices.reserve(&gpu.device, counters.total_entries as u64 * 4);
+            self.params.index_capacity = (self.indices.capacity() / 4).min(u32::MAX as u64) as u32;
+        }
         gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
         gpu.queue.write_buffer(&self.counters, 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
         self.rebind_if_grown(&gpu.device);
@@ -346,6 +409,7 @@ impl ClusterResources {
             dropped_pairs: c.dropped_pairs as u64,
             clusters_overflowed: c.clusters_overflowed,
             index_capacity: self.params.index_capacity as u64,
+            tile_entries: c.tile_entries as u64,
             regrows,
             cull_test: self.cull.name().to_string(),
             z_slicing: self.grid.slicing.name().to_string(),

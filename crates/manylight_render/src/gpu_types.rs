@@ -143,8 +143,10 @@ pub struct GpuClusterParams {
     pub slicing: u32,
     /// ln(far / near), precomputed for exponential slicing.
     pub log_far_over_near: f32,
+    /// Entries the per-tile light lists (first level of the build) can hold.
+    pub tile_index_capacity: u32,
     /// Padding to 16 bytes.
-    pub _pad: [u32; 2],
+    pub _pad: u32,
 }
 
 /// Bounds of one cluster in view space (`GpuClusterBounds` in `shaders/common/clusters.wgsl`).
@@ -173,6 +175,8 @@ pub struct GpuClusterCounters {
     pub max_count: u32,
     /// Clusters with at least one light.
     pub non_empty: u32,
+    /// Entries the per-tile lists needed.
+    pub tile_entries: u32,
     /// Padding.
-    pub _pad: [u32; 3],
+    pub _pad: [u32; 2],
 }

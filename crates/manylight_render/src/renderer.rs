@@ -127,7 +127,7 @@ impl Renderer {
                 return Ok(report);
             };
             let counters = clusters.read_counters(&self.gpu)?;
-            if regrows < 4 && clusters.grow_if_needed(&self.gpu, counters.total_entries as u64) {
+            if regrows < 4 && clusters.grow_if_needed(&self.gpu, &counters) {
                 regrows += 1;
                 tracing::debug!("light-index list grew to {} entries", clusters.params.index_capacity);
                 continue;

@@ -16,6 +16,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("common/fullscreen.wgsl", include_str!("../../../shaders/common/fullscreen.wgsl")),
     ("common/surface.wgsl", include_str!("../../../shaders/common/surface.wgsl")),
     ("common/clusters.wgsl", include_str!("../../../shaders/common/clusters.wgsl")),
+    ("common/packing.wgsl", include_str!("../../../shaders/common/packing.wgsl")),
     ("forward.wgsl", include_str!("../../../shaders/forward.wgsl")),
     ("depth_prepass.wgsl", include_str!("../../../shaders/depth_prepass.wgsl")),
     ("cluster_build.wgsl", include_str!("../../../shaders/cluster_build.wgsl")),

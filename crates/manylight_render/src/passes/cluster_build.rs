@@ -1,6 +1,6 @@
-//! The `cluster_build` compute pass: count → prefix sum → fill (see
-//! `shaders/cluster_build.wgsl`), producing per-cluster `(offset, count)` ranges into one
-//! light-index list.
+//! The `cluster_build` compute pass: per-tile lists, then per-cluster lists from them, each by
+//! count → prefix sum → fill (see `shaders/cluster_build.wgsl`), producing per-cluster
+//! `(offset, count)` ranges into one light-index list.
 
 use super::CLUSTERS;
 use crate::context::RenderError;
@@ -8,6 +8,9 @@ use crate::graph::{Pass, PassContext, ResourceName};
 
 /// The three compute pipelines of the build, for one workgroup size.
 pub struct ClusterBuildPipelines {
+    tile_count: wgpu::ComputePipeline,
+    tile_scan: wgpu::ComputePipeline,
+    tile_fill: wgpu::ComputePipeline,
     count: wgpu::ComputePipeline,
     scan: wgpu::ComputePipeline,
     fill: wgpu::ComputePipeline,
@@ -39,7 +42,14 @@ impl ClusterBuildPipelines {
                 cache: None,
             })
         };
-        Ok(ClusterBuildPipelines { count: make("count"), scan: make("scan"), fill: make("fill") })
+        Ok(ClusterBuildPipelines {
+            tile_count: make("tile_count"),
+            tile_scan: make("tile_scan"),
+            tile_fill: make("tile_fill"),
+            count: make("count"),
+            scan: make("scan"),
+            fill: make("fill"),
+        })
     }
 }
 
@@ -71,6 +81,7 @@ impl Pass for ClusterBuildPass {
             .pipelines
             .get_or_create(wg as u64, || ClusterBuildPipelines::new(&ctx.gpu.device, layout, wg))?;
         let groups = clusters.params.dims[3].div_ceil(wg);
+        let tile_groups = (clusters.params.dims[0] * clusters.params.dims[1]).div_ceil(wg);
         let timestamps = ctx.compute_timestamps(true, true);
         {
             let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -78,6 +89,12 @@ impl Pass for ClusterBuildPass {
                 timestamp_writes: timestamps,
             });
             pass.set_bind_group(0, &clusters.build_bind_group, &[]);
+            pass.set_pipeline(&pipelines.tile_count);
+            pass.dispatch_workgroups(tile_groups, 1, 1);
+            pass.set_pipeline(&pipelines.tile_scan);
+            pass.dispatch_workgroups(1, 1, 1);
+            pass.set_pipeline(&pipelines.tile_fill);
+            pass.dispatch_workgroups(tile_groups, 1, 1);
             pass.set_pipeline(&pipelines.count);
             pass.dispatch_workgroups(groups, 1, 1);
             pass.set_pipeline(&pipelines.scan);

@@ -1,0 +1,146 @@
+//! The window surface on the render thread: configured on first use and on resize, skipped
+//! while minimised (0×0) or larger than the device allows, reconfigured when outdated and
+//! recreated when lost.
+
+use crate::backend::FrameSink;
+use crate::render_world::{RenderWorld, empty_report};
+use glam::UVec2;
+use manylight_render::{FrameReport, FrameSnapshot, GpuContext, RenderError};
+use std::sync::Arc;
+use winit::window::Window;
+
+/// Renders snapshots to a window surface.
+pub struct SurfaceSink {
+    window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    config: Option<wgpu::SurfaceConfiguration>,
+    render_world: RenderWorld,
+    vsync: bool,
+    warned_too_large: bool,
+}
+
+impl SurfaceSink {
+    /// Creates the surface and a GPU context able to present to it.
+    pub fn new(window: Arc<Window>, vsync: bool) -> Result<SurfaceSink, RenderError> {
+        let instance = manylight_render::context::new_instance();
+        let surface =
+            instance.create_surface(window.clone()).map_err(|e| RenderError::Surface(e.to_string()))?;
+        let gpu = GpuContext::with_instance(instance, Some(&surface))?;
+        Ok(SurfaceSink {
+            window,
+            surface,
+            config: None,
+            render_world: RenderWorld::new(gpu),
+            vsync,
+            warned_too_large: false,
+        })
+    }
+
+    /// Configures the surface for `size` (both sides non-zero).
+    fn configure(&mut self, size: UVec2) -> Result<(), RenderError> {
+        let gpu = self.render_world.gpu();
+        let caps = self.surface.get_capabilities(&gpu.adapter);
+        let format = caps.formats.iter().copied().find(|f| f.is_srgb()).or(caps.formats.first().copied());
+        let Some(format) = format else {
+            return Err(RenderError::Surface(format!(
+                "the window surface supports no format on adapter `{}`",
+                gpu.info.name
+            )));
+        };
+        let present_mode =
+            if self.vsync { wgpu::PresentMode::AutoVsync } else { wgpu::PresentMode::AutoNoVsync };
+        let config = wgpu::SurfaceConfiguration {
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            format,
+            width: size.x,
+            height: size.y,
+            present_mode,
+            desired_maximum_frame_latency: 2,
+            alpha_mode: caps.alpha_modes.first().copied().unwrap_or(wgpu::CompositeAlphaMode::Auto),
+            view_formats: vec![],
+            color_space: wgpu::SurfaceColorSpace::Auto,
+        };
+        tracing::debug!("configuring the window surface: {}x{} {format:?}", size.x, size.y);
+        self.surface.configure(&gpu.device, &config);
+        self.config = Some(config);
+        Ok(())
+    }
+
+    fn recreate_surface(&mut self) -> Result<(), RenderError> {
+        let gpu = self.render_world.gpu();
+        let surface = gpu
+            .instance
+            .create_surface(self.window.clone())
+            .map_err(|e| RenderError::Surface(e.to_string()))?;
+        self.surface = surface;
+        self.config = None;
+        Ok(())
+    }
+
+    /// The next surface texture at `size`, configuring or recreating the surface as needed.
+    /// An outdated or lost surface is fixed and tried once more; `None` skips the frame.
+    fn acquire(&mut self, size: UVec2) -> Result<Option<wgpu::SurfaceTexture>, RenderError> {
+        for _attempt in 0..2 {
+            if self.config.as_ref().map(|c| (c.width, c.height)) != Some((size.x, size.y)) {
+                self.configure(size)?;
+            }
+            match self.surface.get_current_texture() {
+                wgpu::CurrentSurfaceTexture::Success(frame) => return Ok(Some(frame)),
+                wgpu::CurrentSurfaceTexture::Suboptimal(frame) => {
+                    self.config = None; // configure again next frame
+                    return Ok(Some(frame));
+                }
+                wgpu::CurrentSurfaceTexture::Outdated => {
+                    tracing::debug!("surface outdated: configuring it again");
+                    self.config = None;
+                }
+                wgpu::CurrentSurfaceTexture::Lost => {
+                    tracing::warn!("surface lost: recreating it");
+                    self.recreate_surface()?;
+                }
+                wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
+                    tracing::debug!("no surface texture this frame (timeout or occluded)");
+                    return Ok(None);
+                }
+                wgpu::CurrentSurfaceTexture::Validation => {
+                    // The error itself went to the device's error handler and fails the next
+                    // frame with its message; configure from scratch in case that was the cause.
+                    tracing::warn!("acquiring the surface texture raised a validation error");
+                    self.config = None;
+                    return Ok(None);
+                }
+            }
+        }
+        Ok(None)
+    }
+}
+
+impl FrameSink for SurfaceSink {
+    fn render_frame(
+        &mut self,
+        snapshot: FrameSnapshot,
+        _readback: bool,
+    ) -> Result<(FrameReport, Option<image::RgbaImage>), RenderError> {
+        let size = snapshot.viewport;
+        if size.x == 0 || size.y == 0 {
+            return Ok((empty_report(&snapshot), None)); // minimised: nothing to draw
+        }
+        let max = self.render_world.gpu().device.limits().max_texture_dimension_2d;
+        if size.x > max || size.y > max {
+            if !self.warned_too_large {
+                tracing::warn!("window is {}x{}, larger than this GPU's {max}: not drawing", size.x, size.y);
+                self.warned_too_large = true;
+            }
+            return Ok((empty_report(&snapshot), None));
+        }
+        let Some(frame) = self.acquire(size)? else {
+            return Ok((empty_report(&snapshot), None));
+        };
+        let format = frame.texture.format();
+        let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
+        let report = self.render_world.render(snapshot, &view, format)?;
+        self.window.pre_present_notify();
+        self.render_world.gpu().queue.present(frame);
+        Ok((report, None))
+    }
+}
