@@ -4,7 +4,7 @@
 mod support;
 
 use manylight::app::headless::{finish_frames, render_headless};
-use manylight::app::{FrameStats, HeadlessCapture, RenderFailure, ViewportSize};
+use manylight::app::{FrameStats, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize};
 use manylight::prelude::*;
 use std::time::Duration;
 use support::gpu;
@@ -224,4 +224,43 @@ fn a_scene_without_lights_builds_no_clusters() {
     let s = stats(&app);
     assert_eq!(s.pass_names(), ["forward", "tonemap"]);
     assert!(s.last.expect("a report").clusters.is_none());
+}
+
+#[test]
+fn each_pipeline_builds_exactly_its_passes() {
+    let _gpu = gpu();
+    let cases: [(PipelineKind, bool, &[&str]); 5] = [
+        (PipelineKind::NaiveForward, true, &["forward", "tonemap"]),
+        (
+            PipelineKind::ForwardPlus,
+            true,
+            &["depth_prepass", "cluster_build", "clustered_forward", "tonemap"],
+        ),
+        (
+            PipelineKind::ClusteredForward,
+            true,
+            &["depth_prepass", "cluster_build", "clustered_forward", "tonemap"],
+        ),
+        (
+            PipelineKind::ClusteredDeferred,
+            true,
+            &["cluster_build", "gbuffer", "deferred_lighting", "tonemap"],
+        ),
+        // Without lights nothing is assigned: no cluster build, no light lists, plain forward.
+        (PipelineKind::ClusteredDeferred, false, &["forward", "tonemap"]),
+    ];
+    for (pipeline, lights, expected) in cases {
+        let mut app = App::new();
+        app.add_plugins(ManyLightPlugin::headless(SIZE))
+            .insert_resource(RenderSettings { pipeline, ..RenderSettings::default() })
+            .add_systems(Startup, move |mut commands: Commands| {
+                let mut scene = default_scene();
+                if !lights {
+                    scene.lights.clear();
+                }
+                spawn_scene(&mut commands, &scene, true, 1.5);
+            });
+        app.update();
+        assert_eq!(stats(&app).pass_names(), expected, "{pipeline:?}, lights: {lights}");
+    }
 }

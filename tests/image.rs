@@ -67,8 +67,9 @@ fn with_pipeline(pipeline: PipelineKind) -> RenderSettings {
     RenderSettings { pipeline, ..RenderSettings::default() }
 }
 
-/// Forward+ and clustered forward (with and without depth pre-pass, both culling tests and
-/// both slicings) match naive forward on the default scene and a glTF scene.
+/// Forward+, clustered forward (with and without depth pre-pass, several culling tests and
+/// both slicings) and clustered deferred (both G-buffer layouts) match naive forward on the
+/// default scene and a glTF scene.
 #[test]
 fn tiled_and_clustered_pipelines_match_naive_forward() {
     use manylight::app::prelude::{ClusterSettings, CullTest, GridConfig, ZSlicing};
@@ -82,7 +83,11 @@ fn tiled_and_clustered_pipelines_match_naive_forward() {
     let small = UVec2::new(128, 128);
     let bright = |p| RenderSettings { exposure: 4.0, ..with_pipeline(p) };
     let naive_cornell = render(cornell(), small, 0, bright(PipelineKind::NaiveForward));
+    use manylight::app::prelude::GBufferLayout;
+    let deferred = |gbuffer| RenderSettings { gbuffer, ..with_pipeline(PipelineKind::ClusteredDeferred) };
     let variants = [
+        ("clustered_deferred_full", deferred(GBufferLayout::Full)),
+        ("clustered_deferred_compact", deferred(GBufferLayout::Compact)),
         ("forward_plus", with_pipeline(PipelineKind::ForwardPlus)),
         ("clustered", with_pipeline(PipelineKind::ClusteredForward)),
         (
@@ -99,12 +104,23 @@ fn tiled_and_clustered_pipelines_match_naive_forward() {
         ),
     ];
     for (name, settings) in variants {
+        // The Compact G-buffer stores albedo in 8 bits: a measured approximation (FLIP mean
+        // ≈ 0.01 against naive, docs/accuracy.md), so it gets its own stated tolerance.
+        let tol = if settings.gbuffer == GBufferLayout::Compact
+            && settings.pipeline == PipelineKind::ClusteredDeferred
+        {
+            support::Tolerance { mean: 0.015, p99: 0.05 }
+        } else {
+            STRICT
+        };
         let frame = render(default_scene(), size, 128, settings);
         let report = frame.stats.last.as_ref().expect("report");
         assert!(report.pass_names().contains(&"cluster_build"), "{name}: {:?}", report.pass_names());
-        assert_similar(&format!("{name}_vs_naive"), &naive.image, &frame.image, STRICT);
+        let s = assert_similar(&format!("{name}_vs_naive"), &naive.image, &frame.image, tol);
+        eprintln!("{name} vs naive, default scene: FLIP mean {:.5}, p99 {:.5}", s.mean, s.p99);
         let frame = render(cornell(), small, 0, RenderSettings { exposure: 4.0, ..settings });
-        assert_similar(&format!("{name}_vs_naive_cornell"), &naive_cornell.image, &frame.image, STRICT);
+        let s = assert_similar(&format!("{name}_vs_naive_cornell"), &naive_cornell.image, &frame.image, tol);
+        eprintln!("{name} vs naive, Cornell box: FLIP mean {:.5}, p99 {:.5}", s.mean, s.p99);
     }
 }
 

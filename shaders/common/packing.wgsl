@@ -241,3 +241,13 @@ fn xyz_decode(e: vec2<f32>) -> vec3<f32> {
     let z = sqrt(max(1.0 - e.x * e.x - e.y * e.y, 0.0));
     return packing_sanitize(vec3<f32>(e.x, e.y, z));
 }
+
+// sRGB transfer function (IEC 61966-2-1), for 8-bit colour storage in packed G-buffers.
+fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
+    let x = saturate(c);
+    return select(1.055 * pow(x, vec3<f32>(1.0 / 2.4)) - 0.055, x * 12.92, x <= vec3<f32>(0.0031308));
+}
+
+fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
+    return select(pow((c + 0.055) / 1.055, vec3<f32>(2.4)), c / 12.92, c <= vec3<f32>(0.04045));
+}

@@ -39,5 +39,5 @@ pub mod prelude {
     pub use glam::{Quat, UVec2, Vec3};
     pub use manylight_core::cluster::{CullTest, GridConfig, ZSlicing};
     pub use manylight_core::{MaterialData, MeshData, ShadingModel};
-    pub use manylight_render::{ClusterSettings, DebugView, PipelineKind};
+    pub use manylight_render::{ClusterSettings, DebugView, GBufferLayout, PipelineKind};
 }

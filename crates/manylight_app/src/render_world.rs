@@ -6,7 +6,8 @@
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::ScheduleLabel;
 use manylight_render::passes::{
-    ClusterBuildPass, ClusteredForwardPass, DebugViewPass, DepthPrepass, ForwardPass, TonemapPass,
+    ClusterBuildPass, ClusteredForwardPass, DebugViewPass, DeferredLightingPass, DepthPrepass, ForwardPass,
+    GBufferPass, TonemapPass,
 };
 use manylight_render::{
     DebugView, FrameReport, FrameSnapshot, GpuContext, HeadlessTarget, PipelineKind, RenderError,
@@ -82,6 +83,8 @@ impl RenderWorld {
                 add_cluster_build,
                 add_forward_pass,
                 add_clustered_forward_pass,
+                add_gbuffer_pass,
+                add_deferred_lighting_pass,
                 add_output_pass,
             )
                 .chain()
@@ -142,10 +145,17 @@ fn shades_with_clusters(snapshot: &FrameSnapshot) -> bool {
     snapshot.settings.pipeline.uses_clusters() && snapshot.has_lights()
 }
 
-/// True when the frame runs a depth pre-pass.
+/// True when the frame is shaded deferred (G-buffer, then a full-screen lighting pass).
+fn shades_deferred(snapshot: &FrameSnapshot) -> bool {
+    shades_with_clusters(snapshot) && snapshot.settings.pipeline == PipelineKind::ClusteredDeferred
+}
+
+/// True when the frame runs a depth pre-pass (forward pipelines only).
 fn runs_depth_prepass(snapshot: &FrameSnapshot) -> bool {
     let s = &snapshot.settings;
-    shades_with_clusters(snapshot) && (s.pipeline == PipelineKind::ForwardPlus || s.clusters.depth_prepass)
+    shades_with_clusters(snapshot)
+        && !shades_deferred(snapshot)
+        && (s.pipeline == PipelineKind::ForwardPlus || s.clusters.depth_prepass)
 }
 
 fn add_depth_prepass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
@@ -167,8 +177,21 @@ fn add_forward_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph
     }
 }
 
+fn add_gbuffer_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
+    if shades_deferred(&snapshot.0) {
+        graph.0.add(GBufferPass { layout: snapshot.0.settings.gbuffer });
+    }
+}
+
+fn add_deferred_lighting_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
+    if shades_deferred(&snapshot.0) {
+        let s = &snapshot.0.settings;
+        graph.0.add(DeferredLightingPass { layout: s.gbuffer, clear_color: s.clear_color });
+    }
+}
+
 fn add_clustered_forward_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
-    if shades_with_clusters(&snapshot.0) {
+    if shades_with_clusters(&snapshot.0) && !shades_deferred(&snapshot.0) {
         graph.0.add(ClusteredForwardPass {
             clear_color: snapshot.0.settings.clear_color,
             after_prepass: runs_depth_prepass(&snapshot.0),

@@ -3,7 +3,7 @@
 use bevy_ecs::prelude::*;
 use glam::UVec2;
 use manylight_core::ShadingModel;
-use manylight_render::{ClusterSettings, DebugView, FrameReport, FrameSettings, PipelineKind};
+use manylight_render::{ClusterSettings, DebugView, FrameReport, FrameSettings, GBufferLayout, PipelineKind};
 
 /// How frames are rendered; changes apply from the next frame.
 #[derive(Resource, Clone, Copy, Debug, PartialEq)]
@@ -25,6 +25,8 @@ pub struct RenderSettings {
     pub debug_view: DebugView,
     /// Light count shown as the hottest colour of the light-count heatmap.
     pub debug_heatmap_max: u32,
+    /// G-buffer layout of the deferred pipeline.
+    pub gbuffer: GBufferLayout,
 }
 
 impl Default for RenderSettings {
@@ -39,6 +41,7 @@ impl Default for RenderSettings {
             clusters: f.clusters,
             debug_view: f.debug_view,
             debug_heatmap_max: f.debug_heatmap_max,
+            gbuffer: f.gbuffer,
         }
     }
 }
@@ -55,6 +58,7 @@ impl RenderSettings {
             clusters: self.clusters,
             debug_view: self.debug_view,
             debug_heatmap_max: self.debug_heatmap_max,
+            gbuffer: self.gbuffer,
         }
     }
 }

@@ -6,7 +6,7 @@ use anyhow::{Context, Result};
 use glam::UVec2;
 use indicatif::{ProgressBar, ProgressStyle};
 use manylight_app::render_world::HeadlessRenderer;
-use manylight_render::{FrameReport, FrameSettings, PipelineKind};
+use manylight_render::{FrameReport, FrameSettings, GBufferLayout, PipelineKind};
 use manylight_scene::{Scene, light_rig};
 use std::fmt::Write as _;
 use std::time::Instant;
@@ -14,6 +14,7 @@ use std::time::Instant;
 /// One benchmark configuration's measurements.
 pub struct Row {
     pipeline: PipelineKind,
+    gbuffer: Option<GBufferLayout>,
     lights: usize,
     frame_ms: Vec<f64>,
     last: FrameReport,
@@ -50,6 +51,8 @@ pub struct Sweep {
     pub naive_max_lights: usize,
     /// Also measure the culling efficiency of the tiled/clustered pipelines.
     pub culling_efficiency: bool,
+    /// G-buffer layouts swept for the deferred pipeline.
+    pub gbuffers: Vec<GBufferLayout>,
     /// Settings other than the pipeline.
     pub settings: FrameSettings,
 }
@@ -58,11 +61,20 @@ pub struct Sweep {
 pub fn run(scene: &Scene, sweep: &Sweep) -> Result<String> {
     let mut renderer = HeadlessRenderer::new()?;
     let adapter = renderer.render_world.gpu().info.name.clone();
-    let configs: Vec<(PipelineKind, usize)> = sweep
+    let configs: Vec<(PipelineKind, Option<GBufferLayout>, usize)> = sweep
         .lights
         .iter()
-        .flat_map(|&n| sweep.pipelines.iter().map(move |&p| (p, n)))
-        .filter(|&(p, n)| p != PipelineKind::NaiveForward || n <= sweep.naive_max_lights)
+        .flat_map(|&n| {
+            sweep.pipelines.iter().flat_map(move |&p| {
+                let layouts: Vec<Option<GBufferLayout>> = if p == PipelineKind::ClusteredDeferred {
+                    sweep.gbuffers.iter().copied().map(Some).collect()
+                } else {
+                    vec![None]
+                };
+                layouts.into_iter().map(move |g| (p, g, n))
+            })
+        })
+        .filter(|&(p, _, n)| p != PipelineKind::NaiveForward || n <= sweep.naive_max_lights)
         .collect();
     let bar = ProgressBar::new(configs.len() as u64 * u64::from(sweep.warmup + sweep.frames));
     bar.set_style(
@@ -70,10 +82,11 @@ pub fn run(scene: &Scene, sweep: &Sweep) -> Result<String> {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let mut rows = Vec::new();
-    for (pipeline, lights) in configs {
+    for (pipeline, gbuffer, lights) in configs {
         bar.set_message(format!("{} {lights}", pipeline.name()));
         let rig = light_rig(lights, scene.bounds(), 1);
-        let settings = FrameSettings { pipeline, ..sweep.settings };
+        let settings =
+            FrameSettings { pipeline, gbuffer: gbuffer.unwrap_or(sweep.settings.gbuffer), ..sweep.settings };
         let mut frame_ms = Vec::new();
         let mut last = None;
         for f in 0..sweep.warmup + sweep.frames {
@@ -93,7 +106,7 @@ pub fn run(scene: &Scene, sweep: &Sweep) -> Result<String> {
         } else {
             None
         };
-        rows.push(Row { pipeline, lights, frame_ms, last: last.context("no frame")?, culling });
+        rows.push(Row { pipeline, gbuffer, lights, frame_ms, last: last.context("no frame")?, culling });
     }
     bar.finish_and_clear();
     Ok(csv(&rows, sweep.size, &adapter))
@@ -101,9 +114,9 @@ pub fn run(scene: &Scene, sweep: &Sweep) -> Result<String> {
 
 fn csv(rows: &[Row], size: UVec2, adapter: &str) -> String {
     let mut out = String::from(
-        "adapter,pipeline,lights,width,height,frames,frame_ms_median,frame_ms_mean,\
-         depth_prepass_gpu_ms,cluster_build_gpu_ms,cluster_build_gpu_trusted,forward_gpu_ms,\
-         clustered_forward_gpu_ms,tonemap_gpu_ms,clusters,non_empty_clusters,list_entries,\
+        "adapter,pipeline,gbuffer,gbuffer_bytes_per_pixel,lights,width,height,frames,frame_ms_median,\
+         frame_ms_mean,depth_prepass_gpu_ms,cluster_build_gpu_ms,cluster_build_gpu_trusted,\
+         forward_gpu_ms,clustered_forward_gpu_ms,gbuffer_gpu_ms,deferred_lighting_gpu_ms,tonemap_gpu_ms,clusters,non_empty_clusters,list_entries,\
          max_per_cluster,mean_per_non_empty,dropped_pairs,culling_ratio\n",
     );
     for r in rows {
@@ -117,8 +130,10 @@ fn csv(rows: &[Row], size: UVec2, adapter: &str) -> String {
         let mean = r.frame_ms.iter().sum::<f64>() / r.frame_ms.len().max(1) as f64;
         let _ = writeln!(
             out,
-            "\"{adapter}\",{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "\"{adapter}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             r.pipeline.name(),
+            r.gbuffer.map_or("", |g| g.name()),
+            r.gbuffer.map_or(String::new(), |g| g.bytes_per_pixel().to_string()),
             r.lights,
             size.x,
             size.y,
@@ -130,6 +145,8 @@ fn csv(rows: &[Row], size: UVec2, adapter: &str) -> String {
             trusted,
             pass_ms(&r.last, "forward"),
             pass_ms(&r.last, "clustered_forward"),
+            pass_ms(&r.last, "gbuffer"),
+            pass_ms(&r.last, "deferred_lighting"),
             pass_ms(&r.last, "tonemap"),
             c.map_or(String::new(), |c| c.clusters.to_string()),
             c.map_or(String::new(), |c| c.non_empty.to_string()),

@@ -11,13 +11,14 @@ use manylight_app::headless::{render_headless, save_png};
 use manylight_app::scene::{spawn_light_rig, spawn_scene};
 use manylight_core::ShadingModel;
 use manylight_core::cluster::{CullTest, GridConfig, MAX_GRID_DIM, ZSlicing};
-use manylight_render::{ClusterSettings, DebugView, PipelineKind};
+use manylight_render::{ClusterSettings, DebugView, GBufferLayout, PipelineKind};
 use manylight_scene::{LoadOptions, Scene, load_scene};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 mod bench;
 mod direct;
+mod report;
 
 #[derive(Parser)]
 #[command(name = "manylight", version, about = "Many-light rendering with wgpu: render, check, bench")]
@@ -37,6 +38,27 @@ enum Command {
     },
     /// Sweep pipelines × light counts at one size and write the timings as CSV.
     Bench(BenchArgs),
+    /// What accuracy costs in time: every pipeline and G-buffer layout against the naive
+    /// reference (FLIP) and its frame time, in one run, as a markdown table.
+    Report(ReportArgs),
+}
+
+#[derive(clap::Args)]
+struct ReportArgs {
+    /// `default`, `sphere-shell` or a .gltf/.glb path.
+    #[arg(long, default_value = "default")]
+    scene: String,
+    /// Rig lights.
+    #[arg(long, default_value_t = 1024)]
+    lights: usize,
+    /// Image size, WxH.
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    size: UVec2,
+    /// Timed frames per configuration (after one warm-up).
+    #[arg(long, default_value_t = 2)]
+    frames: u32,
+    #[command(flatten)]
+    clusters: ClusterArgs,
 }
 
 #[derive(clap::Args)]
@@ -45,7 +67,12 @@ struct BenchArgs {
     #[arg(long, default_value = "default")]
     scene: String,
     /// Comma-separated pipelines.
-    #[arg(long, value_delimiter = ',', default_value = "naive,forward-plus,clustered-forward", value_parser = parse_pipeline)]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "naive,forward-plus,clustered-forward,clustered-deferred",
+        value_parser = parse_pipeline
+    )]
     pipelines: Vec<PipelineKind>,
     /// Comma-separated rig light counts.
     #[arg(long, value_delimiter = ',', default_value = "16,64,256,1024,4096,16384")]
@@ -65,6 +92,9 @@ struct BenchArgs {
     /// Also measure each tiled/clustered configuration's culling efficiency.
     #[arg(long)]
     culling_efficiency: bool,
+    /// G-buffer layouts swept for clustered-deferred.
+    #[arg(long, value_delimiter = ',', default_value = "full,compact", value_parser = parse_gbuffer)]
+    gbuffers: Vec<GBufferLayout>,
     #[command(flatten)]
     clusters: ClusterArgs,
     /// CSV output.
@@ -77,7 +107,7 @@ struct RenderArgs {
     /// `default` (embedded hall), `sphere-shell`, or a path to a .gltf/.glb file.
     #[arg(long, default_value = "default")]
     scene: String,
-    /// Pipeline: naive, forward-plus or clustered-forward.
+    /// Pipeline: naive, forward-plus, clustered-forward or clustered-deferred.
     #[arg(long, default_value = "clustered-forward", value_parser = parse_pipeline)]
     pipeline: PipelineKind,
     #[command(flatten)]
@@ -138,6 +168,9 @@ struct ClusterArgs {
     /// Workgroup size of the cluster-build compute shader.
     #[arg(long, default_value_t = 64)]
     workgroup_size: u32,
+    /// G-buffer layout of clustered-deferred: full or compact.
+    #[arg(long, default_value = "full", value_parser = parse_gbuffer)]
+    gbuffer: GBufferLayout,
     /// Debug view: none, light-count, slice-x, slice-y, slice-z.
     #[arg(long, default_value = "none", value_parser = parse_debug_view)]
     debug_view: DebugView,
@@ -153,6 +186,11 @@ impl ClusterArgs {
             workgroup_size: self.workgroup_size,
         }
     }
+}
+
+fn parse_gbuffer(s: &str) -> Result<GBufferLayout, String> {
+    GBufferLayout::from_name(s)
+        .ok_or_else(|| format!("unknown G-buffer layout `{s}` (expected full or compact)"))
 }
 
 fn parse_cull(s: &str) -> Result<CullTest, String> {
@@ -267,6 +305,7 @@ fn render(args: RenderArgs) -> Result<()> {
             pipeline: args.pipeline,
             shading: args.shading,
             clusters: args.clusters.settings(),
+            gbuffer: args.clusters.gbuffer,
             ..Default::default()
         };
         let snap = direct::snapshot(&scene, &rig, t, args.size, settings, 0);
@@ -291,6 +330,7 @@ fn render(args: RenderArgs) -> Result<()> {
         exposure: args.exposure,
         clusters: args.clusters.settings(),
         debug_view: args.clusters.debug_view,
+        gbuffer: args.clusters.gbuffer,
         ..RenderSettings::default()
     };
     let (image, stats) = render_scene(scene, args.size, args.frames, lights, args.seed, settings)?;
@@ -350,6 +390,13 @@ fn check(path: PathBuf) -> Result<()> {
     Ok(())
 }
 
+fn report_cmd(args: ReportArgs) -> Result<()> {
+    let scene = load_scene(&args.scene, &LoadOptions::default())?;
+    let base = manylight_render::FrameSettings { clusters: args.clusters.settings(), ..Default::default() };
+    print!("{}", report::run(&scene, args.lights, args.size, args.frames.max(1), base)?);
+    Ok(())
+}
+
 fn bench_cmd(args: BenchArgs) -> Result<()> {
     let scene = load_scene(&args.scene, &LoadOptions::default())?;
     let sweep = bench::Sweep {
@@ -360,8 +407,10 @@ fn bench_cmd(args: BenchArgs) -> Result<()> {
         frames: args.frames.max(1),
         naive_max_lights: args.naive_max_lights,
         culling_efficiency: args.culling_efficiency,
+        gbuffers: args.gbuffers,
         settings: manylight_render::FrameSettings {
             clusters: args.clusters.settings(),
+            gbuffer: args.clusters.gbuffer,
             ..Default::default()
         },
     };
@@ -388,6 +437,7 @@ fn main() -> ExitCode {
         Command::Render(args) => render(args),
         Command::Check { path } => check(path),
         Command::Bench(args) => bench_cmd(args),
+        Command::Report(args) => report_cmd(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

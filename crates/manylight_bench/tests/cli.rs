@@ -135,10 +135,14 @@ fn bench_writes_a_csv_row_per_configuration() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let text = std::fs::read_to_string(&csv).expect("csv");
     let lines: Vec<&str> = text.lines().collect();
-    assert_eq!(lines.len(), 1 + 6, "header + 3 pipelines x 2 light counts:\n{text}");
-    assert!(lines[0].starts_with("adapter,pipeline,lights,"));
-    assert!(lines.iter().any(|l| l.contains(",clustered-forward,32,")));
-    let clustered = lines.iter().find(|l| l.contains(",clustered-forward,32,")).expect("row");
+    assert_eq!(
+        lines.len(),
+        1 + 10,
+        "header + (3 pipelines + deferred x 2 layouts) x 2 light counts:\n{text}"
+    );
+    assert!(lines[0].starts_with("adapter,pipeline,gbuffer,"));
+    assert!(lines.iter().any(|l| l.contains(",clustered-deferred,compact,20,32,")), "{text}");
+    let clustered = lines.iter().find(|l| l.contains(",clustered-forward,,,32,")).expect("row");
     let culling = clustered.rsplit(',').next().expect("last column");
     assert!(culling.parse::<f64>().is_ok_and(|r| r >= 1.0), "culling ratio `{culling}`");
 }

@@ -24,6 +24,6 @@ pub use readback::{HEADLESS_FORMAT, HeadlessTarget};
 pub use renderer::Renderer;
 pub use snapshot::{
     ClusterSettings, DebugView, ExtractedCamera, ExtractedInstance, ExtractedPointLight, FrameSettings,
-    FrameSnapshot, PipelineKind,
+    FrameSnapshot, GBufferLayout, PipelineKind,
 };
 pub use stats::{FrameReport, PassTiming};

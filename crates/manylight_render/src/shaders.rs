@@ -22,6 +22,8 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("cluster_build.wgsl", include_str!("../../../shaders/cluster_build.wgsl")),
     ("clustered_forward.wgsl", include_str!("../../../shaders/clustered_forward.wgsl")),
     ("debug_view.wgsl", include_str!("../../../shaders/debug_view.wgsl")),
+    ("gbuffer.wgsl", include_str!("../../../shaders/gbuffer.wgsl")),
+    ("deferred_lighting.wgsl", include_str!("../../../shaders/deferred_lighting.wgsl")),
     ("tonemap.wgsl", include_str!("../../../shaders/tonemap.wgsl")),
 ];
 

@@ -16,12 +16,19 @@ pub enum PipelineKind {
     /// Clustered forward: screen tiles × depth slices, optional depth pre-pass (the default).
     #[default]
     ClusteredForward,
+    /// Clustered deferred: a G-buffer pass, then one full-screen pass walks each pixel's
+    /// cluster list.
+    ClusteredDeferred,
 }
 
 impl PipelineKind {
     /// Every pipeline, in the order the CLI lists them.
-    pub const ALL: [PipelineKind; 3] =
-        [PipelineKind::NaiveForward, PipelineKind::ForwardPlus, PipelineKind::ClusteredForward];
+    pub const ALL: [PipelineKind; 4] = [
+        PipelineKind::NaiveForward,
+        PipelineKind::ForwardPlus,
+        PipelineKind::ClusteredForward,
+        PipelineKind::ClusteredDeferred,
+    ];
 
     /// Name used on the command line and in reports.
     pub fn name(self) -> &'static str {
@@ -29,6 +36,7 @@ impl PipelineKind {
             PipelineKind::NaiveForward => "naive",
             PipelineKind::ForwardPlus => "forward-plus",
             PipelineKind::ClusteredForward => "clustered-forward",
+            PipelineKind::ClusteredDeferred => "clustered-deferred",
         }
     }
 
@@ -39,7 +47,48 @@ impl PipelineKind {
 
     /// True for pipelines that build light lists per tile or cluster.
     pub fn uses_clusters(self) -> bool {
-        matches!(self, PipelineKind::ForwardPlus | PipelineKind::ClusteredForward)
+        matches!(
+            self,
+            PipelineKind::ForwardPlus | PipelineKind::ClusteredForward | PipelineKind::ClusteredDeferred
+        )
+    }
+}
+
+/// How the deferred pipeline stores surfaces (see `shaders/gbuffer.wgsl`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum GBufferLayout {
+    /// Three targets: position rgba32f, normal rgba16f, albedo rgba16f (+ depth).
+    #[default]
+    Full,
+    /// One rgba32uint target: albedo rgba8 (sRGB-encoded), normal 2×16 octahedral,
+    /// shininess/specular f16,
+    /// shading model; position reconstructed from depth.
+    Compact,
+}
+
+impl GBufferLayout {
+    /// Every layout, in CLI order.
+    pub const ALL: [GBufferLayout; 2] = [GBufferLayout::Full, GBufferLayout::Compact];
+
+    /// Name used on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            GBufferLayout::Full => "full",
+            GBufferLayout::Compact => "compact",
+        }
+    }
+
+    /// Parses a command-line name.
+    pub fn from_name(name: &str) -> Option<GBufferLayout> {
+        Self::ALL.into_iter().find(|l| l.name() == name)
+    }
+
+    /// Bytes per pixel of the G-buffer, depth (4 bytes) included.
+    pub fn bytes_per_pixel(self) -> u32 {
+        match self {
+            GBufferLayout::Full => 16 + 8 + 8 + 4,
+            GBufferLayout::Compact => 16 + 4,
+        }
     }
 }
 
@@ -147,6 +196,8 @@ pub struct FrameSettings {
     pub debug_view: DebugView,
     /// Light count shown as the hottest colour of the light-count heatmap.
     pub debug_heatmap_max: u32,
+    /// G-buffer layout of the deferred pipeline.
+    pub gbuffer: GBufferLayout,
 }
 
 impl Default for FrameSettings {
@@ -160,6 +211,7 @@ impl Default for FrameSettings {
             clusters: ClusterSettings::default(),
             debug_view: DebugView::None,
             debug_heatmap_max: 32,
+            gbuffer: GBufferLayout::Full,
         }
     }
 }

@@ -4,21 +4,33 @@
 pub mod cluster_build;
 pub mod clustered_forward;
 pub mod debug_view;
+pub mod deferred_lighting;
 pub mod depth_prepass;
 pub mod forward;
+pub mod gbuffer;
 pub mod tonemap;
 
 pub use cluster_build::ClusterBuildPass;
 pub use clustered_forward::ClusteredForwardPass;
 pub use debug_view::DebugViewPass;
+pub use deferred_lighting::DeferredLightingPass;
 pub use depth_prepass::DepthPrepass;
 pub use forward::ForwardPass;
+pub use gbuffer::GBufferPass;
 pub use tonemap::TonemapPass;
 
 /// Graph resource: the HDR scene colour.
 pub const HDR: crate::graph::ResourceName = "hdr";
 /// Graph resource: the depth buffer (reverse-Z).
 pub const DEPTH: crate::graph::ResourceName = "depth";
+/// Graph resource: G-buffer position (Full layout).
+pub const GBUFFER_POSITION: crate::graph::ResourceName = "gbuffer_position";
+/// Graph resource: G-buffer normal (Full layout).
+pub const GBUFFER_NORMAL: crate::graph::ResourceName = "gbuffer_normal";
+/// Graph resource: G-buffer albedo (Full layout).
+pub const GBUFFER_ALBEDO: crate::graph::ResourceName = "gbuffer_albedo";
+/// Graph resource: the single G-buffer target of the Compact layout.
+pub const GBUFFER_COMPACT: crate::graph::ResourceName = "gbuffer_compact";
 /// Graph resource: the cluster light lists (persistent buffers, ordered through the graph).
 pub const CLUSTERS: crate::graph::ResourceName = "clusters";
 

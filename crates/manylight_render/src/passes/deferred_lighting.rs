@@ -1,0 +1,191 @@
+//! Clustered deferred lighting: one full-screen pass reads the G-buffer and walks each pixel's
+//! cluster list into [`HDR`].
+
+use super::gbuffer::targets;
+use super::{CLUSTERS, DEPTH, HDR};
+use crate::context::RenderError;
+use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::resources::HDR_FORMAT;
+use crate::snapshot::GBufferLayout;
+use wgpu::util::DeviceExt;
+
+/// The pipeline of [`DeferredLightingPass`] for one layout.
+pub struct DeferredLightingPipeline {
+    pipeline: wgpu::RenderPipeline,
+    gbuffer_layout: wgpu::BindGroupLayout,
+}
+
+fn texture_entry(binding: u32, sample_type: wgpu::TextureSampleType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+/// Binding number of each G-buffer target in `shaders/deferred_lighting.wgsl`, group 1.
+fn binding_of(name: ResourceName) -> u32 {
+    match name {
+        super::GBUFFER_POSITION => 0,
+        super::GBUFFER_NORMAL => 1,
+        super::GBUFFER_ALBEDO => 2,
+        _ => 3,
+    }
+}
+
+impl DeferredLightingPipeline {
+    fn new(
+        device: &wgpu::Device,
+        view_layout: &wgpu::BindGroupLayout,
+        cluster_layout: &wgpu::BindGroupLayout,
+        layout: GBufferLayout,
+    ) -> Result<Self, RenderError> {
+        let module = crate::shaders::create_module(device, "deferred_lighting.wgsl")?;
+        let float = wgpu::TextureSampleType::Float { filterable: false };
+        let mut entries: Vec<wgpu::BindGroupLayoutEntry> = targets(layout)
+            .iter()
+            .map(|&(name, _)| {
+                let sample =
+                    if name == super::GBUFFER_COMPACT { wgpu::TextureSampleType::Uint } else { float };
+                texture_entry(binding_of(name), sample)
+            })
+            .collect();
+        entries.push(texture_entry(4, wgpu::TextureSampleType::Depth));
+        entries.push(wgpu::BindGroupLayoutEntry {
+            binding: 5,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        });
+        let gbuffer_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("deferred_gbuffer"),
+            entries: &entries,
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("deferred_lighting"),
+            bind_group_layouts: &[Some(view_layout), Some(&gbuffer_layout), Some(cluster_layout)],
+            immediate_size: 0,
+        });
+        let entry = match layout {
+            GBufferLayout::Full => "fs_full",
+            GBufferLayout::Compact => "fs_compact",
+        };
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("deferred_lighting"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("fullscreen_vs"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: HDR_FORMAT,
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        Ok(DeferredLightingPipeline { pipeline, gbuffer_layout })
+    }
+}
+
+/// Lights the G-buffer with the pixels' cluster lists.
+pub struct DeferredLightingPass {
+    /// The G-buffer layout to read.
+    pub layout: GBufferLayout,
+    /// Linear colour of pixels no geometry covers.
+    pub clear_color: [f32; 3],
+}
+
+impl Pass for DeferredLightingPass {
+    fn name(&self) -> &'static str {
+        "deferred_lighting"
+    }
+    fn reads(&self) -> Vec<ResourceName> {
+        targets(self.layout).iter().map(|&(name, _)| name).chain([DEPTH, CLUSTERS]).collect()
+    }
+    fn writes(&self) -> Vec<ResourceName> {
+        vec![HDR]
+    }
+    fn creates(&self) -> Vec<TextureSpec> {
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        vec![TextureSpec { name: HDR, format: HDR_FORMAT, usage, scale: 1.0 }]
+    }
+    fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
+        let clusters = ctx
+            .clusters
+            .ok_or_else(|| RenderError::Graph("deferred_lighting needs cluster resources".into()))?;
+        let device = &ctx.gpu.device;
+        let layout = self.layout;
+        let view_layout = &ctx.scene.view_layout;
+        let pipeline = ctx.pipelines.get_or_create(layout as u64, || {
+            DeferredLightingPipeline::new(device, view_layout, &clusters.shading_layout, layout)
+        })?;
+        let [r, g, b] = self.clear_color;
+        let clear = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("deferred_clear_color"),
+            contents: bytemuck::cast_slice(&[r, g, b, 1.0f32]),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let mut entries = Vec::new();
+        for &(name, _) in targets(layout) {
+            entries.push(wgpu::BindGroupEntry {
+                binding: binding_of(name),
+                resource: wgpu::BindingResource::TextureView(ctx.texture(name)?),
+            });
+        }
+        entries.push(wgpu::BindGroupEntry {
+            binding: 4,
+            resource: wgpu::BindingResource::TextureView(ctx.texture(DEPTH)?),
+        });
+        entries.push(wgpu::BindGroupEntry { binding: 5, resource: clear.as_entire_binding() });
+        let gbuffer = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("deferred_gbuffer"),
+            layout: &pipeline.gbuffer_layout,
+            entries: &entries,
+        });
+        let hdr = ctx.texture(HDR)?;
+        let timestamps = ctx.render_timestamps(true, true);
+        let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("deferred_lighting"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: hdr,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: timestamps,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&pipeline.pipeline);
+        pass.set_bind_group(0, &ctx.scene.view_bind_group, &[]);
+        pass.set_bind_group(1, &gbuffer, &[]);
+        pass.set_bind_group(2, &clusters.shading_bind_group, &[]);
+        pass.draw(0..3, 0..1);
+        Ok(())
+    }
+}

@@ -1,0 +1,55 @@
+// G-buffer pass of clustered deferred: writes the surface at each pixel, in one of two layouts
+// (Rust: `GBufferLayout`):
+// - Full (3 targets): position rgba32f (xyz, w = shading model), normal rgba16f (xyz, w =
+//   shininess), albedo rgba16f (rgb, a = specular);
+// - Compact (1 × rgba32uint): x = albedo rgba8 (sRGB-encoded, so dark colours keep their
+//   precision), y = normal as 2×16-bit octahedral,
+//   z = shininess (f16) | specular (f16), w = shading model; position comes from depth.
+//!include common/view.wgsl
+//!include common/mesh.wgsl
+//!include common/surface.wgsl
+//!include common/packing.wgsl
+
+@group(0) @binding(0) var<uniform> view: ViewUniform;
+@group(0) @binding(2) var<storage, read> instances: array<GpuInstance>;
+
+@group(1) @binding(0) var<uniform> material: GpuMaterial;
+@group(1) @binding(1) var base_color_texture: texture_2d<f32>;
+@group(1) @binding(2) var base_color_sampler: sampler;
+
+struct FullOut {
+    @location(0) position: vec4<f32>,
+    @location(1) normal: vec4<f32>,
+    @location(2) albedo: vec4<f32>,
+};
+
+@vertex
+fn vs_main(v: VertexIn, @builtin(instance_index) instance_index: u32) -> SurfaceVertexOut {
+    return surface_vertex(v, instances[instance_index], view.clip_from_world);
+}
+
+fn surface_of(in: SurfaceVertexOut, front_facing: bool) -> SurfaceParams {
+    let albedo = surface_albedo(material, base_color_texture, base_color_sampler, in.uv);
+    return surface_params(material, view.shading_model, albedo.rgb, in.world_normal, front_facing);
+}
+
+@fragment
+fn fs_full(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> FullOut {
+    let s = surface_of(in, front_facing);
+    var out: FullOut;
+    out.position = vec4<f32>(in.world_position, f32(s.model));
+    out.normal = vec4<f32>(s.normal, s.shininess);
+    out.albedo = vec4<f32>(s.albedo, saturate(s.specular));
+    return out;
+}
+
+@fragment
+fn fs_compact(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<u32> {
+    let s = surface_of(in, front_facing);
+    return vec4<u32>(
+        pack4x8unorm(vec4<f32>(linear_to_srgb(s.albedo), 1.0)),
+        pack_octa16(s.normal),
+        pack2x16float(vec2<f32>(s.shininess, s.specular)),
+        s.model,
+    );
+}
