@@ -9,7 +9,9 @@ use crate::context::{GpuContext, RenderError};
 use crate::gpu_types::{
     CLUSTER_NO_CAP, CULL_AABB, CULL_BOTH, CULL_PLANES, GpuClusterBounds, GpuClusterCounters, GpuClusterParams,
 };
+use crate::passes::common::{storage_entry, uniform_entry};
 use crate::pool::GrowableBuffer;
+use crate::readback::read_buffer;
 use crate::snapshot::FrameSnapshot;
 use glam::Mat4;
 use manylight_core::cluster::{ClusterAssignment, ClusterGrid, CullTest, ViewSphere, view_spheres};
@@ -87,36 +89,6 @@ pub const INITIAL_INDEX_CAPACITY: u64 = 1 << 16;
 /// Initial entries of the per-tile lists (they grow as frames need).
 pub const INITIAL_TILE_INDEX_CAPACITY: u64 = 1 << 12;
 
-fn storage_entry(
-    binding: u32,
-    read_only: bool,
-    visibility: wgpu::ShaderStages,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
-fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
 impl ClusterResources {
     /// Creates the buffers (small; they grow with the grid and the lights).
     pub fn new(gpu: &GpuContext) -> ClusterResources {
@@ -126,20 +98,20 @@ impl ClusterResources {
             label: Some("cluster_build"),
             entries: &[
                 uniform_entry(0, compute),
-                storage_entry(1, true, compute),
-                storage_entry(2, true, compute),
-                storage_entry(3, false, compute),
-                storage_entry(4, false, compute),
-                storage_entry(5, false, compute),
-                storage_entry(6, true, compute),
-                storage_entry(7, false, compute),
-                storage_entry(8, false, compute),
+                storage_entry(1, compute, true),
+                storage_entry(2, compute, true),
+                storage_entry(3, compute, false),
+                storage_entry(4, compute, false),
+                storage_entry(5, compute, false),
+                storage_entry(6, compute, true),
+                storage_entry(7, compute, false),
+                storage_entry(8, compute, false),
             ],
         });
         let shade = wgpu::ShaderStages::FRAGMENT;
         let shading_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("cluster_lists"),
-            entries: &[uniform_entry(0, shade), storage_entry(1, true, shade), storage_entry(2, true, shade)],
+            entries: &[uniform_entry(0, shade), storage_entry(1, shade, true), storage_entry(2, shade, true)],
         });
         let params_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("cluster_params"),
@@ -436,43 +408,4 @@ impl ClusterResources {
             clusters_overflowed: counters.clusters_overflowed,
         })
     }
-}
-
-/// Copies `size` bytes of `buffer` from `offset` to the CPU (waits for the GPU).
-pub fn read_buffer(
-    gpu: &GpuContext,
-    buffer: &wgpu::Buffer,
-    offset: u64,
-    size: u64,
-) -> Result<Vec<u8>, RenderError> {
-    let size = size.max(4).div_ceil(4) * 4;
-    let staging_needed = !buffer.usage().contains(wgpu::BufferUsages::MAP_READ);
-    let staging;
-    let (source, start) = if staging_needed {
-        staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("readback"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut encoder =
-            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
-        encoder.copy_buffer_to_buffer(buffer, offset, &staging, 0, size);
-        gpu.queue.submit([encoder.finish()]);
-        (&staging, 0)
-    } else {
-        (buffer, offset)
-    };
-    let slice = source.slice(start..start + size);
-    let (tx, rx) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = tx.send(r);
-    });
-    gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| RenderError::Readback(e.to_string()))?;
-    rx.recv()
-        .map_err(|e| RenderError::Readback(e.to_string()))?
-        .map_err(|e| RenderError::Readback(e.to_string()))?;
-    let data = slice.get_mapped_range().map_err(|e| RenderError::Readback(e.to_string()))?.to_vec();
-    source.unmap();
-    Ok(data)
 }

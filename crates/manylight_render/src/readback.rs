@@ -47,25 +47,41 @@ impl HeadlessTarget {
     }
 }
 
-/// Reads a 4-bytes-per-pixel texture into an image.
+/// Reads a 4-bytes-per-pixel colour texture into an image (waits for the GPU).
 pub fn read_texture_rgba8(
     gpu: &GpuContext,
     texture: &wgpu::Texture,
     width: u32,
     height: u32,
 ) -> Result<image::RgbaImage, RenderError> {
-    let row = width * 4;
+    let pixels = read_texture(gpu, texture, wgpu::TextureAspect::All, 4)?;
+    image::RgbaImage::from_raw(width, height, pixels)
+        .ok_or_else(|| RenderError::Readback("size mismatch".into()))
+}
+
+/// Copies one aspect of a texture (`bytes_per_pixel` per texel) to the CPU as tightly packed
+/// rows (waits for the GPU).
+pub fn read_texture(
+    gpu: &GpuContext,
+    texture: &wgpu::Texture,
+    aspect: wgpu::TextureAspect,
+    bytes_per_pixel: u32,
+) -> Result<Vec<u8>, RenderError> {
+    let (width, height) = (texture.width(), texture.height());
+    let row = width * bytes_per_pixel;
     let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let size = padded as u64 * height as u64;
     let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size: padded as u64 * height as u64,
+        label: Some("texture_readback"),
+        size,
         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
         mapped_at_creation: false,
     });
-    let mut encoder =
-        gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
+    let mut encoder = gpu
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("texture_readback") });
     encoder.copy_texture_to_buffer(
-        texture.as_image_copy(),
+        wgpu::TexelCopyTextureInfo { texture, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect },
         wgpu::TexelCopyBufferInfo {
             buffer: &buffer,
             layout: wgpu::TexelCopyBufferLayout {
@@ -77,7 +93,41 @@ pub fn read_texture_rgba8(
         wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
     );
     gpu.queue.submit([encoder.finish()]);
-    let slice = buffer.slice(..);
+    let bytes = read_buffer(gpu, &buffer, 0, size)?;
+    let mut out = Vec::with_capacity((row * height) as usize);
+    for y in 0..height as usize {
+        let start = y * padded as usize;
+        out.extend_from_slice(&bytes[start..start + row as usize]);
+    }
+    Ok(out)
+}
+
+/// Copies `size` bytes of `buffer` from `offset` to the CPU (waits for the GPU).
+pub fn read_buffer(
+    gpu: &GpuContext,
+    buffer: &wgpu::Buffer,
+    offset: u64,
+    size: u64,
+) -> Result<Vec<u8>, RenderError> {
+    let size = size.max(4).div_ceil(4) * 4;
+    let staging_needed = !buffer.usage().contains(wgpu::BufferUsages::MAP_READ);
+    let staging;
+    let (source, start) = if staging_needed {
+        staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder =
+            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
+        encoder.copy_buffer_to_buffer(buffer, offset, &staging, 0, size);
+        gpu.queue.submit([encoder.finish()]);
+        (&staging, 0)
+    } else {
+        (buffer, offset)
+    };
+    let slice = source.slice(start..start + size);
     let (tx, rx) = std::sync::mpsc::channel();
     slice.map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
@@ -86,15 +136,7 @@ pub fn read_texture_rgba8(
     rx.recv()
         .map_err(|e| RenderError::Readback(e.to_string()))?
         .map_err(|e| RenderError::Readback(e.to_string()))?;
-    let mut pixels = Vec::with_capacity((row * height) as usize);
-    {
-        let view = slice.get_mapped_range().map_err(|e| RenderError::Readback(e.to_string()))?;
-        for y in 0..height as usize {
-            let start = y * padded as usize;
-            pixels.extend_from_slice(&view[start..start + row as usize]);
-        }
-    }
-    buffer.unmap();
-    image::RgbaImage::from_raw(width, height, pixels)
-        .ok_or_else(|| RenderError::Readback("size mismatch".into()))
+    let data = slice.get_mapped_range().map_err(|e| RenderError::Readback(e.to_string()))?.to_vec();
+    source.unmap();
+    Ok(data)
 }

@@ -64,43 +64,9 @@ impl Renderer {
             return Ok(None);
         };
         let texture = view.texture();
+        let bytes = crate::readback::read_texture(&self.gpu, texture, wgpu::TextureAspect::DepthOnly, 4)?;
         let (w, h) = (texture.width(), texture.height());
-        let row = w * 4;
-        let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let buffer = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("depth_readback"),
-            size: padded as u64 * h as u64,
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
-        let mut encoder = self
-            .gpu
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("depth_readback") });
-        encoder.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo {
-                texture,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::DepthOnly,
-            },
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(padded),
-                    rows_per_image: Some(h),
-                },
-            },
-            wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-        );
-        self.gpu.queue.submit([encoder.finish()]);
-        let bytes = crate::clusters::read_buffer(&self.gpu, &buffer, 0, padded as u64 * h as u64)?;
-        let mut depth = Vec::with_capacity((w * h) as usize);
-        for y in 0..h as usize {
-            let start = y * padded as usize;
-            depth.extend(bytemuck::pod_collect_to_vec::<u8, f32>(&bytes[start..start + row as usize]));
-        }
+        let depth = bytemuck::pod_collect_to_vec::<u8, f32>(&bytes);
         Ok(Some((w, h, depth)))
     }
 

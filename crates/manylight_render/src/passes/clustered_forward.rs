@@ -1,7 +1,8 @@
 //! Clustered forward shading (Forward+ when the grid has one slice): each fragment walks its
 //! cluster's light list instead of every light.
 
-use super::forward::{draw_scene, vertex_layout};
+use super::common::{MeshPipelineDesc, clear_color, color_attachment, depth_attachment, mesh_pipeline};
+use super::forward::draw_scene;
 use super::{CLUSTERS, DEPTH, HDR};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
@@ -18,48 +19,23 @@ impl ClusteredForwardPipeline {
         layouts: [&wgpu::BindGroupLayout; 3],
         after_prepass: bool,
     ) -> Result<Self, RenderError> {
-        let module = crate::shaders::create_module(device, "clustered_forward.wgsl")?;
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("clustered_forward"),
-            bind_group_layouts: &layouts.map(Some),
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("clustered_forward"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(vertex_layout())],
-            },
-            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
+        let pipeline = mesh_pipeline(
+            device,
+            &MeshPipelineDesc {
+                label: "clustered_forward",
+                shader: "clustered_forward.wgsl",
+                layouts: &layouts,
+                fragment: Some("fs_main"),
+                targets: &[HDR_FORMAT],
                 // After a pre-pass only the nearest surface passes (reverse-Z: greater-equal).
-                depth_write_enabled: Some(!after_prepass),
-                depth_compare: Some(if after_prepass {
+                depth_write: !after_prepass,
+                depth_compare: if after_prepass {
                     wgpu::CompareFunction::GreaterEqual
                 } else {
                     wgpu::CompareFunction::Greater
-                }),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: HDR_FORMAT,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+                },
+            },
+        )?;
         Ok(ClusteredForwardPipeline { pipeline })
     }
 }
@@ -108,24 +84,10 @@ impl Pass for ClusteredForwardPass {
         let hdr = ctx.texture(HDR)?;
         let depth = ctx.texture(DEPTH)?;
         let timestamps = ctx.render_timestamps(true, true);
-        let [r, g, b] = self.clear_color.map(f64::from);
-        let depth_load = if after { wgpu::LoadOp::Load } else { wgpu::LoadOp::Clear(0.0) };
         let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("clustered_forward"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: hdr,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a: 1.0 }),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: depth,
-                depth_ops: Some(wgpu::Operations { load: depth_load, store: wgpu::StoreOp::Store }),
-                stencil_ops: None,
-            }),
+            color_attachments: &[color_attachment(hdr, clear_color(self.clear_color))],
+            depth_stencil_attachment: depth_attachment(depth, !after),
             timestamp_writes: timestamps,
             occlusion_query_set: None,
             multiview_mask: None,

@@ -1,6 +1,7 @@
 //! Debug view: replaces tone mapping with the per-pixel light count of the pixel's cluster (a
 //! heatmap with a legend bar) or the cluster x / y / z index.
 
+use super::common::{draw_fullscreen, fullscreen_pipeline, storage_entry, texture_entry, uniform_entry};
 use super::{CLUSTERS, DEPTH};
 use crate::context::RenderError;
 use crate::graph::{OUTPUT, Pass, PassContext, ResourceName};
@@ -16,76 +17,19 @@ pub struct DebugViewPipeline {
 
 impl DebugViewPipeline {
     fn new(device: &wgpu::Device, output: wgpu::TextureFormat) -> Result<Self, RenderError> {
-        let module = crate::shaders::create_module(device, "debug_view.wgsl")?;
         let fragment = wgpu::ShaderStages::FRAGMENT;
-        let uniform = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: fragment,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("debug_view"),
             entries: &[
-                uniform(0),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: fragment,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                uniform(2),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 3,
-                    visibility: fragment,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-                uniform(4),
+                uniform_entry(0, fragment),
+                texture_entry(1, wgpu::TextureSampleType::Depth),
+                uniform_entry(2, fragment),
+                storage_entry(3, fragment, true),
+                uniform_entry(4, fragment),
             ],
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("debug_view"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("debug_view"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("fullscreen_vs"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: output,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline =
+            fullscreen_pipeline(device, "debug_view", "debug_view.wgsl", &[&layout], "fs_main", output)?;
         Ok(DebugViewPipeline { pipeline, layout })
     }
 }
@@ -136,25 +80,7 @@ impl Pass for DebugViewPass {
         });
         let output = ctx.texture(OUTPUT)?;
         let timestamps = ctx.render_timestamps(true, true);
-        let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("debug_view"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: output,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: timestamps,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&pipeline.pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
-        pass.draw(0..3, 0..1);
+        draw_fullscreen(ctx.encoder, "debug_view", output, timestamps, &pipeline.pipeline, &[&bind_group]);
         Ok(())
     }
 }

@@ -1,6 +1,7 @@
 //! Clustered deferred lighting: one full-screen pass reads the G-buffer and walks each pixel's
 //! cluster list into [`HDR`].
 
+use super::common::{draw_fullscreen, fullscreen_pipeline, texture_entry, uniform_entry};
 use super::gbuffer::targets;
 use super::{CLUSTERS, DEPTH, HDR};
 use crate::context::RenderError;
@@ -13,19 +14,6 @@ use wgpu::util::DeviceExt;
 pub struct DeferredLightingPipeline {
     pipeline: wgpu::RenderPipeline,
     gbuffer_layout: wgpu::BindGroupLayout,
-}
-
-fn texture_entry(binding: u32, sample_type: wgpu::TextureSampleType) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Texture {
-            sample_type,
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        },
-        count: None,
-    }
 }
 
 /// Binding number of each G-buffer target in `shaders/deferred_lighting.wgsl`, group 1.
@@ -45,7 +33,6 @@ impl DeferredLightingPipeline {
         cluster_layout: &wgpu::BindGroupLayout,
         layout: GBufferLayout,
     ) -> Result<Self, RenderError> {
-        let module = crate::shaders::create_module(device, "deferred_lighting.wgsl")?;
         let float = wgpu::TextureSampleType::Float { filterable: false };
         let mut entries: Vec<wgpu::BindGroupLayoutEntry> = targets(layout)
             .iter()
@@ -56,54 +43,23 @@ impl DeferredLightingPipeline {
             })
             .collect();
         entries.push(texture_entry(4, wgpu::TextureSampleType::Depth));
-        entries.push(wgpu::BindGroupLayoutEntry {
-            binding: 5,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        });
+        entries.push(uniform_entry(5, wgpu::ShaderStages::FRAGMENT));
         let gbuffer_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("deferred_gbuffer"),
             entries: &entries,
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("deferred_lighting"),
-            bind_group_layouts: &[Some(view_layout), Some(&gbuffer_layout), Some(cluster_layout)],
-            immediate_size: 0,
         });
         let entry = match layout {
             GBufferLayout::Full => "fs_full",
             GBufferLayout::Compact => "fs_compact",
         };
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("deferred_lighting"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("fullscreen_vs"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: HDR_FORMAT,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = fullscreen_pipeline(
+            device,
+            "deferred_lighting",
+            "deferred_lighting.wgsl",
+            &[view_layout, &gbuffer_layout, cluster_layout],
+            entry,
+            HDR_FORMAT,
+        )?;
         Ok(DeferredLightingPipeline { pipeline, gbuffer_layout })
     }
 }
@@ -165,27 +121,8 @@ impl Pass for DeferredLightingPass {
         });
         let hdr = ctx.texture(HDR)?;
         let timestamps = ctx.render_timestamps(true, true);
-        let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("deferred_lighting"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: hdr,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: timestamps,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&pipeline.pipeline);
-        pass.set_bind_group(0, &ctx.scene.view_bind_group, &[]);
-        pass.set_bind_group(1, &gbuffer, &[]);
-        pass.set_bind_group(2, &clusters.shading_bind_group, &[]);
-        pass.draw(0..3, 0..1);
+        let groups = [&ctx.scene.view_bind_group, &gbuffer, &clusters.shading_bind_group];
+        draw_fullscreen(ctx.encoder, "deferred_lighting", hdr, timestamps, &pipeline.pipeline, &groups);
         Ok(())
     }
 }

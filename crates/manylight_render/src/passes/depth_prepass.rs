@@ -1,7 +1,8 @@
 //! Depth pre-pass: lays down depth so the lighting pass shades each visible pixel once.
 
 use super::DEPTH;
-use super::forward::{draw_scene, vertex_layout};
+use super::common::{MeshPipelineDesc, depth_attachment, mesh_pipeline};
+use super::forward::draw_scene;
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::resources::{DEPTH_FORMAT, SceneResources};
@@ -13,34 +14,18 @@ pub struct DepthPrepassPipeline {
 
 impl DepthPrepassPipeline {
     fn new(device: &wgpu::Device, scene: &SceneResources) -> Result<Self, RenderError> {
-        let module = crate::shaders::create_module(device, "depth_prepass.wgsl")?;
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("depth_prepass"),
-            bind_group_layouts: &[Some(&scene.view_layout), Some(&scene.material_layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("depth_prepass"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(vertex_layout())],
+        let pipeline = mesh_pipeline(
+            device,
+            &MeshPipelineDesc {
+                label: "depth_prepass",
+                shader: "depth_prepass.wgsl",
+                layouts: &[&scene.view_layout, &scene.material_layout],
+                fragment: None,
+                targets: &[],
+                depth_write: true,
+                depth_compare: wgpu::CompareFunction::Greater,
             },
-            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Greater),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: None,
-            multiview_mask: None,
-            cache: None,
-        });
+        )?;
         Ok(DepthPrepassPipeline { pipeline })
     }
 }
@@ -70,14 +55,7 @@ impl Pass for DepthPrepass {
         let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("depth_prepass"),
             color_attachments: &[],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: depth,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(0.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
+            depth_stencil_attachment: depth_attachment(depth, true),
             timestamp_writes: timestamps,
             occlusion_query_set: None,
             multiview_mask: None,

@@ -1,6 +1,7 @@
 //! Naive forward pass: draws every instance, evaluating every light per fragment, into the
 //! HDR target with a reverse-Z depth test.
 
+use super::common::{MeshPipelineDesc, clear_color, color_attachment, depth_attachment, mesh_pipeline};
 use super::{DEPTH, HDR};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
@@ -14,48 +15,18 @@ pub struct ForwardPipeline {
 
 impl ForwardPipeline {
     fn new(device: &wgpu::Device, scene: &SceneResources) -> Result<Self, RenderError> {
-        let module = crate::shaders::create_module(device, "forward.wgsl")?;
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("forward"),
-            bind_group_layouts: &[Some(&scene.view_layout), Some(&scene.material_layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("forward"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(vertex_layout())],
+        let pipeline = mesh_pipeline(
+            device,
+            &MeshPipelineDesc {
+                label: "forward",
+                shader: "forward.wgsl",
+                layouts: &[&scene.view_layout, &scene.material_layout],
+                fragment: Some("fs_main"),
+                targets: &[HDR_FORMAT],
+                depth_write: true,
+                depth_compare: wgpu::CompareFunction::Greater,
             },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                // Two-sided: glTF double-sided materials and negative scales need no special case.
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Greater),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: HDR_FORMAT,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        )?;
         Ok(ForwardPipeline { pipeline })
     }
 }
@@ -100,26 +71,10 @@ impl Pass for ForwardPass {
         let hdr = ctx.texture(HDR)?;
         let depth = ctx.texture(DEPTH)?;
         let timestamps = ctx.render_timestamps(true, true);
-        let [r, g, b] = self.clear_color.map(f64::from);
         let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("forward"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: hdr,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a: 1.0 }),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: depth,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(0.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
+            color_attachments: &[color_attachment(hdr, clear_color(self.clear_color))],
+            depth_stencil_attachment: depth_attachment(depth, true),
             timestamp_writes: timestamps,
             occlusion_query_set: None,
             multiview_mask: None,

@@ -1,7 +1,8 @@
 //! G-buffer pass of clustered deferred: writes each pixel's surface (position or depth,
 //! normal, albedo, shading parameters) in the chosen [`GBufferLayout`].
 
-use super::forward::{draw_scene, vertex_layout};
+use super::common::{MeshPipelineDesc, color_attachment, depth_attachment, mesh_pipeline};
+use super::forward::draw_scene;
 use super::{DEPTH, DEPTH_USAGE, GBUFFER_ALBEDO, GBUFFER_COMPACT, GBUFFER_NORMAL, GBUFFER_POSITION};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
@@ -33,49 +34,22 @@ impl GBufferPipeline {
         scene: &SceneResources,
         layout: GBufferLayout,
     ) -> Result<Self, RenderError> {
-        let module = crate::shaders::create_module(device, "gbuffer.wgsl")?;
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("gbuffer"),
-            bind_group_layouts: &[Some(&scene.view_layout), Some(&scene.material_layout)],
-            immediate_size: 0,
-        });
-        let color_targets: Vec<Option<wgpu::ColorTargetState>> = targets(layout)
-            .iter()
-            .map(|&(_, format)| {
-                Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })
-            })
-            .collect();
-        let entry = match layout {
-            GBufferLayout::Full => "fs_full",
-            GBufferLayout::Compact => "fs_compact",
-        };
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("gbuffer"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(vertex_layout())],
+        let formats: Vec<wgpu::TextureFormat> = targets(layout).iter().map(|&(_, format)| format).collect();
+        let pipeline = mesh_pipeline(
+            device,
+            &MeshPipelineDesc {
+                label: "gbuffer",
+                shader: "gbuffer.wgsl",
+                layouts: &[&scene.view_layout, &scene.material_layout],
+                fragment: Some(match layout {
+                    GBufferLayout::Full => "fs_full",
+                    GBufferLayout::Compact => "fs_compact",
+                }),
+                targets: &formats,
+                depth_write: true,
+                depth_compare: wgpu::CompareFunction::Greater,
             },
-            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Greater),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                targets: &color_targets,
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        )?;
         Ok(GBufferPipeline { pipeline })
     }
 }
@@ -114,31 +88,12 @@ impl Pass for GBufferPass {
             targets(layout).iter().map(|&(name, _)| ctx.texture(name)).collect::<Result<Vec<_>, _>>()?;
         let depth = ctx.texture(DEPTH)?;
         let timestamps = ctx.render_timestamps(true, true);
-        let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = views
-            .iter()
-            .map(|view| {
-                Some(wgpu::RenderPassColorAttachment {
-                    view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })
-            })
-            .collect();
+        let attachments: Vec<_> =
+            views.iter().map(|view| color_attachment(view, wgpu::Color::TRANSPARENT)).collect();
         let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("gbuffer"),
             color_attachments: &attachments,
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: depth,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(0.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
+            depth_stencil_attachment: depth_attachment(depth, true),
             timestamp_writes: timestamps,
             occlusion_query_set: None,
             multiview_mask: None,

@@ -3,6 +3,7 @@
 
 pub mod cluster_build;
 pub mod clustered_forward;
+pub mod common;
 pub mod debug_view;
 pub mod deferred_lighting;
 pub mod depth_prepass;

@@ -1,0 +1,216 @@
+//! What the passes share: pipeline construction for mesh and full-screen passes, the attachments
+//! they use, and bind-group-layout entries.
+
+use super::forward::vertex_layout;
+use crate::context::RenderError;
+use crate::resources::DEPTH_FORMAT;
+
+/// A uniform-buffer layout entry.
+pub fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    buffer_entry(binding, visibility, wgpu::BufferBindingType::Uniform)
+}
+
+/// A storage-buffer layout entry.
+pub fn storage_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    read_only: bool,
+) -> wgpu::BindGroupLayoutEntry {
+    buffer_entry(binding, visibility, wgpu::BufferBindingType::Storage { read_only })
+}
+
+fn buffer_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    ty: wgpu::BufferBindingType,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
+        count: None,
+    }
+}
+
+/// A fragment-stage 2D texture layout entry (no sampler: passes use `textureLoad`).
+pub fn texture_entry(binding: u32, sample_type: wgpu::TextureSampleType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+fn pipeline_layout(
+    device: &wgpu::Device,
+    label: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+) -> wgpu::PipelineLayout {
+    let layouts: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().copied().map(Some).collect();
+    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &layouts,
+        immediate_size: 0,
+    })
+}
+
+fn color_targets(formats: &[wgpu::TextureFormat]) -> Vec<Option<wgpu::ColorTargetState>> {
+    formats
+        .iter()
+        .map(|&format| {
+            Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })
+        })
+        .collect()
+}
+
+/// A pipeline that draws the scene's meshes (vertex entry `vs_main`) with a reverse-Z depth test.
+pub struct MeshPipelineDesc<'a> {
+    /// Label, also the pipeline's name in captures.
+    pub label: &'a str,
+    /// Shader file under `shaders/`.
+    pub shader: &'a str,
+    /// Bind group layouts, in group order.
+    pub layouts: &'a [&'a wgpu::BindGroupLayout],
+    /// Fragment entry point; `None` for depth only.
+    pub fragment: Option<&'a str>,
+    /// Colour target formats.
+    pub targets: &'a [wgpu::TextureFormat],
+    /// Write depth.
+    pub depth_write: bool,
+    /// Depth comparison (reverse-Z: `Greater`, or `GreaterEqual` after a pre-pass).
+    pub depth_compare: wgpu::CompareFunction,
+}
+
+/// Builds a [`MeshPipelineDesc`]. Faces are not culled: glTF double-sided materials and negative
+/// scales need no special case, and the shaders light the face the camera sees.
+pub fn mesh_pipeline(
+    device: &wgpu::Device,
+    d: &MeshPipelineDesc<'_>,
+) -> Result<wgpu::RenderPipeline, RenderError> {
+    let module = crate::shaders::create_module(device, d.shader)?;
+    let layout = pipeline_layout(device, d.label, d.layouts);
+    let targets = color_targets(d.targets);
+    Ok(device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(d.label),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[Some(vertex_layout())],
+        },
+        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(d.depth_write),
+            depth_compare: Some(d.depth_compare),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: d.fragment.map(|entry| wgpu::FragmentState {
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            targets: &targets,
+        }),
+        multiview_mask: None,
+        cache: None,
+    }))
+}
+
+/// A full-screen pipeline: vertex `fullscreen_vs` from `common/fullscreen.wgsl`, no depth.
+pub fn fullscreen_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    shader: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+    fragment: &str,
+    output: wgpu::TextureFormat,
+) -> Result<wgpu::RenderPipeline, RenderError> {
+    let module = crate::shaders::create_module(device, shader)?;
+    let layout = pipeline_layout(device, label, layouts);
+    let targets = color_targets(&[output]);
+    Ok(device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("fullscreen_vs"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: Default::default(),
+        depth_stencil: None,
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some(fragment),
+            compilation_options: Default::default(),
+            targets: &targets,
+        }),
+        multiview_mask: None,
+        cache: None,
+    }))
+}
+
+/// A colour attachment cleared to `clear` and stored.
+pub fn color_attachment(
+    view: &wgpu::TextureView,
+    clear: wgpu::Color,
+) -> Option<wgpu::RenderPassColorAttachment<'_>> {
+    Some(wgpu::RenderPassColorAttachment {
+        view,
+        depth_slice: None,
+        resolve_target: None,
+        ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store },
+    })
+}
+
+/// A linear RGB clear colour.
+pub fn clear_color([r, g, b]: [f32; 3]) -> wgpu::Color {
+    wgpu::Color { r: r as f64, g: g as f64, b: b as f64, a: 1.0 }
+}
+
+/// The depth attachment: cleared to 0 (reverse-Z far) or, after a pre-pass, loaded.
+pub fn depth_attachment(
+    view: &wgpu::TextureView,
+    clear: bool,
+) -> Option<wgpu::RenderPassDepthStencilAttachment<'_>> {
+    let load = if clear { wgpu::LoadOp::Clear(0.0) } else { wgpu::LoadOp::Load };
+    Some(wgpu::RenderPassDepthStencilAttachment {
+        view,
+        depth_ops: Some(wgpu::Operations { load, store: wgpu::StoreOp::Store }),
+        stencil_ops: None,
+    })
+}
+
+/// Records a full-screen triangle into `target` (cleared first) with `bind_groups` as groups
+/// 0, 1, … and the pass's timestamps.
+pub fn draw_fullscreen(
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    target: &wgpu::TextureView,
+    timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    pipeline: &wgpu::RenderPipeline,
+    bind_groups: &[&wgpu::BindGroup],
+) {
+    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[color_attachment(target, wgpu::Color::BLACK)],
+        depth_stencil_attachment: None,
+        timestamp_writes: timestamps,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    pass.set_pipeline(pipeline);
+    for (i, group) in bind_groups.iter().enumerate() {
+        pass.set_bind_group(i as u32, *group, &[]);
+    }
+    pass.draw(0..3, 0..1);
+}
