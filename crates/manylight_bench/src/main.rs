@@ -128,6 +128,10 @@ struct RenderArgs {
     /// Exposure multiplier before tone mapping.
     #[arg(long, default_value_t = 1.0)]
     exposure: f32,
+    /// Constant ambient light, as a fraction of albedo (default: 0.03, or 0.2 for a scene
+    /// that brings no lights of its own, so its shapes read).
+    #[arg(long)]
+    ambient: Option<f32>,
     /// Seed of the light placement.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -297,7 +301,9 @@ fn stats_json(stats: &FrameStats) -> serde_json::Value {
 fn render(args: RenderArgs) -> Result<()> {
     let mut scene = load_scene(&args.scene, &LoadOptions::default())?;
     select_camera(&mut scene, &args.camera)?;
-    let lights = args.lights.unwrap_or(if scene.lights.is_empty() { 64 } else { 0 });
+    let unlit = scene.lights.is_empty();
+    let lights = args.lights.unwrap_or(if unlit { 64 } else { 0 });
+    let ambient = args.ambient.unwrap_or(if unlit { 0.2 } else { RenderSettings::default().ambient });
     let culling = if args.culling_efficiency {
         let rig = manylight_scene::light_rig(lights, scene.bounds(), args.seed);
         let t = args.frames.max(1).saturating_sub(1) as f32 / 60.0;
@@ -328,6 +334,7 @@ fn render(args: RenderArgs) -> Result<()> {
         pipeline: args.pipeline,
         shading: args.shading,
         exposure: args.exposure,
+        ambient,
         clusters: args.clusters.settings(),
         debug_view: args.clusters.debug_view,
         gbuffer: args.clusters.gbuffer,
