@@ -3,15 +3,13 @@
 
 mod support;
 
-use glam::{Mat4, UVec2, Vec3};
+use glam::{UVec2, Vec3};
 use manylight::app::render_world::HeadlessRenderer;
+use manylight::app::scene::extracted_light;
 use manylight::core::Projection;
 use manylight::core::cluster::{ClusterAssignment, CullTest, GridConfig, ZSlicing, assign_lights};
 use manylight::prelude::*;
-use manylight::render::{
-    ClusterSettings, ExtractedCamera, ExtractedInstance, ExtractedPointLight, FrameReport, FrameSettings,
-    FrameSnapshot,
-};
+use manylight::render::{ClusterSettings, ExtractedPointLight, FrameReport, FrameSettings, FrameSnapshot};
 use support::gpu;
 
 fn scene_snapshot(
@@ -20,41 +18,13 @@ fn scene_snapshot(
     lights: Vec<ExtractedPointLight>,
     settings: FrameSettings,
 ) -> FrameSnapshot {
-    let cam = scene.camera_or_fit(size.x as f32 / size.y as f32);
-    FrameSnapshot {
-        frame_index: 0,
-        viewport: size,
-        camera: Some(ExtractedCamera {
-            world_from_view: cam.transform,
-            projection: cam.projection,
-            prev_clip_from_world: None,
-        }),
-        instances: scene
-            .instances
-            .iter()
-            .map(|i| ExtractedInstance {
-                mesh: scene.meshes[i.mesh].clone(),
-                material: scene.materials[i.material].clone(),
-                world_from_local: i.transform,
-            })
-            .collect(),
-        lights,
-        settings,
-    }
+    manylight::app::scene::scene_snapshot(scene, lights, size, settings, 0)
 }
 
 fn rig(scene: &Scene, count: usize, seed: u64) -> Vec<ExtractedPointLight> {
     manylight::scene::light_rig(count, scene.bounds(), seed)
         .iter()
-        .map(|a| {
-            let l = a.at(0.0);
-            ExtractedPointLight {
-                position: l.position,
-                color: l.color,
-                intensity: l.intensity,
-                radius: l.radius,
-            }
-        })
+        .map(|a| extracted_light(&a.at(0.0)))
         .collect()
 }
 
@@ -222,7 +192,6 @@ fn the_index_list_grows_instead_of_truncating() {
     assert!(c.regrows >= 1, "{c:?}");
     assert_eq!(c.dropped_pairs, 0);
     assert_same_lists("grown", &gpu, &cpu);
-    let _ = Mat4::IDENTITY;
 }
 
 #[test]

@@ -3,8 +3,11 @@
 use crate::components::{Camera3d, LightAnimation, Material, Mesh3d, PointLight, Transform};
 use bevy_ecs::prelude::*;
 use manylight_core::Aabb;
-use manylight_scene::Scene;
+use manylight_render::{
+    ExtractedCamera, ExtractedInstance, ExtractedPointLight, FrameSettings, FrameSnapshot,
+};
 use manylight_scene::light_rig;
+use manylight_scene::{Scene, SceneLight};
 
 /// Spawns the scene's instances and lights, and its camera (or one framing it) when
 /// `spawn_camera` is set. `aspect` is the viewport's width / height.
@@ -45,5 +48,44 @@ pub fn spawn_light_rig(commands: &mut Commands, count: usize, bounds: Aabb, seed
             PointLight { color: anim.color_at(0.0), intensity: anim.intensity, radius: anim.radius },
             LightAnimation(anim),
         ));
+    }
+}
+
+/// A scene light as the render side sees it.
+pub fn extracted_light(l: &SceneLight) -> ExtractedPointLight {
+    ExtractedPointLight { position: l.position, color: l.color, intensity: l.intensity, radius: l.radius }
+}
+
+/// The snapshot of `scene` seen through its camera (or one framing it) at `size`, lit by
+/// `lights`, without an app: for benchmarks and tests that drive the renderer directly.
+pub fn scene_snapshot(
+    scene: &Scene,
+    lights: Vec<ExtractedPointLight>,
+    size: glam::UVec2,
+    settings: FrameSettings,
+    frame_index: u64,
+) -> FrameSnapshot {
+    let cam = scene.camera_or_fit(size.x as f32 / size.y.max(1) as f32);
+    FrameSnapshot {
+        frame_index,
+        viewport: size,
+        camera: Some(ExtractedCamera {
+            world_from_view: cam.transform,
+            projection: cam.projection,
+            prev_clip_from_world: None,
+        }),
+        instances: scene
+            .instances
+            .iter()
+            .filter_map(|i| {
+                Some(ExtractedInstance {
+                    mesh: scene.meshes.get(i.mesh)?.clone(),
+                    material: scene.materials.get(i.material)?.clone(),
+                    world_from_local: i.transform,
+                })
+            })
+            .collect(),
+        lights,
+        settings,
     }
 }

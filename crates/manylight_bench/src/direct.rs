@@ -5,10 +5,9 @@
 use anyhow::{Context, Result};
 use glam::UVec2;
 use manylight_app::render_world::HeadlessRenderer;
+use manylight_app::scene::{extracted_light, scene_snapshot};
 use manylight_core::efficiency::{CullingEfficiency, culling_efficiency};
-use manylight_render::{
-    ExtractedCamera, ExtractedInstance, ExtractedPointLight, FrameReport, FrameSettings, FrameSnapshot,
-};
+use manylight_render::{FrameReport, FrameSettings, FrameSnapshot};
 use manylight_scene::{AnimatedLight, Scene};
 
 /// The snapshot of `scene` plus `rig` at animation time `t` (the camera is the scene's first,
@@ -21,39 +20,9 @@ pub fn snapshot(
     settings: FrameSettings,
     frame_index: u64,
 ) -> FrameSnapshot {
-    let cam = scene.camera_or_fit(size.x as f32 / size.y.max(1) as f32);
-    let scene_lights = scene.lights.iter().map(|l| ExtractedPointLight {
-        position: l.position,
-        color: l.color,
-        intensity: l.intensity,
-        radius: l.radius,
-    });
-    let rig_lights = rig.iter().map(|a| {
-        let l = a.at(t);
-        ExtractedPointLight { position: l.position, color: l.color, intensity: l.intensity, radius: l.radius }
-    });
-    FrameSnapshot {
-        frame_index,
-        viewport: size,
-        camera: Some(ExtractedCamera {
-            world_from_view: cam.transform,
-            projection: cam.projection,
-            prev_clip_from_world: None,
-        }),
-        instances: scene
-            .instances
-            .iter()
-            .filter_map(|i| {
-                Some(ExtractedInstance {
-                    mesh: scene.meshes.get(i.mesh)?.clone(),
-                    material: scene.materials.get(i.material)?.clone(),
-                    world_from_local: i.transform,
-                })
-            })
-            .collect(),
-        lights: scene_lights.chain(rig_lights).collect(),
-        settings,
-    }
+    let rig_lights = rig.iter().map(|a| extracted_light(&a.at(t)));
+    let lights = scene.lights.iter().map(extracted_light).chain(rig_lights).collect();
+    scene_snapshot(scene, lights, size, settings, frame_index)
 }
 
 /// Renders `snapshot` and measures the culling efficiency of its cluster lists against its

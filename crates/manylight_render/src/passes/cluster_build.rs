@@ -89,18 +89,20 @@ impl Pass for ClusterBuildPass {
                 timestamp_writes: timestamps,
             });
             pass.set_bind_group(0, &clusters.build_bind_group, &[]);
-            pass.set_pipeline(&pipelines.tile_count);
-            pass.dispatch_workgroups(tile_groups, 1, 1);
-            pass.set_pipeline(&pipelines.tile_scan);
-            pass.dispatch_workgroups(1, 1, 1);
-            pass.set_pipeline(&pipelines.tile_fill);
-            pass.dispatch_workgroups(tile_groups, 1, 1);
-            pass.set_pipeline(&pipelines.count);
-            pass.dispatch_workgroups(groups, 1, 1);
-            pass.set_pipeline(&pipelines.scan);
-            pass.dispatch_workgroups(1, 1, 1);
-            pass.set_pipeline(&pipelines.fill);
-            pass.dispatch_workgroups(groups, 1, 1);
+            // The six steps of the build (shaders/cluster_build.wgsl), in order; the scans run
+            // as one workgroup.
+            let steps = [
+                (&pipelines.tile_count, tile_groups),
+                (&pipelines.tile_scan, 1),
+                (&pipelines.tile_fill, tile_groups),
+                (&pipelines.count, groups),
+                (&pipelines.scan, 1),
+                (&pipelines.fill, groups),
+            ];
+            for (pipeline, workgroups) in steps {
+                pass.set_pipeline(pipeline);
+                pass.dispatch_workgroups(workgroups, 1, 1);
+            }
         }
         clusters.copy_counters(ctx.encoder);
         Ok(())
