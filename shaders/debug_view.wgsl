@@ -1,6 +1,10 @@
-// Debug views that replace tone mapping: per-pixel light count of the pixel's cluster as a
-// heatmap (with a legend bar along the bottom edge), or the cluster x / y / z index as
-// alternating colours.
+// Debug views that replace tone mapping (Rust: crates/manylight_render/src/passes/debug_view.rs):
+// - fs_clusters: per-pixel light count of the pixel's cluster as a heatmap (with a legend bar
+//   along the bottom edge), the cluster x / y / z index as alternating colours, or overflow
+//   (clusters whose list hit the cap in red, the others green by how full they are);
+// - fs_depth: the linearised view distance (near white, far black; log scale so both near
+//   and far detail show);
+// - fs_surface: albedo or world-space normal (n * 0.5 + 0.5) from the Full G-buffer.
 //!include common/view.wgsl
 //!include common/clusters.wgsl
 //!include common/fullscreen.wgsl
@@ -18,6 +22,10 @@ struct DebugParams {
 @group(0) @binding(2) var<uniform> cluster_params: ClusterParams;
 @group(0) @binding(3) var<storage, read> cluster_ranges: array<vec2<u32>>;
 @group(0) @binding(4) var<uniform> debug: DebugParams;
+@group(0) @binding(5) var gbuffer_albedo: texture_2d<f32>;
+@group(0) @binding(6) var gbuffer_normal: texture_2d<f32>;
+
+const BACKGROUND = vec4<f32>(0.02, 0.02, 0.02, 1.0);
 
 // Blue -> cyan -> green -> yellow -> red, t in [0, 1].
 fn heat(t: f32) -> vec3<f32> {
@@ -34,8 +42,16 @@ fn index_color(i: u32) -> vec3<f32> {
     return clamp(abs(fract(vec3<f32>(h) + k) * 6.0 - 3.0) - 1.0, vec3<f32>(0.0), vec3<f32>(1.0)) * select(0.55, 0.95, i % 2u == 0u);
 }
 
+// View distance (positive) of a reverse-Z depth value
+// (manylight_core::camera::linearize_depth_reverse_z).
+fn linearize_depth(z: f32) -> f32 {
+    let near = view.params.x;
+    let far = view.params.y;
+    return near * far / (z * (far - near) + near);
+}
+
 @fragment
-fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
+fn fs_clusters(in: FullscreenOut) -> @location(0) vec4<f32> {
     let px = vec2<i32>(in.position.xy);
     let size = vec2<f32>(cluster_params.viewport.xy);
     // Legend: a bar of the heat scale along the bottom 4% with ticks every 1/8 of the scale.
@@ -47,7 +63,7 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     }
     let z = textureLoad(depth, px, 0);
     if z <= 0.0 {
-        return vec4<f32>(0.02, 0.02, 0.02, 1.0); // background (reverse-Z: cleared to 0)
+        return BACKGROUND; // reverse-Z: cleared to 0
     }
     let clip = vec4<f32>(in.uv.x * 2.0 - 1.0, 1.0 - in.uv.y * 2.0, z, 1.0);
     let world = view.world_from_clip * clip;
@@ -59,6 +75,17 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     if debug.mode == DEBUG_LIGHT_COUNT {
         let n = cluster_ranges[cluster].y;
         color = select(heat(f32(n) / f32(max(debug.scale_max, 1u))), vec3<f32>(0.0), n == 0u);
+    } else if debug.mode == DEBUG_OVERFLOW {
+        // The stored count is capped, so a cluster at the cap is one that overflowed (or was
+        // exactly full); without a cap nothing overflows and the green shows the fill.
+        let n = cluster_ranges[cluster].y;
+        let capped = cluster_params.cap != CLUSTER_NO_CAP;
+        let full = select(max(debug.scale_max, 1u), max(cluster_params.cap, 1u), capped);
+        if capped && n >= cluster_params.cap {
+            color = vec3<f32>(1.0, 0.05, 0.05);
+        } else {
+            color = vec3<f32>(0.0, 0.1 + 0.7 * clamp(f32(n) / f32(full), 0.0, 1.0), 0.05);
+        }
     } else if debug.mode == DEBUG_SLICE_X {
         color = index_color(cluster % dims.x);
     } else if debug.mode == DEBUG_SLICE_Y {
@@ -67,4 +94,30 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
         color = index_color(cluster / (dims.x * dims.y));
     }
     return vec4<f32>(color, 1.0);
+}
+
+@fragment
+fn fs_depth(in: FullscreenOut) -> @location(0) vec4<f32> {
+    let z = textureLoad(depth, vec2<i32>(in.position.xy), 0);
+    if z <= 0.0 {
+        return BACKGROUND;
+    }
+    let near = view.params.x;
+    let far = view.params.y;
+    let d = linearize_depth(z);
+    let t = clamp(log(d / near) / log(far / near), 0.0, 1.0);
+    return vec4<f32>(vec3<f32>(1.0 - t), 1.0);
+}
+
+@fragment
+fn fs_surface(in: FullscreenOut) -> @location(0) vec4<f32> {
+    let px = vec2<i32>(in.position.xy);
+    if textureLoad(depth, px, 0) <= 0.0 {
+        return BACKGROUND;
+    }
+    if debug.mode == DEBUG_ALBEDO {
+        return vec4<f32>(saturate(textureLoad(gbuffer_albedo, px, 0).rgb), 1.0);
+    }
+    let n = textureLoad(gbuffer_normal, px, 0).xyz;
+    return vec4<f32>(saturate(n * 0.5 + 0.5), 1.0);
 }

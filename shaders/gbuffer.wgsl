@@ -1,14 +1,17 @@
-// G-buffer pass of clustered deferred: writes the surface at each pixel, in one of two layouts
-// (Rust: `GBufferLayout`):
+// G-buffer pass of the deferred pipelines: writes the surface at each pixel, in one of three
+// layouts (Rust: `GBufferLayout`); the normal codec of Packed and Compact is the override
+// constant NORMAL_CODEC (common/gbuffer_codec.wgsl):
 // - Full (3 targets): position rgba32f (xyz, w = shading model), normal rgba16f (xyz, w =
 //   shininess), albedo rgba16f (rgb, a = specular);
-// - Compact (1 × rgba32uint): x = albedo rgba8 (sRGB-encoded, so dark colours keep their
-//   precision), y = normal as 2×16-bit octahedral,
-//   z = shininess (f16) | specular (f16), w = shading model; position comes from depth.
+// - Packed (2 x rgba32f): (albedo.rgb + material parameters in the integer parts, n.a) and
+//   (position.xyz, n.b);
+// - Compact (1 x rgba32uint): x = albedo rgba8 (sRGB-encoded, so dark colours keep their
+//   precision), y = the normal codec's word, z = shininess (f16) | specular (f16),
+//   w = shading model; position comes from depth.
 //!include common/view.wgsl
 //!include common/mesh.wgsl
 //!include common/surface.wgsl
-//!include common/packing.wgsl
+//!include common/gbuffer_codec.wgsl
 
 @group(0) @binding(0) var<uniform> view: ViewUniform;
 @group(0) @binding(2) var<storage, read> instances: array<GpuInstance>;
@@ -43,12 +46,27 @@ fn fs_full(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> F
     return out;
 }
 
+struct PackedOut {
+    @location(0) albedo: vec4<f32>,
+    @location(1) position: vec4<f32>,
+};
+
+@fragment
+fn fs_packed(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> PackedOut {
+    let s = surface_of(in, front_facing);
+    let n = gbuffer_encode_components(s.normal, view.view_from_world);
+    var out: PackedOut;
+    out.albedo = vec4<f32>(gbuffer_pack_albedo_params(s), n.x);
+    out.position = vec4<f32>(in.world_position, n.y);
+    return out;
+}
+
 @fragment
 fn fs_compact(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<u32> {
     let s = surface_of(in, front_facing);
     return vec4<u32>(
         pack4x8unorm(vec4<f32>(linear_to_srgb(s.albedo), 1.0)),
-        pack_octa16(s.normal),
+        gbuffer_encode_word(s.normal),
         pack2x16float(vec2<f32>(s.shininess, s.specular)),
         s.model,
     );

@@ -2,9 +2,11 @@
 //! it to the render side. Mesh and material data travel as `Arc`s (no copy of the data).
 
 use crate::backend::RenderBackend;
-use crate::components::{Camera3d, LightAnimation, Material, Mesh3d, PointLight, Transform};
+use crate::components::{
+    Bloom, Camera3d, LightAnimation, Material, Mesh3d, MotionBlur, PointLight, Transform,
+};
 use crate::resources::{
-    FrameClock, FrameStats, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize,
+    DebugView, FrameClock, FrameStats, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize,
 };
 use bevy_app::AppExit;
 use bevy_ecs::prelude::*;
@@ -22,21 +24,27 @@ pub struct ExtractState {
     warned_cameras: bool,
 }
 
+/// What extract reads of a camera: placement, projection and its opt-in effects.
+pub type CameraItem = (&'static Transform, &'static Camera3d, Option<&'static Bloom>, Option<&'static MotionBlur>);
+
 /// Builds the frame's snapshot from the world.
 #[allow(clippy::too_many_arguments)]
 pub fn build_snapshot(
     state: &mut ExtractState,
     viewport: glam::UVec2,
     settings: &RenderSettings,
-    cameras: &Query<(&Transform, &Camera3d)>,
+    debug: &DebugView,
+    cameras: &Query<CameraItem>,
     meshes: &Query<(&Transform, &Mesh3d, Option<&Material>)>,
     lights: &Query<(&Transform, &PointLight)>,
 ) -> FrameSnapshot {
     let mut camera_iter = cameras.iter();
-    let camera = camera_iter.next().map(|(t, c)| ExtractedCamera {
+    let camera = camera_iter.next().map(|(t, c, bloom, motion_blur)| ExtractedCamera {
         world_from_view: Mat4::from_rotation_translation(t.rotation, t.translation),
         projection: c.projection(),
         prev_clip_from_world: state.prev_clip_from_world,
+        bloom: bloom.map(Bloom::settings),
+        motion_blur: motion_blur.map(MotionBlur::settings),
     });
     if camera_iter.next().is_some() && !state.warned_cameras {
         tracing::warn!("more than one Camera3d: rendering the first one only");
@@ -68,7 +76,7 @@ pub fn build_snapshot(
         camera,
         instances,
         lights,
-        settings: settings.frame_settings(),
+        settings: settings.frame_settings(debug),
     };
     state.frame_index += 1;
     snapshot
@@ -80,7 +88,8 @@ pub fn extract_and_render(
     mut state: Local<ExtractState>,
     viewport: Res<ViewportSize>,
     settings: Res<RenderSettings>,
-    cameras: Query<(&Transform, &Camera3d)>,
+    debug: Res<DebugView>,
+    cameras: Query<CameraItem>,
     meshes: Query<(&Transform, &Mesh3d, Option<&Material>)>,
     lights: Query<(&Transform, &PointLight)>,
     mut backend: ResMut<RenderBackend>,
@@ -92,7 +101,7 @@ pub fn extract_and_render(
     if failure.0.is_some() {
         return;
     }
-    let snapshot = build_snapshot(&mut state, viewport.0, &settings, &cameras, &meshes, &lights);
+    let snapshot = build_snapshot(&mut state, viewport.0, &settings, &debug, &cameras, &meshes, &lights);
     backend.submit(snapshot, capture.enabled);
     for result in backend.drain() {
         match result {

@@ -22,22 +22,25 @@ pub mod resources;
 pub mod scene;
 pub mod window;
 
-pub use components::{Camera3d, LightAnimation, Material, Mesh3d, PointLight, Transform};
+pub use components::{Bloom, Camera3d, LightAnimation, Material, Mesh3d, MotionBlur, PointLight, Transform};
 pub use plugin::{HeadlessConfig, ManyLightPlugin, ManyLightSet, OutputMode};
-pub use resources::{FrameClock, FrameStats, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize};
-pub use window::{WindowConfig, WindowRequests};
+pub use resources::{DebugView, FrameClock, FrameStats, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize};
+pub use window::{PressedKeys, WindowConfig, WindowRequests};
 
 /// What an app needs in scope to use manylight.
 pub mod prelude {
-    pub use crate::components::{Camera3d, LightAnimation, Material, Mesh3d, PointLight, Transform};
+    pub use crate::components::{
+        Bloom, Camera3d, LightAnimation, Material, Mesh3d, MotionBlur, PointLight, Transform,
+    };
     pub use crate::plugin::{ManyLightPlugin, ManyLightSet};
-    pub use crate::resources::{FrameClock, FrameStats, HeadlessCapture, RenderSettings};
+    pub use crate::resources::{DebugView, FrameClock, FrameStats, HeadlessCapture, RenderSettings};
     pub use crate::scene::{spawn_light_rig, spawn_scene};
-    pub use crate::window::{WindowConfig, WindowRequests};
+    pub use crate::window::{PressedKeys, WindowConfig, WindowRequests};
     pub use bevy_app::prelude::*;
     pub use bevy_ecs::prelude::*;
     pub use glam::{Quat, UVec2, Vec3};
     pub use manylight_core::cluster::{CullTest, GridConfig, ZSlicing};
+    pub use manylight_core::codec::NormalCodec;
     pub use manylight_core::{MaterialData, MeshData, ShadingModel};
-    pub use manylight_render::{ClusterSettings, DebugView, GBufferLayout, PipelineKind};
+    pub use manylight_render::{BloomChain, ClusterSettings, DebugViewMode, GBufferLayout, PipelineKind};
 }

@@ -4,7 +4,7 @@ use crate::backend::{RenderBackend, RenderThread};
 use crate::extract::{animate_lights, extract_and_render, tick_clock};
 use crate::render_world::HeadlessRenderer;
 use crate::resources::{
-    FrameClock, FrameStats, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize,
+    DebugView, FrameClock, FrameStats, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize,
 };
 use crate::window::WindowConfig;
 use bevy_app::prelude::*;
@@ -99,9 +99,11 @@ impl ManyLightPlugin {
 impl Plugin for ManyLightPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<RenderSettings>()
+            .init_resource::<DebugView>()
             .init_resource::<FrameStats>()
             .init_resource::<RenderFailure>()
             .init_resource::<crate::window::WindowRequests>()
+            .init_resource::<crate::window::PressedKeys>()
             .configure_sets(Update, ManyLightSet::Animate)
             .configure_sets(Last, ManyLightSet::Extract)
             .add_systems(First, tick_clock)

@@ -7,10 +7,10 @@ use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::ScheduleLabel;
 use manylight_render::passes::{
     ClusterBuildPass, ClusteredForwardPass, DebugViewPass, DeferredLightingPass, DepthPrepass, ForwardPass,
-    GBufferPass, TonemapPass,
+    GBufferPass, LightVolumesPass, MotionBlurPass, TonemapPass,
 };
 use manylight_render::{
-    DebugView, FrameReport, FrameSnapshot, GpuContext, HeadlessTarget, PipelineKind, RenderError,
+    DebugViewMode, FrameReport, GBufferLayout, FrameSnapshot, GpuContext, HeadlessTarget, PipelineKind, RenderError,
     RenderGraph, Renderer,
 };
 
@@ -77,19 +77,7 @@ impl RenderWorld {
         let mut schedule = Schedule::new(RenderSchedule);
         schedule.configure_sets((RenderSet::Prepare, RenderSet::Graph, RenderSet::Execute).chain());
         schedule.add_systems(prepare.in_set(RenderSet::Prepare));
-        schedule.add_systems(
-            (
-                add_depth_prepass,
-                add_cluster_build,
-                add_forward_pass,
-                add_clustered_forward_pass,
-                add_gbuffer_pass,
-                add_deferred_lighting_pass,
-                add_output_pass,
-            )
-                .chain()
-                .in_set(RenderSet::Graph),
-        );
+        add_graph_systems(&mut schedule);
         schedule.add_systems(execute.in_set(RenderSet::Execute));
         RenderWorld { world, schedule }
     }
@@ -130,6 +118,38 @@ impl RenderWorld {
     }
 }
 
+/// Adds the `Graph` systems, in order: each adds its pass only if the snapshot calls for it.
+fn add_graph_systems(schedule: &mut Schedule) {
+    schedule.add_systems(
+        (
+            add_depth_prepass,
+            add_cluster_build,
+            add_forward_pass,
+            add_clustered_forward_pass,
+            add_gbuffer_pass,
+            add_deferred_lighting_pass,
+            add_light_volumes_pass,
+            add_motion_blur_pass,
+            add_bloom_passes,
+            add_output_pass,
+        )
+            .chain()
+            .in_set(RenderSet::Graph),
+    );
+}
+
+/// The passes the `Graph` systems would run for `snapshot`, in order, without a GPU (tests and
+/// tools use it to see what a scene calls for).
+pub fn plan_passes(snapshot: FrameSnapshot) -> Result<Vec<&'static str>, RenderError> {
+    let mut world = World::new();
+    world.insert_resource(CurrentSnapshot(snapshot));
+    world.init_resource::<FrameGraph>();
+    let mut schedule = Schedule::new(RenderSchedule);
+    add_graph_systems(&mut schedule);
+    schedule.run(&mut world);
+    world.resource::<FrameGraph>().0.pass_names()
+}
+
 fn prepare(
     mut renderer: ResMut<RendererResource>,
     snapshot: Res<CurrentSnapshot>,
@@ -142,12 +162,13 @@ fn prepare(
 
 /// True when the frame shades with cluster lists (a tiled/clustered pipeline with lights).
 fn shades_with_clusters(snapshot: &FrameSnapshot) -> bool {
-    snapshot.settings.pipeline.uses_clusters() && snapshot.has_lights()
+    snapshot.settings.pipeline.uses_clusters() && snapshot.has_lights() && !replaces_shading(snapshot)
 }
 
-/// True when the frame is shaded deferred (G-buffer, then a full-screen lighting pass).
+/// True when the frame is shaded deferred: a G-buffer, then a full-screen lighting pass
+/// (clustered deferred) or light volumes. Without lights the forward pass draws the ambient.
 fn shades_deferred(snapshot: &FrameSnapshot) -> bool {
-    shades_with_clusters(snapshot) && snapshot.settings.pipeline == PipelineKind::ClusteredDeferred
+    snapshot.settings.pipeline.is_deferred() && snapshot.has_lights() && !replaces_shading(snapshot)
 }
 
 /// True when the frame runs a depth pre-pass (forward pipelines only).
@@ -158,8 +179,20 @@ fn runs_depth_prepass(snapshot: &FrameSnapshot) -> bool {
         && (s.pipeline == PipelineKind::ForwardPlus || s.clusters.depth_prepass)
 }
 
+/// True when a debug view shows surface attributes (albedo, normal): the frame then draws the
+/// Full G-buffer instead of shading (the debug view replaces the image), in every pipeline.
+fn shows_surfaces(snapshot: &FrameSnapshot) -> bool {
+    snapshot.settings.debug_view.uses_surfaces()
+}
+
+/// True when a debug view that needs neither lighting nor clusters replaces the image: albedo
+/// and normal draw the Full G-buffer, depth only the depth pre-pass, in every pipeline.
+fn replaces_shading(snapshot: &FrameSnapshot) -> bool {
+    shows_surfaces(snapshot) || snapshot.settings.debug_view == DebugViewMode::Depth
+}
+
 fn add_depth_prepass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
-    if runs_depth_prepass(&snapshot.0) {
+    if runs_depth_prepass(&snapshot.0) || snapshot.0.settings.debug_view == DebugViewMode::Depth {
         graph.0.add(DepthPrepass);
     }
 }
@@ -171,22 +204,39 @@ fn add_cluster_build(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGrap
 }
 
 fn add_forward_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
-    // Naive forward, and the tiled/clustered pipelines when there are no lights to assign.
-    if !shades_with_clusters(&snapshot.0) {
+    // Naive forward, and the other pipelines when there are no lights to assign.
+    if !shades_with_clusters(&snapshot.0) && !shades_deferred(&snapshot.0) && !replaces_shading(&snapshot.0) {
         graph.0.add(ForwardPass { clear_color: snapshot.0.settings.clear_color });
     }
 }
 
 fn add_gbuffer_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
-    if shades_deferred(&snapshot.0) {
-        graph.0.add(GBufferPass { layout: snapshot.0.settings.gbuffer });
+    let s = &snapshot.0.settings;
+    if shows_surfaces(&snapshot.0) {
+        graph.0.add(GBufferPass { layout: GBufferLayout::Full, codec: s.normal_codec });
+    } else if shades_deferred(&snapshot.0) {
+        graph.0.add(GBufferPass { layout: s.gbuffer, codec: s.normal_codec });
     }
 }
 
 fn add_deferred_lighting_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
-    if shades_deferred(&snapshot.0) {
-        let s = &snapshot.0.settings;
-        graph.0.add(DeferredLightingPass { layout: s.gbuffer, clear_color: s.clear_color });
+    let s = &snapshot.0.settings;
+    if shades_deferred(&snapshot.0) && s.pipeline == PipelineKind::ClusteredDeferred {
+        let (layout, codec, clear_color) = (s.gbuffer, s.normal_codec, s.clear_color);
+        graph.0.add(DeferredLightingPass { layout, codec, clear_color });
+    }
+}
+
+fn add_light_volumes_pass(
+    snapshot: Res<CurrentSnapshot>,
+    renderer: Res<RendererResource>,
+    mut graph: ResMut<FrameGraph>,
+) {
+    let s = &snapshot.0.settings;
+    if shades_deferred(&snapshot.0) && s.pipeline == PipelineKind::LightVolumes {
+        let (layout, codec, clear_color) = (s.gbuffer, s.normal_codec, s.clear_color);
+        let accumulation = LightVolumesPass::accumulation_format(&renderer.0.gpu.device);
+        graph.0.add(LightVolumesPass { layout, codec, clear_color, accumulation });
     }
 }
 
@@ -199,10 +249,33 @@ fn add_clustered_forward_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<
     }
 }
 
+/// Camera-motion blur, when the camera has it (and no debug view replaces the image).
+fn add_motion_blur_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
+    let s = &snapshot.0;
+    if let Some(settings) = s.camera.and_then(|c| c.motion_blur)
+        && s.settings.debug_view == DebugViewMode::None
+    {
+        graph.0.add(MotionBlurPass { settings });
+    }
+}
+
+/// Bloom's bright pass, blur chain and composite, when the camera has bloom (and no debug view
+/// replaces the image).
+fn add_bloom_passes(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
+    let s = &snapshot.0;
+    if let Some(bloom) = s.camera.and_then(|c| c.bloom)
+        && s.settings.debug_view == DebugViewMode::None
+    {
+        for pass in bloom.passes() {
+            graph.0.add_boxed(pass);
+        }
+    }
+}
+
 /// Tone mapping, or the debug view that replaces it.
 fn add_output_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
     let s = &snapshot.0.settings;
-    if s.debug_view == DebugView::None {
+    if s.debug_view == DebugViewMode::None {
         graph.0.add(TonemapPass);
     } else {
         graph.0.add(DebugViewPass { view: s.debug_view, heatmap_max: s.debug_heatmap_max });

@@ -3,7 +3,8 @@
 use bevy_ecs::prelude::*;
 use glam::UVec2;
 use manylight_core::ShadingModel;
-use manylight_render::{ClusterSettings, DebugView, FrameReport, FrameSettings, GBufferLayout, PipelineKind};
+use manylight_core::codec::NormalCodec;
+use manylight_render::{ClusterSettings, DebugViewMode, FrameReport, FrameSettings, GBufferLayout, PipelineKind};
 
 /// How frames are rendered; changes apply from the next frame.
 #[derive(Resource, Clone, Copy, Debug, PartialEq)]
@@ -21,12 +22,10 @@ pub struct RenderSettings {
     /// Cluster grid, culling test, optional cap and depth pre-pass of the tiled and clustered
     /// pipelines.
     pub clusters: ClusterSettings,
-    /// Debug view shown instead of the image (`DebugView::None` for the image).
-    pub debug_view: DebugView,
-    /// Light count shown as the hottest colour of the light-count heatmap.
-    pub debug_heatmap_max: u32,
-    /// G-buffer layout of the deferred pipeline.
+    /// G-buffer layout of the deferred pipelines.
     pub gbuffer: GBufferLayout,
+    /// Normal encoding of the `Packed` and `Compact` G-buffer layouts.
+    pub normal_codec: NormalCodec,
 }
 
 impl Default for RenderSettings {
@@ -39,16 +38,15 @@ impl Default for RenderSettings {
             ambient: f.ambient,
             clear_color: f.clear_color,
             clusters: f.clusters,
-            debug_view: f.debug_view,
-            debug_heatmap_max: f.debug_heatmap_max,
             gbuffer: f.gbuffer,
+            normal_codec: f.normal_codec,
         }
     }
 }
 
 impl RenderSettings {
-    /// The render side's copy.
-    pub fn frame_settings(&self) -> FrameSettings {
+    /// The render side's copy, with the debug view of `debug`.
+    pub fn frame_settings(&self, debug: &DebugView) -> FrameSettings {
         FrameSettings {
             pipeline: self.pipeline,
             shading: self.shading,
@@ -56,9 +54,55 @@ impl RenderSettings {
             ambient: self.ambient,
             clear_color: self.clear_color,
             clusters: self.clusters,
-            debug_view: self.debug_view,
-            debug_heatmap_max: self.debug_heatmap_max,
+            debug_view: debug.mode,
+            debug_heatmap_max: debug.heatmap_max,
             gbuffer: self.gbuffer,
+            normal_codec: self.normal_codec,
+        }
+    }
+}
+
+/// The debug view shown instead of the tone-mapped image; systems may change it at run time
+/// (it applies from the next frame). `mode: DebugViewMode::None` shows the image.
+#[derive(Resource, Clone, Copy, Debug, PartialEq)]
+pub struct DebugView {
+    /// What to show.
+    pub mode: DebugViewMode,
+    /// Light count shown as the hottest colour of the light-count heatmap.
+    pub heatmap_max: u32,
+}
+
+impl Default for DebugView {
+    fn default() -> Self {
+        let f = FrameSettings::default();
+        DebugView { mode: f.debug_view, heatmap_max: f.debug_heatmap_max }
+    }
+}
+
+impl DebugView {
+    /// A debug view showing `mode` with the default heatmap scale.
+    pub fn new(mode: DebugViewMode) -> DebugView {
+        DebugView { mode, ..DebugView::default() }
+    }
+
+    /// One line saying what the view shows and how to read its colours.
+    pub fn legend(&self) -> String {
+        match self.mode {
+            DebugViewMode::None => "image (tone-mapped)".into(),
+            DebugViewMode::LightCount => format!(
+                "light count per pixel: blue 0 → red {} (bar at the bottom, ticks every 1/8); black = no light",
+                self.heatmap_max
+            ),
+            DebugViewMode::SliceX => "cluster x index (alternating colours per tile column)".into(),
+            DebugViewMode::SliceY => "cluster y index (alternating colours per tile row)".into(),
+            DebugViewMode::SliceZ => "cluster z index (alternating colours per depth slice)".into(),
+            DebugViewMode::Albedo => "surface albedo".into(),
+            DebugViewMode::Normal => "world normal: rgb = n * 0.5 + 0.5 (+x red, +y green, +z blue)".into(),
+            DebugViewMode::Depth => "linear view depth, log scale: white near → black far".into(),
+            DebugViewMode::Overflow => format!(
+                "cluster overflow: red = list hit the cap; green = fill (of the cap, or of {} without one)",
+                self.heatmap_max
+            ),
         }
     }
 }

@@ -73,6 +73,8 @@ pub fn scene_snapshot(
             world_from_view: cam.transform,
             projection: cam.projection,
             prev_clip_from_world: None,
+            bloom: None,
+            motion_blur: None,
         }),
         instances: scene
             .instances

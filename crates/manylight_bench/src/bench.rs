@@ -66,7 +66,7 @@ pub fn run(scene: &Scene, sweep: &Sweep) -> Result<String> {
         .iter()
         .flat_map(|&n| {
             sweep.pipelines.iter().flat_map(move |&p| {
-                let layouts: Vec<Option<GBufferLayout>> = if p == PipelineKind::ClusteredDeferred {
+                let layouts: Vec<Option<GBufferLayout>> = if p.is_deferred() {
                     sweep.gbuffers.iter().copied().map(Some).collect()
                 } else {
                     vec![None]
@@ -116,7 +116,7 @@ fn csv(rows: &[Row], size: UVec2, adapter: &str) -> String {
     let mut out = String::from(
         "adapter,pipeline,gbuffer,gbuffer_bytes_per_pixel,lights,width,height,frames,frame_ms_median,\
          frame_ms_mean,depth_prepass_gpu_ms,cluster_build_gpu_ms,cluster_build_gpu_trusted,\
-         forward_gpu_ms,clustered_forward_gpu_ms,gbuffer_gpu_ms,deferred_lighting_gpu_ms,tonemap_gpu_ms,clusters,non_empty_clusters,list_entries,\
+         forward_gpu_ms,clustered_forward_gpu_ms,gbuffer_gpu_ms,deferred_lighting_gpu_ms,light_volumes_gpu_ms,tonemap_gpu_ms,clusters,non_empty_clusters,list_entries,\
          max_per_cluster,mean_per_non_empty,dropped_pairs,culling_ratio\n",
     );
     for r in rows {
@@ -130,7 +130,7 @@ fn csv(rows: &[Row], size: UVec2, adapter: &str) -> String {
         let mean = r.frame_ms.iter().sum::<f64>() / r.frame_ms.len().max(1) as f64;
         let _ = writeln!(
             out,
-            "\"{adapter}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "\"{adapter}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             r.pipeline.name(),
             r.gbuffer.map_or("", |g| g.name()),
             r.gbuffer.map_or(String::new(), |g| g.bytes_per_pixel().to_string()),
@@ -147,6 +147,7 @@ fn csv(rows: &[Row], size: UVec2, adapter: &str) -> String {
             pass_ms(&r.last, "clustered_forward"),
             pass_ms(&r.last, "gbuffer"),
             pass_ms(&r.last, "deferred_lighting"),
+            pass_ms(&r.last, "light_volumes"),
             pass_ms(&r.last, "tonemap"),
             c.map_or(String::new(), |c| c.clusters.to_string()),
             c.map_or(String::new(), |c| c.non_empty.to_string()),

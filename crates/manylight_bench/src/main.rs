@@ -10,8 +10,9 @@ use manylight_app::RenderSettings;
 use manylight_app::headless::{render_headless, save_png};
 use manylight_app::scene::{spawn_light_rig, spawn_scene};
 use manylight_core::ShadingModel;
+use manylight_core::codec::NormalCodec;
 use manylight_core::cluster::{CullTest, GridConfig, MAX_GRID_DIM, ZSlicing};
-use manylight_render::{ClusterSettings, DebugView, GBufferLayout, PipelineKind};
+use manylight_render::{BloomChain, ClusterSettings, DebugViewMode, GBufferLayout, PipelineKind};
 use manylight_scene::{LoadOptions, Scene, load_scene};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -149,7 +150,43 @@ struct RenderArgs {
     /// with a non-zero contribution (CPU reference over the depth buffer read back).
     #[arg(long)]
     culling_efficiency: bool,
+    #[command(flatten)]
+    post: PostArgs,
 }
+
+/// Opt-in post stages of `render`.
+#[derive(clap::Args, Clone, Debug)]
+struct PostArgs {
+    /// Bloom on the camera.
+    #[arg(long)]
+    bloom: bool,
+    /// Bloom chain: downsampled (halves the resolution per iteration) or full-resolution
+    /// (seed 002: 1×9/9×1 kernels at full size).
+    #[arg(long, default_value = "downsampled", value_parser = parse_bloom_chain)]
+    bloom_chain: BloomChain,
+    /// Camera-motion blur on the camera; the camera turns between frames so it shows (at least
+    /// 2 frames are rendered).
+    #[arg(long)]
+    motion_blur: bool,
+}
+
+fn parse_bloom_chain(s: &str) -> Result<BloomChain, String> {
+    [BloomChain::Downsampled, BloomChain::FullResolution]
+        .into_iter()
+        .find(|c| c.name() == s)
+        .ok_or_else(|| format!("unknown bloom chain `{s}` (expected downsampled or full-resolution)"))
+}
+
+/// What `render_scene` adds beyond the scene: post stages on the camera and the debug view.
+#[derive(Clone, Copy, Debug, Default)]
+struct Extras {
+    bloom: Option<manylight_app::Bloom>,
+    motion_blur: Option<manylight_app::MotionBlur>,
+    debug: manylight_app::DebugView,
+}
+
+/// Camera turn per frame under `--motion-blur` (about 20 px of motion at 1280 px wide).
+const MOTION_BLUR_TURN: f32 = 0.015;
 
 /// Light-assignment options of the tiled and clustered pipelines.
 #[derive(clap::Args, Clone, Debug)]
@@ -172,12 +209,18 @@ struct ClusterArgs {
     /// Workgroup size of the cluster-build compute shader.
     #[arg(long, default_value_t = 64)]
     workgroup_size: u32,
-    /// G-buffer layout of clustered-deferred: full or compact.
+    /// G-buffer layout of the deferred pipelines (clustered-deferred, light-volumes): full,
+    /// packed or compact.
     #[arg(long, default_value = "full", value_parser = parse_gbuffer)]
     gbuffer: GBufferLayout,
-    /// Debug view: none, light-count, slice-x, slice-y, slice-z.
+    /// Normal codec of the packed and compact G-buffers: xyz (packed only), spherical,
+    /// octa16 or octa8. The full G-buffer stores normals unencoded.
+    #[arg(long, default_value = "octa16", value_parser = parse_normal_codec)]
+    normal_codec: NormalCodec,
+    /// Debug view: none, albedo, normal, depth, light-count, slice-x, slice-y, slice-z or
+    /// overflow (replaces tone mapping).
     #[arg(long, default_value = "none", value_parser = parse_debug_view)]
-    debug_view: DebugView,
+    debug_view: DebugViewMode,
 }
 
 impl ClusterArgs {
@@ -193,8 +236,17 @@ impl ClusterArgs {
 }
 
 fn parse_gbuffer(s: &str) -> Result<GBufferLayout, String> {
-    GBufferLayout::from_name(s)
-        .ok_or_else(|| format!("unknown G-buffer layout `{s}` (expected full or compact)"))
+    GBufferLayout::from_name(s).ok_or_else(|| {
+        let names: Vec<_> = GBufferLayout::ALL.iter().map(|l| l.name()).collect();
+        format!("unknown G-buffer layout `{s}` (expected one of: {})", names.join(", "))
+    })
+}
+
+fn parse_normal_codec(s: &str) -> Result<NormalCodec, String> {
+    NormalCodec::from_name(s).ok_or_else(|| {
+        let names: Vec<_> = NormalCodec::ALL.iter().map(|c| c.name()).collect();
+        format!("unknown normal codec `{s}` (expected one of: {})", names.join(", "))
+    })
 }
 
 fn parse_cull(s: &str) -> Result<CullTest, String> {
@@ -206,9 +258,9 @@ fn parse_slicing(s: &str) -> Result<ZSlicing, String> {
     ZSlicing::from_name(s).ok_or_else(|| format!("unknown z slicing `{s}` (expected linear or exponential)"))
 }
 
-fn parse_debug_view(s: &str) -> Result<DebugView, String> {
-    DebugView::from_name(s).ok_or_else(|| {
-        let names: Vec<_> = DebugView::ALL.iter().map(|v| v.name()).collect();
+fn parse_debug_view(s: &str) -> Result<DebugViewMode, String> {
+    DebugViewMode::from_name(s).ok_or_else(|| {
+        let names: Vec<_> = DebugViewMode::ALL.iter().map(|v| v.name()).collect();
         format!("unknown debug view `{s}` (expected one of: {})", names.join(", "))
     })
 }
@@ -234,7 +286,7 @@ fn parse_pipeline(s: &str) -> Result<PipelineKind, String> {
 }
 
 fn parse_shading(s: &str) -> Result<ShadingModel, String> {
-    ShadingModel::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
+    ShadingModel::from_name(s).ok_or_else(|| {
         let names: Vec<_> = ShadingModel::ALL.iter().map(|m| m.name()).collect();
         format!("unknown shading model `{s}` (expected one of: {})", names.join(", "))
     })
@@ -258,16 +310,40 @@ fn render_scene(
     lights: usize,
     seed: u64,
     settings: RenderSettings,
+    extras: Extras,
 ) -> Result<(image::RgbaImage, FrameStats)> {
+    use bevy_ecs::prelude::{Entity, Query, With};
+    use manylight_app::{Camera3d, Transform};
     let aspect = size.x as f32 / size.y as f32;
     let bounds = scene.bounds();
     let frame = render_headless(size, frames, move |app| {
-        app.insert_resource(settings).add_systems(Startup, move |mut commands: Commands| {
-            spawn_scene(&mut commands, &scene, true, aspect);
-            if lights > 0 {
-                spawn_light_rig(&mut commands, lights, bounds, seed);
+        app.insert_resource(settings).insert_resource(extras.debug).add_systems(
+            Startup,
+            move |mut commands: Commands| {
+                spawn_scene(&mut commands, &scene, true, aspect);
+                if lights > 0 {
+                    spawn_light_rig(&mut commands, lights, bounds, seed);
+                }
+            },
+        );
+        app.add_systems(bevy_app::PostStartup, move |mut commands: Commands, cameras: Query<Entity, With<Camera3d>>| {
+            for camera in &cameras {
+                let mut camera = commands.entity(camera);
+                if let Some(bloom) = extras.bloom {
+                    camera.insert(bloom);
+                }
+                if let Some(motion_blur) = extras.motion_blur {
+                    camera.insert(motion_blur);
+                }
             }
         });
+        if extras.motion_blur.is_some() {
+            app.add_systems(bevy_app::Update, |mut cameras: Query<&mut Transform, With<Camera3d>>| {
+                for mut t in &mut cameras {
+                    t.rotation = glam::Quat::from_rotation_y(MOTION_BLUR_TURN) * t.rotation;
+                }
+            });
+        }
     })
     .map_err(anyhow::Error::msg)?;
     Ok((frame.image, frame.stats))
@@ -312,6 +388,7 @@ fn render(args: RenderArgs) -> Result<()> {
             shading: args.shading,
             clusters: args.clusters.settings(),
             gbuffer: args.clusters.gbuffer,
+            normal_codec: args.clusters.normal_codec,
             ..Default::default()
         };
         let snap = direct::snapshot(&scene, &rig, t, args.size, settings, 0);
@@ -336,11 +413,20 @@ fn render(args: RenderArgs) -> Result<()> {
         exposure: args.exposure,
         ambient,
         clusters: args.clusters.settings(),
-        debug_view: args.clusters.debug_view,
         gbuffer: args.clusters.gbuffer,
+        normal_codec: args.clusters.normal_codec,
         ..RenderSettings::default()
     };
-    let (image, stats) = render_scene(scene, args.size, args.frames, lights, args.seed, settings)?;
+    let extras = Extras {
+        bloom: args
+            .post
+            .bloom
+            .then(|| manylight_app::Bloom { chain: args.post.bloom_chain, ..manylight_app::Bloom::default() }),
+        motion_blur: args.post.motion_blur.then(manylight_app::MotionBlur::default),
+        debug: manylight_app::DebugView::new(args.clusters.debug_view),
+    };
+    let frames = if args.post.motion_blur { args.frames.max(2) } else { args.frames };
+    let (image, stats) = render_scene(scene, args.size, frames, lights, args.seed, settings, extras)?;
     save_png(&image, &args.out).map_err(anyhow::Error::msg)?;
     if let Some(path) = &args.stats_json {
         let mut json = stats_json(&stats);
@@ -391,7 +477,7 @@ fn check(path: PathBuf) -> Result<()> {
         scene.lights.len(),
         scene.cameras.len()
     );
-    render_scene(scene, UVec2::new(64, 64), 1, 0, 1, RenderSettings::default())
+    render_scene(scene, UVec2::new(64, 64), 1, 0, 1, RenderSettings::default(), Extras::default())
         .with_context(|| format!("`{spec}` loaded but did not render"))?;
     println!("ok: {summary}");
     Ok(())
@@ -418,6 +504,7 @@ fn bench_cmd(args: BenchArgs) -> Result<()> {
         settings: manylight_render::FrameSettings {
             clusters: args.clusters.settings(),
             gbuffer: args.clusters.gbuffer,
+            normal_codec: args.clusters.normal_codec,
             ..Default::default()
         },
     };

@@ -7,8 +7,10 @@ use crate::direct::snapshot;
 use anyhow::Result;
 use glam::UVec2;
 use manylight_app::render_world::HeadlessRenderer;
+use manylight_core::cluster::CullTest;
+use manylight_core::codec::NormalCodec;
 use manylight_core::image_metrics::flip_compare;
-use manylight_render::{FrameReport, FrameSettings, GBufferLayout, PipelineKind};
+use manylight_render::{ClusterSettings, FrameReport, FrameSettings, GBufferLayout, PipelineKind};
 use manylight_scene::{Scene, light_rig};
 use std::fmt::Write as _;
 use std::time::Instant;
@@ -41,28 +43,56 @@ fn measure(
     Ok((median, report, image.ok_or_else(|| anyhow::anyhow!("no image"))?))
 }
 
+/// Every approximation the report compares with naive forward: the tiled and clustered
+/// pipelines, each culling test, a cluster cap, and both deferred pipelines with every G-buffer
+/// layout and (for `Packed` and `Compact`) every normal codec the layout can store.
+fn configurations(base: FrameSettings) -> Vec<(String, FrameSettings)> {
+    let mut configs =
+        vec![("forward-plus".to_string(), FrameSettings { pipeline: PipelineKind::ForwardPlus, ..base })];
+    for cull in [CullTest::Both, CullTest::Aabb, CullTest::Planes] {
+        let clusters = ClusterSettings { cull, ..base.clusters };
+        let settings = FrameSettings { pipeline: PipelineKind::ClusteredForward, clusters, ..base };
+        configs.push((format!("clustered-forward, cull {}", cull.name()), settings));
+    }
+    let capped = ClusterSettings { cap: Some(8), ..base.clusters };
+    configs.push((
+        "clustered-forward, cap 8 lights/cluster".into(),
+        FrameSettings { pipeline: PipelineKind::ClusteredForward, clusters: capped, ..base },
+    ));
+    for pipeline in [PipelineKind::ClusteredDeferred, PipelineKind::LightVolumes] {
+        for gbuffer in GBufferLayout::ALL {
+            let codecs: Vec<NormalCodec> = if !gbuffer.uses_codec() {
+                vec![base.normal_codec]
+            } else if pipeline == PipelineKind::ClusteredDeferred {
+                NormalCodec::ALL.into_iter().filter(|&c| gbuffer.supports(c)).collect()
+            } else {
+                vec![NormalCodec::Octa16] // the codecs cost the same in both deferred pipelines
+            };
+            for normal_codec in codecs {
+                let name = if gbuffer.uses_codec() {
+                    format!(
+                        "{}, {} G-buffer, {} normals",
+                        pipeline.name(),
+                        gbuffer.name(),
+                        normal_codec.name()
+                    )
+                } else {
+                    format!("{}, {} G-buffer", pipeline.name(), gbuffer.name())
+                };
+                configs.push((name, FrameSettings { pipeline, gbuffer, normal_codec, ..base }));
+            }
+        }
+    }
+    configs
+}
+
 /// Runs the comparison and returns the markdown table.
 pub fn run(scene: &Scene, lights: usize, size: UVec2, frames: u32, base: FrameSettings) -> Result<String> {
     let mut renderer = HeadlessRenderer::new()?;
     let adapter = renderer.render_world.gpu().info.name.clone();
     let naive = FrameSettings { pipeline: PipelineKind::NaiveForward, ..base };
     let (naive_ms, naive_report, reference) = measure(&mut renderer, scene, lights, size, naive, frames)?;
-    let configs: Vec<(String, FrameSettings)> = vec![
-        ("forward-plus".into(), FrameSettings { pipeline: PipelineKind::ForwardPlus, ..base }),
-        ("clustered-forward".into(), FrameSettings { pipeline: PipelineKind::ClusteredForward, ..base }),
-        (
-            "clustered-deferred, full G-buffer".into(),
-            FrameSettings { pipeline: PipelineKind::ClusteredDeferred, gbuffer: GBufferLayout::Full, ..base },
-        ),
-        (
-            "clustered-deferred, compact G-buffer".into(),
-            FrameSettings {
-                pipeline: PipelineKind::ClusteredDeferred,
-                gbuffer: GBufferLayout::Compact,
-                ..base
-            },
-        ),
-    ];
+    let configs = configurations(base);
     let passes = |r: &FrameReport| {
         r.passes
             .iter()
@@ -82,26 +112,27 @@ pub fn run(scene: &Scene, lights: usize, size: UVec2, frames: u32, base: FrameSe
     );
     let _ = writeln!(
         out,
-        "| pipeline | G-buffer bytes/px | FLIP mean | FLIP p99 | frame ms | speed-up | passes (GPU ms; * = untrusted) |"
+        "| pipeline | G-buffer bytes/px | FLIP mean | FLIP p99 | dropped light-cluster pairs | frame ms | speed-up | passes (GPU ms; * = untrusted) |"
     );
-    let _ = writeln!(out, "|---|---:|---:|---:|---:|---:|---|");
+    let _ = writeln!(out, "|---|---:|---:|---:|---:|---:|---:|---|");
     let _ = writeln!(
         out,
-        "| naive forward (reference) | – | 0 | 0 | {naive_ms:.0} | 1.0× | {} |",
+        "| naive forward (reference) | – | 0 | 0 | 0 | {naive_ms:.0} | 1.0× | {} |",
         passes(&naive_report)
     );
     for (name, settings) in configs {
         let (ms, report, image) = measure(&mut renderer, scene, lights, size, settings, frames)?;
         let (flip, _) =
             flip_compare(reference.dimensions(), reference.as_raw(), image.dimensions(), image.as_raw())?;
-        let bytes = if settings.pipeline == PipelineKind::ClusteredDeferred {
+        let bytes = if settings.pipeline.is_deferred() {
             settings.gbuffer.bytes_per_pixel().to_string()
         } else {
             "–".into()
         };
+        let dropped = report.clusters.as_ref().map_or(0, |c| c.dropped_pairs);
         let _ = writeln!(
             out,
-            "| {name} | {bytes} | {:.5} | {:.5} | {ms:.0} | {:.1}× | {} |",
+            "| {name} | {bytes} | {:.5} | {:.5} | {dropped} | {ms:.0} | {:.1}× | {} |",
             flip.mean,
             flip.p99,
             naive_ms / ms,

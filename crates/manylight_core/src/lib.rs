@@ -8,6 +8,7 @@ pub mod camera;
 pub mod cluster;
 pub mod codec;
 pub mod efficiency;
+pub mod icosphere;
 pub mod image_metrics;
 pub mod material;
 pub mod mesh;

@@ -11,7 +11,15 @@ pub enum ShadingModel {
     /// Diffuse plus a Blinn-Phong specular lobe.
     #[default]
     BlinnPhong,
+    /// Cel shading: each light's diffuse term in [`TOON_BANDS`] flat bands, plus a rim light
+    /// on silhouettes the light reaches (`shade_point_light` in `shaders/common/brdf.wgsl`).
+    Toon,
 }
+
+/// Number of flat diffuse bands of [`ShadingModel::Toon`] (shared with WGSL).
+pub const TOON_BANDS: u32 = 3;
+/// Strength of the toon rim light, as a fraction of the light's diffuse colour.
+pub const TOON_RIM_STRENGTH: f32 = 0.5;
 
 impl ShadingModel {
     /// Value the shaders switch on (`SHADING_*` in `shaders/common/brdf.wgsl`).
@@ -19,18 +27,25 @@ impl ShadingModel {
         match self {
             ShadingModel::Lambert => 0,
             ShadingModel::BlinnPhong => 1,
+            ShadingModel::Toon => 2,
         }
     }
 
     /// Every model, in `gpu_id` order.
-    pub const ALL: [ShadingModel; 2] = [ShadingModel::Lambert, ShadingModel::BlinnPhong];
+    pub const ALL: [ShadingModel; 3] = [ShadingModel::Lambert, ShadingModel::BlinnPhong, ShadingModel::Toon];
 
     /// The name used on the command line.
     pub fn name(self) -> &'static str {
         match self {
             ShadingModel::Lambert => "lambert",
             ShadingModel::BlinnPhong => "blinn-phong",
+            ShadingModel::Toon => "toon",
         }
+    }
+
+    /// Parses a name written by [`ShadingModel::name`].
+    pub fn from_name(name: &str) -> Option<ShadingModel> {
+        Self::ALL.into_iter().find(|m| m.name() == name)
     }
 }
 

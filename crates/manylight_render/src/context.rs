@@ -25,6 +25,9 @@ pub enum RenderError {
     /// The window surface could not be created.
     #[error("could not create a window surface: {0}")]
     Surface(String),
+    /// The render settings ask for a combination that cannot work.
+    #[error("unsupported render settings: {0}")]
+    UnsupportedSettings(String),
     /// A shader was not embedded.
     #[error(transparent)]
     Shader(#[from] crate::shaders::ShaderError),
@@ -94,6 +97,15 @@ impl GpuContext {
         let mut required_features = wgpu::Features::empty();
         if timestamps {
             required_features |= wgpu::Features::TIMESTAMP_QUERY;
+        }
+        // Light volumes keep sphere proxies that cross the far plane (depth clamped, not clipped).
+        let unclipped_depth = adapter.features().contains(wgpu::Features::DEPTH_CLIP_CONTROL);
+        if unclipped_depth {
+            required_features |= wgpu::Features::DEPTH_CLIP_CONTROL;
+        }
+        // Light volumes sum their lights in an rgba32f target where blending it is supported.
+        if adapter.features().contains(wgpu::Features::FLOAT32_BLENDABLE) {
+            required_features |= wgpu::Features::FLOAT32_BLENDABLE;
         }
         let adapter_limits = adapter.limits();
         let required_limits = wgpu::Limits {

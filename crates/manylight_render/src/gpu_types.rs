@@ -6,6 +6,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec4};
 use manylight_core::ShadingModel;
+use manylight_core::codec::NormalCodec;
 
 /// `GpuMaterial::shading_model` value meaning "use the view's global model".
 pub const SHADING_GLOBAL: u32 = 0xffff_ffff;
@@ -23,11 +24,17 @@ pub const CULL_BOTH: u32 = 2;
 
 /// Constants emitted into WGSL as `const NAME: u32 = VALUE;`.
 pub fn shared_u32_constants() -> Vec<(&'static str, u32)> {
-    use crate::snapshot::DebugView;
+    use crate::snapshot::DebugViewMode as DebugView;
     use manylight_core::cluster::ZSlicing;
     vec![
         ("SHADING_LAMBERT", ShadingModel::Lambert.gpu_id()),
         ("SHADING_BLINN_PHONG", ShadingModel::BlinnPhong.gpu_id()),
+        ("SHADING_TOON", ShadingModel::Toon.gpu_id()),
+        ("TOON_BANDS", manylight_core::material::TOON_BANDS),
+        ("NORMAL_CODEC_XYZ", NormalCodec::Xyz.gpu_id()),
+        ("NORMAL_CODEC_SPHERICAL", NormalCodec::Spherical.gpu_id()),
+        ("NORMAL_CODEC_OCTA16", NormalCodec::Octa16.gpu_id()),
+        ("NORMAL_CODEC_OCTA8", NormalCodec::Octa8.gpu_id()),
         ("SHADING_GLOBAL", SHADING_GLOBAL),
         ("CLUSTER_NO_CAP", CLUSTER_NO_CAP),
         ("SCAN_WORKGROUP_SIZE", SCAN_WORKGROUP_SIZE),
@@ -40,6 +47,10 @@ pub fn shared_u32_constants() -> Vec<(&'static str, u32)> {
         ("DEBUG_SLICE_X", DebugView::SliceX.gpu_id()),
         ("DEBUG_SLICE_Y", DebugView::SliceY.gpu_id()),
         ("DEBUG_SLICE_Z", DebugView::SliceZ.gpu_id()),
+        ("DEBUG_ALBEDO", DebugView::Albedo.gpu_id()),
+        ("DEBUG_NORMAL", DebugView::Normal.gpu_id()),
+        ("DEBUG_DEPTH", DebugView::Depth.gpu_id()),
+        ("DEBUG_OVERFLOW", DebugView::Overflow.gpu_id()),
     ]
 }
 
@@ -120,7 +131,10 @@ pub struct GpuMaterial {
 
 /// Constants emitted into WGSL as `const NAME: f32 = VALUE;` (printed so they round-trip).
 pub fn shared_f32_constants() -> Vec<(&'static str, f32)> {
-    vec![("RADIUS_INFLATION", manylight_core::cluster::RADIUS_INFLATION)]
+    vec![
+        ("RADIUS_INFLATION", manylight_core::cluster::RADIUS_INFLATION),
+        ("TOON_RIM_STRENGTH", manylight_core::material::TOON_RIM_STRENGTH),
+    ]
 }
 
 /// Cluster-grid constants (`ClusterParams` in `shaders/common/clusters.wgsl`).

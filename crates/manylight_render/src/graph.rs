@@ -131,6 +131,11 @@ impl RenderGraph {
         self.passes.push(Box::new(pass));
     }
 
+    /// Adds a pass that is already boxed (e.g. one of a list a settings type builds).
+    pub fn add_boxed(&mut self, pass: Box<dyn Pass>) {
+        self.passes.push(pass);
+    }
+
     /// Removes every pass (the graph is rebuilt each frame).
     pub fn clear(&mut self) {
         self.passes.clear();

@@ -48,6 +48,14 @@ impl Renderer {
 
     /// Uploads the snapshot's data (the `Prepare` step).
     pub fn prepare(&mut self, snapshot: &FrameSnapshot) -> Result<(), RenderError> {
+        let settings = &snapshot.settings;
+        if settings.pipeline.is_deferred() && !settings.gbuffer.supports(settings.normal_codec) {
+            return Err(RenderError::UnsupportedSettings(format!(
+                "the {} G-buffer cannot store normals with the {} codec",
+                settings.gbuffer.name(),
+                settings.normal_codec.name()
+            )));
+        }
         self.scene.prepare(&self.gpu, snapshot)?;
         if snapshot.needs_clusters() {
             let gpu = &self.gpu;

@@ -125,7 +125,7 @@ impl SceneResources {
                     },
                     count: None,
                 },
-                storage(1, wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE),
+                storage(1, all),
                 storage(2, wgpu::ShaderStages::VERTEX),
             ],
         });

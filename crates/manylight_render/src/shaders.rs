@@ -17,6 +17,9 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("common/surface.wgsl", include_str!("../../../shaders/common/surface.wgsl")),
     ("common/clusters.wgsl", include_str!("../../../shaders/common/clusters.wgsl")),
     ("common/packing.wgsl", include_str!("../../../shaders/common/packing.wgsl")),
+    ("common/gbuffer_codec.wgsl", include_str!("../../../shaders/common/gbuffer_codec.wgsl")),
+    ("common/gbuffer_read.wgsl", include_str!("../../../shaders/common/gbuffer_read.wgsl")),
+    ("light_volumes.wgsl", include_str!("../../../shaders/light_volumes.wgsl")),
     ("forward.wgsl", include_str!("../../../shaders/forward.wgsl")),
     ("depth_prepass.wgsl", include_str!("../../../shaders/depth_prepass.wgsl")),
     ("cluster_build.wgsl", include_str!("../../../shaders/cluster_build.wgsl")),
@@ -25,6 +28,8 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("gbuffer.wgsl", include_str!("../../../shaders/gbuffer.wgsl")),
     ("deferred_lighting.wgsl", include_str!("../../../shaders/deferred_lighting.wgsl")),
     ("tonemap.wgsl", include_str!("../../../shaders/tonemap.wgsl")),
+    ("bloom.wgsl", include_str!("../../../shaders/bloom.wgsl")),
+    ("motion_blur.wgsl", include_str!("../../../shaders/motion_blur.wgsl")),
 ];
 
 /// A shader could not be composed.

@@ -3,8 +3,12 @@
 
 use glam::{Mat4, UVec2, Vec3};
 use manylight_core::cluster::{CullTest, GridConfig};
+use manylight_core::codec::NormalCodec;
 use manylight_core::{MaterialData, MeshData, Projection, ShadingModel};
 use std::sync::Arc;
+
+pub use crate::passes::bloom::{BloomChain, BloomSettings};
+pub use crate::passes::motion_blur::MotionBlurSettings;
 
 /// Which many-light pipeline renders the frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -19,15 +23,19 @@ pub enum PipelineKind {
     /// Clustered deferred: a G-buffer pass, then one full-screen pass walks each pixel's
     /// cluster list.
     ClusteredDeferred,
+    /// Deferred light volumes: a G-buffer pass, then each light drawn as an instanced sphere
+    /// proxy that adds its light to the pixels it covers (no cluster lists).
+    LightVolumes,
 }
 
 impl PipelineKind {
     /// Every pipeline, in the order the CLI lists them.
-    pub const ALL: [PipelineKind; 4] = [
+    pub const ALL: [PipelineKind; 5] = [
         PipelineKind::NaiveForward,
         PipelineKind::ForwardPlus,
         PipelineKind::ClusteredForward,
         PipelineKind::ClusteredDeferred,
+        PipelineKind::LightVolumes,
     ];
 
     /// Name used on the command line and in reports.
@@ -37,12 +45,18 @@ impl PipelineKind {
             PipelineKind::ForwardPlus => "forward-plus",
             PipelineKind::ClusteredForward => "clustered-forward",
             PipelineKind::ClusteredDeferred => "clustered-deferred",
+            PipelineKind::LightVolumes => "light-volumes",
         }
     }
 
     /// Parses a command-line name.
     pub fn from_name(name: &str) -> Option<PipelineKind> {
         Self::ALL.into_iter().find(|p| p.name() == name)
+    }
+
+    /// True for the pipelines that render a G-buffer and light it afterwards.
+    pub fn is_deferred(self) -> bool {
+        matches!(self, PipelineKind::ClusteredDeferred | PipelineKind::LightVolumes)
     }
 
     /// True for pipelines that build light lists per tile or cluster.
@@ -54,28 +68,45 @@ impl PipelineKind {
     }
 }
 
-/// How the deferred pipeline stores surfaces (see `shaders/gbuffer.wgsl`).
+/// How the deferred pipelines store surfaces (see `shaders/gbuffer.wgsl`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum GBufferLayout {
-    /// Three targets: position rgba32f, normal rgba16f, albedo rgba16f (+ depth).
+    /// Three targets: position rgba32f, normal rgba16f (unencoded xyz), albedo rgba16f
+    /// (+ depth). The normal codec setting does not apply.
     #[default]
     Full,
-    /// One rgba32uint target: albedo rgba8 (sRGB-encoded), normal 2×16 octahedral,
-    /// shininess/specular f16,
-    /// shading model; position reconstructed from depth.
+    /// Two rgba32f targets: (albedo.rgb, n.a) and (position.xyz, n.b), where (n.a, n.b) are the
+    /// normal codec's two components. The albedo channels carry the material parameters in
+    /// their integer parts (`shaders/gbuffer.wgsl` explains how).
+    Packed,
+    /// One rgba32uint target: albedo rgba8 (sRGB-encoded), the normal codec's 32-bit word,
+    /// shininess/specular f16, shading model; position reconstructed from depth.
     Compact,
 }
 
 impl GBufferLayout {
     /// Every layout, in CLI order.
-    pub const ALL: [GBufferLayout; 2] = [GBufferLayout::Full, GBufferLayout::Compact];
+    pub const ALL: [GBufferLayout; 3] = [GBufferLayout::Full, GBufferLayout::Packed, GBufferLayout::Compact];
 
     /// Name used on the command line.
     pub fn name(self) -> &'static str {
         match self {
             GBufferLayout::Full => "full",
+            GBufferLayout::Packed => "packed",
             GBufferLayout::Compact => "compact",
         }
+    }
+
+    /// True when the layout can store normals with `codec`: `Full` stores them unencoded (any
+    /// codec setting is ignored); `Compact` has 32 bits, which the xyz codec's two f32
+    /// components do not fit.
+    pub fn supports(self, codec: NormalCodec) -> bool {
+        !(self == GBufferLayout::Compact && codec == NormalCodec::Xyz)
+    }
+
+    /// True when the layout stores normals with the normal codec (`Packed`, `Compact`).
+    pub fn uses_codec(self) -> bool {
+        self != GBufferLayout::Full
     }
 
     /// Parses a command-line name.
@@ -87,6 +118,7 @@ impl GBufferLayout {
     pub fn bytes_per_pixel(self) -> u32 {
         match self {
             GBufferLayout::Full => 16 + 8 + 8 + 4,
+            GBufferLayout::Packed => 16 + 16 + 4,
             GBufferLayout::Compact => 16 + 4,
         }
     }
@@ -94,7 +126,7 @@ impl GBufferLayout {
 
 /// What the debug view shows instead of the tone-mapped image.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum DebugView {
+pub enum DebugViewMode {
     /// The normal image.
     #[default]
     None,
@@ -106,32 +138,76 @@ pub enum DebugView {
     SliceY,
     /// Cluster z (depth slice) index.
     SliceZ,
+    /// Surface albedo (linear, shown through the sRGB output).
+    Albedo,
+    /// World-space normal mapped to colour (`n * 0.5 + 0.5`).
+    Normal,
+    /// Linearised view depth (reverse-Z undone), near white to far black.
+    Depth,
+    /// Clusters whose list hit the per-cluster cap (red) and how full the others are (green).
+    Overflow,
 }
 
-impl DebugView {
+impl DebugViewMode {
     /// Every view, in CLI order.
-    pub const ALL: [DebugView; 5] =
-        [DebugView::None, DebugView::LightCount, DebugView::SliceX, DebugView::SliceY, DebugView::SliceZ];
+    pub const ALL: [DebugViewMode; 9] = [
+        DebugViewMode::None,
+        DebugViewMode::Albedo,
+        DebugViewMode::Normal,
+        DebugViewMode::Depth,
+        DebugViewMode::LightCount,
+        DebugViewMode::SliceX,
+        DebugViewMode::SliceY,
+        DebugViewMode::SliceZ,
+        DebugViewMode::Overflow,
+    ];
 
     /// Name used on the command line.
     pub fn name(self) -> &'static str {
         match self {
-            DebugView::None => "none",
-            DebugView::LightCount => "light-count",
-            DebugView::SliceX => "slice-x",
-            DebugView::SliceY => "slice-y",
-            DebugView::SliceZ => "slice-z",
+            DebugViewMode::None => "none",
+            DebugViewMode::LightCount => "light-count",
+            DebugViewMode::SliceX => "slice-x",
+            DebugViewMode::SliceY => "slice-y",
+            DebugViewMode::SliceZ => "slice-z",
+            DebugViewMode::Albedo => "albedo",
+            DebugViewMode::Normal => "normal",
+            DebugViewMode::Depth => "depth",
+            DebugViewMode::Overflow => "overflow",
         }
     }
 
     /// Parses a command-line name.
-    pub fn from_name(name: &str) -> Option<DebugView> {
+    pub fn from_name(name: &str) -> Option<DebugViewMode> {
         Self::ALL.into_iter().find(|v| v.name() == name)
     }
 
     /// The id the debug shader switches on.
     pub fn gpu_id(self) -> u32 {
         self as u32
+    }
+
+    /// True for views that show cluster data (they need the cluster build).
+    pub fn uses_clusters(self) -> bool {
+        matches!(
+            self,
+            DebugViewMode::LightCount
+                | DebugViewMode::SliceX
+                | DebugViewMode::SliceY
+                | DebugViewMode::SliceZ
+                | DebugViewMode::Overflow
+        )
+    }
+
+    /// True for views that show surface attributes (they need a G-buffer).
+    pub fn uses_surfaces(self) -> bool {
+        matches!(self, DebugViewMode::Albedo | DebugViewMode::Normal)
+    }
+
+    /// The next view (wrapping), for key-driven cycling.
+    pub fn next(self) -> DebugViewMode {
+        let i = Self::ALL.iter().position(|&v| v == self).unwrap_or(0);
+        Self::ALL[(i + 1) % Self::ALL.len()]
     }
 }
 
@@ -193,11 +269,13 @@ pub struct FrameSettings {
     /// Light assignment of the tiled and clustered pipelines.
     pub clusters: ClusterSettings,
     /// Debug view (replaces tone mapping when not `None`).
-    pub debug_view: DebugView,
+    pub debug_view: DebugViewMode,
     /// Light count shown as the hottest colour of the light-count heatmap.
     pub debug_heatmap_max: u32,
-    /// G-buffer layout of the deferred pipeline.
+    /// G-buffer layout of the deferred pipelines.
     pub gbuffer: GBufferLayout,
+    /// Normal encoding of the `Packed` and `Compact` G-buffer layouts.
+    pub normal_codec: NormalCodec,
 }
 
 impl Default for FrameSettings {
@@ -209,9 +287,10 @@ impl Default for FrameSettings {
             ambient: 0.03,
             clear_color: [0.005, 0.006, 0.01],
             clusters: ClusterSettings::default(),
-            debug_view: DebugView::None,
+            debug_view: DebugViewMode::None,
             debug_heatmap_max: 32,
             gbuffer: GBufferLayout::Full,
+            normal_codec: NormalCodec::Octa16,
         }
     }
 }
@@ -225,6 +304,10 @@ pub struct ExtractedCamera {
     pub projection: Projection,
     /// Last frame's clip-from-world; `None` on the first frame.
     pub prev_clip_from_world: Option<Mat4>,
+    /// Bloom, when the camera has it.
+    pub bloom: Option<BloomSettings>,
+    /// Camera-motion blur, when the camera has it.
+    pub motion_blur: Option<MotionBlurSettings>,
 }
 
 impl ExtractedCamera {
@@ -308,11 +391,14 @@ impl FrameSnapshot {
         self.lights.iter().any(|l| l.is_valid())
     }
 
-    /// True when the frame needs the cluster build: a tiled/clustered pipeline with lights, or
-    /// a debug view that shows cluster data.
+    /// True when the frame needs the cluster build: a tiled/clustered pipeline with lights and
+    /// no debug view, or a debug view that shows cluster data.
     pub fn needs_clusters(&self) -> bool {
+        // A debug view replaces the image: then only a view of cluster data needs them.
         self.camera.is_some()
-            && ((self.settings.pipeline.uses_clusters() && self.has_lights())
-                || self.settings.debug_view != DebugView::None)
+            && match self.settings.debug_view {
+                DebugViewMode::None => self.settings.pipeline.uses_clusters() && self.has_lights(),
+                view => view.uses_clusters(),
+            }
     }
 }

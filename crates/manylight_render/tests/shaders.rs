@@ -132,3 +132,51 @@ fn constants_come_from_rust() {
         assert!(code.contains(&format!("const {name}: u32 = {value}u;")), "{name}");
     }
 }
+
+/// Every entry point of every shader also goes through naga's SPIR-V backend (what wgpu runs
+/// for Vulkan), with each value of the `NORMAL_CODEC` override the passes use, so a backend
+/// failure shows up without a GPU. (naga 30's backend panicked with "Expression … is not
+/// cached" on a struct field passed as `ptr<function, …>`; validation had accepted it.)
+#[test]
+fn every_entry_point_compiles_to_spirv() {
+    let codecs: Vec<f64> =
+        manylight_core::codec::NormalCodec::ALL.iter().map(|c| c.gpu_id() as f64).collect();
+    for (path, _) in SOURCES {
+        let module = validate(path);
+        let info = naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::all(),
+        )
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{path}: {e}"));
+        let has_codec = module.overrides.iter().any(|(_, o)| o.name.as_deref() == Some("NORMAL_CODEC"));
+        let variants: Vec<naga::back::PipelineConstants> = if has_codec {
+            codecs.iter().map(|&c| [("NORMAL_CODEC".to_string(), c)].into_iter().collect()).collect()
+        } else {
+            vec![Default::default()]
+        };
+        for constants in &variants {
+            for ep in &module.entry_points {
+                let (module, info) = naga::back::pipeline_constants::process_overrides(
+                    &module,
+                    &info,
+                    Some((ep.stage, &ep.name)),
+                    constants,
+                )
+                .unwrap_or_else(|e| panic!("{path} {}: {e}", ep.name));
+                let options = naga::back::spv::Options::default();
+                let pipeline =
+                    naga::back::spv::PipelineOptions { shader_stage: ep.stage, entry_point: ep.name.clone() };
+                // naga's backend may panic rather than return an error: name the shader either way.
+                let written = std::panic::catch_unwind(|| {
+                    naga::back::spv::write_vec(&module, &info, &options, Some(&pipeline))
+                });
+                match written {
+                    Ok(Ok(_)) => {}
+                    Ok(Err(e)) => panic!("{path} {} {constants:?}: {e}", ep.name),
+                    Err(_) => panic!("{path} {} {constants:?}: naga's SPIR-V backend panicked", ep.name),
+                }
+            }
+        }
+    }
+}

@@ -58,6 +58,12 @@ impl Default for WindowConfig {
     }
 }
 
+/// Keys pressed in the window since the last update, as logical keys: the character typed
+/// (`"d"`, `"1"`) or the named key (`"ArrowRight"`, `"Space"`). Cleared after each update;
+/// always empty headless.
+#[derive(Resource, Clone, Debug, Default, PartialEq, Eq)]
+pub struct PressedKeys(pub Vec<String>);
+
 /// Changes to the window that systems ask for; the window runner applies them after each
 /// update (the runner inserts this resource when it starts).
 ///
@@ -156,6 +162,9 @@ impl WinitRunner {
         }
         self.publish_viewport();
         self.app.update();
+        if let Some(mut keys) = self.app.world_mut().get_resource_mut::<PressedKeys>() {
+            keys.0.clear();
+        }
         if let Some(exit) = self.app.should_exit() {
             return self.exit_with(event_loop, exit);
         }
@@ -294,6 +303,14 @@ impl ApplicationHandler for WinitRunner {
                     KeyEvent { logical_key: Key::Named(NamedKey::Escape), state: ElementState::Pressed, .. },
                 ..
             } => self.exit_with(event_loop, AppExit::Success),
+            WindowEvent::KeyboardInput { event: KeyEvent { logical_key, state: ElementState::Pressed, .. }, .. } => {
+                if let Some(mut keys) = self.app.world_mut().get_resource_mut::<PressedKeys>() {
+                    keys.0.push(match &logical_key {
+                        Key::Character(c) => c.to_string(),
+                        other => format!("{other:?}").trim_start_matches("Named(").trim_end_matches(')').to_string(),
+                    });
+                }
+            }
             WindowEvent::Resized(size) => {
                 tracing::trace!("window resized to {}x{}", size.width, size.height);
                 self.window_size = UVec2::new(size.width, size.height);

@@ -92,6 +92,16 @@ pub fn mesh_pipeline(
     device: &wgpu::Device,
     d: &MeshPipelineDesc<'_>,
 ) -> Result<wgpu::RenderPipeline, RenderError> {
+    mesh_pipeline_with_constants(device, d, &[])
+}
+
+/// [`mesh_pipeline`] with values for the shader's `override` constants.
+pub fn mesh_pipeline_with_constants(
+    device: &wgpu::Device,
+    d: &MeshPipelineDesc<'_>,
+    constants: &[(&str, f64)],
+) -> Result<wgpu::RenderPipeline, RenderError> {
+    let options = || wgpu::PipelineCompilationOptions { constants, ..Default::default() };
     let module = crate::shaders::create_module(device, d.shader)?;
     let layout = pipeline_layout(device, d.label, d.layouts);
     let targets = color_targets(d.targets);
@@ -101,7 +111,7 @@ pub fn mesh_pipeline(
         vertex: wgpu::VertexState {
             module: &module,
             entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
+            compilation_options: options(),
             buffers: &[Some(vertex_layout())],
         },
         primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
@@ -116,7 +126,7 @@ pub fn mesh_pipeline(
         fragment: d.fragment.map(|entry| wgpu::FragmentState {
             module: &module,
             entry_point: Some(entry),
-            compilation_options: Default::default(),
+            compilation_options: options(),
             targets: &targets,
         }),
         multiview_mask: None,
@@ -133,6 +143,20 @@ pub fn fullscreen_pipeline(
     fragment: &str,
     output: wgpu::TextureFormat,
 ) -> Result<wgpu::RenderPipeline, RenderError> {
+    fullscreen_pipeline_with_constants(device, label, shader, layouts, fragment, output, &[])
+}
+
+/// [`fullscreen_pipeline`] with values for the shader's `override` constants.
+pub fn fullscreen_pipeline_with_constants(
+    device: &wgpu::Device,
+    label: &str,
+    shader: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+    fragment: &str,
+    output: wgpu::TextureFormat,
+    constants: &[(&str, f64)],
+) -> Result<wgpu::RenderPipeline, RenderError> {
+    let options = || wgpu::PipelineCompilationOptions { constants, ..Default::default() };
     let module = crate::shaders::create_module(device, shader)?;
     let layout = pipeline_layout(device, label, layouts);
     let targets = color_targets(&[output]);
@@ -142,7 +166,7 @@ pub fn fullscreen_pipeline(
         vertex: wgpu::VertexState {
             module: &module,
             entry_point: Some("fullscreen_vs"),
-            compilation_options: Default::default(),
+            compilation_options: options(),
             buffers: &[],
         },
         primitive: Default::default(),
@@ -151,7 +175,7 @@ pub fn fullscreen_pipeline(
         fragment: Some(wgpu::FragmentState {
             module: &module,
             entry_point: Some(fragment),
-            compilation_options: Default::default(),
+            compilation_options: options(),
             targets: &targets,
         }),
         multiview_mask: None,

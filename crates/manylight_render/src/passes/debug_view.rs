@@ -1,44 +1,81 @@
-//! Debug view: replaces tone mapping with the per-pixel light count of the pixel's cluster (a
-//! heatmap with a legend bar) or the cluster x / y / z index.
+//! Debug view: replaces tone mapping with what explains a frame (`shaders/debug_view.wgsl`).
+//! Three families, each its own entry point and bind group layout, so a view binds only what it
+//! reads:
+//! - cluster views (light-count heatmap with a legend bar, cluster x / y / z index, overflow):
+//!   depth + the cluster lists;
+//! - depth: the linearised view distance;
+//! - surface views (albedo, normal): the Full G-buffer.
 
 use super::common::{draw_fullscreen, fullscreen_pipeline, storage_entry, texture_entry, uniform_entry};
-use super::{CLUSTERS, DEPTH};
+use super::{CLUSTERS, DEPTH, GBUFFER_ALBEDO, GBUFFER_NORMAL};
 use crate::context::RenderError;
 use crate::graph::{OUTPUT, Pass, PassContext, ResourceName};
 use crate::pipelines::format_key;
-use crate::snapshot::DebugView;
+use crate::snapshot::DebugViewMode;
 use wgpu::util::DeviceExt;
 
-/// The pipeline of [`DebugViewPass`] for one output format.
+/// The data a debug view reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Family {
+    Clusters,
+    Depth,
+    Surface,
+}
+
+impl Family {
+    fn of(mode: DebugViewMode) -> Family {
+        if mode.uses_surfaces() {
+            Family::Surface
+        } else if mode.uses_clusters() {
+            Family::Clusters
+        } else {
+            Family::Depth
+        }
+    }
+}
+
+/// The pipeline of [`DebugViewPass`] for one family and output format.
 pub struct DebugViewPipeline {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
 }
 
 impl DebugViewPipeline {
-    fn new(device: &wgpu::Device, output: wgpu::TextureFormat) -> Result<Self, RenderError> {
+    fn new(device: &wgpu::Device, family: Family, output: wgpu::TextureFormat) -> Result<Self, RenderError> {
         let fragment = wgpu::ShaderStages::FRAGMENT;
+        let mut entries = vec![
+            uniform_entry(0, fragment),
+            texture_entry(1, wgpu::TextureSampleType::Depth),
+            uniform_entry(4, fragment),
+        ];
+        let unfiltered = wgpu::TextureSampleType::Float { filterable: false };
+        let entry = match family {
+            Family::Clusters => {
+                entries.extend([uniform_entry(2, fragment), storage_entry(3, fragment, true)]);
+                "fs_clusters"
+            }
+            Family::Depth => "fs_depth",
+            Family::Surface => {
+                entries.extend([texture_entry(5, unfiltered), texture_entry(6, unfiltered)]);
+                "fs_surface"
+            }
+        };
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("debug_view"),
-            entries: &[
-                uniform_entry(0, fragment),
-                texture_entry(1, wgpu::TextureSampleType::Depth),
-                uniform_entry(2, fragment),
-                storage_entry(3, fragment, true),
-                uniform_entry(4, fragment),
-            ],
+            entries: &entries,
         });
         let pipeline =
-            fullscreen_pipeline(device, "debug_view", "debug_view.wgsl", &[&layout], "fs_main", output)?;
+            fullscreen_pipeline(device, "debug_view", "debug_view.wgsl", &[&layout], entry, output)?;
         Ok(DebugViewPipeline { pipeline, layout })
     }
 }
 
 /// Writes a debug visualisation to [`OUTPUT`].
 pub struct DebugViewPass {
-    /// What to show (not `DebugView::None`).
-    pub view: DebugView,
-    /// Light count drawn as the hottest colour of the heatmap.
+    /// What to show (not `DebugViewMode::None`).
+    pub view: DebugViewMode,
+    /// Light count drawn as the hottest colour of the heatmap (and a full cluster of the
+    /// overflow view when there is no cap).
     pub heatmap_max: u32,
 }
 
@@ -47,36 +84,57 @@ impl Pass for DebugViewPass {
         "debug_view"
     }
     fn reads(&self) -> Vec<ResourceName> {
-        vec![DEPTH, CLUSTERS]
+        match Family::of(self.view) {
+            Family::Clusters => vec![DEPTH, CLUSTERS],
+            Family::Depth => vec![DEPTH],
+            Family::Surface => vec![DEPTH, GBUFFER_ALBEDO, GBUFFER_NORMAL],
+        }
     }
     fn writes(&self) -> Vec<ResourceName> {
         vec![OUTPUT]
     }
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
-        let clusters =
-            ctx.clusters.ok_or_else(|| RenderError::Graph("debug_view needs cluster resources".into()))?;
+        let family = Family::of(self.view);
         let format = ctx.output_format;
         let device = &ctx.gpu.device;
-        let pipeline =
-            ctx.pipelines.get_or_create(format_key(format), || DebugViewPipeline::new(device, format))?;
+        let key = format_key(format).wrapping_add(family as u64);
+        let pipeline = ctx.pipelines.get_or_create(key, || DebugViewPipeline::new(device, family, format))?;
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("debug_view_params"),
             contents: bytemuck::cast_slice(&[self.view.gpu_id(), self.heatmap_max.max(1), 0, 0]),
             usage: wgpu::BufferUsages::UNIFORM,
         });
+        let texture = |binding: u32, name: ResourceName| -> Result<wgpu::BindGroupEntry<'_>, RenderError> {
+            Ok(wgpu::BindGroupEntry {
+                binding,
+                resource: wgpu::BindingResource::TextureView(ctx.texture(name)?),
+            })
+        };
+        let mut entries = vec![
+            wgpu::BindGroupEntry { binding: 0, resource: ctx.scene.view_buffer.as_entire_binding() },
+            texture(1, DEPTH)?,
+            wgpu::BindGroupEntry { binding: 4, resource: params.as_entire_binding() },
+        ];
+        match family {
+            Family::Clusters => {
+                let clusters = ctx
+                    .clusters
+                    .ok_or_else(|| RenderError::Graph("debug_view needs cluster resources".into()))?;
+                entries.extend([
+                    wgpu::BindGroupEntry { binding: 2, resource: clusters.params_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: clusters.ranges.buffer().as_entire_binding(),
+                    },
+                ]);
+            }
+            Family::Depth => {}
+            Family::Surface => entries.extend([texture(5, GBUFFER_ALBEDO)?, texture(6, GBUFFER_NORMAL)?]),
+        }
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("debug_view"),
             layout: &pipeline.layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: ctx.scene.view_buffer.as_entire_binding() },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(ctx.texture(DEPTH)?),
-                },
-                wgpu::BindGroupEntry { binding: 2, resource: clusters.params_buffer.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: clusters.ranges.buffer().as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: params.as_entire_binding() },
-            ],
+            entries: &entries,
         });
         let output = ctx.texture(OUTPUT)?;
         let timestamps = ctx.render_timestamps(true, true);

@@ -1,13 +1,14 @@
 //! Clustered deferred lighting: one full-screen pass reads the G-buffer and walks each pixel's
 //! cluster list into [`HDR`].
 
-use super::common::{draw_fullscreen, fullscreen_pipeline, texture_entry, uniform_entry};
-use super::gbuffer::targets;
+use super::common::{draw_fullscreen, fullscreen_pipeline_with_constants, texture_entry, uniform_entry};
+use super::gbuffer::{codec_constants, fragment_entry, targets, variant_key};
 use super::{CLUSTERS, DEPTH, HDR};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::resources::HDR_FORMAT;
 use crate::snapshot::GBufferLayout;
+use manylight_core::codec::NormalCodec;
 use wgpu::util::DeviceExt;
 
 /// The pipeline of [`DeferredLightingPass`] for one layout.
@@ -16,14 +17,68 @@ pub struct DeferredLightingPipeline {
     gbuffer_layout: wgpu::BindGroupLayout,
 }
 
-/// Binding number of each G-buffer target in `shaders/deferred_lighting.wgsl`, group 1.
+/// Binding number of each G-buffer target in `shaders/common/gbuffer_read.wgsl`, group 1.
 fn binding_of(name: ResourceName) -> u32 {
     match name {
         super::GBUFFER_POSITION => 0,
         super::GBUFFER_NORMAL => 1,
         super::GBUFFER_ALBEDO => 2,
+        super::GBUFFER_PACKED_ALBEDO => 6,
+        super::GBUFFER_PACKED_POSITION => 7,
         _ => 3,
     }
+}
+
+/// Group 1 of `common/gbuffer_read.wgsl` for a layout: its targets, depth and the clear colour.
+pub fn gbuffer_read_layout(device: &wgpu::Device, layout: GBufferLayout) -> wgpu::BindGroupLayout {
+    let float = wgpu::TextureSampleType::Float { filterable: false };
+    let mut entries: Vec<wgpu::BindGroupLayoutEntry> = targets(layout)
+        .iter()
+        .map(|&(name, _)| {
+            let sample = if name == super::GBUFFER_COMPACT { wgpu::TextureSampleType::Uint } else { float };
+            texture_entry(binding_of(name), sample)
+        })
+        .collect();
+    entries.push(texture_entry(4, wgpu::TextureSampleType::Depth));
+    entries.push(uniform_entry(5, wgpu::ShaderStages::FRAGMENT));
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("gbuffer_read"),
+        entries: &entries,
+    })
+}
+
+/// A bind group for [`gbuffer_read_layout`]: the frame's G-buffer targets, depth and
+/// `clear_color` (linear RGB).
+pub fn gbuffer_read_bind_group(
+    ctx: &PassContext<'_>,
+    bind_group_layout: &wgpu::BindGroupLayout,
+    layout: GBufferLayout,
+    clear_color: [f32; 3],
+) -> Result<wgpu::BindGroup, RenderError> {
+    let device = &ctx.gpu.device;
+    let [r, g, b] = clear_color;
+    let clear = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("gbuffer_clear_color"),
+        contents: bytemuck::cast_slice(&[r, g, b, 1.0f32]),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let mut entries = Vec::new();
+    for &(name, _) in targets(layout) {
+        entries.push(wgpu::BindGroupEntry {
+            binding: binding_of(name),
+            resource: wgpu::BindingResource::TextureView(ctx.texture(name)?),
+        });
+    }
+    entries.push(wgpu::BindGroupEntry {
+        binding: 4,
+        resource: wgpu::BindingResource::TextureView(ctx.texture(DEPTH)?),
+    });
+    entries.push(wgpu::BindGroupEntry { binding: 5, resource: clear.as_entire_binding() });
+    Ok(device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("gbuffer_read"),
+        layout: bind_group_layout,
+        entries: &entries,
+    }))
 }
 
 impl DeferredLightingPipeline {
@@ -32,33 +87,17 @@ impl DeferredLightingPipeline {
         view_layout: &wgpu::BindGroupLayout,
         cluster_layout: &wgpu::BindGroupLayout,
         layout: GBufferLayout,
+        codec: NormalCodec,
     ) -> Result<Self, RenderError> {
-        let float = wgpu::TextureSampleType::Float { filterable: false };
-        let mut entries: Vec<wgpu::BindGroupLayoutEntry> = targets(layout)
-            .iter()
-            .map(|&(name, _)| {
-                let sample =
-                    if name == super::GBUFFER_COMPACT { wgpu::TextureSampleType::Uint } else { float };
-                texture_entry(binding_of(name), sample)
-            })
-            .collect();
-        entries.push(texture_entry(4, wgpu::TextureSampleType::Depth));
-        entries.push(uniform_entry(5, wgpu::ShaderStages::FRAGMENT));
-        let gbuffer_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("deferred_gbuffer"),
-            entries: &entries,
-        });
-        let entry = match layout {
-            GBufferLayout::Full => "fs_full",
-            GBufferLayout::Compact => "fs_compact",
-        };
-        let pipeline = fullscreen_pipeline(
+        let gbuffer_layout = gbuffer_read_layout(device, layout);
+        let pipeline = fullscreen_pipeline_with_constants(
             device,
             "deferred_lighting",
             "deferred_lighting.wgsl",
             &[view_layout, &gbuffer_layout, cluster_layout],
-            entry,
+            fragment_entry(layout),
             HDR_FORMAT,
+            &codec_constants(codec),
         )?;
         Ok(DeferredLightingPipeline { pipeline, gbuffer_layout })
     }
@@ -68,6 +107,8 @@ impl DeferredLightingPipeline {
 pub struct DeferredLightingPass {
     /// The G-buffer layout to read.
     pub layout: GBufferLayout,
+    /// Normal codec of the `Packed` and `Compact` layouts.
+    pub codec: NormalCodec,
     /// Linear colour of pixels no geometry covers.
     pub clear_color: [f32; 3],
 }
@@ -91,34 +132,12 @@ impl Pass for DeferredLightingPass {
             .clusters
             .ok_or_else(|| RenderError::Graph("deferred_lighting needs cluster resources".into()))?;
         let device = &ctx.gpu.device;
-        let layout = self.layout;
+        let (layout, codec) = (self.layout, self.codec);
         let view_layout = &ctx.scene.view_layout;
-        let pipeline = ctx.pipelines.get_or_create(layout as u64, || {
-            DeferredLightingPipeline::new(device, view_layout, &clusters.shading_layout, layout)
+        let pipeline = ctx.pipelines.get_or_create(variant_key(layout, codec), || {
+            DeferredLightingPipeline::new(device, view_layout, &clusters.shading_layout, layout, codec)
         })?;
-        let [r, g, b] = self.clear_color;
-        let clear = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("deferred_clear_color"),
-            contents: bytemuck::cast_slice(&[r, g, b, 1.0f32]),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let mut entries = Vec::new();
-        for &(name, _) in targets(layout) {
-            entries.push(wgpu::BindGroupEntry {
-                binding: binding_of(name),
-                resource: wgpu::BindingResource::TextureView(ctx.texture(name)?),
-            });
-        }
-        entries.push(wgpu::BindGroupEntry {
-            binding: 4,
-            resource: wgpu::BindingResource::TextureView(ctx.texture(DEPTH)?),
-        });
-        entries.push(wgpu::BindGroupEntry { binding: 5, resource: clear.as_entire_binding() });
-        let gbuffer = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("deferred_gbuffer"),
-            layout: &pipeline.gbuffer_layout,
-            entries: &entries,
-        });
+        let gbuffer = gbuffer_read_bind_group(ctx, &pipeline.gbuffer_layout, layout, self.clear_color)?;
         let hdr = ctx.texture(HDR)?;
         let timestamps = ctx.render_timestamps(true, true);
         let groups = [&ctx.scene.view_bind_group, &gbuffer, &clusters.shading_bind_group];

@@ -1,13 +1,17 @@
 //! G-buffer pass of clustered deferred: writes each pixel's surface (position or depth,
 //! normal, albedo, shading parameters) in the chosen [`GBufferLayout`].
 
-use super::common::{MeshPipelineDesc, color_attachment, depth_attachment, mesh_pipeline};
+use super::common::{MeshPipelineDesc, color_attachment, depth_attachment, mesh_pipeline_with_constants};
 use super::forward::draw_scene;
-use super::{DEPTH, DEPTH_USAGE, GBUFFER_ALBEDO, GBUFFER_COMPACT, GBUFFER_NORMAL, GBUFFER_POSITION};
+use super::{
+    DEPTH, DEPTH_USAGE, GBUFFER_ALBEDO, GBUFFER_COMPACT, GBUFFER_NORMAL, GBUFFER_PACKED_ALBEDO,
+    GBUFFER_PACKED_POSITION, GBUFFER_POSITION,
+};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::resources::{DEPTH_FORMAT, SceneResources};
 use crate::snapshot::GBufferLayout;
+use manylight_core::codec::NormalCodec;
 
 /// The G-buffer targets of a layout: name and format.
 pub fn targets(layout: GBufferLayout) -> &'static [(ResourceName, wgpu::TextureFormat)] {
@@ -19,11 +23,34 @@ pub fn targets(layout: GBufferLayout) -> &'static [(ResourceName, wgpu::TextureF
             (GBUFFER_NORMAL, wgpu::TextureFormat::Rgba16Float),
             (GBUFFER_ALBEDO, wgpu::TextureFormat::Rgba16Float),
         ],
+        GBufferLayout::Packed => &[
+            (GBUFFER_PACKED_ALBEDO, wgpu::TextureFormat::Rgba32Float),
+            (GBUFFER_PACKED_POSITION, wgpu::TextureFormat::Rgba32Float),
+        ],
         GBufferLayout::Compact => &[(GBUFFER_COMPACT, wgpu::TextureFormat::Rgba32Uint)],
     }
 }
 
-/// The pipeline of [`GBufferPass`] for one layout.
+/// The fragment entry point of `gbuffer.wgsl` and `deferred_lighting.wgsl` for a layout.
+pub fn fragment_entry(layout: GBufferLayout) -> &'static str {
+    match layout {
+        GBufferLayout::Full => "fs_full",
+        GBufferLayout::Packed => "fs_packed",
+        GBufferLayout::Compact => "fs_compact",
+    }
+}
+
+/// The `override` constants selecting `codec` in the G-buffer shaders.
+pub fn codec_constants(codec: NormalCodec) -> [(&'static str, f64); 1] {
+    [("NORMAL_CODEC", codec.gpu_id() as f64)]
+}
+
+/// Pipeline-cache key of a (layout, codec) pair.
+pub fn variant_key(layout: GBufferLayout, codec: NormalCodec) -> u64 {
+    (layout as u64) << 8 | codec.gpu_id() as u64
+}
+
+/// The pipeline of [`GBufferPass`] for one layout and codec.
 pub struct GBufferPipeline {
     pipeline: wgpu::RenderPipeline,
 }
@@ -33,22 +60,21 @@ impl GBufferPipeline {
         device: &wgpu::Device,
         scene: &SceneResources,
         layout: GBufferLayout,
+        codec: NormalCodec,
     ) -> Result<Self, RenderError> {
         let formats: Vec<wgpu::TextureFormat> = targets(layout).iter().map(|&(_, format)| format).collect();
-        let pipeline = mesh_pipeline(
+        let pipeline = mesh_pipeline_with_constants(
             device,
             &MeshPipelineDesc {
                 label: "gbuffer",
                 shader: "gbuffer.wgsl",
                 layouts: &[&scene.view_layout, &scene.material_layout],
-                fragment: Some(match layout {
-                    GBufferLayout::Full => "fs_full",
-                    GBufferLayout::Compact => "fs_compact",
-                }),
+                fragment: Some(fragment_entry(layout)),
                 targets: &formats,
                 depth_write: true,
                 depth_compare: wgpu::CompareFunction::Greater,
             },
+            &codec_constants(codec),
         )?;
         Ok(GBufferPipeline { pipeline })
     }
@@ -58,6 +84,8 @@ impl GBufferPipeline {
 pub struct GBufferPass {
     /// The layout.
     pub layout: GBufferLayout,
+    /// Normal codec of the `Packed` and `Compact` layouts.
+    pub codec: NormalCodec,
 }
 
 impl Pass for GBufferPass {
@@ -80,10 +108,10 @@ impl Pass for GBufferPass {
     }
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
         let scene = ctx.scene;
-        let layout = self.layout;
-        let pipeline = ctx
-            .pipelines
-            .get_or_create(layout as u64, || GBufferPipeline::new(&ctx.gpu.device, scene, layout))?;
+        let (layout, codec) = (self.layout, self.codec);
+        let pipeline = ctx.pipelines.get_or_create(variant_key(layout, codec), || {
+            GBufferPipeline::new(&ctx.gpu.device, scene, layout, codec)
+        })?;
         let views =
             targets(layout).iter().map(|&(name, _)| ctx.texture(name)).collect::<Result<Vec<_>, _>>()?;
         let depth = ctx.texture(DEPTH)?;

@@ -1,6 +1,7 @@
 //! One module per pass. Each pass declares its reads and writes and records itself; its
 //! pipeline is created on first use through the [`crate::pipelines::PipelineCache`].
 
+pub mod bloom;
 pub mod cluster_build;
 pub mod clustered_forward;
 pub mod common;
@@ -9,8 +10,11 @@ pub mod deferred_lighting;
 pub mod depth_prepass;
 pub mod forward;
 pub mod gbuffer;
+pub mod motion_blur;
+pub mod light_volumes;
 pub mod tonemap;
 
+pub use bloom::{BloomBlurPass, BloomBrightPass, BloomCompositePass};
 pub use cluster_build::ClusterBuildPass;
 pub use clustered_forward::ClusteredForwardPass;
 pub use debug_view::DebugViewPass;
@@ -18,6 +22,8 @@ pub use deferred_lighting::DeferredLightingPass;
 pub use depth_prepass::DepthPrepass;
 pub use forward::ForwardPass;
 pub use gbuffer::GBufferPass;
+pub use motion_blur::MotionBlurPass;
+pub use light_volumes::LightVolumesPass;
 pub use tonemap::TonemapPass;
 
 /// Graph resource: the HDR scene colour.
@@ -32,6 +38,12 @@ pub const GBUFFER_NORMAL: crate::graph::ResourceName = "gbuffer_normal";
 pub const GBUFFER_ALBEDO: crate::graph::ResourceName = "gbuffer_albedo";
 /// Graph resource: the single G-buffer target of the Compact layout.
 pub const GBUFFER_COMPACT: crate::graph::ResourceName = "gbuffer_compact";
+/// Packed G-buffer: albedo + material parameters + first normal component (rgba32f).
+pub const GBUFFER_PACKED_ALBEDO: crate::graph::ResourceName = "gbuffer_packed_albedo";
+/// Packed G-buffer: world position + second normal component (rgba32f).
+pub const GBUFFER_PACKED_POSITION: crate::graph::ResourceName = "gbuffer_packed_position";
+/// Light volumes: the sum of the lights, in f32 where the device can blend it.
+pub const LIGHT_ACCUM: crate::graph::ResourceName = "light_accum";
 /// Graph resource: the cluster light lists (persistent buffers, ordered through the graph).
 pub const CLUSTERS: crate::graph::ResourceName = "clusters";
 

@@ -1,0 +1,384 @@
+//! Bloom: light above a threshold spreads into its surroundings. Three kinds of pass, all in
+//! `shaders/bloom.wgsl`, added only when the camera has bloom:
+//! 1. [`BloomBrightPass`]: the soft-thresholded HDR colour into level 0 (half resolution in the
+//!    downsampled chain, full resolution in the seed's chain);
+//! 2. [`BloomBlurPass`] × 2 per iteration: a separable 9-tap gaussian, horizontal then
+//!    vertical. In the downsampled chain iteration `k` reads level `k − 1` (twice its size, so the
+//!    bilinear taps also box-filter it down) and writes level `k` at `1/2^(k+1)` of the viewport;
+//!    in the seed's chain every iteration blurs level 0 again at full resolution;
+//! 3. [`BloomCompositePass`]: the mean of the levels × intensity, added (blend One + One) to the
+//!    HDR target before tone mapping.
+
+use super::HDR;
+use crate::context::RenderError;
+use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::resources::HDR_FORMAT;
+use wgpu::util::DeviceExt;
+
+/// Most levels (iterations) of the chain.
+pub const MAX_BLOOM_LEVELS: usize = 6;
+
+/// Graph resources: the blurred levels of the chain.
+pub const BLOOM_LEVELS: [ResourceName; MAX_BLOOM_LEVELS] =
+    ["bloom_0", "bloom_1", "bloom_2", "bloom_3", "bloom_4", "bloom_5"];
+
+/// Graph resources: the horizontally blurred intermediate of each level.
+pub const BLOOM_TEMPS: [ResourceName; MAX_BLOOM_LEVELS] =
+    ["bloom_tmp_0", "bloom_tmp_1", "bloom_tmp_2", "bloom_tmp_3", "bloom_tmp_4", "bloom_tmp_5"];
+
+/// How the blur iterations are laid out.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum BloomChain {
+    /// Each iteration halves the resolution (1/2, 1/4, …); the composite sums every level.
+    #[default]
+    Downsampled,
+    /// Seed 002's variant: every iteration blurs at full resolution (1×9 then 9×1).
+    FullResolution,
+}
+
+impl BloomChain {
+    /// Name used on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            BloomChain::Downsampled => "downsampled",
+            BloomChain::FullResolution => "full-resolution",
+        }
+    }
+}
+
+/// Bloom parameters (the render side's copy of the camera's `Bloom` component).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BloomSettings {
+    /// HDR brightness (largest channel, before exposure) where bloom starts.
+    pub threshold: f32,
+    /// Width of the soft knee below the threshold (0 = hard cut).
+    pub knee: f32,
+    /// Weight of the blurred light added back to the image.
+    pub intensity: f32,
+    /// Blur iterations (levels of the chain), 1 to [`MAX_BLOOM_LEVELS`].
+    pub iterations: u32,
+    /// Downsampled chain or the seed's full-resolution one.
+    pub chain: BloomChain,
+}
+
+impl Default for BloomSettings {
+    fn default() -> Self {
+        Self { threshold: 1.0, knee: 0.5, intensity: 0.3, iterations: 5, chain: BloomChain::Downsampled }
+    }
+}
+
+impl BloomSettings {
+    /// Seed 002's bloom: 1×9 / 9×1 kernels, 5 iterations, full resolution.
+    pub fn seed() -> Self {
+        Self { chain: BloomChain::FullResolution, iterations: 5, ..Self::default() }
+    }
+
+    /// Iterations clamped to what the chain supports (1 to [`MAX_BLOOM_LEVELS`]).
+    pub fn levels(&self) -> usize {
+        (self.iterations as usize).clamp(1, MAX_BLOOM_LEVELS)
+    }
+
+    /// The passes of this bloom, in order (the app adds them to the graph).
+    pub fn passes(&self) -> Vec<Box<dyn Pass>> {
+        let levels = self.levels();
+        let mut passes: Vec<Box<dyn Pass>> = Vec::with_capacity(2 + 2 * levels);
+        let full = self.chain == BloomChain::FullResolution;
+        let scale = |k: usize| if full { 1.0 } else { 0.5f32.powi(k as i32 + 1) };
+        passes.push(Box::new(BloomBrightPass { settings: *self, scale: scale(0) }));
+        for k in 0..levels {
+            // Downsampled: level k from level k-1 (level 0 blurs the bright pass in place).
+            // Full resolution: level 0 again and again.
+            let (level, source) = if full { (0, 0) } else { (k, k.saturating_sub(1)) };
+            let creates = !full || k == 0;
+            passes.push(Box::new(BloomBlurPass {
+                source: BLOOM_LEVELS[source],
+                target: BLOOM_TEMPS[level],
+                horizontal: true,
+                create: creates.then_some(scale(level)),
+            }));
+            passes.push(Box::new(BloomBlurPass {
+                source: BLOOM_TEMPS[level],
+                target: BLOOM_LEVELS[level],
+                horizontal: false,
+                create: (creates && level > 0).then_some(scale(level)),
+            }));
+        }
+        let used = if full { 1 } else { levels };
+        passes.push(Box::new(BloomCompositePass { levels: used, intensity: self.intensity }));
+        passes
+    }
+}
+
+/// Uniforms of the bloom shader (`BloomParams` in `shaders/bloom.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct BloomParams {
+    direction: [f32; 2],
+    threshold: f32,
+    knee: f32,
+    intensity: f32,
+    level_count: u32,
+    _pad: [u32; 2],
+}
+
+impl BloomParams {
+    fn new() -> Self {
+        bytemuck::Zeroable::zeroed()
+    }
+}
+
+const LEVEL_USAGE: wgpu::TextureUsages =
+    wgpu::TextureUsages::RENDER_ATTACHMENT.union(wgpu::TextureUsages::TEXTURE_BINDING);
+
+fn level_spec(name: ResourceName, scale: f32) -> TextureSpec {
+    TextureSpec { name, format: HDR_FORMAT, usage: LEVEL_USAGE, scale }
+}
+
+/// Which entry point of `bloom.wgsl` a pipeline runs.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Stage {
+    Bright,
+    Blur,
+    Composite,
+}
+
+/// The pipeline of one bloom stage.
+struct BloomPipeline {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+}
+
+impl BloomPipeline {
+    fn new(device: &wgpu::Device, stage: Stage) -> Result<Self, RenderError> {
+        let fragment = wgpu::ShaderStages::FRAGMENT;
+        let textures = if stage == Stage::Composite { MAX_BLOOM_LEVELS } else { 1 };
+        let mut entries = vec![super::common::uniform_entry(0, fragment)];
+        entries.push(wgpu::BindGroupLayoutEntry {
+            binding: 1,
+            visibility: fragment,
+            ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+            count: None,
+        });
+        for i in 0..textures {
+            entries.push(super::common::texture_entry(
+                2 + i as u32,
+                wgpu::TextureSampleType::Float { filterable: true },
+            ));
+        }
+        let (label, entry) = match stage {
+            Stage::Bright => ("bloom_bright", "fs_bright"),
+            Stage::Blur => ("bloom_blur", "fs_blur"),
+            Stage::Composite => ("bloom_composite", "fs_composite"),
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(label),
+            entries: &entries,
+        });
+        let module = crate::shaders::create_module(device, "bloom.wgsl")?;
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        // The composite adds to the HDR image; the other stages overwrite their level.
+        let blend = (stage == Stage::Composite).then_some(wgpu::BlendState {
+            color: wgpu::BlendComponent {
+                src_factor: wgpu::BlendFactor::One,
+                dst_factor: wgpu::BlendFactor::One,
+                operation: wgpu::BlendOperation::Add,
+            },
+            alpha: wgpu::BlendComponent {
+                src_factor: wgpu::BlendFactor::Zero,
+                dst_factor: wgpu::BlendFactor::One,
+                operation: wgpu::BlendOperation::Add,
+            },
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("fullscreen_vs"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: HDR_FORMAT,
+                    blend,
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some(label),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        Ok(BloomPipeline { pipeline, layout, sampler })
+    }
+}
+
+/// Records one full-screen draw of `stage` into `target` with `params` and `sources`.
+fn draw(
+    ctx: &mut PassContext<'_>,
+    stage: Stage,
+    params: BloomParams,
+    sources: &[ResourceName],
+    target: ResourceName,
+) -> Result<(), RenderError> {
+    let device = &ctx.gpu.device;
+    let pipeline = ctx.pipelines.get_or_create(stage as u64, || BloomPipeline::new(device, stage))?;
+    let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("bloom_params"),
+        contents: bytemuck::bytes_of(&params),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let mut entries = vec![
+        wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
+        wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&pipeline.sampler) },
+    ];
+    for (i, &name) in sources.iter().enumerate() {
+        entries.push(wgpu::BindGroupEntry {
+            binding: 2 + i as u32,
+            resource: wgpu::BindingResource::TextureView(ctx.texture(name)?),
+        });
+    }
+    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("bloom"),
+        layout: &pipeline.layout,
+        entries: &entries,
+    });
+    let view = ctx.texture(target)?;
+    let timestamps = ctx.render_timestamps(true, true);
+    // The composite loads the HDR image and adds to it; the other stages replace their level.
+    let load =
+        if stage == Stage::Composite { wgpu::LoadOp::Load } else { wgpu::LoadOp::Clear(wgpu::Color::BLACK) };
+    let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("bloom"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations { load, store: wgpu::StoreOp::Store },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes: timestamps,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    pass.set_pipeline(&pipeline.pipeline);
+    pass.set_bind_group(0, &bind_group, &[]);
+    pass.draw(0..3, 0..1);
+    Ok(())
+}
+
+/// Bright pass: the HDR colour above the (soft) threshold into level 0.
+pub struct BloomBrightPass {
+    /// Threshold and knee.
+    pub settings: BloomSettings,
+    /// Size of level 0 relative to the viewport.
+    pub scale: f32,
+}
+
+impl Pass for BloomBrightPass {
+    fn name(&self) -> &'static str {
+        "bloom_bright"
+    }
+    fn reads(&self) -> Vec<ResourceName> {
+        vec![HDR]
+    }
+    fn writes(&self) -> Vec<ResourceName> {
+        vec![BLOOM_LEVELS[0]]
+    }
+    fn creates(&self) -> Vec<TextureSpec> {
+        vec![level_spec(BLOOM_LEVELS[0], self.scale)]
+    }
+    fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
+        let params = BloomParams {
+            threshold: self.settings.threshold,
+            knee: self.settings.knee,
+            ..BloomParams::new()
+        };
+        draw(ctx, Stage::Bright, params, &[HDR], BLOOM_LEVELS[0])
+    }
+}
+
+/// One direction of the separable 9-tap gaussian, from `source` into `target`.
+pub struct BloomBlurPass {
+    /// Level read.
+    pub source: ResourceName,
+    /// Level written.
+    pub target: ResourceName,
+    /// Horizontal (1×9) or vertical (9×1).
+    pub horizontal: bool,
+    /// `Some(scale)` when this pass creates `target` (its first writer).
+    pub create: Option<f32>,
+}
+
+impl Pass for BloomBlurPass {
+    fn name(&self) -> &'static str {
+        if self.horizontal { "bloom_blur_h" } else { "bloom_blur_v" }
+    }
+    fn reads(&self) -> Vec<ResourceName> {
+        vec![self.source]
+    }
+    fn writes(&self) -> Vec<ResourceName> {
+        vec![self.target]
+    }
+    fn creates(&self) -> Vec<TextureSpec> {
+        self.create.map(|scale| level_spec(self.target, scale)).into_iter().collect()
+    }
+    fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
+        // One texel of the target along the blur direction, in uv units.
+        let target = ctx.texture(self.target)?.texture();
+        let direction = if self.horizontal {
+            [1.0 / target.width().max(1) as f32, 0.0]
+        } else {
+            [0.0, 1.0 / target.height().max(1) as f32]
+        };
+        draw(ctx, Stage::Blur, BloomParams { direction, ..BloomParams::new() }, &[self.source], self.target)
+    }
+}
+
+/// Adds the mean of the first `levels` levels × intensity to the HDR image.
+pub struct BloomCompositePass {
+    /// Levels summed (1 to [`MAX_BLOOM_LEVELS`]).
+    pub levels: usize,
+    /// Weight of the bloom.
+    pub intensity: f32,
+}
+
+impl Pass for BloomCompositePass {
+    fn name(&self) -> &'static str {
+        "bloom_composite"
+    }
+    fn reads(&self) -> Vec<ResourceName> {
+        // HDR: ordered after the lighting that writes it (it is blended into, not sampled).
+        std::iter::once(HDR)
+            .chain(BLOOM_LEVELS[..self.levels.clamp(1, MAX_BLOOM_LEVELS)].iter().copied())
+            .collect()
+    }
+    fn writes(&self) -> Vec<ResourceName> {
+        vec![HDR]
+    }
+    fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
+        let levels = self.levels.clamp(1, MAX_BLOOM_LEVELS);
+        // Unused slots repeat level 0; the shader reads only `level_count` of them.
+        let sources: Vec<ResourceName> =
+            (0..MAX_BLOOM_LEVELS).map(|i| BLOOM_LEVELS[if i < levels { i } else { 0 }]).collect();
+        let params =
+            BloomParams { intensity: self.intensity, level_count: levels as u32, ..BloomParams::new() };
+        draw(ctx, Stage::Composite, params, &sources, HDR)
+    }
+}

@@ -1,0 +1,310 @@
+//! Deferred light volumes: after the G-buffer pass, a full-screen ambient/background triangle,
+//! then every light drawn as an instanced sphere proxy that adds its light to the pixels it
+//! covers (see `shaders/light_volumes.wgsl` for the depth-test rule that lights each pixel once
+//! per light, camera inside the sphere and far-plane crossing included).
+
+use super::common::texture_entry;
+use super::common::{clear_color, color_attachment, draw_fullscreen};
+use super::deferred_lighting::{gbuffer_read_bind_group, gbuffer_read_layout};
+use super::gbuffer::{codec_constants, targets, variant_key};
+use super::{DEPTH, HDR, LIGHT_ACCUM};
+use crate::context::RenderError;
+use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::resources::{DEPTH_FORMAT, HDR_FORMAT};
+use crate::snapshot::GBufferLayout;
+use manylight_core::codec::NormalCodec;
+use manylight_core::icosphere::Icosphere;
+use wgpu::util::DeviceExt;
+
+/// Subdivision level of the sphere proxy: 320 triangles, at most 4.6 % larger than the sphere.
+pub const PROXY_SUBDIVISIONS: u32 = 2;
+
+/// The pipelines and proxy mesh of [`LightVolumesPass`] for one layout and codec.
+pub struct LightVolumesPipeline {
+    ambient: wgpu::RenderPipeline,
+    volume: wgpu::RenderPipeline,
+    /// Copies the f32 sum into HDR (only with an f32 accumulation target).
+    resolve: Option<(wgpu::RenderPipeline, wgpu::BindGroupLayout)>,
+    gbuffer_layout: wgpu::BindGroupLayout,
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    index_count: u32,
+}
+
+fn entry_suffix(layout: GBufferLayout) -> &'static str {
+    match layout {
+        GBufferLayout::Full => "full",
+        GBufferLayout::Packed => "packed",
+        GBufferLayout::Compact => "compact",
+    }
+}
+
+impl LightVolumesPipeline {
+    fn new(
+        device: &wgpu::Device,
+        view_layout: &wgpu::BindGroupLayout,
+        layout: GBufferLayout,
+        codec: NormalCodec,
+        accumulation: wgpu::TextureFormat,
+    ) -> Result<Self, RenderError> {
+        let module = crate::shaders::create_module(device, "light_volumes.wgsl")?;
+        let gbuffer_layout = gbuffer_read_layout(device, layout);
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("light_volumes"),
+            bind_group_layouts: &[Some(view_layout), Some(&gbuffer_layout)],
+            immediate_size: 0,
+        });
+        let constants = codec_constants(codec);
+        let options = || wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
+        let depth = |compare| {
+            Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(false),
+                depth_compare: Some(compare),
+                stencil: Default::default(),
+                bias: Default::default(),
+            })
+        };
+        let suffix = entry_suffix(layout);
+        let ambient_entry = format!("fs_ambient_{suffix}");
+        let ambient = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("light_volumes_ambient"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("fullscreen_vs"),
+                compilation_options: options(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: depth(wgpu::CompareFunction::Always),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some(&ambient_entry),
+                compilation_options: options(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: accumulation,
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        // Back faces only, kept where they lie at or behind the stored surface (reverse-Z:
+        // LessEqual). Without depth clamping, back faces beyond the far plane would be clipped
+        // and their pixels miss the light, so the depth test is dropped instead.
+        let unclipped_depth = device.features().contains(wgpu::Features::DEPTH_CLIP_CONTROL);
+        let compare =
+            if unclipped_depth { wgpu::CompareFunction::LessEqual } else { wgpu::CompareFunction::Always };
+        let additive = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::One,
+            dst_factor: wgpu::BlendFactor::One,
+            operation: wgpu::BlendOperation::Add,
+        };
+        let volume_entry = format!("fs_volume_{suffix}");
+        let volume = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("light_volumes"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_volume"),
+                compilation_options: options(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: 12,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &wgpu::vertex_attr_array![0 => Float32x3],
+                })],
+            },
+            primitive: wgpu::PrimitiveState {
+                front_face: wgpu::FrontFace::Ccw,
+                cull_mode: Some(wgpu::Face::Front),
+                unclipped_depth,
+                ..Default::default()
+            },
+            depth_stencil: depth(compare),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some(&volume_entry),
+                compilation_options: options(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: accumulation,
+                    blend: Some(wgpu::BlendState { color: additive, alpha: additive }),
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let resolve = (accumulation != HDR_FORMAT).then(|| {
+            let accum_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("light_accum"),
+                entries: &[texture_entry(0, wgpu::TextureSampleType::Float { filterable: false })],
+            });
+            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("light_volumes_resolve"),
+                bind_group_layouts: &[Some(view_layout), Some(&gbuffer_layout), Some(&accum_layout)],
+                immediate_size: 0,
+            });
+            let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("light_volumes_resolve"),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("fullscreen_vs"),
+                    compilation_options: options(),
+                    buffers: &[],
+                },
+                primitive: Default::default(),
+                depth_stencil: None,
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some("fs_resolve"),
+                    compilation_options: options(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: HDR_FORMAT,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            });
+            (pipeline, accum_layout)
+        });
+        let proxy = Icosphere::circumscribing_unit_sphere(PROXY_SUBDIVISIONS);
+        let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("light_volume_proxy_vertices"),
+            contents: bytemuck::cast_slice(&proxy.positions.iter().map(|p| p.to_array()).collect::<Vec<_>>()),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+        // Pad to a multiple of 4 bytes (wgpu's copy alignment) with a repeated index.
+        let mut index_data = proxy.indices.clone();
+        if index_data.len() % 2 == 1 {
+            index_data.push(0);
+        }
+        let indices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("light_volume_proxy_indices"),
+            contents: bytemuck::cast_slice(&index_data),
+            usage: wgpu::BufferUsages::INDEX,
+        });
+        Ok(LightVolumesPipeline {
+            ambient,
+            volume,
+            resolve,
+            gbuffer_layout,
+            vertices,
+            indices,
+            index_count: proxy.indices.len() as u32,
+        })
+    }
+}
+
+/// Lights the G-buffer light by light with sphere proxies into [`HDR`].
+pub struct LightVolumesPass {
+    /// The G-buffer layout to read.
+    pub layout: GBufferLayout,
+    /// Normal codec of the `Packed` and `Compact` layouts.
+    pub codec: NormalCodec,
+    /// Linear colour of pixels no geometry covers.
+    pub clear_color: [f32; 3],
+    /// Format the lights are summed in: [`HDR_FORMAT`] (directly into HDR), or rgba32f where
+    /// the device can blend it ([`LightVolumesPass::accumulation_format`]), then copied to HDR.
+    pub accumulation: wgpu::TextureFormat,
+}
+
+impl LightVolumesPass {
+    /// rgba32f when `device` can blend it, else [`HDR_FORMAT`].
+    pub fn accumulation_format(device: &wgpu::Device) -> wgpu::TextureFormat {
+        if device.features().contains(wgpu::Features::FLOAT32_BLENDABLE) {
+            wgpu::TextureFormat::Rgba32Float
+        } else {
+            HDR_FORMAT
+        }
+    }
+
+    fn accumulates_separately(&self) -> bool {
+        self.accumulation != HDR_FORMAT
+    }
+}
+
+impl Pass for LightVolumesPass {
+    fn name(&self) -> &'static str {
+        "light_volumes"
+    }
+    fn reads(&self) -> Vec<ResourceName> {
+        targets(self.layout).iter().map(|&(name, _)| name).chain([DEPTH]).collect()
+    }
+    fn writes(&self) -> Vec<ResourceName> {
+        vec![HDR]
+    }
+    fn creates(&self) -> Vec<TextureSpec> {
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        let mut specs = vec![TextureSpec { name: HDR, format: HDR_FORMAT, usage, scale: 1.0 }];
+        if self.accumulates_separately() {
+            specs.push(TextureSpec { name: LIGHT_ACCUM, format: self.accumulation, usage, scale: 1.0 });
+        }
+        specs
+    }
+    fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
+        let (layout, codec, accumulation) = (self.layout, self.codec, self.accumulation);
+        let scene = ctx.scene;
+        let device = &ctx.gpu.device;
+        let key = variant_key(layout, codec) | (self.accumulates_separately() as u64) << 16;
+        let pipeline = ctx.pipelines.get_or_create(key, || {
+            LightVolumesPipeline::new(device, &scene.view_layout, layout, codec, accumulation)
+        })?;
+        let gbuffer = gbuffer_read_bind_group(ctx, &pipeline.gbuffer_layout, layout, self.clear_color)?;
+        let hdr = ctx.texture(HDR)?;
+        let target = if self.accumulates_separately() { ctx.texture(LIGHT_ACCUM)? } else { hdr };
+        let depth = ctx.texture(DEPTH)?;
+        let resolve = match &pipeline.resolve {
+            Some((resolve, accum_layout)) => Some((
+                resolve,
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("light_accum"),
+                    layout: accum_layout,
+                    entries: &[wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::TextureView(target),
+                    }],
+                }),
+            )),
+            None => None,
+        };
+        let timestamps = ctx.render_timestamps(true, resolve.is_none());
+        let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("light_volumes"),
+            color_attachments: &[color_attachment(target, clear_color(self.clear_color))],
+            // Read-only depth: tested against, and sampled by the shaders at the same time.
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                depth_ops: None,
+                stencil_ops: None,
+            }),
+            timestamp_writes: timestamps,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_bind_group(0, &scene.view_bind_group, &[]);
+        pass.set_bind_group(1, &gbuffer, &[]);
+        pass.set_pipeline(&pipeline.ambient);
+        pass.draw(0..3, 0..1);
+        if scene.light_count > 0 {
+            pass.set_pipeline(&pipeline.volume);
+            pass.set_vertex_buffer(0, pipeline.vertices.slice(..));
+            pass.set_index_buffer(pipeline.indices.slice(..), wgpu::IndexFormat::Uint16);
+            pass.draw_indexed(0..pipeline.index_count, 0, 0..scene.light_count);
+        }
+        drop(pass);
+        if let Some((resolve, accum)) = resolve {
+            let timestamps = ctx.render_timestamps(false, true);
+            let groups = [&scene.view_bind_group, &gbuffer, &accum];
+            draw_fullscreen(ctx.encoder, "light_volumes_resolve", hdr, timestamps, resolve, &groups);
+        }
+        Ok(())
+    }
+}

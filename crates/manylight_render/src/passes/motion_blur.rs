@@ -1,0 +1,156 @@
+//! Camera-motion blur (GPU Gems 3, ch. 27): each pixel's world position is rebuilt from depth,
+//! projected with last frame's clip-from-world, and the HDR image is averaged along the
+//! resulting screen velocity. Two wgpu passes in one graph pass (`shaders/motion_blur.wgsl`):
+//! 1. `fs_blur`: HDR + depth → the `motion_blur` transient;
+//! 2. `fs_copy`: `motion_blur` → HDR, so tone mapping and bloom read the blurred image.
+//!
+//! A pixel that moved less than half a pixel keeps its exact colour, so a still camera (and the
+//! first frame, whose previous matrix is the current one) gives the unblurred image.
+
+use super::common::{draw_fullscreen, fullscreen_pipeline, texture_entry, uniform_entry};
+use super::{DEPTH, HDR};
+use crate::context::RenderError;
+use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::resources::HDR_FORMAT;
+use wgpu::util::DeviceExt;
+
+/// Graph resource: the blurred image before it is copied back into HDR.
+pub const MOTION_BLUR: ResourceName = "motion_blur";
+
+/// Motion-blur parameters (the render side's copy of the camera's `MotionBlur` component).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MotionBlurSettings {
+    /// Taps along the velocity (2 to 64).
+    pub samples: u32,
+    /// Fraction of the frame-to-frame motion that is blurred (1 = a full-frame shutter).
+    pub strength: f32,
+    /// Longest blur in pixels (velocities are clamped to it).
+    pub max_pixels: f32,
+}
+
+impl Default for MotionBlurSettings {
+    fn default() -> Self {
+        Self { samples: 8, strength: 1.0, max_pixels: 64.0 }
+    }
+}
+
+/// Uniforms of `shaders/motion_blur.wgsl` (`MotionBlurParams`).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct MotionBlurParams {
+    samples: u32,
+    strength: f32,
+    max_pixels: f32,
+    _pad: u32,
+}
+
+/// The two pipelines of [`MotionBlurPass`].
+struct MotionBlurPipeline {
+    blur: wgpu::RenderPipeline,
+    blur_layout: wgpu::BindGroupLayout,
+    copy: wgpu::RenderPipeline,
+    copy_layout: wgpu::BindGroupLayout,
+}
+
+impl MotionBlurPipeline {
+    fn new(device: &wgpu::Device) -> Result<Self, RenderError> {
+        let fragment = wgpu::ShaderStages::FRAGMENT;
+        let unfiltered = wgpu::TextureSampleType::Float { filterable: false };
+        let blur_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("motion_blur"),
+            entries: &[
+                uniform_entry(0, fragment),
+                uniform_entry(1, fragment),
+                texture_entry(2, unfiltered),
+                texture_entry(3, wgpu::TextureSampleType::Depth),
+            ],
+        });
+        let copy_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("motion_blur_copy"),
+            entries: &[texture_entry(4, unfiltered)],
+        });
+        let blur = fullscreen_pipeline(
+            device,
+            "motion_blur",
+            "motion_blur.wgsl",
+            &[&blur_layout],
+            "fs_blur",
+            HDR_FORMAT,
+        )?;
+        let copy = fullscreen_pipeline(
+            device,
+            "motion_blur_copy",
+            "motion_blur.wgsl",
+            &[&copy_layout],
+            "fs_copy",
+            HDR_FORMAT,
+        )?;
+        Ok(MotionBlurPipeline { blur, blur_layout, copy, copy_layout })
+    }
+}
+
+/// Blurs the HDR image along each pixel's camera-motion velocity, in place.
+pub struct MotionBlurPass {
+    /// Samples, strength, clamp.
+    pub settings: MotionBlurSettings,
+}
+
+impl Pass for MotionBlurPass {
+    fn name(&self) -> &'static str {
+        "motion_blur"
+    }
+    fn reads(&self) -> Vec<ResourceName> {
+        vec![HDR, DEPTH]
+    }
+    fn writes(&self) -> Vec<ResourceName> {
+        vec![HDR, MOTION_BLUR]
+    }
+    fn creates(&self) -> Vec<TextureSpec> {
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        vec![TextureSpec { name: MOTION_BLUR, format: HDR_FORMAT, usage, scale: 1.0 }]
+    }
+    fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
+        let device = &ctx.gpu.device;
+        let pipeline = ctx.pipelines.get_or_create(0, || MotionBlurPipeline::new(device))?;
+        let s = self.settings;
+        let params = MotionBlurParams {
+            samples: s.samples.clamp(2, 64),
+            strength: if s.strength.is_finite() { s.strength.max(0.0) } else { 0.0 },
+            max_pixels: if s.max_pixels.is_finite() { s.max_pixels.max(0.0) } else { 0.0 },
+            _pad: 0,
+        };
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("motion_blur_params"),
+            contents: bytemuck::bytes_of(&params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let hdr = ctx.texture(HDR)?;
+        let blurred = ctx.texture(MOTION_BLUR)?;
+        let blur_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("motion_blur"),
+            layout: &pipeline.blur_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: ctx.scene.view_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: params.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(hdr) },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(ctx.texture(DEPTH)?),
+                },
+            ],
+        });
+        let copy_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("motion_blur_copy"),
+            layout: &pipeline.copy_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 4,
+                resource: wgpu::BindingResource::TextureView(blurred),
+            }],
+        });
+        let first = ctx.render_timestamps(true, false);
+        draw_fullscreen(ctx.encoder, "motion_blur", blurred, first, &pipeline.blur, &[&blur_group]);
+        let last = ctx.render_timestamps(false, true);
+        draw_fullscreen(ctx.encoder, "motion_blur_copy", hdr, last, &pipeline.copy, &[&copy_group]);
+        Ok(())
+    }
+}

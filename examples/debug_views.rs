@@ -1,0 +1,112 @@
+//! Debug views toggled at run time by a system: the embedded hall with 256 animated lights.
+//!
+//! `cargo run --release --example debug_views` opens a window. Keys: Right / Space next view,
+//! Left previous view, 0–8 pick a view, `b` toggles bloom, `m` toggles motion blur, `c` toggles
+//! a per-cluster cap of 8 (so the overflow view has something to show), Esc quits. Each change
+//! logs one line saying what the view shows and how to read its colours (the light-count view
+//! also draws its scale along the bottom edge).
+//!
+//! `cargo run --release --example debug_views -- --headless DIR` writes one PNG per view to DIR.
+
+use manylight::app::headless::{finish_frames, finish_plugins, save_png};
+use manylight::app::{DebugView, HeadlessCapture, PressedKeys};
+use manylight::prelude::*;
+
+fn setup(mut commands: Commands) {
+    let scene = default_scene();
+    spawn_scene(&mut commands, &scene, true, 16.0 / 9.0);
+    spawn_light_rig(&mut commands, 256, scene.bounds(), 1);
+}
+
+/// Reads the keys pressed this frame and changes the `DebugView` resource and the camera's
+/// opt-in effects; logs the legend of the new view.
+fn toggle(
+    keys: Res<PressedKeys>,
+    mut debug: ResMut<DebugView>,
+    mut settings: ResMut<RenderSettings>,
+    cameras: Query<(Entity, Has<Bloom>, Has<MotionBlur>), With<Camera3d>>,
+    mut commands: Commands,
+) {
+    let all = DebugViewMode::ALL;
+    let index = all.iter().position(|&m| m == debug.mode).unwrap_or(0);
+    for key in &keys.0 {
+        match key.as_str() {
+            "ArrowRight" | "Space" => debug.mode = all[(index + 1) % all.len()],
+            "ArrowLeft" => debug.mode = all[(index + all.len() - 1) % all.len()],
+            "b" | "m" => {
+                for (camera, bloom, motion_blur) in &cameras {
+                    let mut camera = commands.entity(camera);
+                    match (key.as_str(), bloom, motion_blur) {
+                        ("b", true, _) => camera.remove::<Bloom>(),
+                        ("b", false, _) => camera.insert(Bloom::default()),
+                        (_, _, true) => camera.remove::<MotionBlur>(),
+                        (_, _, false) => camera.insert(MotionBlur::default()),
+                    };
+                    tracing::info!(
+                        "{} {}",
+                        if key == "b" { "bloom" } else { "motion blur" },
+                        match key.as_str() {
+                            "b" if bloom => "off",
+                            "m" if motion_blur => "off",
+                            _ => "on",
+                        }
+                    );
+                }
+            }
+            "c" => {
+                settings.clusters.cap = if settings.clusters.cap.is_some() { None } else { Some(8) };
+                tracing::info!("per-cluster cap: {:?}", settings.clusters.cap);
+            }
+            digit => {
+                if let Some(mode) = digit.parse::<usize>().ok().and_then(|i| all.get(i)) {
+                    debug.mode = *mode;
+                }
+            }
+        }
+    }
+    if debug.is_changed() {
+        tracing::info!("debug view {}: {}", debug.mode.name(), debug.legend());
+    }
+}
+
+fn main() -> AppExit {
+    tracing_subscriber::fmt().with_env_filter("warn,winit=error,debug_views=info").init();
+    let args: Vec<String> = std::env::args().collect();
+    if let Some(i) = args.iter().position(|a| a == "--headless") {
+        let dir = std::path::PathBuf::from(args.get(i + 1).map_or("debug_views", |s| s.as_str()));
+        return headless(&dir);
+    }
+    tracing::info!("keys: Right/Space next view, Left previous, 0-8 pick, b bloom, m motion blur, c cap");
+    App::new()
+        .add_plugins(ManyLightPlugin::default())
+        .add_systems(Startup, setup)
+        .add_systems(Update, toggle)
+        .run()
+}
+
+/// Renders every view once into `dir`.
+fn headless(dir: &std::path::Path) -> AppExit {
+    if let Err(e) = std::fs::create_dir_all(dir) {
+        tracing::error!("cannot create {}: {e}", dir.display());
+        return AppExit::error();
+    }
+    let mut app = App::new();
+    app.add_plugins(ManyLightPlugin::headless(UVec2::new(960, 540))).add_systems(Startup, setup);
+    finish_plugins(&mut app);
+    for mode in DebugViewMode::ALL {
+        app.world_mut().resource_mut::<DebugView>().mode = mode;
+        app.update();
+        finish_frames(&mut app);
+        let Some(image) = app.world().resource::<HeadlessCapture>().image.clone() else {
+            tracing::error!("no frame was rendered");
+            return AppExit::error();
+        };
+        let path = dir.join(format!("{}.png", mode.name()));
+        if let Err(e) = save_png(&image, &path) {
+            tracing::error!("{e}");
+            return AppExit::error();
+        }
+        println!("{} — {}", path.display(), DebugView::new(mode).legend());
+    }
+    AppExit::Success
+}

@@ -1,0 +1,76 @@
+// Reading the G-buffer back (clustered deferred lighting and light volumes). Group 1 holds the
+// targets of the pipeline's layout; each entry point touches only its own layout's bindings.
+// Declares the view uniform (group 0, binding 0) too, which decoding needs.
+//!include common/view.wgsl
+//!include common/gbuffer_codec.wgsl
+
+@group(0) @binding(0) var<uniform> view: ViewUniform;
+
+// Full layout
+@group(1) @binding(0) var gb_position: texture_2d<f32>;
+@group(1) @binding(1) var gb_normal: texture_2d<f32>;
+@group(1) @binding(2) var gb_albedo: texture_2d<f32>;
+// Compact layout
+@group(1) @binding(3) var gb_compact: texture_2d<u32>;
+// Every layout
+@group(1) @binding(4) var gb_depth: texture_depth_2d;
+@group(1) @binding(5) var<uniform> clear_color: vec4<f32>;
+// Packed layout
+@group(1) @binding(6) var gb_packed_albedo: texture_2d<f32>;
+@group(1) @binding(7) var gb_packed_position: texture_2d<f32>;
+
+// A surface read back from the G-buffer.
+struct GSurface {
+    params: SurfaceParams,
+    world_position: vec3<f32>,
+};
+
+// Reverse-Z depth of the pixel (0: nothing was drawn there).
+fn gbuffer_depth(px: vec2<i32>) -> f32 {
+    return textureLoad(gb_depth, px, 0);
+}
+
+fn gbuffer_read_full(px: vec2<i32>) -> GSurface {
+    let p = textureLoad(gb_position, px, 0);
+    let n = textureLoad(gb_normal, px, 0);
+    let a = textureLoad(gb_albedo, px, 0);
+    var g: GSurface;
+    g.params.albedo = a.rgb;
+    g.params.normal = normalize(n.xyz);
+    g.params.shininess = n.w;
+    g.params.specular = a.a;
+    g.params.model = u32(p.w + 0.5);
+    g.world_position = p.xyz;
+    return g;
+}
+
+fn gbuffer_read_packed(px: vec2<i32>) -> GSurface {
+    let a = textureLoad(gb_packed_albedo, px, 0);
+    let p = textureLoad(gb_packed_position, px, 0);
+    var g: GSurface;
+    g.params = gbuffer_unpack_albedo_params(a.rgb);
+    g.params.normal = gbuffer_decode_components(vec2<f32>(a.a, p.a), view.view_from_world);
+    g.world_position = p.xyz;
+    return g;
+}
+
+// World position of the pixel centre at `uv` (0..1, top-left origin) and reverse-Z `depth`.
+fn gbuffer_position_from_depth(uv: vec2<f32>, depth: f32) -> vec3<f32> {
+    let ndc = vec2<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0);
+    let world = view.world_from_clip * vec4<f32>(ndc, depth, 1.0);
+    return world.xyz / world.w;
+}
+
+fn gbuffer_read_compact(px: vec2<i32>, depth: f32) -> GSurface {
+    let g = textureLoad(gb_compact, px, 0);
+    let params = unpack2x16float(g.z);
+    var out: GSurface;
+    out.params.albedo = srgb_to_linear(unpack4x8unorm(g.x).rgb);
+    out.params.normal = gbuffer_decode_word(g.y);
+    out.params.shininess = params.x;
+    out.params.specular = params.y;
+    out.params.model = g.w;
+    let uv = (vec2<f32>(px) + 0.5) * view.viewport.zw;
+    out.world_position = gbuffer_position_from_depth(uv, depth);
+    return out;
+}

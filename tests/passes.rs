@@ -1,0 +1,237 @@
+//! "Only what the scene calls for": the exact pass list for the matrix {lights yes/no} ×
+//! {Bloom yes/no} × {MotionBlur yes/no} × {clustered forward / clustered deferred} × {debug view
+//! on/off}, planned without a GPU for every point and rendered on the device for every point
+//! (one app, toggled at run time: each change shows in the next frame), and transients of a
+//! removed effect freed after a few frames.
+
+mod support;
+
+use manylight::app::render_world::plan_passes;
+use manylight::app::scene::scene_snapshot;
+use manylight::app::{DebugView, FrameStats};
+use manylight::prelude::*;
+use manylight::render::{
+    BloomSettings, DebugViewMode, ExtractedPointLight, FrameSettings, MotionBlurSettings,
+};
+use support::gpu;
+
+const SIZE: UVec2 = UVec2::new(64, 48);
+
+/// One point of the matrix.
+#[derive(Clone, Copy, Debug)]
+struct Point {
+    lights: bool,
+    bloom: bool,
+    motion_blur: bool,
+    deferred: bool,
+    debug: bool,
+}
+
+fn matrix() -> Vec<Point> {
+    let mut points = Vec::new();
+    for i in 0..32u32 {
+        let bit = |b: u32| i & (1 << b) != 0;
+        points.push(Point {
+            lights: bit(0),
+            bloom: bit(1),
+            motion_blur: bit(2),
+            deferred: bit(3),
+            debug: bit(4),
+        });
+    }
+    points
+}
+
+fn pipeline(p: Point) -> PipelineKind {
+    if p.deferred { PipelineKind::ClusteredDeferred } else { PipelineKind::ClusteredForward }
+}
+
+/// The debug view of the "on" points: the light-count heatmap (it needs cluster data).
+const DEBUG_MODE: DebugViewMode = DebugViewMode::LightCount;
+
+/// The passes a point needs, written out rule by rule.
+fn expected(p: Point) -> Vec<&'static str> {
+    let mut passes: Vec<&'static str> = match (p.debug, p.deferred, p.lights) {
+        // Shading: clustered forward (with its depth pre-pass) or G-buffer + deferred lighting.
+        (false, false, true) => vec!["depth_prepass", "cluster_build", "clustered_forward"],
+        (false, true, true) => vec!["cluster_build", "gbuffer", "deferred_lighting"],
+        // No lights: no cluster build, no light lists, no G-buffer: the ambient forward pass.
+        (false, _, false) => vec!["forward"],
+        // The light-count view replaces shading: depth (pre-pass or G-buffer) + clusters only.
+        (true, false, true) => vec!["depth_prepass", "cluster_build"],
+        (true, true, true) => vec!["cluster_build", "gbuffer"],
+        // … and shows the (empty) grid without lights, over the forward pass's depth.
+        (true, _, false) => vec!["cluster_build", "forward"],
+    };
+    if p.debug {
+        // The debug view replaces tone mapping and the post stages with it.
+        passes.push("debug_view");
+        return passes;
+    }
+    if p.motion_blur {
+        passes.push("motion_blur");
+    }
+    if p.bloom {
+        passes.push("bloom_bright");
+        for _ in 0..BloomSettings::default().iterations {
+            passes.extend(["bloom_blur_h", "bloom_blur_v"]);
+        }
+        passes.push("bloom_composite");
+    }
+    passes.push("tonemap");
+    passes
+}
+
+fn snapshot(p: Point) -> manylight::render::FrameSnapshot {
+    let scene = default_scene();
+    let lights: Vec<ExtractedPointLight> = if p.lights {
+        scene.lights.iter().map(manylight::app::scene::extracted_light).collect()
+    } else {
+        Vec::new()
+    };
+    assert!(!p.lights || !lights.is_empty(), "the default scene brings lights");
+    let settings = FrameSettings {
+        pipeline: pipeline(p),
+        debug_view: if p.debug { DEBUG_MODE } else { DebugViewMode::None },
+        ..FrameSettings::default()
+    };
+    let mut s = scene_snapshot(&scene, lights, SIZE, settings, 0);
+    if let Some(camera) = &mut s.camera {
+        camera.bloom = p.bloom.then(BloomSettings::default);
+        camera.motion_blur = p.motion_blur.then(MotionBlurSettings::default);
+    }
+    s
+}
+
+#[test]
+fn planned_pass_lists_match_the_matrix() {
+    for p in matrix() {
+        let planned = plan_passes(snapshot(p)).unwrap_or_else(|e| panic!("{p:?}: {e}"));
+        assert_eq!(planned, expected(p), "{p:?}");
+    }
+}
+
+#[test]
+fn other_debug_views_need_only_their_data() {
+    let with = |pipeline, view, lights| {
+        let p = Point { lights, bloom: true, motion_blur: true, deferred: false, debug: true };
+        let mut s = snapshot(p);
+        s.settings.pipeline = pipeline;
+        s.settings.debug_view = view;
+        plan_passes(s).expect("plan")
+    };
+    use DebugViewMode::*;
+    use PipelineKind::*;
+    // Surface views draw the Full G-buffer instead of shading, in forward pipelines too.
+    assert_eq!(with(ClusteredForward, Albedo, true), ["gbuffer", "debug_view"]);
+    assert_eq!(with(NaiveForward, Normal, true), ["gbuffer", "debug_view"]);
+    assert_eq!(with(ClusteredDeferred, Normal, false), ["gbuffer", "debug_view"]);
+    // Depth needs depth only: no cluster build, no lighting.
+    assert_eq!(with(ClusteredForward, Depth, true), ["depth_prepass", "debug_view"]);
+    assert_eq!(with(ClusteredDeferred, Depth, true), ["depth_prepass", "debug_view"]);
+    assert_eq!(with(NaiveForward, Depth, false), ["depth_prepass", "debug_view"]);
+    assert_eq!(with(ClusteredForward, Overflow, true), ["depth_prepass", "cluster_build", "debug_view"]);
+    // The seed's bloom: 5 iterations at full resolution.
+    let p = Point { lights: true, bloom: true, motion_blur: false, deferred: false, debug: false };
+    let mut s = snapshot(p);
+    if let Some(c) = &mut s.camera {
+        c.bloom = Some(BloomSettings::seed());
+    }
+    let names = plan_passes(s).expect("plan");
+    assert_eq!(names.iter().filter(|n| n.starts_with("bloom_blur")).count(), 10, "{names:?}");
+}
+
+fn set_point(app: &mut App, p: Point) {
+    let world = app.world_mut();
+    world.resource_mut::<RenderSettings>().pipeline = pipeline(p);
+    world.resource_mut::<DebugView>().mode = if p.debug { DEBUG_MODE } else { DebugViewMode::None };
+    let lights: Vec<Entity> = world.query_filtered::<Entity, With<PointLight>>().iter(world).collect();
+    if p.lights && lights.is_empty() {
+        for l in &default_scene().lights {
+            world.spawn((
+                Transform::from_translation(l.position),
+                PointLight { color: l.color, intensity: l.intensity, radius: l.radius },
+            ));
+        }
+    } else if !p.lights {
+        for e in lights {
+            world.despawn(e);
+        }
+    }
+    let camera = world.query_filtered::<Entity, With<Camera3d>>().single(world).expect("one camera");
+    let mut camera = world.entity_mut(camera);
+    if p.bloom {
+        camera.insert(Bloom::default());
+    } else {
+        camera.remove::<Bloom>();
+    }
+    if p.motion_blur {
+        camera.insert(MotionBlur::default());
+    } else {
+        camera.remove::<MotionBlur>();
+    }
+}
+
+fn scene_app() -> App {
+    let mut app = App::new();
+    app.add_plugins(ManyLightPlugin::headless(SIZE)).add_systems(Startup, |mut commands: Commands| {
+        spawn_scene(&mut commands, &default_scene(), true, SIZE.x as f32 / SIZE.y as f32);
+    });
+    app
+}
+
+fn last_passes(app: &App) -> Vec<String> {
+    app.world().resource::<FrameStats>().pass_names()
+}
+
+#[test]
+fn rendered_pass_lists_follow_run_time_changes() {
+    let _gpu = gpu();
+    let mut app = scene_app();
+    app.update();
+    for p in matrix() {
+        set_point(&mut app, p);
+        app.update();
+        if let Some(e) = &app.world().resource::<manylight::app::RenderFailure>().0 {
+            panic!("{p:?}: {e}");
+        }
+        assert_eq!(last_passes(&app), expected(p), "{p:?}");
+    }
+}
+
+#[test]
+fn removing_bloom_frees_its_textures() {
+    let _gpu = gpu();
+    let mut app = scene_app();
+    app.update();
+    let base = Point { lights: true, bloom: false, motion_blur: false, deferred: false, debug: false };
+    set_point(&mut app, base);
+    app.update();
+    let live =
+        |app: &App| app.world().resource::<FrameStats>().last.as_ref().expect("report").transient_textures;
+    let without = live(&app);
+    assert_eq!(without, 2, "hdr + depth");
+    set_point(&mut app, Point { bloom: true, ..base });
+    app.update();
+    // Downsampled chain, 5 levels: each level and its horizontal intermediate.
+    let with = live(&app);
+    assert_eq!(with, without + 2 * BloomSettings::default().iterations);
+    set_point(&mut app, base);
+    // Kept for reuse while unused for up to TRANSIENT_KEEP_FRAMES frames, then freed.
+    let keep = manylight::render::pool::TRANSIENT_KEEP_FRAMES;
+    for frame in 1..=keep + 1 {
+        app.update();
+        assert!(!last_passes(&app).iter().any(|n| n.starts_with("bloom")));
+        let expected = if frame <= keep { with } else { without };
+        assert_eq!(live(&app), expected, "frame {frame} after removing Bloom");
+    }
+    // Motion blur: one full-size intermediate, freed the same way.
+    set_point(&mut app, Point { motion_blur: true, ..base });
+    app.update();
+    assert_eq!(live(&app), without + 1);
+    set_point(&mut app, base);
+    for _ in 0..=keep {
+        app.update();
+    }
+    assert_eq!(live(&app), without);
+}
