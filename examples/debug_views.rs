@@ -42,7 +42,7 @@ fn toggle(
                         (_, _, true) => camera.remove::<MotionBlur>(),
                         (_, _, false) => camera.insert(MotionBlur::default()),
                     };
-                    tracing::info!(
+                    println!(
                         "{} {}",
                         if key == "b" { "bloom" } else { "motion blur" },
                         match key.as_str() {
@@ -55,7 +55,7 @@ fn toggle(
             }
             "c" => {
                 settings.clusters.cap = if settings.clusters.cap.is_some() { None } else { Some(8) };
-                tracing::info!("per-cluster cap: {:?}", settings.clusters.cap);
+                println!("per-cluster cap: {:?}", settings.clusters.cap);
             }
             digit => {
                 if let Some(mode) = digit.parse::<usize>().ok().and_then(|i| all.get(i)) {
@@ -65,18 +65,18 @@ fn toggle(
         }
     }
     if debug.is_changed() {
-        tracing::info!("debug view {}: {}", debug.mode.name(), debug.legend());
+        println!("debug view {}: {}", debug.mode.name(), debug.legend());
     }
 }
 
 fn main() -> AppExit {
-    tracing_subscriber::fmt().with_env_filter("warn,winit=error,debug_views=info").init();
+    tracing_subscriber::fmt().with_env_filter("warn,winit=error").init();
     let args: Vec<String> = std::env::args().collect();
     if let Some(i) = args.iter().position(|a| a == "--headless") {
         let dir = std::path::PathBuf::from(args.get(i + 1).map_or("debug_views", |s| s.as_str()));
         return headless(&dir);
     }
-    tracing::info!("keys: Right/Space next view, Left previous, 0-8 pick, b bloom, m motion blur, c cap");
+    println!("keys: Right/Space next view, Left previous, 0-8 pick, b bloom, m motion blur, c cap");
     App::new()
         .add_plugins(ManyLightPlugin::default())
         .add_systems(Startup, setup)
@@ -87,7 +87,7 @@ fn main() -> AppExit {
 /// Renders every view once into `dir`.
 fn headless(dir: &std::path::Path) -> AppExit {
     if let Err(e) = std::fs::create_dir_all(dir) {
-        tracing::error!("cannot create {}: {e}", dir.display());
+        eprintln!("cannot create {}: {e}", dir.display());
         return AppExit::error();
     }
     let mut app = App::new();
@@ -98,12 +98,12 @@ fn headless(dir: &std::path::Path) -> AppExit {
         app.update();
         finish_frames(&mut app);
         let Some(image) = app.world().resource::<HeadlessCapture>().image.clone() else {
-            tracing::error!("no frame was rendered");
+            eprintln!("no frame was rendered");
             return AppExit::error();
         };
         let path = dir.join(format!("{}.png", mode.name()));
         if let Err(e) = save_png(&image, &path) {
-            tracing::error!("{e}");
+            eprintln!("{e}");
             return AppExit::error();
         }
         println!("{} — {}", path.display(), DebugView::new(mode).legend());

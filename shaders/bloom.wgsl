@@ -2,7 +2,9 @@
 // - fs_bright: the HDR colour above a soft threshold (bilinear taps box-filter it down when
 //   the target is smaller than the source);
 // - fs_blur: one direction of a separable 9-tap gaussian (sigma ~ 2 texels of the target);
-// - fs_composite: the mean of the chain's levels x intensity, blended additively into HDR.
+// - fs_upsample: a smaller level, bilinearly upsampled, blended additively into the next larger;
+// - fs_composite: level 0 (the sum of the levels) / level count x intensity, blended
+//   additively into HDR.
 //!include common/fullscreen.wgsl
 
 struct BloomParams {
@@ -19,11 +21,6 @@ struct BloomParams {
 @group(0) @binding(0) var<uniform> params: BloomParams;
 @group(0) @binding(1) var linear_sampler: sampler;
 @group(0) @binding(2) var source: texture_2d<f32>;
-@group(0) @binding(3) var level1: texture_2d<f32>;
-@group(0) @binding(4) var level2: texture_2d<f32>;
-@group(0) @binding(5) var level3: texture_2d<f32>;
-@group(0) @binding(6) var level4: texture_2d<f32>;
-@group(0) @binding(7) var level5: texture_2d<f32>;
 
 // Largest HDR value that takes part (keeps single bright pixels from flickering into huge
 // blobs and keeps f16 from overflowing when levels are summed).
@@ -58,13 +55,12 @@ fn fs_blur(in: FullscreenOut) -> @location(0) vec4<f32> {
 }
 
 @fragment
+fn fs_upsample(in: FullscreenOut) -> @location(0) vec4<f32> {
+    return vec4<f32>(textureSampleLevel(source, linear_sampler, in.uv, 0.0).rgb, 0.0);
+}
+
+@fragment
 fn fs_composite(in: FullscreenOut) -> @location(0) vec4<f32> {
-    let n = params.level_count;
-    var sum = textureSampleLevel(source, linear_sampler, in.uv, 0.0).rgb;
-    if n > 1u { sum += textureSampleLevel(level1, linear_sampler, in.uv, 0.0).rgb; }
-    if n > 2u { sum += textureSampleLevel(level2, linear_sampler, in.uv, 0.0).rgb; }
-    if n > 3u { sum += textureSampleLevel(level3, linear_sampler, in.uv, 0.0).rgb; }
-    if n > 4u { sum += textureSampleLevel(level4, linear_sampler, in.uv, 0.0).rgb; }
-    if n > 5u { sum += textureSampleLevel(level5, linear_sampler, in.uv, 0.0).rgb; }
-    return vec4<f32>(sum / f32(max(n, 1u)) * params.intensity, 0.0);
+    let sum = textureSampleLevel(source, linear_sampler, in.uv, 0.0).rgb;
+    return vec4<f32>(sum / f32(max(params.level_count, 1u)) * params.intensity, 0.0);
 }

@@ -201,3 +201,18 @@ fn compact_gbuffer_rejects_the_xyz_codec() {
     let err = try_render(default_scene(), UVec2::new(64, 36), 8, settings).expect_err("must be refused");
     assert!(err.contains("compact") && err.contains("xyz"), "{err}");
 }
+
+/// Light volumes build no cluster lists; without lights every pipeline falls back to the plain
+/// forward pass (no G-buffer). Planned without a GPU.
+#[test]
+fn light_volumes_plan_only_what_they_need() {
+    use manylight::app::render_world::plan_passes;
+    use manylight::app::scene::scene_snapshot;
+    use manylight::render::{ExtractedPointLight, FrameSettings};
+    let light = ExtractedPointLight { position: Vec3::ZERO, color: Vec3::ONE, intensity: 1.0, radius: 2.0 };
+    let settings = FrameSettings { pipeline: PipelineKind::LightVolumes, ..FrameSettings::default() };
+    let lit = scene_snapshot(&default_scene(), vec![light], UVec2::new(64, 36), settings, 0);
+    assert_eq!(plan_passes(lit).expect("plan"), ["gbuffer", "light_volumes", "tonemap"]);
+    let unlit = scene_snapshot(&default_scene(), Vec::new(), UVec2::new(64, 36), settings, 0);
+    assert_eq!(plan_passes(unlit).expect("plan"), ["forward", "tonemap"]);
+}

@@ -76,6 +76,8 @@ fn expected(p: Point) -> Vec<&'static str> {
         for _ in 0..BloomSettings::default().iterations {
             passes.extend(["bloom_blur_h", "bloom_blur_v"]);
         }
+        // Downsampled chain: the levels are summed from the smallest up.
+        passes.extend(std::iter::repeat_n("bloom_upsample", BloomSettings::default().levels() - 1));
         passes.push("bloom_composite");
     }
     passes.push("tonemap");
@@ -139,6 +141,7 @@ fn other_debug_views_need_only_their_data() {
     }
     let names = plan_passes(s).expect("plan");
     assert_eq!(names.iter().filter(|n| n.starts_with("bloom_blur")).count(), 10, "{names:?}");
+    assert!(!names.contains(&"bloom_upsample"), "one full-resolution level: {names:?}");
 }
 
 fn set_point(app: &mut App, p: Point) {

@@ -30,7 +30,7 @@ fn render(setup: Setup, frames: u32) -> HeadlessFrame {
             let mut scene = scene.clone();
             if setup.one_bright_light {
                 let centre = scene.bounds().center();
-                let mut light = scene.lights[0].clone();
+                let mut light = scene.lights[0];
                 light.position = glam::Vec3::new(centre.x, scene.bounds().min.y + 0.6, centre.z);
                 light.color = Vec3::ONE;
                 light.intensity = 4000.0;
@@ -125,6 +125,18 @@ fn motion_blur_with_a_still_camera_changes_nothing() {
     let plain = render(Setup::default(), 3);
     let m = flip_mean(&plain.image, &still.image);
     assert!(m <= 0.001, "still camera: FLIP mean {m}");
+    // A camera that moves by far less than a pixel runs the blur shader, whose per-pixel
+    // early-out keeps every colour exact.
+    let turn = 1e-6;
+    let creeping = render(Setup { motion_blur: blur, turn, ..Setup::default() }, 3);
+    let plain = render(Setup { turn, ..Setup::default() }, 3);
+    let m = flip_mean(&plain.image, &creeping.image);
+    assert!(m <= 0.001, "sub-pixel motion: FLIP mean {m}");
+    let gpu_ms = |f: &HeadlessFrame| {
+        f.stats.last.as_ref().and_then(|r| r.passes.iter().find(|p| p.name == "motion_blur")?.gpu_ms)
+    };
+    assert!(gpu_ms(&still).is_none(), "a still camera records no motion-blur work");
+    assert!(gpu_ms(&creeping).is_some(), "a moving camera runs the blur");
 }
 
 #[test]

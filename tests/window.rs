@@ -359,6 +359,7 @@ fn drive_window(pipelined: bool) {
         height: 240,
         vsync: false,
         any_thread: true,
+        overlay: true,
     };
     let started = Instant::now();
     let exit = App::new()

@@ -137,7 +137,13 @@ impl Default for Bloom {
 
 impl From<manylight_render::BloomSettings> for Bloom {
     fn from(s: manylight_render::BloomSettings) -> Self {
-        Bloom { threshold: s.threshold, knee: s.knee, intensity: s.intensity, iterations: s.iterations, chain: s.chain }
+        Bloom {
+            threshold: s.threshold,
+            knee: s.knee,
+            intensity: s.intensity,
+            iterations: s.iterations,
+            chain: s.chain,
+        }
     }
 }
 

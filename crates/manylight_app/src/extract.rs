@@ -25,7 +25,8 @@ pub struct ExtractState {
 }
 
 /// What extract reads of a camera: placement, projection and its opt-in effects.
-pub type CameraItem = (&'static Transform, &'static Camera3d, Option<&'static Bloom>, Option<&'static MotionBlur>);
+pub type CameraItem =
+    (&'static Transform, &'static Camera3d, Option<&'static Bloom>, Option<&'static MotionBlur>);
 
 /// Builds the frame's snapshot from the world.
 #[allow(clippy::too_many_arguments)]

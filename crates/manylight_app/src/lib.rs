@@ -24,8 +24,11 @@ pub mod window;
 
 pub use components::{Bloom, Camera3d, LightAnimation, Material, Mesh3d, MotionBlur, PointLight, Transform};
 pub use plugin::{HeadlessConfig, ManyLightPlugin, ManyLightSet, OutputMode};
-pub use resources::{DebugView, FrameClock, FrameStats, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize};
-pub use window::{PressedKeys, WindowConfig, WindowRequests};
+pub use resources::{
+    DebugView, FrameClock, FrameStats, HeadlessCapture, LightControls, RenderFailure, RenderSettings,
+    ViewportSize,
+};
+pub use window::{Overlay, PressedKeys, WindowConfig, WindowRequests};
 
 /// What an app needs in scope to use manylight.
 pub mod prelude {
@@ -33,9 +36,11 @@ pub mod prelude {
         Bloom, Camera3d, LightAnimation, Material, Mesh3d, MotionBlur, PointLight, Transform,
     };
     pub use crate::plugin::{ManyLightPlugin, ManyLightSet};
-    pub use crate::resources::{DebugView, FrameClock, FrameStats, HeadlessCapture, RenderSettings};
+    pub use crate::resources::{
+        DebugView, FrameClock, FrameStats, HeadlessCapture, LightControls, RenderSettings,
+    };
     pub use crate::scene::{spawn_light_rig, spawn_scene};
-    pub use crate::window::{PressedKeys, WindowConfig, WindowRequests};
+    pub use crate::window::{Overlay, PressedKeys, WindowConfig, WindowRequests};
     pub use bevy_app::prelude::*;
     pub use bevy_ecs::prelude::*;
     pub use glam::{Quat, UVec2, Vec3};

@@ -10,8 +10,8 @@ use manylight_render::passes::{
     GBufferPass, LightVolumesPass, MotionBlurPass, TonemapPass,
 };
 use manylight_render::{
-    DebugViewMode, FrameReport, GBufferLayout, FrameSnapshot, GpuContext, HeadlessTarget, PipelineKind, RenderError,
-    RenderGraph, Renderer,
+    DebugViewMode, FrameReport, FrameSnapshot, GBufferLayout, GpuContext, HeadlessTarget, PipelineKind,
+    RenderError, RenderGraph, Renderer,
 };
 
 /// The ordered steps of one rendered frame.
@@ -229,13 +229,16 @@ fn add_deferred_lighting_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<
 
 fn add_light_volumes_pass(
     snapshot: Res<CurrentSnapshot>,
-    renderer: Res<RendererResource>,
+    renderer: Option<Res<RendererResource>>,
     mut graph: ResMut<FrameGraph>,
 ) {
     let s = &snapshot.0.settings;
     if shades_deferred(&snapshot.0) && s.pipeline == PipelineKind::LightVolumes {
         let (layout, codec, clear_color) = (s.gbuffer, s.normal_codec, s.clear_color);
-        let accumulation = LightVolumesPass::accumulation_format(&renderer.0.gpu.device);
+        // Planning without a GPU (`plan_passes`) lists the same passes with either format.
+        let accumulation = renderer.map_or(manylight_render::resources::HDR_FORMAT, |r| {
+            LightVolumesPass::accumulation_format(&r.0.gpu.device)
+        });
         graph.0.add(LightVolumesPass { layout, codec, clear_color, accumulation });
     }
 }
@@ -252,10 +255,10 @@ fn add_clustered_forward_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<
 /// Camera-motion blur, when the camera has it (and no debug view replaces the image).
 fn add_motion_blur_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
     let s = &snapshot.0;
-    if let Some(settings) = s.camera.and_then(|c| c.motion_blur)
+    if let Some(pass) = s.camera.and_then(|c| MotionBlurPass::for_camera(&c, s.viewport))
         && s.settings.debug_view == DebugViewMode::None
     {
-        graph.0.add(MotionBlurPass { settings });
+        graph.0.add(pass);
     }
 }
 

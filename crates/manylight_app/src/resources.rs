@@ -4,7 +4,9 @@ use bevy_ecs::prelude::*;
 use glam::UVec2;
 use manylight_core::ShadingModel;
 use manylight_core::codec::NormalCodec;
-use manylight_render::{ClusterSettings, DebugViewMode, FrameReport, FrameSettings, GBufferLayout, PipelineKind};
+use manylight_render::{
+    ClusterSettings, DebugViewMode, FrameReport, FrameSettings, GBufferLayout, PipelineKind,
+};
 
 /// How frames are rendered; changes apply from the next frame.
 #[derive(Resource, Clone, Copy, Debug, PartialEq)]
@@ -183,3 +185,20 @@ pub struct HeadlessCapture {
 /// The error that stopped rendering, if any (the app also receives `AppExit::error()`).
 #[derive(Resource, Clone, Debug, Default)]
 pub struct RenderFailure(pub Option<String>);
+
+/// Light count and radius multiplier a user asks for at run time (the window overlay edits
+/// them when this resource exists); an app that spawns lights reads them, as the `stress`
+/// example does.
+#[derive(Resource, Clone, Copy, Debug, PartialEq)]
+pub struct LightControls {
+    /// Lights the app should keep alive.
+    pub count: u32,
+    /// Multiplier of each light's base radius.
+    pub radius_scale: f32,
+}
+
+impl Default for LightControls {
+    fn default() -> Self {
+        LightControls { count: 1024, radius_scale: 1.0 }
+    }
+}

@@ -10,8 +10,8 @@ use manylight_app::RenderSettings;
 use manylight_app::headless::{render_headless, save_png};
 use manylight_app::scene::{spawn_light_rig, spawn_scene};
 use manylight_core::ShadingModel;
-use manylight_core::codec::NormalCodec;
 use manylight_core::cluster::{CullTest, GridConfig, MAX_GRID_DIM, ZSlicing};
+use manylight_core::codec::NormalCodec;
 use manylight_render::{BloomChain, ClusterSettings, DebugViewMode, GBufferLayout, PipelineKind};
 use manylight_scene::{LoadOptions, Scene, load_scene};
 use std::path::PathBuf;
@@ -19,6 +19,7 @@ use std::process::ExitCode;
 
 mod bench;
 mod direct;
+mod post;
 mod report;
 
 #[derive(Parser)]
@@ -42,6 +43,9 @@ enum Command {
     /// What accuracy costs in time: every pipeline and G-buffer layout against the naive
     /// reference (FLIP) and its frame time, in one run, as a markdown table.
     Report(ReportArgs),
+    /// What bloom and motion blur cost per frame: the same frame without post stages, with
+    /// each bloom chain, with motion blur and with both, in one run, as a markdown table.
+    Post(ReportArgs),
 }
 
 #[derive(clap::Args)]
@@ -117,7 +121,8 @@ struct RenderArgs {
     #[arg(long, default_value = "blinn-phong", value_parser = parse_shading)]
     shading: ShadingModel,
     /// Animated lights added to the scene's own lights (default: 64 for a scene that has no
-    /// lights of its own, so it is not black; 0 otherwise).
+    /// lights of its own, so it is not black; 0 otherwise). For `sphere-shell`: the lights of
+    /// its lattice instead (default 100 000).
     #[arg(long)]
     lights: Option<usize>,
     /// Image size, WxH.
@@ -326,17 +331,20 @@ fn render_scene(
                 }
             },
         );
-        app.add_systems(bevy_app::PostStartup, move |mut commands: Commands, cameras: Query<Entity, With<Camera3d>>| {
-            for camera in &cameras {
-                let mut camera = commands.entity(camera);
-                if let Some(bloom) = extras.bloom {
-                    camera.insert(bloom);
+        app.add_systems(
+            bevy_app::PostStartup,
+            move |mut commands: Commands, cameras: Query<Entity, With<Camera3d>>| {
+                for camera in &cameras {
+                    let mut camera = commands.entity(camera);
+                    if let Some(bloom) = extras.bloom {
+                        camera.insert(bloom);
+                    }
+                    if let Some(motion_blur) = extras.motion_blur {
+                        camera.insert(motion_blur);
+                    }
                 }
-                if let Some(motion_blur) = extras.motion_blur {
-                    camera.insert(motion_blur);
-                }
-            }
-        });
+            },
+        );
         if extras.motion_blur.is_some() {
             app.add_systems(bevy_app::Update, |mut cameras: Query<&mut Transform, With<Camera3d>>| {
                 for mut t in &mut cameras {
@@ -377,8 +385,15 @@ fn stats_json(stats: &FrameStats) -> serde_json::Value {
 fn render(args: RenderArgs) -> Result<()> {
     let mut scene = load_scene(&args.scene, &LoadOptions::default())?;
     select_camera(&mut scene, &args.camera)?;
+    // The sphere-shell preset is lit by its own lattice (`--lights`, default 100 000 of range
+    // 0.3 just inside the radius-50 sphere), not by the animated rig.
+    let shell = args.scene == "sphere-shell";
+    if shell {
+        let n = args.lights.unwrap_or(100_000);
+        scene.lights = manylight_scene::sphere_shell_lights(n, 50.0, 0.3, args.seed);
+    }
     let unlit = scene.lights.is_empty();
-    let lights = args.lights.unwrap_or(if unlit { 64 } else { 0 });
+    let lights = if shell { 0 } else { args.lights.unwrap_or(if unlit { 64 } else { 0 }) };
     let ambient = args.ambient.unwrap_or(if unlit { 0.2 } else { RenderSettings::default().ambient });
     let culling = if args.culling_efficiency {
         let rig = manylight_scene::light_rig(lights, scene.bounds(), args.seed);
@@ -418,10 +433,10 @@ fn render(args: RenderArgs) -> Result<()> {
         ..RenderSettings::default()
     };
     let extras = Extras {
-        bloom: args
-            .post
-            .bloom
-            .then(|| manylight_app::Bloom { chain: args.post.bloom_chain, ..manylight_app::Bloom::default() }),
+        bloom: args.post.bloom.then(|| manylight_app::Bloom {
+            chain: args.post.bloom_chain,
+            ..manylight_app::Bloom::default()
+        }),
         motion_blur: args.post.motion_blur.then(manylight_app::MotionBlur::default),
         debug: manylight_app::DebugView::new(args.clusters.debug_view),
     };
@@ -490,6 +505,13 @@ fn report_cmd(args: ReportArgs) -> Result<()> {
     Ok(())
 }
 
+fn post_cmd(args: ReportArgs) -> Result<()> {
+    let scene = load_scene(&args.scene, &LoadOptions::default())?;
+    let base = manylight_render::FrameSettings { clusters: args.clusters.settings(), ..Default::default() };
+    print!("{}", post::run(&scene, args.lights, args.size, args.frames.max(1), base)?);
+    Ok(())
+}
+
 fn bench_cmd(args: BenchArgs) -> Result<()> {
     let scene = load_scene(&args.scene, &LoadOptions::default())?;
     let sweep = bench::Sweep {
@@ -532,6 +554,7 @@ fn main() -> ExitCode {
         Command::Check { path } => check(path),
         Command::Bench(args) => bench_cmd(args),
         Command::Report(args) => report_cmd(args),
+        Command::Post(args) => post_cmd(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -7,6 +7,7 @@ pub mod attenuation;
 pub mod camera;
 pub mod cluster;
 pub mod codec;
+pub mod depth_precision;
 pub mod efficiency;
 pub mod icosphere;
 pub mod image_metrics;

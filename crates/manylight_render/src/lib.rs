@@ -23,7 +23,7 @@ pub use graph::{OUTPUT, Pass, PassContext, RenderGraph, ResourceName, TextureSpe
 pub use readback::{HEADLESS_FORMAT, HeadlessTarget};
 pub use renderer::Renderer;
 pub use snapshot::{
-    BloomChain, BloomSettings, ClusterSettings, DebugViewMode, ExtractedCamera, ExtractedInstance, ExtractedPointLight, FrameSettings,
-    FrameSnapshot, GBufferLayout, MotionBlurSettings, PipelineKind,
+    BloomChain, BloomSettings, ClusterSettings, DebugViewMode, ExtractedCamera, ExtractedInstance,
+    ExtractedPointLight, FrameSettings, FrameSnapshot, GBufferLayout, MotionBlurSettings, PipelineKind,
 };
 pub use stats::{FrameReport, PassTiming};

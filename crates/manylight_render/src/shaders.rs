@@ -30,6 +30,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("tonemap.wgsl", include_str!("../../../shaders/tonemap.wgsl")),
     ("bloom.wgsl", include_str!("../../../shaders/bloom.wgsl")),
     ("motion_blur.wgsl", include_str!("../../../shaders/motion_blur.wgsl")),
+    ("tests/codec_roundtrip.wgsl", include_str!("../../../shaders/tests/codec_roundtrip.wgsl")),
 ];
 
 /// A shader could not be composed.

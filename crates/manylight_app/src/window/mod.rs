@@ -13,9 +13,14 @@
 //!    is configured again and a lost one recreated, and the frame is retried once.
 //! 4. On exit, the runner waits for the frames in flight, records their results, drops the
 //!    surface (joining the render thread) and only then the window.
+//!
+//! With [`WindowConfig::overlay`] the egui overlay ([`overlay`]) gets each window event first
+//! and builds its UI before each update; the sink draws it after the frame.
 
+pub mod overlay;
 mod surface;
 
+pub use overlay::{OVERLAY_PASS, Overlay};
 pub use surface::SurfaceSink;
 
 use crate::backend::{RenderBackend, RenderThread};
@@ -50,11 +55,20 @@ pub struct WindowConfig {
     /// ignored elsewhere). Off by default because macOS cannot do it; tests turn it on, since
     /// the test harness runs each test on a thread of its own.
     pub any_thread: bool,
+    /// Show the egui overlay (settings and timings; F1 or the [`Overlay`] resource hides it).
+    pub overlay: bool,
 }
 
 impl Default for WindowConfig {
     fn default() -> Self {
-        Self { title: "manylight".into(), width: 1280, height: 720, vsync: true, any_thread: false }
+        Self {
+            title: "manylight".into(),
+            width: 1280,
+            height: 720,
+            vsync: true,
+            any_thread: false,
+            overlay: true,
+        }
     }
 }
 
@@ -123,6 +137,8 @@ struct WinitRunner {
     seen_hidden: bool,
     next_idle_update: Instant,
     exit: Option<AppExit>,
+    /// The egui overlay, when the config asks for it and the window exists.
+    overlay: Option<overlay::OverlayHost>,
 }
 
 impl WinitRunner {
@@ -161,7 +177,17 @@ impl WinitRunner {
             return;
         }
         self.publish_viewport();
+        let idle = self.idle();
+        if let (Some(host), Some(window)) = (self.overlay.as_mut(), self.window.as_ref())
+            && !idle
+        {
+            host.run(window, self.app.world_mut());
+        }
+        let started = Instant::now();
         self.app.update();
+        if let Some(host) = self.overlay.as_mut() {
+            host.record_update(started.elapsed().as_secs_f64() * 1e3);
+        }
         if let Some(mut keys) = self.app.world_mut().get_resource_mut::<PressedKeys>() {
             keys.0.clear();
         }
@@ -274,10 +300,16 @@ impl ApplicationHandler for WinitRunner {
             Ok(w) => Arc::new(w),
             Err(e) => return self.fail(event_loop, format!("could not open a window: {e}")),
         };
-        let sink = match SurfaceSink::new(window.clone(), self.config.vsync) {
+        let mut sink = match SurfaceSink::new(window.clone(), self.config.vsync) {
             Ok(s) => s,
             Err(e) => return self.fail(event_loop, e.to_string()),
         };
+        if self.config.overlay {
+            let (host, painter) = overlay::OverlayHost::new(&window);
+            sink = sink.with_overlay(painter);
+            self.overlay = Some(host);
+            self.app.world_mut().init_resource::<Overlay>();
+        }
         let backend = if self.pipelined {
             match RenderThread::spawn(Box::new(sink)) {
                 Ok(t) => RenderBackend::Pipelined(t),
@@ -294,6 +326,24 @@ impl ApplicationHandler for WinitRunner {
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        if let WindowEvent::KeyboardInput {
+            event: KeyEvent { logical_key: Key::Named(NamedKey::F1), state: ElementState::Pressed, .. },
+            ..
+        } = &event
+            && let Some(mut overlay) = self.app.world_mut().get_resource_mut::<Overlay>()
+        {
+            overlay.visible = !overlay.visible;
+            return;
+        }
+        // Input goes to the overlay first; what it uses does not reach the app.
+        let overlay_visible = self.app.world().get_resource::<Overlay>().is_some_and(|o| o.visible);
+        if let (Some(host), Some(window)) = (self.overlay.as_mut(), self.window.as_ref())
+            && overlay_visible
+            && host.on_window_event(window, &event)
+            && matches!(event, WindowEvent::KeyboardInput { .. })
+        {
+            return;
+        }
         match event {
             WindowEvent::CloseRequested | WindowEvent::Destroyed => {
                 self.exit_with(event_loop, AppExit::Success);
@@ -303,11 +353,17 @@ impl ApplicationHandler for WinitRunner {
                     KeyEvent { logical_key: Key::Named(NamedKey::Escape), state: ElementState::Pressed, .. },
                 ..
             } => self.exit_with(event_loop, AppExit::Success),
-            WindowEvent::KeyboardInput { event: KeyEvent { logical_key, state: ElementState::Pressed, .. }, .. } => {
+            WindowEvent::KeyboardInput {
+                event: KeyEvent { logical_key, state: ElementState::Pressed, .. },
+                ..
+            } => {
                 if let Some(mut keys) = self.app.world_mut().get_resource_mut::<PressedKeys>() {
                     keys.0.push(match &logical_key {
                         Key::Character(c) => c.to_string(),
-                        other => format!("{other:?}").trim_start_matches("Named(").trim_end_matches(')').to_string(),
+                        other => format!("{other:?}")
+                            .trim_start_matches("Named(")
+                            .trim_end_matches(')')
+                            .to_string(),
                     });
                 }
             }
@@ -359,6 +415,7 @@ impl ApplicationHandler for WinitRunner {
 
     fn exiting(&mut self, _event_loop: &ActiveEventLoop) {
         self.shut_down_renderer();
+        self.overlay = None;
         self.window = None;
     }
 }
@@ -426,10 +483,12 @@ pub fn run_window(mut app: App, config: WindowConfig, pipelined: bool) -> AppExi
         seen_hidden: false,
         next_idle_update: Instant::now(),
         exit: None,
+        overlay: None,
     };
     let result = event_loop.run_app(&mut runner);
     // `exiting` has already stopped the renderer; this covers a loop that ended without it.
     runner.shut_down_renderer();
+    runner.overlay = None;
     runner.window = None;
     if let Err(e) = result {
         tracing::error!("window event loop failed: {e}");

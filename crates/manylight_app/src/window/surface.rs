@@ -2,6 +2,7 @@
 //! while minimised (0×0) or larger than the device allows, reconfigured when outdated and
 //! recreated when lost.
 
+use super::overlay::OverlayPainter;
 use crate::backend::FrameSink;
 use crate::render_world::{RenderWorld, empty_report};
 use glam::UVec2;
@@ -17,6 +18,7 @@ pub struct SurfaceSink {
     render_world: RenderWorld,
     vsync: bool,
     warned_too_large: bool,
+    overlay: Option<OverlayPainter>,
 }
 
 impl SurfaceSink {
@@ -33,7 +35,14 @@ impl SurfaceSink {
             render_world: RenderWorld::new(gpu),
             vsync,
             warned_too_large: false,
+            overlay: None,
         })
+    }
+
+    /// Draws the egui overlay after each frame (its last pass, `egui_overlay`).
+    pub(crate) fn with_overlay(mut self, painter: OverlayPainter) -> SurfaceSink {
+        self.overlay = Some(painter);
+        self
     }
 
     /// Configures the surface for `size` (both sides non-zero).
@@ -138,7 +147,12 @@ impl FrameSink for SurfaceSink {
         };
         let format = frame.texture.format();
         let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
-        let report = self.render_world.render(snapshot, &view, format)?;
+        let mut report = self.render_world.render(snapshot, &view, format)?;
+        if let Some(painter) = self.overlay.as_mut()
+            && let Some(timing) = painter.paint(self.render_world.gpu(), &view, format, size)
+        {
+            report.passes.push(timing);
+        }
         self.window.pre_present_notify();
         self.render_world.gpu().queue.present(frame);
         Ok((report, None))

@@ -6,8 +6,11 @@
 //!    vertical. In the downsampled chain iteration `k` reads level `k − 1` (twice its size, so the
 //!    bilinear taps also box-filter it down) and writes level `k` at `1/2^(k+1)` of the viewport;
 //!    in the seed's chain every iteration blurs level 0 again at full resolution;
-//! 3. [`BloomCompositePass`]: the mean of the levels × intensity, added (blend One + One) to the
-//!    HDR target before tone mapping.
+//! 3. [`BloomUpsamplePass`] (downsampled chain only), from the smallest level up: level `k` is
+//!    added (bilinear, blend One + One) to level `k − 1`, so level 0 ends up holding the sum of
+//!    all levels at a fraction of the cost of sampling each at full resolution;
+//! 4. [`BloomCompositePass`]: level 0 ÷ level count × intensity (the mean of the levels), added
+//!    (blend One + One) to the HDR target before tone mapping.
 
 use super::HDR;
 use crate::context::RenderError;
@@ -78,13 +81,26 @@ impl BloomSettings {
         (self.iterations as usize).clamp(1, MAX_BLOOM_LEVELS)
     }
 
+    /// The settings with non-finite or negative values replaced: a NaN or infinite threshold
+    /// blooms nothing, a NaN intensity adds nothing (never a NaN pixel).
+    pub fn sanitized(&self) -> BloomSettings {
+        let finite_or = |v: f32, fallback: f32| if v.is_finite() { v.max(0.0) } else { fallback };
+        BloomSettings {
+            threshold: finite_or(self.threshold, f32::MAX),
+            knee: finite_or(self.knee, 0.0),
+            intensity: finite_or(self.intensity, 0.0),
+            ..*self
+        }
+    }
+
     /// The passes of this bloom, in order (the app adds them to the graph).
     pub fn passes(&self) -> Vec<Box<dyn Pass>> {
+        let settings = self.sanitized();
         let levels = self.levels();
         let mut passes: Vec<Box<dyn Pass>> = Vec::with_capacity(2 + 2 * levels);
         let full = self.chain == BloomChain::FullResolution;
         let scale = |k: usize| if full { 1.0 } else { 0.5f32.powi(k as i32 + 1) };
-        passes.push(Box::new(BloomBrightPass { settings: *self, scale: scale(0) }));
+        passes.push(Box::new(BloomBrightPass { settings, scale: scale(0) }));
         for k in 0..levels {
             // Downsampled: level k from level k-1 (level 0 blurs the bright pass in place).
             // Full resolution: level 0 again and again.
@@ -104,7 +120,10 @@ impl BloomSettings {
             }));
         }
         let used = if full { 1 } else { levels };
-        passes.push(Box::new(BloomCompositePass { levels: used, intensity: self.intensity }));
+        for k in (1..used).rev() {
+            passes.push(Box::new(BloomUpsamplePass { source: BLOOM_LEVELS[k], target: BLOOM_LEVELS[k - 1] }));
+        }
+        passes.push(Box::new(BloomCompositePass { levels: used, intensity: settings.intensity }));
         passes
     }
 }
@@ -139,7 +158,15 @@ fn level_spec(name: ResourceName, scale: f32) -> TextureSpec {
 enum Stage {
     Bright,
     Blur,
+    Upsample,
     Composite,
+}
+
+impl Stage {
+    /// Stages that add to their target instead of replacing it.
+    fn adds(self) -> bool {
+        matches!(self, Stage::Upsample | Stage::Composite)
+    }
 }
 
 /// The pipeline of one bloom stage.
@@ -152,7 +179,6 @@ struct BloomPipeline {
 impl BloomPipeline {
     fn new(device: &wgpu::Device, stage: Stage) -> Result<Self, RenderError> {
         let fragment = wgpu::ShaderStages::FRAGMENT;
-        let textures = if stage == Stage::Composite { MAX_BLOOM_LEVELS } else { 1 };
         let mut entries = vec![super::common::uniform_entry(0, fragment)];
         entries.push(wgpu::BindGroupLayoutEntry {
             binding: 1,
@@ -160,15 +186,11 @@ impl BloomPipeline {
             ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
             count: None,
         });
-        for i in 0..textures {
-            entries.push(super::common::texture_entry(
-                2 + i as u32,
-                wgpu::TextureSampleType::Float { filterable: true },
-            ));
-        }
+        entries.push(super::common::texture_entry(2, wgpu::TextureSampleType::Float { filterable: true }));
         let (label, entry) = match stage {
             Stage::Bright => ("bloom_bright", "fs_bright"),
             Stage::Blur => ("bloom_blur", "fs_blur"),
+            Stage::Upsample => ("bloom_upsample", "fs_upsample"),
             Stage::Composite => ("bloom_composite", "fs_composite"),
         };
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -182,7 +204,7 @@ impl BloomPipeline {
             immediate_size: 0,
         });
         // The composite adds to the HDR image; the other stages overwrite their level.
-        let blend = (stage == Stage::Composite).then_some(wgpu::BlendState {
+        let blend = stage.adds().then_some(wgpu::BlendState {
             color: wgpu::BlendComponent {
                 src_factor: wgpu::BlendFactor::One,
                 dst_factor: wgpu::BlendFactor::One,
@@ -262,8 +284,7 @@ fn draw(
     let view = ctx.texture(target)?;
     let timestamps = ctx.render_timestamps(true, true);
     // The composite loads the HDR image and adds to it; the other stages replace their level.
-    let load =
-        if stage == Stage::Composite { wgpu::LoadOp::Load } else { wgpu::LoadOp::Clear(wgpu::Color::BLACK) };
+    let load = if stage.adds() { wgpu::LoadOp::Load } else { wgpu::LoadOp::Clear(wgpu::Color::BLACK) };
     let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some("bloom"),
         color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -351,9 +372,32 @@ impl Pass for BloomBlurPass {
     }
 }
 
-/// Adds the mean of the first `levels` levels × intensity to the HDR image.
+/// Adds level `source` (bilinearly upsampled) to the next larger level `target`.
+pub struct BloomUpsamplePass {
+    /// The smaller level.
+    pub source: ResourceName,
+    /// The level twice its size, added to.
+    pub target: ResourceName,
+}
+
+impl Pass for BloomUpsamplePass {
+    fn name(&self) -> &'static str {
+        "bloom_upsample"
+    }
+    fn reads(&self) -> Vec<ResourceName> {
+        vec![self.source, self.target]
+    }
+    fn writes(&self) -> Vec<ResourceName> {
+        vec![self.target]
+    }
+    fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
+        draw(ctx, Stage::Upsample, BloomParams::new(), &[self.source], self.target)
+    }
+}
+
+/// Adds level 0 (holding the sum of `levels` levels) ÷ `levels` × intensity to the HDR image.
 pub struct BloomCompositePass {
-    /// Levels summed (1 to [`MAX_BLOOM_LEVELS`]).
+    /// Levels summed into level 0 (1 to [`MAX_BLOOM_LEVELS`]).
     pub levels: usize,
     /// Weight of the bloom.
     pub intensity: f32,
@@ -365,20 +409,14 @@ impl Pass for BloomCompositePass {
     }
     fn reads(&self) -> Vec<ResourceName> {
         // HDR: ordered after the lighting that writes it (it is blended into, not sampled).
-        std::iter::once(HDR)
-            .chain(BLOOM_LEVELS[..self.levels.clamp(1, MAX_BLOOM_LEVELS)].iter().copied())
-            .collect()
+        vec![HDR, BLOOM_LEVELS[0]]
     }
     fn writes(&self) -> Vec<ResourceName> {
         vec![HDR]
     }
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
-        let levels = self.levels.clamp(1, MAX_BLOOM_LEVELS);
-        // Unused slots repeat level 0; the shader reads only `level_count` of them.
-        let sources: Vec<ResourceName> =
-            (0..MAX_BLOOM_LEVELS).map(|i| BLOOM_LEVELS[if i < levels { i } else { 0 }]).collect();
-        let params =
-            BloomParams { intensity: self.intensity, level_count: levels as u32, ..BloomParams::new() };
-        draw(ctx, Stage::Composite, params, &sources, HDR)
+        let levels = self.levels.clamp(1, MAX_BLOOM_LEVELS) as u32;
+        let params = BloomParams { intensity: self.intensity, level_count: levels, ..BloomParams::new() };
+        draw(ctx, Stage::Composite, params, &[BLOOM_LEVELS[0]], HDR)
     }
 }

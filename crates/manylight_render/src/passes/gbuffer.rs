@@ -132,3 +132,19 @@ impl Pass for GBufferPass {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The bytes per pixel a layout reports are those of its targets plus 4 of depth.
+    #[test]
+    fn bytes_per_pixel_match_the_targets() {
+        for layout in GBufferLayout::ALL {
+            let targets: u32 =
+                targets(layout).iter().map(|(_, f)| f.block_copy_size(None).unwrap_or(0)).sum();
+            let depth = DEPTH_FORMAT.block_copy_size(Some(wgpu::TextureAspect::DepthOnly)).unwrap_or(0);
+            assert_eq!(layout.bytes_per_pixel(), targets + depth, "{layout:?}");
+        }
+    }
+}

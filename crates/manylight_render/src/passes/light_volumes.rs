@@ -261,20 +261,17 @@ impl Pass for LightVolumesPass {
         let hdr = ctx.texture(HDR)?;
         let target = if self.accumulates_separately() { ctx.texture(LIGHT_ACCUM)? } else { hdr };
         let depth = ctx.texture(DEPTH)?;
-        let resolve = match &pipeline.resolve {
-            Some((resolve, accum_layout)) => Some((
-                resolve,
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("light_accum"),
-                    layout: accum_layout,
-                    entries: &[wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::TextureView(target),
-                    }],
-                }),
-            )),
-            None => None,
-        };
+        let resolve = pipeline.resolve.as_ref().map(|(resolve, accum_layout)| {
+            let accum = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("light_accum"),
+                layout: accum_layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(target),
+                }],
+            });
+            (resolve, accum)
+        });
         let timestamps = ctx.render_timestamps(true, resolve.is_none());
         let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("light_volumes"),

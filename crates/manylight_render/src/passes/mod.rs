@@ -10,11 +10,11 @@ pub mod deferred_lighting;
 pub mod depth_prepass;
 pub mod forward;
 pub mod gbuffer;
-pub mod motion_blur;
 pub mod light_volumes;
+pub mod motion_blur;
 pub mod tonemap;
 
-pub use bloom::{BloomBlurPass, BloomBrightPass, BloomCompositePass};
+pub use bloom::{BloomBlurPass, BloomBrightPass, BloomCompositePass, BloomUpsamplePass};
 pub use cluster_build::ClusterBuildPass;
 pub use clustered_forward::ClusteredForwardPass;
 pub use debug_view::DebugViewPass;
@@ -22,8 +22,8 @@ pub use deferred_lighting::DeferredLightingPass;
 pub use depth_prepass::DepthPrepass;
 pub use forward::ForwardPass;
 pub use gbuffer::GBufferPass;
-pub use motion_blur::MotionBlurPass;
 pub use light_volumes::LightVolumesPass;
+pub use motion_blur::MotionBlurPass;
 pub use tonemap::TonemapPass;
 
 /// Graph resource: the HDR scene colour.

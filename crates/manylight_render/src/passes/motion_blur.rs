@@ -4,8 +4,9 @@
 //! 1. `fs_blur`: HDR + depth → the `motion_blur` transient;
 //! 2. `fs_copy`: `motion_blur` → HDR, so tone mapping and bloom read the blurred image.
 //!
-//! A pixel that moved less than half a pixel keeps its exact colour, so a still camera (and the
-//! first frame, whose previous matrix is the current one) gives the unblurred image.
+//! A pixel that moved less than half a pixel keeps its exact colour. When the whole camera did
+//! not move (a still camera, or the first frame, which has no previous matrix) the pass records
+//! nothing at all: the image is the unblurred one and costs no GPU time.
 
 use super::common::{draw_fullscreen, fullscreen_pipeline, texture_entry, uniform_entry};
 use super::{DEPTH, HDR};
@@ -93,6 +94,19 @@ impl MotionBlurPipeline {
 pub struct MotionBlurPass {
     /// Samples, strength, clamp.
     pub settings: MotionBlurSettings,
+    /// False when the camera's clip-from-world equals last frame's (or there is no last frame):
+    /// nothing moves, nothing is recorded.
+    pub camera_moved: bool,
+}
+
+impl MotionBlurPass {
+    /// The pass for `camera` at `viewport`, with its settings.
+    pub fn for_camera(camera: &crate::snapshot::ExtractedCamera, viewport: glam::UVec2) -> Option<Self> {
+        let settings = camera.motion_blur?;
+        let current = camera.clip_from_world(viewport);
+        let camera_moved = camera.prev_clip_from_world.is_some_and(|prev| prev != current);
+        Some(MotionBlurPass { settings, camera_moved })
+    }
 }
 
 impl Pass for MotionBlurPass {
@@ -110,6 +124,9 @@ impl Pass for MotionBlurPass {
         vec![TextureSpec { name: MOTION_BLUR, format: HDR_FORMAT, usage, scale: 1.0 }]
     }
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
+        if !self.camera_moved {
+            return Ok(());
+        }
         let device = &ctx.gpu.device;
         let pipeline = ctx.pipelines.get_or_create(0, || MotionBlurPipeline::new(device))?;
         let s = self.settings;
