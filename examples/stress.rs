@@ -159,13 +159,16 @@ pub fn scale_shell_lights(controls: Res<LightControls>, mut lights: Query<(&Shel
     }
 }
 
+/// The lights this example spawned (animated or sphere-shell).
+pub type ExampleLights = Or<(With<StressLight>, With<ShellLight>)>;
+
 /// Keeps [`LightControls::count`] lights alive: on the first frame and whenever the count
 /// changes, the example's lights are despawned and the layout spawned again with the new count.
 pub fn sync_light_count(
     mut commands: Commands,
     controls: Res<LightControls>,
     layout: Res<StressLayout>,
-    lights: Query<Entity, Or<(With<StressLight>, With<ShellLight>)>>,
+    lights: Query<Entity, ExampleLights>,
 ) {
     if !controls.is_changed() || lights.iter().count() == controls.count as usize {
         return;
@@ -245,11 +248,7 @@ pub fn time_frames(
                 None => format!("{}=cpu:{:.2}", p.name, p.cpu_ms),
             })
             .collect();
-        println!(
-            "last_frame_gpu_ms: {} render_cpu_ms={:.2}",
-            passes.join(" "),
-            report.frame_cpu_ms
-        );
+        println!("last_frame_gpu_ms: {} render_cpu_ms={:.2}", passes.join(" "), report.frame_cpu_ms);
     }
     if times.exit_when_done {
         exit.write(AppExit::Success);

@@ -1,13 +1,17 @@
 // Cluster light assignment on the GPU, in two levels of three dispatches each, in one compute
 // pass. Level 1 builds a list per screen tile (the column of clusters behind it); level 2
 // builds each cluster's list from its tile's list instead of from every light:
-// 1. `tile_count`: one invocation per tile counts the lights whose sphere passes the chosen
-//    test against the tile's whole column, radius inflated a little more: the column's box
-//    contains each cluster's box and its planes are each cluster's side planes moved outwards,
-//    so this is a superset of what any cluster of the column accepts (checked on the CPU by
-//    crates/manylight_core/tests/tile_prefilter.rs);
-// 2. `tile_scan`: one workgroup turns the counts into offsets (exclusive prefix sum);
-// 3. `tile_fill`: writes each tile's lights in ascending order;
+// 1. `tile_count`: one invocation per (tile, chunk of TILE_LIGHT_CHUNK lights) counts the
+//    chunk's lights whose sphere passes the chosen test against the tile's whole column,
+//    radius inflated a little more: the column's box contains each cluster's box and its
+//    planes are each cluster's side planes moved outwards, so this is a superset of what any
+//    cluster of the column accepts (checked on the CPU by
+//    crates/manylight_core/tests/tile_prefilter.rs). Chunks keep every invocation's loop short:
+//    lavapipe stops an invocation after 65 535 loop iterations (gpu_types::TILE_LIGHT_CHUNK);
+// 2. `tile_scan`: one workgroup turns the (tile, chunk) counts, tile-major, into offsets
+//    (exclusive prefix sum), so a tile's chunks lie one after another;
+// 3. `tile_fill`: each (tile, chunk) writes its lights in ascending order, so each tile's
+//    list is in ascending light order;
 // 4. `count`: one invocation per cluster tests its tile's lights against the cluster's bounds,
 //    stores the count (capped if a cap is set) and updates the counters;
 // 5. `scan`: prefix sum of the cluster counts, and the total the index list needs;
@@ -69,35 +73,48 @@ fn tile_count_total() -> u32 {
     return params.dims.x * params.dims.y;
 }
 
+// Entries of `tile_ranges`: one per (tile, chunk), tile-major.
+fn tile_entry_total() -> u32 {
+    return tile_count_total() * params.tile_chunks;
+}
+
+// The lights [first, end) of entry `e`'s chunk.
+fn chunk_lights(e: u32) -> vec2<u32> {
+    let first = (e % params.tile_chunks) * TILE_LIGHT_CHUNK;
+    return vec2<u32>(first, min(first + TILE_LIGHT_CHUNK, params.light_count));
+}
+
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn tile_count(@builtin(global_invocation_id) id: vec3<u32>) {
-    let tile = id.x;
-    if tile >= tile_count_total() {
+    let e = id.x;
+    if e >= tile_entry_total() {
         return;
     }
-    let b = tile_bounds[tile];
+    let b = tile_bounds[e / params.tile_chunks];
+    let lights = chunk_lights(e);
     var n = 0u;
-    for (var l = 0u; l < params.light_count; l++) {
+    for (var l = lights.x; l < lights.y; l++) {
         if touches_tile(b, l) {
             n += 1u;
         }
     }
-    tile_ranges[tile] = vec2<u32>(0u, n);
+    tile_ranges[e] = vec2<u32>(0u, n);
 }
 
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn tile_fill(@builtin(global_invocation_id) id: vec3<u32>) {
-    let tile = id.x;
-    if tile >= tile_count_total() {
+    let e = id.x;
+    if e >= tile_entry_total() {
         return;
     }
-    let range = tile_ranges[tile];
+    let range = tile_ranges[e];
     if range.x + range.y > params.tile_index_capacity {
         return;
     }
-    let b = tile_bounds[tile];
+    let b = tile_bounds[e / params.tile_chunks];
+    let lights = chunk_lights(e);
     var k = 0u;
-    for (var l = 0u; l < params.light_count && k < range.y; l++) {
+    for (var l = lights.x; l < lights.y && k < range.y; l++) {
         if touches_tile(b, l) {
             tile_indices[range.x + k] = l;
             k += 1u;
@@ -105,9 +122,13 @@ fn tile_fill(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
-// The lights of the cluster's tile: (offset, count) into `tile_indices`.
+// The lights of the cluster's tile: (offset, count) into `tile_indices`, from its first and
+// last chunk's ranges.
 fn tile_lights(cluster: u32) -> vec2<u32> {
-    let range = tile_ranges[cluster % tile_count_total()];
+    let first = (cluster % tile_count_total()) * params.tile_chunks;
+    let a = tile_ranges[first];
+    let z = tile_ranges[first + params.tile_chunks - 1u];
+    let range = vec2<u32>(a.x, z.x + z.y - a.x);
     // A tile list that did not fit this frame is empty; the frame is rendered again.
     return select(vec2<u32>(0u), range, range.x + range.y <= params.tile_index_capacity);
 }
@@ -144,7 +165,7 @@ var<workgroup> partial_sums: array<u32, SCAN_WORKGROUP_SIZE>;
 // offsets (`.x`); returns the total. One workgroup: each invocation sums a chunk, invocation
 // 0 scans the chunk sums, each invocation then writes its chunk's offsets.
 fn scan_ranges(tiles: bool, t: u32) -> u32 {
-    let total_entries = select(params.dims.w, tile_count_total(), tiles);
+    let total_entries = select(params.dims.w, tile_entry_total(), tiles);
     let chunk = (total_entries + SCAN_WORKGROUP_SIZE - 1u) / SCAN_WORKGROUP_SIZE;
     let begin = min(t * chunk, total_entries);
     let end = min(begin + chunk, total_entries);

@@ -223,3 +223,20 @@ fn culling_efficiency_finds_no_missing_light_and_clusters_beat_tiles() {
     }
     assert!(ratios[0] < ratios[1], "depth slices must cut evaluated pairs: {ratios:?}");
 }
+
+/// Tens of thousands of lights: level 1 of the build splits the lights into chunks, so no
+/// invocation loops long enough to hit lavapipe's limit (65 535 loop iterations per
+/// invocation, which silently dropped every light past about the 16 000th). The lists equal the
+/// CPU reference, and lights past index 65 535 are in them.
+#[test]
+fn gpu_lists_keep_every_light_of_a_large_rig() {
+    let _gpu = gpu();
+    let mut r = HeadlessRenderer::new().expect("adapter");
+    let scene = default_scene();
+    let settings = clustered(CullTest::Both, ZSlicing::Exponential, None);
+    let snap = scene_snapshot(&scene, UVec2::new(128, 72), rig(&scene, 70_000, 5), settings);
+    let (_, gpu, cpu) = gpu_and_cpu(&mut r, snap);
+    assert_same_lists("70 000 lights", &gpu, &cpu);
+    let last = (0..gpu.ranges.len() as u32).flat_map(|c| gpu.lights_of(c).to_vec()).max().unwrap_or(0);
+    assert!(last >= 65_536, "lights past index 65 535 must be assigned (largest: {last})");
+}

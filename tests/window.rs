@@ -187,6 +187,8 @@ struct Log {
     zero_sized_frames: u32,
     /// `FrameStats::frames_rendered` at the close request.
     frames_rendered: u64,
+    /// Rendered frames whose last pass was the egui overlay.
+    overlay_frames: u32,
     /// When the close was requested.
     close_requested: Option<Instant>,
 }
@@ -222,6 +224,9 @@ fn run_script(
             assert!(report.passes.is_empty(), "a 0×0 frame ran passes");
         } else if !report.passes.is_empty() {
             log.rendered.push((report.width, report.height));
+            if report.passes.last().is_some_and(|p| p.name == manylight::app::window::OVERLAY_PASS) {
+                log.overlay_frames += 1;
+            }
         }
     }
     if minimised {
@@ -403,6 +408,7 @@ fn drive_window(pipelined: bool) {
     assert!(exit.is_success(), "the app exited with {exit:?}");
     assert_eq!(log.step, SCRIPT.len(), "the script did not finish");
     assert!(log.frames_rendered > 0, "no frame was rendered");
+    assert!(log.overlay_frames > 0, "no frame drew the egui overlay as its last pass");
     for size in [(320, 240), (400, 300), (360, 270), (300, 200)] {
         assert!(log.rendered.contains(&size), "no frame rendered at {size:?}: {:?}", log.rendered);
     }

@@ -12,7 +12,8 @@ struct ClusterParams {
     slicing: u32,
     log_far_over_near: f32,
     tile_index_capacity: u32,
-    _pad0: u32,
+    // light chunks of level 1 (TILE_LIGHT_CHUNK lights each), at least 1
+    tile_chunks: u32,
 };
 
 struct GpuClusterBounds {
@@ -57,16 +58,17 @@ fn sphere_intersects_aabb(c: vec3<f32>, radius: f32, mn: vec3<f32>, mx: vec3<f32
 }
 
 // Conservative sphere–planes test (manylight_core::cluster::sphere_intersects_planes).
+// Written without a loop: lavapipe stops a shader invocation after 65 535 loop iterations in
+// total, so a 6-iteration loop here would cut the light loops around it to a seventh.
 fn sphere_intersects_planes(c: vec3<f32>, radius: f32, b: GpuClusterBounds) -> bool {
     if !(radius > 0.0) {
         return false;
     }
     let r = radius * RADIUS_INFLATION;
-    for (var i = 0u; i < 6u; i++) {
-        let pl = b.planes[i];
-        if dot(pl.xyz, c) + pl.w < -r {
-            return false;
-        }
-    }
-    return true;
+    // `< -r` as in Rust, so a NaN distance (overflow) keeps the light.
+    let p = b.planes;
+    let outside = dot(p[0].xyz, c) + p[0].w < -r || dot(p[1].xyz, c) + p[1].w < -r
+        || dot(p[2].xyz, c) + p[2].w < -r || dot(p[3].xyz, c) + p[3].w < -r
+        || dot(p[4].xyz, c) + p[4].w < -r || dot(p[5].xyz, c) + p[5].w < -r;
+    return !outside;
 }

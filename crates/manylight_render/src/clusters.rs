@@ -7,7 +7,8 @@
 
 use crate::context::{GpuContext, RenderError};
 use crate::gpu_types::{
-    CLUSTER_NO_CAP, CULL_AABB, CULL_BOTH, CULL_PLANES, GpuClusterBounds, GpuClusterCounters, GpuClusterParams,
+    CLUSTER_NO_CAP, CULL_AABB, CULL_BOTH, CULL_PLANES, GpuClusterBounds, GpuClusterCounters,
+    GpuClusterParams, TILE_LIGHT_CHUNK,
 };
 use crate::passes::common::{storage_entry, uniform_entry};
 use crate::pool::GrowableBuffer;
@@ -298,7 +299,6 @@ impl ClusterResources {
                 }
             }
             self.tile_bounds.write(device, queue, bytemuck::cast_slice(&tiles));
-            self.tile_ranges.reserve(device, tiles.len() as u64 * 8);
             self.bounds_of = Some(self.grid);
         }
         self.view_spheres = view_spheres(view_from_world, lights.iter().copied());
@@ -310,6 +310,9 @@ impl ClusterResources {
             self.spheres.write(device, queue, bytemuck::cast_slice(&spheres));
         }
         self.ranges.reserve(device, count as u64 * 8);
+        let tiles = self.grid.dims.x as u64 * self.grid.dims.y as u64;
+        let tile_chunks = (spheres.len() as u32).div_ceil(TILE_LIGHT_CHUNK).max(1);
+        self.tile_ranges.reserve(device, tiles * tile_chunks as u64 * 8);
         let p = projection.sanitized();
         self.params = GpuClusterParams {
             dims: [self.grid.dims.x, self.grid.dims.y, self.grid.dims.z, count],
@@ -325,7 +328,7 @@ impl ClusterResources {
             slicing: self.grid.slicing.gpu_id(),
             log_far_over_near: (p.far / p.near).ln(),
             tile_index_capacity: (self.tile_indices.capacity() / 4).min(u32::MAX as u64) as u32,
-            _pad: 0,
+            tile_chunks,
         };
         queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
         queue.write_buffer(&self.counters, 0, bytemuck::bytes_of(&GpuClusterCounters::default()));

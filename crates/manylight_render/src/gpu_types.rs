@@ -13,6 +13,12 @@ pub const SHADING_GLOBAL: u32 = 0xffff_ffff;
 
 /// `GpuClusterParams::cap` value meaning "no cap" (exact assignment).
 pub const CLUSTER_NO_CAP: u32 = 0xffff_ffff;
+/// Lights one invocation of the cluster build's level 1 tests against its tile. Each
+/// invocation handles one (tile, chunk of lights) pair, because lavapipe (Mesa 22.3's llvmpipe)
+/// silently stops a shader invocation after 65 535 loop iterations in total: a loop over all
+/// lights lost every light past the ~16 000th. 4096 lights × (1 + 6 plane-test iterations)
+/// stays well below that.
+pub const TILE_LIGHT_CHUNK: u32 = 4096;
 /// Workgroup size of the prefix-sum step of the cluster build (one workgroup scans all).
 pub const SCAN_WORKGROUP_SIZE: u32 = 256;
 /// `GpuClusterParams::cull_test` values.
@@ -38,6 +44,7 @@ pub fn shared_u32_constants() -> Vec<(&'static str, u32)> {
         ("SHADING_GLOBAL", SHADING_GLOBAL),
         ("CLUSTER_NO_CAP", CLUSTER_NO_CAP),
         ("SCAN_WORKGROUP_SIZE", SCAN_WORKGROUP_SIZE),
+        ("TILE_LIGHT_CHUNK", TILE_LIGHT_CHUNK),
         ("CULL_AABB", CULL_AABB),
         ("CULL_PLANES", CULL_PLANES),
         ("CULL_BOTH", CULL_BOTH),
@@ -159,8 +166,8 @@ pub struct GpuClusterParams {
     pub log_far_over_near: f32,
     /// Entries the per-tile light lists (first level of the build) can hold.
     pub tile_index_capacity: u32,
-    /// Padding to 16 bytes.
-    pub _pad: u32,
+    /// Light chunks of level 1: `ceil(light_count / TILE_LIGHT_CHUNK)`, at least 1.
+    pub tile_chunks: u32,
 }
 
 /// Bounds of one cluster in view space (`GpuClusterBounds` in `shaders/common/clusters.wgsl`).

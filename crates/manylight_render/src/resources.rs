@@ -167,7 +167,8 @@ impl SceneResources {
             mapped_at_creation: false,
         });
         let storage_usage = wgpu::BufferUsages::STORAGE;
-        let lights = GrowableBuffer::new(device, "point_lights", storage_usage, 64 * 32);
+        // One placeholder light (every pipeline binds the buffer); it grows when lights appear.
+        let lights = GrowableBuffer::new(device, "point_lights", storage_usage, 32);
         let instances = GrowableBuffer::new(device, "instances", storage_usage, 64 * 128);
         let view_bind_group =
             Self::make_view_bind_group(device, &view_layout, &view_buffer, &lights, &instances);

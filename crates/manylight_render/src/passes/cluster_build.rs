@@ -81,7 +81,9 @@ impl Pass for ClusterBuildPass {
             .pipelines
             .get_or_create(wg as u64, || ClusterBuildPipelines::new(&ctx.gpu.device, layout, wg))?;
         let groups = clusters.params.dims[3].div_ceil(wg);
-        let tile_groups = (clusters.params.dims[0] * clusters.params.dims[1]).div_ceil(wg);
+        // Level 1 runs one invocation per (tile, chunk of lights).
+        let tile_entries = clusters.params.dims[0] * clusters.params.dims[1] * clusters.params.tile_chunks;
+        let tile_groups = tile_entries.div_ceil(wg);
         let timestamps = ctx.compute_timestamps(true, true);
         {
             let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
