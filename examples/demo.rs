@@ -10,6 +10,7 @@
 
 use clap::Parser;
 use manylight::app::RenderFailure;
+use manylight::app::cli::parse_pipeline;
 use manylight::app::headless::save_png;
 use manylight::app::window::WindowConfig;
 use manylight::prelude::*;
@@ -38,13 +39,6 @@ struct Args {
     /// Where headless frames go (default: target/demo in the workspace).
     #[arg(long)]
     out_dir: Option<PathBuf>,
-}
-
-fn parse_pipeline(s: &str) -> Result<PipelineKind, String> {
-    PipelineKind::from_name(s).ok_or_else(|| {
-        let names: Vec<_> = PipelineKind::ALL.iter().map(|p| p.name()).collect();
-        format!("unknown pipeline `{s}` (expected one of: {})", names.join(", "))
-    })
 }
 
 /// Spawns the hall (with its camera and six warm lights) and the light rig.

@@ -25,6 +25,7 @@
 
 use anyhow::{Result, bail};
 use clap::Parser;
+use manylight::app::cli::{parse_pipeline, parse_size};
 use manylight::core::Aabb;
 use manylight::prelude::*;
 use manylight::scene::{AnimatedLight, light_rig, sphere_shell_lights};
@@ -74,23 +75,6 @@ pub struct Args {
     /// Seed of the light placement and colours.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-}
-
-fn parse_pipeline(s: &str) -> Result<PipelineKind, String> {
-    PipelineKind::from_name(s).ok_or_else(|| {
-        let names: Vec<_> = PipelineKind::ALL.iter().map(|p| p.name()).collect();
-        format!("unknown pipeline `{s}` (expected one of: {})", names.join(", "))
-    })
-}
-
-fn parse_size(s: &str) -> Result<UVec2, String> {
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("size `{s}` is not WxH"))?;
-    let parse = |v: &str| v.trim().parse::<u32>().map_err(|e| format!("size `{s}`: {e}"));
-    let (w, h) = (parse(w)?, parse(h)?);
-    if w == 0 || h == 0 || w > 16384 || h > 16384 {
-        return Err(format!("size `{s}`: each side must be in 1..=16384"));
-    }
-    Ok(UVec2::new(w, h))
 }
 
 /// Where the example's lights go: the rig's bounds, or the sphere shell.

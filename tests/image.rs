@@ -53,13 +53,7 @@ fn shading_models_give_different_images() {
         16,
         RenderSettings { shading: ShadingModel::BlinnPhong, ..RenderSettings::default() },
     );
-    let (stats, _) = manylight::core::image_metrics::flip_compare(
-        lambert.image.dimensions(),
-        lambert.image.as_raw(),
-        blinn.image.dimensions(),
-        blinn.image.as_raw(),
-    )
-    .expect("same size");
+    let stats = support::flip(&lambert.image, &blinn.image);
     assert!(stats.max > 0.05, "Blinn-Phong adds specular highlights, so the images must differ: {stats:?}");
 }
 
@@ -143,12 +137,6 @@ fn a_low_cluster_cap_changes_the_image_and_is_reported() {
     assert!(c.dropped_pairs > 0, "{c:?}");
     let e = exact.stats.last.as_ref().and_then(|r| r.clusters.clone()).expect("cluster report");
     assert_eq!(e.dropped_pairs, 0);
-    let (stats, _) = manylight::core::image_metrics::flip_compare(
-        exact.image.dimensions(),
-        exact.image.as_raw(),
-        capped.image.dimensions(),
-        capped.image.as_raw(),
-    )
-    .expect("same size");
+    let stats = support::flip(&exact.image, &capped.image);
     assert!(stats.mean > 0.005, "dropping lights must show: {stats:?}");
 }

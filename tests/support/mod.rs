@@ -111,3 +111,8 @@ pub fn shared_asset(rel: &str) -> PathBuf {
     assert!(p.exists(), "test asset {} is missing", p.display());
     p
 }
+
+/// FLIP statistics of two images of the same size (panics on a size mismatch).
+pub fn flip(a: &RgbaImage, b: &RgbaImage) -> FlipStats {
+    flip_compare(a.dimensions(), a.as_raw(), b.dimensions(), b.as_raw()).expect("images of the same size").0
+}

@@ -13,6 +13,7 @@
 //! ```
 
 pub mod backend;
+pub mod cli;
 pub mod components;
 pub mod extract;
 pub mod headless;

@@ -7,10 +7,14 @@ use clap::{Parser, Subcommand};
 use glam::{UVec2, UVec3};
 use manylight_app::FrameStats;
 use manylight_app::RenderSettings;
+use manylight_app::cli::{
+    parse_bloom_chain, parse_cull, parse_debug_view, parse_gbuffer, parse_grid, parse_normal_codec,
+    parse_pipeline, parse_shading, parse_size, parse_slicing,
+};
 use manylight_app::headless::{render_headless, save_png};
 use manylight_app::scene::{spawn_light_rig, spawn_scene};
 use manylight_core::ShadingModel;
-use manylight_core::cluster::{CullTest, GridConfig, MAX_GRID_DIM, ZSlicing};
+use manylight_core::cluster::{CullTest, GridConfig, ZSlicing};
 use manylight_core::codec::NormalCodec;
 use manylight_render::{BloomChain, ClusterSettings, DebugViewMode, GBufferLayout, PipelineKind};
 use manylight_scene::{LoadOptions, Scene, load_scene};
@@ -175,13 +179,6 @@ struct PostArgs {
     motion_blur: bool,
 }
 
-fn parse_bloom_chain(s: &str) -> Result<BloomChain, String> {
-    [BloomChain::Downsampled, BloomChain::FullResolution]
-        .into_iter()
-        .find(|c| c.name() == s)
-        .ok_or_else(|| format!("unknown bloom chain `{s}` (expected downsampled or full-resolution)"))
-}
-
 /// What `render_scene` adds beyond the scene: post stages on the camera and the debug view.
 #[derive(Clone, Copy, Debug, Default)]
 struct Extras {
@@ -238,73 +235,6 @@ impl ClusterArgs {
             workgroup_size: self.workgroup_size,
         }
     }
-}
-
-fn parse_gbuffer(s: &str) -> Result<GBufferLayout, String> {
-    GBufferLayout::from_name(s).ok_or_else(|| {
-        let names: Vec<_> = GBufferLayout::ALL.iter().map(|l| l.name()).collect();
-        format!("unknown G-buffer layout `{s}` (expected one of: {})", names.join(", "))
-    })
-}
-
-fn parse_normal_codec(s: &str) -> Result<NormalCodec, String> {
-    NormalCodec::from_name(s).ok_or_else(|| {
-        let names: Vec<_> = NormalCodec::ALL.iter().map(|c| c.name()).collect();
-        format!("unknown normal codec `{s}` (expected one of: {})", names.join(", "))
-    })
-}
-
-fn parse_cull(s: &str) -> Result<CullTest, String> {
-    CullTest::from_name(s)
-        .ok_or_else(|| format!("unknown culling test `{s}` (expected aabb, planes or both)"))
-}
-
-fn parse_slicing(s: &str) -> Result<ZSlicing, String> {
-    ZSlicing::from_name(s).ok_or_else(|| format!("unknown z slicing `{s}` (expected linear or exponential)"))
-}
-
-fn parse_debug_view(s: &str) -> Result<DebugViewMode, String> {
-    DebugViewMode::from_name(s).ok_or_else(|| {
-        let names: Vec<_> = DebugViewMode::ALL.iter().map(|v| v.name()).collect();
-        format!("unknown debug view `{s}` (expected one of: {})", names.join(", "))
-    })
-}
-
-fn parse_grid(s: &str) -> Result<UVec3, String> {
-    let parts: Vec<&str> = s.split(['x', 'X']).collect();
-    let [x, y, z] = parts.as_slice() else {
-        return Err(format!("grid `{s}` is not XxYxZ"));
-    };
-    let parse = |v: &str| v.trim().parse::<u32>().map_err(|e| format!("grid `{s}`: {e}"));
-    let dims = UVec3::new(parse(x)?, parse(y)?, parse(z)?);
-    if dims.min_element() == 0 || dims.max_element() > MAX_GRID_DIM {
-        return Err(format!("grid `{s}`: each size must be in 1..={MAX_GRID_DIM}"));
-    }
-    Ok(dims)
-}
-
-fn parse_pipeline(s: &str) -> Result<PipelineKind, String> {
-    PipelineKind::from_name(s).ok_or_else(|| {
-        let names: Vec<_> = PipelineKind::ALL.iter().map(|p| p.name()).collect();
-        format!("unknown pipeline `{s}` (expected one of: {})", names.join(", "))
-    })
-}
-
-fn parse_shading(s: &str) -> Result<ShadingModel, String> {
-    ShadingModel::from_name(s).ok_or_else(|| {
-        let names: Vec<_> = ShadingModel::ALL.iter().map(|m| m.name()).collect();
-        format!("unknown shading model `{s}` (expected one of: {})", names.join(", "))
-    })
-}
-
-fn parse_size(s: &str) -> Result<UVec2, String> {
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("size `{s}` is not WxH"))?;
-    let parse = |v: &str| v.trim().parse::<u32>().map_err(|e| format!("size `{s}`: {e}"));
-    let (w, h) = (parse(w)?, parse(h)?);
-    if w == 0 || h == 0 || w > 16384 || h > 16384 {
-        return Err(format!("size `{s}`: each side must be in 1..=16384"));
-    }
-    Ok(UVec2::new(w, h))
 }
 
 /// Renders `scene` headless through the plugin and returns the last frame and its stats.

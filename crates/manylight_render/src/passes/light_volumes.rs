@@ -3,8 +3,8 @@
 //! covers (see `shaders/light_volumes.wgsl` for the depth-test rule that lights each pixel once
 //! per light, camera inside the sphere and far-plane crossing included).
 
-use super::common::texture_entry;
 use super::common::{clear_color, color_attachment, draw_fullscreen};
+use super::common::{fullscreen_pipeline_with_constants, texture_entry};
 use super::deferred_lighting::{gbuffer_read_bind_group, gbuffer_read_layout};
 use super::gbuffer::{codec_constants, targets, variant_key};
 use super::{DEPTH, HDR, LIGHT_ACCUM};
@@ -138,43 +138,24 @@ impl LightVolumesPipeline {
             multiview_mask: None,
             cache: None,
         });
-        let resolve = (accumulation != HDR_FORMAT).then(|| {
+        let resolve = if accumulation != HDR_FORMAT {
             let accum_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("light_accum"),
                 entries: &[texture_entry(0, wgpu::TextureSampleType::Float { filterable: false })],
             });
-            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("light_volumes_resolve"),
-                bind_group_layouts: &[Some(view_layout), Some(&gbuffer_layout), Some(&accum_layout)],
-                immediate_size: 0,
-            });
-            let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("light_volumes_resolve"),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("fullscreen_vs"),
-                    compilation_options: options(),
-                    buffers: &[],
-                },
-                primitive: Default::default(),
-                depth_stencil: None,
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("fs_resolve"),
-                    compilation_options: options(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: HDR_FORMAT,
-                        blend: None,
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            });
-            (pipeline, accum_layout)
-        });
+            let pipeline = fullscreen_pipeline_with_constants(
+                device,
+                "light_volumes_resolve",
+                "light_volumes.wgsl",
+                &[view_layout, &gbuffer_layout, &accum_layout],
+                "fs_resolve",
+                HDR_FORMAT,
+                &constants,
+            )?;
+            Some((pipeline, accum_layout))
+        } else {
+            None
+        };
         let proxy = Icosphere::circumscribing_unit_sphere(PROXY_SUBDIVISIONS);
         let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("light_volume_proxy_vertices"),

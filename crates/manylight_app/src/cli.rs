@@ -1,0 +1,98 @@
+//! Command-line value parsers shared by the `manylight` CLI and the examples (for clap's
+//! `value_parser`): each names the accepted values in its error.
+
+use glam::{UVec2, UVec3};
+use manylight_core::ShadingModel;
+use manylight_core::cluster::{CullTest, MAX_GRID_DIM, ZSlicing};
+use manylight_core::codec::NormalCodec;
+use manylight_render::{BloomChain, DebugViewMode, GBufferLayout, PipelineKind};
+
+/// The value of `all` whose `name` is `s`, or an error listing every name.
+fn named<T: Copy>(what: &str, s: &str, all: &[T], name: impl Fn(T) -> &'static str) -> Result<T, String> {
+    all.iter().copied().find(|&v| name(v) == s).ok_or_else(|| {
+        let names: Vec<_> = all.iter().map(|&v| name(v)).collect();
+        format!("unknown {what} `{s}` (expected one of: {})", names.join(", "))
+    })
+}
+
+/// `naive`, `forward-plus`, `clustered-forward`, `clustered-deferred` or `light-volumes`.
+pub fn parse_pipeline(s: &str) -> Result<PipelineKind, String> {
+    named("pipeline", s, &PipelineKind::ALL, PipelineKind::name)
+}
+
+/// `lambert`, `blinn-phong` or `toon`.
+pub fn parse_shading(s: &str) -> Result<ShadingModel, String> {
+    named("shading model", s, &ShadingModel::ALL, ShadingModel::name)
+}
+
+/// `full`, `packed` or `compact`.
+pub fn parse_gbuffer(s: &str) -> Result<GBufferLayout, String> {
+    named("G-buffer layout", s, &GBufferLayout::ALL, GBufferLayout::name)
+}
+
+/// `xyz`, `spherical`, `octa16` or `octa8`.
+pub fn parse_normal_codec(s: &str) -> Result<NormalCodec, String> {
+    named("normal codec", s, &NormalCodec::ALL, NormalCodec::name)
+}
+
+/// `aabb`, `planes` or `both`.
+pub fn parse_cull(s: &str) -> Result<CullTest, String> {
+    named("culling test", s, &CullTest::ALL, CullTest::name)
+}
+
+/// `linear` or `exponential`.
+pub fn parse_slicing(s: &str) -> Result<ZSlicing, String> {
+    named("z slicing", s, &ZSlicing::ALL, ZSlicing::name)
+}
+
+/// A debug view name (`DebugViewMode::name`).
+pub fn parse_debug_view(s: &str) -> Result<DebugViewMode, String> {
+    named("debug view", s, &DebugViewMode::ALL, DebugViewMode::name)
+}
+
+/// `downsampled` or `full-resolution`.
+pub fn parse_bloom_chain(s: &str) -> Result<BloomChain, String> {
+    named("bloom chain", s, &[BloomChain::Downsampled, BloomChain::FullResolution], BloomChain::name)
+}
+
+/// `WxH`, each side in `1..=16384`.
+pub fn parse_size(s: &str) -> Result<UVec2, String> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("size `{s}` is not WxH"))?;
+    let parse = |v: &str| v.trim().parse::<u32>().map_err(|e| format!("size `{s}`: {e}"));
+    let (w, h) = (parse(w)?, parse(h)?);
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err(format!("size `{s}`: each side must be in 1..=16384"));
+    }
+    Ok(UVec2::new(w, h))
+}
+
+/// `XxYxZ` cluster-grid dimensions, each in `1..=MAX_GRID_DIM`.
+pub fn parse_grid(s: &str) -> Result<UVec3, String> {
+    let parts: Vec<&str> = s.split(['x', 'X']).collect();
+    let [x, y, z] = parts.as_slice() else {
+        return Err(format!("grid `{s}` is not XxYxZ"));
+    };
+    let parse = |v: &str| v.trim().parse::<u32>().map_err(|e| format!("grid `{s}`: {e}"));
+    let dims = UVec3::new(parse(x)?, parse(y)?, parse(z)?);
+    if dims.min_element() == 0 || dims.max_element() > MAX_GRID_DIM {
+        return Err(format!("grid `{s}`: each size must be in 1..={MAX_GRID_DIM}"));
+    }
+    Ok(dims)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip_and_errors_list_the_choices() {
+        for p in PipelineKind::ALL {
+            assert_eq!(parse_pipeline(p.name()), Ok(p));
+        }
+        assert_eq!(parse_normal_codec("octa8"), Ok(NormalCodec::Octa8));
+        let err = parse_gbuffer("tiny").expect_err("unknown");
+        assert!(err.contains("full, packed, compact"), "{err}");
+        assert_eq!(parse_size("1280x720"), Ok(UVec2::new(1280, 720)));
+        assert!(parse_size("0x720").is_err() && parse_grid("1x2").is_err());
+    }
+}
