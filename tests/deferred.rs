@@ -5,31 +5,9 @@
 mod support;
 
 use manylight::app::RenderSettings;
-use manylight::app::headless::{HeadlessFrame, render_headless};
 use manylight::prelude::*;
 use manylight::scene::SceneLight;
-use support::{STRICT, Tolerance, assert_similar, gpu, shared_asset};
-
-fn try_render(
-    scene: Scene,
-    size: UVec2,
-    lights: usize,
-    settings: RenderSettings,
-) -> Result<HeadlessFrame, String> {
-    let aspect = size.x as f32 / size.y as f32;
-    let bounds = scene.bounds();
-    render_headless(size, 1, move |app| {
-        app.insert_resource(settings).add_systems(Startup, move |mut commands: Commands| {
-            spawn_scene(&mut commands, &scene, true, aspect);
-            spawn_light_rig(&mut commands, lights, bounds, 1);
-        });
-    })
-    .map_err(|e| e.to_string())
-}
-
-fn render(scene: Scene, size: UVec2, lights: usize, settings: RenderSettings) -> HeadlessFrame {
-    try_render(scene, size, lights, settings).unwrap_or_else(|e| panic!("render failed: {e}"))
-}
+use support::{STRICT, Tolerance, assert_similar, gpu, render_scene as render, shared_asset};
 
 fn with_pipeline(pipeline: PipelineKind) -> RenderSettings {
     RenderSettings { pipeline, ..RenderSettings::default() }
@@ -192,7 +170,8 @@ fn compact_gbuffer_rejects_the_xyz_codec() {
         normal_codec: NormalCodec::Xyz,
         ..with_pipeline(PipelineKind::ClusteredDeferred)
     };
-    let err = try_render(default_scene(), UVec2::new(64, 36), 8, settings).expect_err("must be refused");
+    let err = support::try_render_scene(default_scene(), UVec2::new(64, 36), 8, settings)
+        .expect_err("must be refused");
     assert!(err.contains("compact") && err.contains("xyz"), "{err}");
 }
 

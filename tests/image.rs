@@ -3,22 +3,8 @@
 mod support;
 
 use manylight::app::RenderSettings;
-use manylight::app::headless::{HeadlessFrame, render_headless};
 use manylight::prelude::*;
-use support::{STRICT, assert_matches_reference, assert_similar, gpu, shared_asset};
-
-/// Renders `scene` at `size` with `lights` rig lights (seed 1) through the headless plugin.
-fn render(scene: Scene, size: UVec2, lights: usize, settings: RenderSettings) -> HeadlessFrame {
-    let aspect = size.x as f32 / size.y as f32;
-    let bounds = scene.bounds();
-    render_headless(size, 1, move |app| {
-        app.insert_resource(settings).add_systems(Startup, move |mut commands: Commands| {
-            spawn_scene(&mut commands, &scene, true, aspect);
-            spawn_light_rig(&mut commands, lights, bounds, 1);
-        });
-    })
-    .unwrap_or_else(|e| panic!("render failed: {e}"))
-}
+use support::{STRICT, assert_matches_reference, assert_similar, gpu, render_scene as render, shared_asset};
 
 #[test]
 fn default_scene_matches_reference() {

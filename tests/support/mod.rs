@@ -116,3 +116,33 @@ pub fn shared_asset(rel: &str) -> PathBuf {
 pub fn flip(a: &RgbaImage, b: &RgbaImage) -> FlipStats {
     flip_compare(a.dimensions(), a.as_raw(), b.dimensions(), b.as_raw()).expect("images of the same size").0
 }
+
+/// Renders `scene` (with its camera) at `size` with `lights` rig lights (seed 1) through the
+/// headless plugin, one frame.
+pub fn try_render_scene(
+    scene: manylight::prelude::Scene,
+    size: manylight::prelude::UVec2,
+    lights: usize,
+    settings: manylight::app::RenderSettings,
+) -> Result<manylight::app::headless::HeadlessFrame, String> {
+    use manylight::prelude::*;
+    let aspect = size.x as f32 / size.y as f32;
+    let bounds = scene.bounds();
+    manylight::app::headless::render_headless(size, 1, move |app| {
+        app.insert_resource(settings).add_systems(Startup, move |mut commands: Commands| {
+            spawn_scene(&mut commands, &scene, true, aspect);
+            spawn_light_rig(&mut commands, lights, bounds, 1);
+        });
+    })
+    .map_err(|e| e.to_string())
+}
+
+/// [`try_render_scene`] that panics on failure.
+pub fn render_scene(
+    scene: manylight::prelude::Scene,
+    size: manylight::prelude::UVec2,
+    lights: usize,
+    settings: manylight::app::RenderSettings,
+) -> manylight::app::headless::HeadlessFrame {
+    try_render_scene(scene, size, lights, settings).unwrap_or_else(|e| panic!("render failed: {e}"))
+}
