@@ -13,6 +13,7 @@
 //!    (blend One + One) to the HDR target before tone mapping.
 
 use super::HDR;
+use super::common::{FullscreenPipelineDesc, fullscreen_pipeline_desc};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::resources::HDR_FORMAT;
@@ -197,12 +198,6 @@ impl BloomPipeline {
             label: Some(label),
             entries: &entries,
         });
-        let module = crate::shaders::create_module(device, "bloom.wgsl")?;
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(label),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
         // The composite adds to the HDR image; the other stages overwrite their level.
         let blend = stage.adds().then_some(wgpu::BlendState {
             color: wgpu::BlendComponent {
@@ -216,31 +211,18 @@ impl BloomPipeline {
                 operation: wgpu::BlendOperation::Add,
             },
         });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some(label),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("fullscreen_vs"),
-                compilation_options: Default::default(),
-                buffers: &[],
+        let pipeline = fullscreen_pipeline_desc(
+            device,
+            &FullscreenPipelineDesc {
+                label,
+                shader: "bloom.wgsl",
+                layouts: &[&layout],
+                fragment: entry,
+                output: HDR_FORMAT,
+                blend,
+                constants: &[],
             },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: HDR_FORMAT,
-                    blend,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        )?;
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some(label),
             mag_filter: wgpu::FilterMode::Linear,

@@ -143,25 +143,41 @@ pub fn fullscreen_pipeline(
     fragment: &str,
     output: wgpu::TextureFormat,
 ) -> Result<wgpu::RenderPipeline, RenderError> {
-    fullscreen_pipeline_with_constants(device, label, shader, layouts, fragment, output, &[])
+    let desc =
+        FullscreenPipelineDesc { label, shader, layouts, fragment, output, blend: None, constants: &[] };
+    fullscreen_pipeline_desc(device, &desc)
 }
 
-/// [`fullscreen_pipeline`] with values for the shader's `override` constants.
-pub fn fullscreen_pipeline_with_constants(
+/// Everything of a full-screen pipeline; [`fullscreen_pipeline`] covers the common case.
+pub struct FullscreenPipelineDesc<'a> {
+    /// Label, also the pipeline's name in captures.
+    pub label: &'a str,
+    /// Shader file under `shaders/`.
+    pub shader: &'a str,
+    /// Bind group layouts, in group order.
+    pub layouts: &'a [&'a wgpu::BindGroupLayout],
+    /// Fragment entry point.
+    pub fragment: &'a str,
+    /// Format of the one colour target.
+    pub output: wgpu::TextureFormat,
+    /// Blending into the target (`None`: overwrite).
+    pub blend: Option<wgpu::BlendState>,
+    /// Values for the shader's `override` constants.
+    pub constants: &'a [(&'a str, f64)],
+}
+
+/// Builds a [`FullscreenPipelineDesc`].
+pub fn fullscreen_pipeline_desc(
     device: &wgpu::Device,
-    label: &str,
-    shader: &str,
-    layouts: &[&wgpu::BindGroupLayout],
-    fragment: &str,
-    output: wgpu::TextureFormat,
-    constants: &[(&str, f64)],
+    d: &FullscreenPipelineDesc<'_>,
 ) -> Result<wgpu::RenderPipeline, RenderError> {
-    let options = || wgpu::PipelineCompilationOptions { constants, ..Default::default() };
-    let module = crate::shaders::create_module(device, shader)?;
-    let layout = pipeline_layout(device, label, layouts);
-    let targets = color_targets(&[output]);
+    let options = || wgpu::PipelineCompilationOptions { constants: d.constants, ..Default::default() };
+    let module = crate::shaders::create_module(device, d.shader)?;
+    let layout = pipeline_layout(device, d.label, d.layouts);
+    let target =
+        wgpu::ColorTargetState { format: d.output, blend: d.blend, write_mask: wgpu::ColorWrites::ALL };
     Ok(device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some(label),
+        label: Some(d.label),
         layout: Some(&layout),
         vertex: wgpu::VertexState {
             module: &module,
@@ -174,9 +190,9 @@ pub fn fullscreen_pipeline_with_constants(
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
             module: &module,
-            entry_point: Some(fragment),
+            entry_point: Some(d.fragment),
             compilation_options: options(),
-            targets: &targets,
+            targets: &[Some(target)],
         }),
         multiview_mask: None,
         cache: None,

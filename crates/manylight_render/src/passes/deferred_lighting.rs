@@ -1,7 +1,9 @@
 //! Clustered deferred lighting: one full-screen pass reads the G-buffer and walks each pixel's
 //! cluster list into [`HDR`].
 
-use super::common::{draw_fullscreen, fullscreen_pipeline_with_constants, texture_entry, uniform_entry};
+use super::common::{
+    FullscreenPipelineDesc, draw_fullscreen, fullscreen_pipeline_desc, texture_entry, uniform_entry,
+};
 use super::gbuffer::{codec_constants, fragment_entry, targets, variant_key};
 use super::{CLUSTERS, DEPTH, HDR};
 use crate::context::RenderError;
@@ -90,14 +92,19 @@ impl DeferredLightingPipeline {
         codec: NormalCodec,
     ) -> Result<Self, RenderError> {
         let gbuffer_layout = gbuffer_read_layout(device, layout);
-        let pipeline = fullscreen_pipeline_with_constants(
+        let layouts = [view_layout, &gbuffer_layout, cluster_layout];
+        let constants = codec_constants(codec);
+        let pipeline = fullscreen_pipeline_desc(
             device,
-            "deferred_lighting",
-            "deferred_lighting.wgsl",
-            &[view_layout, &gbuffer_layout, cluster_layout],
-            fragment_entry(layout),
-            HDR_FORMAT,
-            &codec_constants(codec),
+            &FullscreenPipelineDesc {
+                label: "deferred_lighting",
+                shader: "deferred_lighting.wgsl",
+                layouts: &layouts,
+                fragment: fragment_entry(layout),
+                output: HDR_FORMAT,
+                blend: None,
+                constants: &constants,
+            },
         )?;
         Ok(DeferredLightingPipeline { pipeline, gbuffer_layout })
     }

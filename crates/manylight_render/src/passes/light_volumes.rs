@@ -3,8 +3,8 @@
 //! covers (see `shaders/light_volumes.wgsl` for the depth-test rule that lights each pixel once
 //! per light, camera inside the sphere and far-plane crossing included).
 
+use super::common::{FullscreenPipelineDesc, fullscreen_pipeline_desc, texture_entry};
 use super::common::{clear_color, color_attachment, draw_fullscreen};
-use super::common::{fullscreen_pipeline_with_constants, texture_entry};
 use super::deferred_lighting::{gbuffer_read_bind_group, gbuffer_read_layout};
 use super::gbuffer::{codec_constants, targets, variant_key};
 use super::{DEPTH, HDR, LIGHT_ACCUM};
@@ -143,14 +143,18 @@ impl LightVolumesPipeline {
                 label: Some("light_accum"),
                 entries: &[texture_entry(0, wgpu::TextureSampleType::Float { filterable: false })],
             });
-            let pipeline = fullscreen_pipeline_with_constants(
+            let layouts = [view_layout, &gbuffer_layout, &accum_layout];
+            let pipeline = fullscreen_pipeline_desc(
                 device,
-                "light_volumes_resolve",
-                "light_volumes.wgsl",
-                &[view_layout, &gbuffer_layout, &accum_layout],
-                "fs_resolve",
-                HDR_FORMAT,
-                &constants,
+                &FullscreenPipelineDesc {
+                    label: "light_volumes_resolve",
+                    shader: "light_volumes.wgsl",
+                    layouts: &layouts,
+                    fragment: "fs_resolve",
+                    output: HDR_FORMAT,
+                    blend: None,
+                    constants: &constants,
+                },
             )?;
             Some((pipeline, accum_layout))
         } else {
