@@ -220,6 +220,7 @@ impl BloomPipeline {
                 fragment: entry,
                 output: HDR_FORMAT,
                 blend,
+                depth: None,
                 constants: &[],
             },
         )?;

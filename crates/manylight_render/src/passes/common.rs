@@ -143,8 +143,16 @@ pub fn fullscreen_pipeline(
     fragment: &str,
     output: wgpu::TextureFormat,
 ) -> Result<wgpu::RenderPipeline, RenderError> {
-    let desc =
-        FullscreenPipelineDesc { label, shader, layouts, fragment, output, blend: None, constants: &[] };
+    let desc = FullscreenPipelineDesc {
+        label,
+        shader,
+        layouts,
+        fragment,
+        output,
+        blend: None,
+        depth: None,
+        constants: &[],
+    };
     fullscreen_pipeline_desc(device, &desc)
 }
 
@@ -162,6 +170,8 @@ pub struct FullscreenPipelineDesc<'a> {
     pub output: wgpu::TextureFormat,
     /// Blending into the target (`None`: overwrite).
     pub blend: Option<wgpu::BlendState>,
+    /// Depth format and test when the pass has a depth attachment (`None`: no depth).
+    pub depth: Option<wgpu::DepthStencilState>,
     /// Values for the shader's `override` constants.
     pub constants: &'a [(&'a str, f64)],
 }
@@ -186,7 +196,7 @@ pub fn fullscreen_pipeline_desc(
             buffers: &[],
         },
         primitive: Default::default(),
-        depth_stencil: None,
+        depth_stencil: d.depth.clone(),
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
             module: &module,

@@ -103,6 +103,7 @@ impl DeferredLightingPipeline {
                 fragment: fragment_entry(layout),
                 output: HDR_FORMAT,
                 blend: None,
+                depth: None,
                 constants: &constants,
             },
         )?;

@@ -67,31 +67,19 @@ impl LightVolumesPipeline {
         };
         let suffix = entry_suffix(layout);
         let ambient_entry = format!("fs_ambient_{suffix}");
-        let ambient = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("light_volumes_ambient"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("fullscreen_vs"),
-                compilation_options: options(),
-                buffers: &[],
+        let ambient = fullscreen_pipeline_desc(
+            device,
+            &FullscreenPipelineDesc {
+                label: "light_volumes_ambient",
+                shader: "light_volumes.wgsl",
+                layouts: &[view_layout, &gbuffer_layout],
+                fragment: &ambient_entry,
+                output: accumulation,
+                blend: None,
+                depth: depth(wgpu::CompareFunction::Always),
+                constants: &constants,
             },
-            primitive: Default::default(),
-            depth_stencil: depth(wgpu::CompareFunction::Always),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some(&ambient_entry),
-                compilation_options: options(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: accumulation,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        )?;
         // Back faces only, kept where they lie at or behind the stored surface (reverse-Z:
         // LessEqual). Without depth clamping, back faces beyond the far plane would be clipped
         // and their pixels miss the light, so the depth test is dropped instead.
@@ -153,6 +141,7 @@ impl LightVolumesPipeline {
                     fragment: "fs_resolve",
                     output: HDR_FORMAT,
                     blend: None,
+                    depth: None,
                     constants: &constants,
                 },
             )?;
