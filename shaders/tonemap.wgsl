@@ -5,6 +5,9 @@
 
 @group(0) @binding(0) var<uniform> view: ViewUniform;
 @group(0) @binding(1) var hdr: texture_2d<f32>;
+// Pixels whose HDR colour is NaN or infinite this frame (cleared before the pass, read back
+// into the frame report): a renderer that promises "no NaN" has to count them, not hide them.
+@group(0) @binding(2) var<storage, read_write> nonfinite_pixels: atomic<u32>;
 
 fn aces_fitted(x: vec3<f32>) -> vec3<f32> {
     let a = 2.51;
@@ -18,7 +21,12 @@ fn aces_fitted(x: vec3<f32>) -> vec3<f32> {
 @fragment
 fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     let color = textureLoad(hdr, vec2<i32>(in.position.xy), 0).rgb;
-    // Non-finite HDR values (never expected) are shown as black rather than propagating.
-    let safe = select(vec3<f32>(0.0), color, color == color);
+    // NaN fails `x == x`; ±inf fails `abs(x) <= max f32` (as does NaN).
+    let finite = abs(color) <= vec3<f32>(3.40282347e38);
+    if !all(finite) {
+        atomicAdd(&nonfinite_pixels, 1u);
+    }
+    // Non-finite HDR values (never expected; counted above) are shown as black.
+    let safe = select(vec3<f32>(0.0), color, finite);
     return vec4<f32>(aces_fitted(max(safe, vec3<f32>(0.0)) * view.params.z), 1.0);
 }

@@ -138,6 +138,37 @@ fn light_volumes_survive_the_hard_cases() {
     }
 }
 
+/// The hard cases above count no NaN or infinite HDR pixel in any pipeline (`render` asserts
+/// it), and the count is real: a light bright enough to overflow the shading sum is seen.
+#[test]
+fn nonfinite_hdr_pixels_are_counted() {
+    let _gpu = gpu();
+    let size = UVec2::new(96, 54);
+    let aspect = size.x as f32 / size.y as f32;
+    for pipeline in PipelineKind::ALL {
+        let frame = render(hard_light_scene(aspect), size, 16, with_pipeline(pipeline));
+        let report = frame.stats.last.as_ref().expect("report");
+        assert_eq!(report.nonfinite_pixels, Some(0), "{}", pipeline.name());
+    }
+    let mut scene = hard_light_scene(aspect);
+    let cam = scene.camera_or_fit(aspect);
+    let eye = cam.transform.w_axis.truncate();
+    let forward = -cam.transform.z_axis.truncate().normalize();
+    // Valid (finite, so not dropped as invalid), but its radiance overflows f32 in the shading
+    // sum near the light. (1e30 is not enough on lavapipe: it clamps f16 writes to 65504.)
+    let light =
+        SceneLight { position: eye + forward * 2.0, color: Vec3::ONE, intensity: f32::MAX, radius: 50.0 };
+    scene.lights.push(light);
+    for pipeline in [PipelineKind::NaiveForward, PipelineKind::ClusteredDeferred] {
+        let frame =
+            support::try_render_scene(scene.clone(), size, 0, with_pipeline(pipeline)).expect("renders");
+        let report = frame.stats.last.as_ref().expect("report");
+        let count = report.nonfinite_pixels.expect("the tone map ran");
+        assert!(count > 0, "{}: an overflowing light must be counted", pipeline.name());
+        eprintln!("{}: {count} non-finite HDR pixels counted", pipeline.name());
+    }
+}
+
 /// Toon shading is its own look (not Lambert), and every pipeline draws it like naive forward.
 #[test]
 fn toon_shading_matches_naive_forward_in_every_pipeline() {

@@ -25,7 +25,7 @@ struct Setup {
 fn render(setup: Setup, frames: u32) -> HeadlessFrame {
     let scene = default_scene();
     let aspect = SIZE.x as f32 / SIZE.y as f32;
-    render_headless(SIZE, frames, move |app| {
+    let frame = render_headless(SIZE, frames, move |app| {
         app.add_systems(Startup, move |mut commands: Commands| {
             let mut scene = scene.clone();
             if setup.one_bright_light {
@@ -61,7 +61,9 @@ fn render(setup: Setup, frames: u32) -> HeadlessFrame {
             });
         }
     })
-    .unwrap_or_else(|e| panic!("render failed: {e}"))
+    .unwrap_or_else(|e| panic!("render failed: {e}"));
+    support::assert_finite(&frame);
+    frame
 }
 
 fn passes(frame: &HeadlessFrame) -> Vec<String> {

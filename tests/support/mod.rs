@@ -137,12 +137,27 @@ pub fn try_render_scene(
     .map_err(|e| e.to_string())
 }
 
-/// [`try_render_scene`] that panics on failure.
+/// [`try_render_scene`] that panics on failure, and when any pixel of the frame's HDR image
+/// was NaN or infinite (the tone map counts them).
 pub fn render_scene(
     scene: manylight::prelude::Scene,
     size: manylight::prelude::UVec2,
     lights: usize,
     settings: manylight::app::RenderSettings,
 ) -> manylight::app::headless::HeadlessFrame {
-    try_render_scene(scene, size, lights, settings).unwrap_or_else(|e| panic!("render failed: {e}"))
+    let frame =
+        try_render_scene(scene, size, lights, settings).unwrap_or_else(|e| panic!("render failed: {e}"));
+    assert_finite(&frame);
+    frame
+}
+
+/// Panics when the frame's tone map counted NaN or infinite HDR pixels.
+pub fn assert_finite(frame: &manylight::app::headless::HeadlessFrame) {
+    let report = frame.stats.last.as_ref().expect("a frame report");
+    assert_eq!(
+        report.nonfinite_pixels.unwrap_or(0),
+        0,
+        "{} pipeline: pixels with a NaN or infinite HDR colour",
+        report.pipeline
+    );
 }

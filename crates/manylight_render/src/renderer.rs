@@ -182,6 +182,13 @@ impl Renderer {
         if !errors.is_empty() {
             return Err(RenderError::Device(errors.join("; ")));
         }
+        let nonfinite_pixels = match passes.iter().any(|p| p.name == "tonemap") {
+            true => Some(self.scene.nonfinite.read(&self.gpu)?),
+            false => None,
+        };
+        if let Some(n) = nonfinite_pixels.filter(|&n| n > 0) {
+            tracing::warn!("frame {}: {n} pixels have a NaN or infinite HDR colour", snapshot.frame_index);
+        }
         let gpu_times: Vec<f64> = passes.iter().filter_map(|p| p.gpu_ms).collect();
         Ok(FrameReport {
             frame_index: snapshot.frame_index,
@@ -193,6 +200,7 @@ impl Renderer {
             frame_cpu_ms: frame_start.elapsed().as_secs_f64() * 1e3,
             light_count: self.scene.light_count,
             invalid_lights: self.scene.invalid_lights,
+            nonfinite_pixels,
             instance_count: self.scene.draws.len() as u32,
             transient_textures: self.pool.live() as u32,
             transient_allocations: self.pool.allocations(),

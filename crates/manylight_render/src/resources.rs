@@ -83,6 +83,8 @@ pub struct SceneResources {
     pub invalid_lights: u32,
     /// (position, radius) of the uploaded lights, in light-buffer order.
     pub light_spheres: Vec<(glam::Vec3, f32)>,
+    /// The tone map's count of non-finite HDR pixels.
+    pub nonfinite: NonFiniteCounter,
     meshes: HashMap<usize, GpuMesh>,
     materials: HashMap<usize, GpuMaterialBinding>,
     textures: HashMap<usize, CachedTexture>,
@@ -91,6 +93,43 @@ pub struct SceneResources {
     frame: u64,
     bound_generations: (u64, u64),
     max_texture_size: u32,
+}
+
+/// A GPU counter of pixels whose HDR colour is NaN or infinite, written by the tone map and
+/// read back into [`FrameReport::nonfinite_pixels`](crate::stats::FrameReport).
+pub struct NonFiniteCounter {
+    /// The `atomic<u32>` the tone map increments (cleared by the pass before it draws).
+    pub counter: wgpu::Buffer,
+    readback: wgpu::Buffer,
+}
+
+impl NonFiniteCounter {
+    fn new(device: &wgpu::Device) -> NonFiniteCounter {
+        let buffer = |label, usage| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: 4,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        use wgpu::BufferUsages as U;
+        NonFiniteCounter {
+            counter: buffer("nonfinite_pixels", U::STORAGE | U::COPY_SRC | U::COPY_DST),
+            readback: buffer("nonfinite_pixels_readback", U::MAP_READ | U::COPY_DST),
+        }
+    }
+
+    /// Records the copy of the counter into the mappable buffer (after the tone map's draw).
+    pub fn copy_for_readback(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.copy_buffer_to_buffer(&self.counter, 0, &self.readback, 0, 4);
+    }
+
+    /// The count of the last frame that ran the tone map (waits for the GPU).
+    pub fn read(&self, gpu: &GpuContext) -> Result<u32, RenderError> {
+        let bytes = crate::readback::read_buffer(gpu, &self.readback, 0, 4)?;
+        Ok(u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]))
+    }
 }
 
 fn key<T>(a: &Arc<T>) -> usize {
@@ -198,6 +237,7 @@ impl SceneResources {
             light_count: 0,
             invalid_lights: 0,
             light_spheres: Vec::new(),
+            nonfinite: NonFiniteCounter::new(device),
             meshes: HashMap::new(),
             materials: HashMap::new(),
             textures: HashMap::new(),

@@ -384,6 +384,12 @@ fn timings_ui(ui: &mut egui::Ui, world: &mut World, history: &VecDeque<Sample>, 
         "{} lights, {} instances, {}×{}, {} transient textures",
         report.light_count, report.instance_count, report.width, report.height, report.transient_textures
     ));
+    if report.invalid_lights > 0 {
+        ui.colored_label(Color32::LIGHT_RED, format!("{} invalid lights dropped", report.invalid_lights));
+    }
+    if let Some(n) = report.nonfinite_pixels.filter(|&n| n > 0) {
+        ui.colored_label(Color32::LIGHT_RED, format!("{n} pixels with a NaN or infinite HDR colour"));
+    }
     egui::Grid::new("passes").striped(true).num_columns(3).show(ui, |ui| {
         ui.strong("pass");
         ui.strong("GPU ms");

@@ -1,7 +1,7 @@
 //! Tone map: HDR colour × exposure through the ACES fit into the output (sRGB) target.
 
 use super::HDR;
-use super::common::{draw_fullscreen, fullscreen_pipeline, texture_entry, uniform_entry};
+use super::common::{draw_fullscreen, fullscreen_pipeline, storage_entry, texture_entry, uniform_entry};
 use crate::context::RenderError;
 use crate::graph::{OUTPUT, Pass, PassContext, ResourceName};
 use crate::pipelines::format_key;
@@ -19,6 +19,7 @@ impl TonemapPipeline {
             entries: &[
                 uniform_entry(0, wgpu::ShaderStages::FRAGMENT),
                 texture_entry(1, wgpu::TextureSampleType::Float { filterable: false }),
+                storage_entry(2, wgpu::ShaderStages::FRAGMENT, false),
             ],
         });
         let pipeline = fullscreen_pipeline(device, "tonemap", "tonemap.wgsl", &[&layout], "fs_main", output)?;
@@ -26,7 +27,8 @@ impl TonemapPipeline {
     }
 }
 
-/// Writes the tone-mapped image to [`OUTPUT`].
+/// Writes the tone-mapped image to [`OUTPUT`] and counts the pixels whose HDR colour is not
+/// finite (shown black) into [`SceneResources::nonfinite`](crate::resources::SceneResources).
 pub struct TonemapPass;
 
 impl Pass for TonemapPass {
@@ -53,11 +55,17 @@ impl Pass for TonemapPass {
                     binding: 1,
                     resource: wgpu::BindingResource::TextureView(ctx.texture(HDR)?),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: ctx.scene.nonfinite.counter.as_entire_binding(),
+                },
             ],
         });
         let output = ctx.texture(OUTPUT)?;
+        ctx.encoder.clear_buffer(&ctx.scene.nonfinite.counter, 0, None);
         let timestamps = ctx.render_timestamps(true, true);
         draw_fullscreen(ctx.encoder, "tonemap", output, timestamps, &pipeline.pipeline, &[&bind_group]);
+        ctx.scene.nonfinite.copy_for_readback(ctx.encoder);
         Ok(())
     }
 }
