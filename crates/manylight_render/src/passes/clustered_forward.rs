@@ -1,8 +1,8 @@
 //! Clustered forward shading (Forward+ when the grid has one slice): each fragment walks its
 //! cluster's light list instead of every light.
 
-use super::common::{MeshPipelineDesc, clear_color, color_attachment, depth_attachment, mesh_pipeline};
-use super::forward::draw_scene;
+use super::common::{MeshPipelineDesc, clear_color, color_attachment, mesh_pipeline};
+use super::forward::record_scene_pass;
 use super::{CLUSTERS, DEPTH, HDR};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
@@ -81,21 +81,10 @@ impl Pass for ClusteredForwardPass {
         let pipeline = ctx
             .pipelines
             .get_or_create(after as u64, || ClusteredForwardPipeline::new(&ctx.gpu.device, layouts, after))?;
-        let hdr = ctx.texture(HDR)?;
+        let color = color_attachment(ctx.texture(HDR)?, clear_color(self.clear_color));
         let depth = ctx.texture(DEPTH)?;
-        let timestamps = ctx.render_timestamps(true, true);
-        let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("clustered_forward"),
-            color_attachments: &[color_attachment(hdr, clear_color(self.clear_color))],
-            depth_stencil_attachment: depth_attachment(depth, !after),
-            timestamp_writes: timestamps,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&pipeline.pipeline);
-        pass.set_bind_group(0, &scene.view_bind_group, &[]);
-        pass.set_bind_group(2, &clusters.shading_bind_group, &[]);
-        draw_scene(&mut pass, scene);
+        let extra = [&clusters.shading_bind_group];
+        record_scene_pass(ctx, "clustered_forward", &[color], depth, !after, &pipeline.pipeline, &extra);
         Ok(())
     }
 }

@@ -1,8 +1,8 @@
 //! Depth pre-pass: lays down depth so the lighting pass shades each visible pixel once.
 
 use super::DEPTH;
-use super::common::{MeshPipelineDesc, depth_attachment, mesh_pipeline};
-use super::forward::draw_scene;
+use super::common::{MeshPipelineDesc, mesh_pipeline};
+use super::forward::record_scene_pass;
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::resources::{DEPTH_FORMAT, SceneResources};
@@ -51,18 +51,7 @@ impl Pass for DepthPrepass {
         let pipeline =
             ctx.pipelines.get_or_create(0, || DepthPrepassPipeline::new(&ctx.gpu.device, scene))?;
         let depth = ctx.texture(DEPTH)?;
-        let timestamps = ctx.render_timestamps(true, true);
-        let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("depth_prepass"),
-            color_attachments: &[],
-            depth_stencil_attachment: depth_attachment(depth, true),
-            timestamp_writes: timestamps,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&pipeline.pipeline);
-        pass.set_bind_group(0, &scene.view_bind_group, &[]);
-        draw_scene(&mut pass, scene);
+        record_scene_pass(ctx, "depth_prepass", &[], depth, true, &pipeline.pipeline, &[]);
         Ok(())
     }
 }

@@ -68,22 +68,41 @@ impl Pass for ForwardPass {
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
         let scene = ctx.scene;
         let pipeline = ctx.pipelines.get_or_create(0, || ForwardPipeline::new(&ctx.gpu.device, scene))?;
-        let hdr = ctx.texture(HDR)?;
+        let color = color_attachment(ctx.texture(HDR)?, clear_color(self.clear_color));
         let depth = ctx.texture(DEPTH)?;
-        let timestamps = ctx.render_timestamps(true, true);
-        let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("forward"),
-            color_attachments: &[color_attachment(hdr, clear_color(self.clear_color))],
-            depth_stencil_attachment: depth_attachment(depth, true),
-            timestamp_writes: timestamps,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&pipeline.pipeline);
-        pass.set_bind_group(0, &scene.view_bind_group, &[]);
-        draw_scene(&mut pass, scene);
+        record_scene_pass(ctx, "forward", &[color], depth, true, &pipeline.pipeline, &[]);
         Ok(())
     }
+}
+
+/// Records the graph pass as one timed wgpu render pass that draws every scene instance with
+/// `pipeline`: group 0 is the view, group 1 each draw's material, `extra` follow from group 2.
+/// The depth attachment is cleared when `clear_depth`, else loaded (after a pre-pass).
+pub fn record_scene_pass(
+    ctx: &mut PassContext<'_>,
+    label: &str,
+    colors: &[Option<wgpu::RenderPassColorAttachment<'_>>],
+    depth: &wgpu::TextureView,
+    clear_depth: bool,
+    pipeline: &wgpu::RenderPipeline,
+    extra: &[&wgpu::BindGroup],
+) {
+    let scene = ctx.scene;
+    let timestamps = ctx.render_timestamps(true, true);
+    let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: colors,
+        depth_stencil_attachment: depth_attachment(depth, clear_depth),
+        timestamp_writes: timestamps,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, &scene.view_bind_group, &[]);
+    for (i, group) in extra.iter().enumerate() {
+        pass.set_bind_group(2 + i as u32, *group, &[]);
+    }
+    draw_scene(&mut pass, scene);
 }
 
 /// Issues one indexed draw per scene draw, switching material bind groups (group 1) and

@@ -1,8 +1,8 @@
 //! G-buffer pass of clustered deferred: writes each pixel's surface (position or depth,
 //! normal, albedo, shading parameters) in the chosen [`GBufferLayout`].
 
-use super::common::{MeshPipelineDesc, color_attachment, depth_attachment, mesh_pipeline_with_constants};
-use super::forward::draw_scene;
+use super::common::{MeshPipelineDesc, color_attachment, mesh_pipeline_with_constants};
+use super::forward::record_scene_pass;
 use super::{
     DEPTH, DEPTH_USAGE, GBUFFER_ALBEDO, GBUFFER_COMPACT, GBUFFER_NORMAL, GBUFFER_PACKED_ALBEDO,
     GBUFFER_PACKED_POSITION, GBUFFER_POSITION,
@@ -115,20 +115,9 @@ impl Pass for GBufferPass {
         let views =
             targets(layout).iter().map(|&(name, _)| ctx.texture(name)).collect::<Result<Vec<_>, _>>()?;
         let depth = ctx.texture(DEPTH)?;
-        let timestamps = ctx.render_timestamps(true, true);
         let attachments: Vec<_> =
             views.iter().map(|view| color_attachment(view, wgpu::Color::TRANSPARENT)).collect();
-        let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("gbuffer"),
-            color_attachments: &attachments,
-            depth_stencil_attachment: depth_attachment(depth, true),
-            timestamp_writes: timestamps,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&pipeline.pipeline);
-        pass.set_bind_group(0, &scene.view_bind_group, &[]);
-        draw_scene(&mut pass, scene);
+        record_scene_pass(ctx, "gbuffer", &attachments, depth, true, &pipeline.pipeline, &[]);
         Ok(())
     }
 }
