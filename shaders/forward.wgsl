@@ -1,22 +1,6 @@
 // Naive forward: every fragment evaluates every light.
-//!include common/view.wgsl
-//!include common/lights.wgsl
+//!include common/mesh_pass.wgsl
 //!include common/brdf.wgsl
-//!include common/mesh.wgsl
-//!include common/surface.wgsl
-
-@group(0) @binding(0) var<uniform> view: ViewUniform;
-@group(0) @binding(1) var<storage, read> lights: array<GpuPointLight>;
-@group(0) @binding(2) var<storage, read> instances: array<GpuInstance>;
-
-@group(1) @binding(0) var<uniform> material: GpuMaterial;
-@group(1) @binding(1) var base_color_texture: texture_2d<f32>;
-@group(1) @binding(2) var base_color_sampler: sampler;
-
-@vertex
-fn vs_main(v: VertexIn, @builtin(instance_index) instance_index: u32) -> SurfaceVertexOut {
-    return surface_vertex(v, instances[instance_index], view.clip_from_world);
-}
 
 @fragment
 fn fs_main(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {

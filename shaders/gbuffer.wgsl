@@ -8,28 +8,14 @@
 // - Compact (1 x rgba32uint): x = albedo rgba8 (sRGB-encoded, so dark colours keep their
 //   precision), y = the normal codec's word, z = shininess (f16) | specular (f16),
 //   w = shading model; position comes from depth.
-//!include common/view.wgsl
-//!include common/mesh.wgsl
-//!include common/surface.wgsl
+//!include common/mesh_pass.wgsl
 //!include common/gbuffer_codec.wgsl
-
-@group(0) @binding(0) var<uniform> view: ViewUniform;
-@group(0) @binding(2) var<storage, read> instances: array<GpuInstance>;
-
-@group(1) @binding(0) var<uniform> material: GpuMaterial;
-@group(1) @binding(1) var base_color_texture: texture_2d<f32>;
-@group(1) @binding(2) var base_color_sampler: sampler;
 
 struct FullOut {
     @location(0) position: vec4<f32>,
     @location(1) normal: vec4<f32>,
     @location(2) albedo: vec4<f32>,
 };
-
-@vertex
-fn vs_main(v: VertexIn, @builtin(instance_index) instance_index: u32) -> SurfaceVertexOut {
-    return surface_vertex(v, instances[instance_index], view.clip_from_world);
-}
 
 fn surface_of(in: SurfaceVertexOut, front_facing: bool) -> SurfaceParams {
     let albedo = surface_albedo(material, base_color_texture, base_color_sampler, in.uv);

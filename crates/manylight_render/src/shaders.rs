@@ -15,6 +15,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("common/mesh.wgsl", include_str!("../../../shaders/common/mesh.wgsl")),
     ("common/fullscreen.wgsl", include_str!("../../../shaders/common/fullscreen.wgsl")),
     ("common/surface.wgsl", include_str!("../../../shaders/common/surface.wgsl")),
+    ("common/mesh_pass.wgsl", include_str!("../../../shaders/common/mesh_pass.wgsl")),
     ("common/clusters.wgsl", include_str!("../../../shaders/common/clusters.wgsl")),
     ("common/packing.wgsl", include_str!("../../../shaders/common/packing.wgsl")),
     ("common/gbuffer_codec.wgsl", include_str!("../../../shaders/common/gbuffer_codec.wgsl")),
