@@ -58,7 +58,10 @@ fn transient_textures_are_reused_across_frames() {
     }
     let report = stats(&app).last.expect("a report");
     assert_eq!(report.transient_textures, 2, "hdr + depth");
-    assert!(report.clusters.is_some());
+    let pixels = (SIZE.x * SIZE.y) as u64;
+    assert_eq!(report.transient_bytes, pixels * (8 + 4), "rgba16f hdr + depth32f");
+    let clusters = report.clusters.as_ref().expect("clusters were built");
+    assert!(clusters.buffer_bytes >= clusters.index_capacity * 4, "{clusters:?}");
     assert_eq!(report.transient_allocations, 2, "no texture re-created after the first frame");
 }
 
@@ -75,6 +78,7 @@ fn resizing_reallocates_and_frees_old_transients() {
     assert_eq!((report.width, report.height), (64, 48));
     assert_eq!(report.transient_allocations, 4);
     assert_eq!(report.transient_textures, 2, "the old size's textures were freed");
+    assert_eq!(report.transient_bytes, 64 * 48 * (8 + 4));
     let image = app.world().resource::<HeadlessCapture>().image.clone().expect("image");
     assert_eq!(image.dimensions(), (64, 48));
 }

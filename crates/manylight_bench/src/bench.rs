@@ -112,12 +112,17 @@ pub fn run(scene: &Scene, sweep: &Sweep) -> Result<String> {
     Ok(csv(&rows, sweep.size, &adapter))
 }
 
+/// Bytes in MiB.
+pub fn mib(bytes: u64) -> f64 {
+    bytes as f64 / (1024.0 * 1024.0)
+}
+
 fn csv(rows: &[Row], size: UVec2, adapter: &str) -> String {
     let mut out = String::from(
         "adapter,pipeline,gbuffer,gbuffer_bytes_per_pixel,lights,width,height,frames,frame_ms_median,\
          frame_ms_mean,depth_prepass_gpu_ms,cluster_build_gpu_ms,cluster_build_gpu_trusted,\
          forward_gpu_ms,clustered_forward_gpu_ms,gbuffer_gpu_ms,deferred_lighting_gpu_ms,light_volumes_gpu_ms,tonemap_gpu_ms,clusters,non_empty_clusters,list_entries,\
-         max_per_cluster,mean_per_non_empty,dropped_pairs,culling_ratio\n",
+         max_per_cluster,mean_per_non_empty,dropped_pairs,culling_ratio,transient_mib,cluster_buffer_mib\n",
     );
     for r in rows {
         let c = r.last.clusters.as_ref();
@@ -130,7 +135,7 @@ fn csv(rows: &[Row], size: UVec2, adapter: &str) -> String {
         let mean = r.frame_ms.iter().sum::<f64>() / r.frame_ms.len().max(1) as f64;
         let _ = writeln!(
             out,
-            "\"{adapter}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "\"{adapter}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{}",
             r.pipeline.name(),
             r.gbuffer.map_or("", |g| g.name()),
             r.gbuffer.map_or(String::new(), |g| g.bytes_per_pixel().to_string()),
@@ -156,6 +161,8 @@ fn csv(rows: &[Row], size: UVec2, adapter: &str) -> String {
             c.map_or(String::new(), |c| format!("{:.2}", c.mean_per_non_empty)),
             c.map_or(String::new(), |c| c.dropped_pairs.to_string()),
             r.culling.map_or(String::new(), |x| format!("{x:.3}")),
+            mib(r.last.transient_bytes),
+            c.map_or(String::new(), |c| format!("{:.2}", mib(c.buffer_bytes))),
         );
     }
     out

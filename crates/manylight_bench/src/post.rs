@@ -88,6 +88,7 @@ pub fn run(scene: &Scene, lights: usize, size: UVec2, frames: u32, base: FrameSe
     // Per configuration: frame wall times, and per frame the post passes grouped by name.
     let mut times: Vec<Vec<f64>> = vec![Vec::new(); configs.len()];
     let mut passes: Vec<Vec<Vec<(String, f64, u32)>>> = vec![Vec::new(); configs.len()];
+    let mut texture_bytes = vec![0u64; configs.len()];
     for f in 0..=frames {
         for (i, (config, renderer)) in configs.iter().zip(&mut renderers).enumerate() {
             let snap = apply(snapshot(scene, &rig, 0.0, size, base, f as u64), config);
@@ -98,6 +99,7 @@ pub fn run(scene: &Scene, lights: usize, size: UVec2, frames: u32, base: FrameSe
                 times[i].push(start.elapsed().as_secs_f64() * 1e3);
                 passes[i].push(post_gpu_ms(&report).1);
             }
+            texture_bytes[i] = report.transient_bytes;
         }
     }
     let mut out = String::new();
@@ -111,10 +113,13 @@ pub fn run(scene: &Scene, lights: usize, size: UVec2, frames: u32, base: FrameSe
         scene.lights.len(),
         base.pipeline.name()
     )?;
-    writeln!(out, "| configuration | frame ms | vs none | post passes GPU ms | per pass GPU ms |")?;
-    writeln!(out, "|---|---:|---:|---:|---|")?;
+    writeln!(
+        out,
+        "| configuration | frame ms | vs none | post passes GPU ms | transient texture MiB | per pass GPU ms |"
+    )?;
+    writeln!(out, "|---|---:|---:|---:|---:|---|")?;
     let none = median(times.first().cloned().unwrap_or_default());
-    for ((config, times), passes) in configs.iter().zip(times).zip(passes) {
+    for (((config, times), passes), bytes) in configs.iter().zip(times).zip(passes).zip(texture_bytes) {
         let ms = median(times);
         let total = median(passes.iter().map(|frame| frame.iter().fold(0.0, |sum, p| sum + p.1)).collect());
         let per_pass = passes
@@ -142,10 +147,11 @@ pub fn run(scene: &Scene, lights: usize, size: UVec2, frames: u32, base: FrameSe
             .unwrap_or_else(|| "–".to_string());
         writeln!(
             out,
-            "| {} | {ms:.1} | {:+.1} ({:+.0} %) | {total:.2} | {per_pass} |",
+            "| {} | {ms:.1} | {:+.1} ({:+.0} %) | {total:.2} | {:.1} | {per_pass} |",
             config.name,
             ms - none,
             (ms / none - 1.0) * 100.0,
+            crate::bench::mib(bytes),
         )?;
     }
     Ok(out)

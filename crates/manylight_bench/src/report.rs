@@ -112,12 +112,13 @@ pub fn run(scene: &Scene, lights: usize, size: UVec2, frames: u32, base: FrameSe
     );
     let _ = writeln!(
         out,
-        "| pipeline | G-buffer bytes/px | FLIP mean | FLIP p99 | dropped light-cluster pairs | frame ms | speed-up | passes (GPU ms; * = untrusted) |"
+        "| pipeline | G-buffer bytes/px | transient texture MiB | FLIP mean | FLIP p99 | dropped light-cluster pairs | frame ms | speed-up | passes (GPU ms; * = untrusted) |"
     );
-    let _ = writeln!(out, "|---|---:|---:|---:|---:|---:|---:|---|");
+    let _ = writeln!(out, "|---|---:|---:|---:|---:|---:|---:|---:|---|");
     let _ = writeln!(
         out,
-        "| naive forward (reference) | – | 0 | 0 | 0 | {naive_ms:.0} | 1.0× | {} |",
+        "| naive forward (reference) | – | {:.1} | 0 | 0 | 0 | {naive_ms:.0} | 1.0× | {} |",
+        crate::bench::mib(naive_report.transient_bytes),
         passes(&naive_report)
     );
     for (name, settings) in configs {
@@ -132,7 +133,8 @@ pub fn run(scene: &Scene, lights: usize, size: UVec2, frames: u32, base: FrameSe
         let dropped = report.clusters.as_ref().map_or(0, |c| c.dropped_pairs);
         let _ = writeln!(
             out,
-            "| {name} | {bytes} | {:.5} | {:.5} | {dropped} | {ms:.0} | {:.1}× | {} |",
+            "| {name} | {bytes} | {:.1} | {:.5} | {:.5} | {dropped} | {ms:.0} | {:.1}× | {} |",
+            crate::bench::mib(report.transient_bytes),
             flip.mean,
             flip.p99,
             naive_ms / ms,

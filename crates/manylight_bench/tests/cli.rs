@@ -96,6 +96,9 @@ fn render_writes_png_and_stats_json() {
     assert!(last["passes"][0]["cpu_ms"].is_number());
     assert!(last["frame_cpu_ms"].is_number());
     assert_eq!(last["light_count"].as_u64(), Some(16 + 6));
+    assert_eq!(last["nonfinite_pixels"].as_u64(), Some(0));
+    assert_eq!(last["invalid_lights"].as_u64(), Some(0));
+    assert_eq!(last["transient_bytes"].as_u64(), Some(96 * 64 * (8 + 4)), "rgba16f hdr + depth");
     assert_eq!(stats["frames_rendered"].as_u64(), Some(2));
 }
 
@@ -142,7 +145,22 @@ fn bench_writes_a_csv_row_per_configuration() {
     );
     assert!(lines[0].starts_with("adapter,pipeline,gbuffer,"));
     assert!(lines.iter().any(|l| l.contains(",clustered-deferred,compact,20,32,")), "{text}");
+    let header: Vec<&str> = lines[0].split(',').collect();
+    let column =
+        |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no column {name}"));
+    // The adapter name is quoted and may hold commas: count columns from the end.
+    let field = |line: &str, name: &str| -> String {
+        let fields: Vec<&str> = line.split(',').collect();
+        fields[fields.len() - (header.len() - column(name))].to_string()
+    };
     let clustered = lines.iter().find(|l| l.contains(",clustered-forward,,,32,")).expect("row");
-    let culling = clustered.rsplit(',').next().expect("last column");
+    let culling = field(clustered, "culling_ratio");
     assert!(culling.parse::<f64>().is_ok_and(|r| r >= 1.0), "culling ratio `{culling}`");
+    // 96×64 rgba16f HDR + depth32f = 72 KiB of frame textures; cluster buffers exist.
+    let textures = field(clustered, "transient_mib");
+    assert!(
+        textures.parse::<f64>().is_ok_and(|m| (m - 96.0 * 64.0 * 12.0 / 1048576.0).abs() < 0.01),
+        "{textures}"
+    );
+    assert!(field(clustered, "cluster_buffer_mib").parse::<f64>().is_ok_and(|m| m > 0.0));
 }

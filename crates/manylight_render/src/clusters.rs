@@ -45,6 +45,9 @@ pub struct ClusterReport {
     pub tile_entries: u64,
     /// Times the index list grew this frame (each re-renders the frame).
     pub regrows: u32,
+    /// Bytes of GPU buffers the cluster build and clustered shading hold (grid bounds, light
+    /// spheres, per-tile and per-cluster ranges and index lists, parameters, counters).
+    pub buffer_bytes: u64,
     /// Culling test used.
     pub cull_test: String,
     /// Z slicing used.
@@ -386,9 +389,27 @@ impl ClusterResources {
             index_capacity: self.params.index_capacity as u64,
             tile_entries: c.tile_entries as u64,
             regrows,
+            buffer_bytes: self.buffer_bytes(),
             cull_test: self.cull.name().to_string(),
             z_slicing: self.grid.slicing.name().to_string(),
         }
+    }
+
+    /// Bytes of the GPU buffers held (capacities, not what this frame filled).
+    pub fn buffer_bytes(&self) -> u64 {
+        let growable = [
+            &self.ranges,
+            &self.indices,
+            &self.bounds,
+            &self.spheres,
+            &self.tile_bounds,
+            &self.tile_ranges,
+            &self.tile_indices,
+        ];
+        growable.iter().map(|b| b.capacity()).sum::<u64>()
+            + self.params_buffer.size()
+            + self.counters.size()
+            + self.counters_readback.size()
     }
 
     /// Reads the GPU's assignment back into the CPU structure (tests compare it with

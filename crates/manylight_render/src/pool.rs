@@ -21,6 +21,12 @@ struct Entry {
     in_use: bool,
 }
 
+impl Entry {
+    fn bytes(&self) -> u64 {
+        texel_bytes(self.key.format) * self.key.width as u64 * self.key.height as u64
+    }
+}
+
 /// Frames a texture may stay unused before it is freed.
 pub const TRANSIENT_KEEP_FRAMES: u64 = 3;
 
@@ -77,15 +83,15 @@ impl TransientPool {
         self.entries.len()
     }
 
-    /// Bytes held by live textures (approximate: block size × pixels).
+    /// Bytes held by live textures: texel size × pixels (drivers may pad or compress).
     pub fn live_bytes(&self) -> u64 {
-        self.entries
-            .iter()
-            .map(|e| {
-                let bpp = e.key.format.block_copy_size(None).unwrap_or(4) as u64;
-                bpp * e.key.width as u64 * e.key.height as u64
-            })
-            .sum()
+        self.entries.iter().map(Entry::bytes).sum()
+    }
+
+    /// Bytes of the textures handed out this frame: what the frame's graph needs, whatever
+    /// earlier frames left in the pool.
+    pub fn frame_bytes(&self) -> u64 {
+        self.entries.iter().filter(|e| e.last_used == self.frame).map(Entry::bytes).sum()
     }
 
     /// Textures created since start-up.
@@ -97,6 +103,14 @@ impl TransientPool {
     pub fn textures(&self) -> impl Iterator<Item = &wgpu::Texture> {
         self.entries.iter().map(|e| &e.texture)
     }
+}
+
+/// Bytes of one texel of `format` (the depth aspect for depth formats).
+fn texel_bytes(format: wgpu::TextureFormat) -> u64 {
+    format
+        .block_copy_size(None)
+        .or_else(|| format.block_copy_size(Some(wgpu::TextureAspect::DepthOnly)))
+        .unwrap_or(4) as u64
 }
 
 /// A growable GPU buffer (storage or uniform) that is re-created larger when data outgrows it.

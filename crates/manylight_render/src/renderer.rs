@@ -203,6 +203,7 @@ impl Renderer {
             nonfinite_pixels,
             instance_count: self.scene.draws.len() as u32,
             transient_textures: self.pool.live() as u32,
+            transient_bytes: self.pool.frame_bytes(),
             transient_allocations: self.pool.allocations(),
             clusters: None,
         })

@@ -43,6 +43,9 @@ pub struct FrameReport {
     pub instance_count: u32,
     /// Transient textures alive in the pool after the frame.
     pub transient_textures: u32,
+    /// Bytes of the transient textures this frame used (render targets, G-buffer, post-stage
+    /// chains; texel size × pixels; the output target is not counted).
+    pub transient_bytes: u64,
     /// Transient textures created since start-up (reuse keeps this flat).
     pub transient_allocations: u64,
     /// Cluster statistics, when the frame built clusters.

@@ -381,8 +381,13 @@ fn timings_ui(ui: &mut egui::Ui, world: &mut World, history: &VecDeque<Sample>, 
         return;
     };
     ui.monospace(format!(
-        "{} lights, {} instances, {}×{}, {} transient textures",
-        report.light_count, report.instance_count, report.width, report.height, report.transient_textures
+        "{} lights, {} instances, {}×{}, {} transient textures ({:.1} MiB this frame)",
+        report.light_count,
+        report.instance_count,
+        report.width,
+        report.height,
+        report.transient_textures,
+        report.transient_bytes as f64 / (1024.0 * 1024.0)
     ));
     if report.invalid_lights > 0 {
         ui.colored_label(Color32::LIGHT_RED, format!("{} invalid lights dropped", report.invalid_lights));
