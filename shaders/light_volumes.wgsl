@@ -3,19 +3,12 @@
 //    on it (fs_ambient_*);
 // 2. every light is drawn as an instanced sphere proxy (vs_volume: an icosphere that contains
 //    the light's sphere) whose pixels add that one light (fs_volume_*, additive blending).
-// Each pixel is lit once per light, with the depth buffer read-only. The CPU sorts the lights
-// into two instanced draws (`volume_order`: outside lights first):
-// - the proxy lies wholly beyond the near plane's reach from the eye ("outside"): front faces
-//   only, kept where they lie at or in front of the stored surface (reverse-Z: GreaterEqual),
-//   so pixels whose surface is in front of the sphere are never shaded (depth-tested away
-//   before the fragment shader runs);
-// - the proxy contains the eye or may cross the near plane ("inside"): back faces only, kept
-//   where they lie at or behind the stored surface (LessEqual): the front faces would be
-//   behind the camera or clipped, the back faces are not. With depth clamping
-//   (DEPTH_CLIP_CONTROL) back faces beyond the far plane are clamped to it instead of clipped;
-//   without it this draw has no depth test (still correct: the light's attenuation is exactly
-//   0 outside its radius). Front faces need no clamp: one beyond the far plane hides no
-//   surface the light reaches.
+// Only back faces are drawn, with the test "back face at or behind the stored surface"
+// (reverse-Z: LessEqual, depth read-only), so a pixel is lit once per light, also when the
+// camera is inside the sphere (its front faces are behind the camera, its back faces are not).
+// With depth clamping (DEPTH_CLIP_CONTROL) back faces beyond the far plane are clamped to it
+// instead of clipped; without it the pass draws them with no depth test (still correct:
+// the light's attenuation is exactly 0 outside its radius).
 // Where the device can blend rgba32f, steps 1-2 go into an f32 target and fs_resolve copies it
 // to HDR: summed in f16, a thousand small additions lose FLIP 0.004 against naive forward.
 //!include common/view.wgsl
@@ -30,9 +23,6 @@
 
 // Only with an f32 accumulation target: the sum, read by fs_resolve.
 @group(2) @binding(0) var light_accum: texture_2d<f32>;
-// The volume draws' light indices, outside lights first (instance i draws light
-// volume_order[i]).
-@group(2) @binding(1) var<storage, read> volume_order: array<u32>;
 
 @fragment
 fn fs_resolve(in: FullscreenOut) -> @location(0) vec4<f32> {
@@ -45,8 +35,7 @@ struct VolumeOut {
 };
 
 @vertex
-fn vs_volume(@location(0) position: vec3<f32>, @builtin(instance_index) instance: u32) -> VolumeOut {
-    let light_index = volume_order[instance];
+fn vs_volume(@location(0) position: vec3<f32>, @builtin(instance_index) light_index: u32) -> VolumeOut {
     let light = lights[light_index];
     let world = light.position_radius.xyz + position * light.position_radius.w;
     var out: VolumeOut;

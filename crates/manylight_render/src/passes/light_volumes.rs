@@ -3,7 +3,7 @@
 //! covers (see `shaders/light_volumes.wgsl` for the depth-test rule that lights each pixel once
 //! per light, camera inside the sphere and far-plane crossing included).
 
-use super::common::{FullscreenPipelineDesc, fullscreen_pipeline_desc, storage_entry, texture_entry};
+use super::common::{FullscreenPipelineDesc, fullscreen_pipeline_desc, texture_entry};
 use super::common::{clear_color, color_attachment, draw_fullscreen};
 use super::deferred_lighting::{gbuffer_read_bind_group, gbuffer_read_layout};
 use super::gbuffer::{codec_constants, targets, variant_key};
@@ -12,7 +12,6 @@ use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::resources::{DEPTH_FORMAT, HDR_FORMAT};
 use crate::snapshot::GBufferLayout;
-use glam::{Mat4, Vec3};
 use manylight_core::codec::NormalCodec;
 use manylight_core::icosphere::Icosphere;
 use wgpu::util::DeviceExt;
@@ -23,13 +22,7 @@ pub const PROXY_SUBDIVISIONS: u32 = 2;
 /// The pipelines and proxy mesh of [`LightVolumesPass`] for one layout and codec.
 pub struct LightVolumesPipeline {
     ambient: wgpu::RenderPipeline,
-    /// Front faces, depth GreaterEqual: lights whose proxy is wholly beyond the near plane.
-    volume_front: wgpu::RenderPipeline,
-    /// Back faces, depth LessEqual (or Always): lights around the eye or across the near plane.
-    volume_back: wgpu::RenderPipeline,
-    order_layout: wgpu::BindGroupLayout,
-    /// Largest distance of a proxy vertex from its centre, for a unit radius.
-    proxy_reach: f32,
+    volume: wgpu::RenderPipeline,
     /// Copies the f32 sum into HDR (only with an f32 accumulation target).
     resolve: Option<(wgpu::RenderPipeline, wgpu::BindGroupLayout)>,
     gbuffer_layout: wgpu::BindGroupLayout,
@@ -56,13 +49,9 @@ impl LightVolumesPipeline {
     ) -> Result<Self, RenderError> {
         let module = crate::shaders::create_module(device, "light_volumes.wgsl")?;
         let gbuffer_layout = gbuffer_read_layout(device, layout);
-        let order_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("light_volume_order"),
-            entries: &[storage_entry(1, wgpu::ShaderStages::VERTEX, true)],
-        });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("light_volumes"),
-            bind_group_layouts: &[Some(view_layout), Some(&gbuffer_layout), Some(&order_layout)],
+            bind_group_layouts: &[Some(view_layout), Some(&gbuffer_layout)],
             immediate_size: 0,
         });
         let constants = codec_constants(codec);
@@ -91,13 +80,11 @@ impl LightVolumesPipeline {
                 constants: &constants,
             },
         )?;
-        // Back faces, kept where they lie at or behind the stored surface (reverse-Z:
+        // Back faces only, kept where they lie at or behind the stored surface (reverse-Z:
         // LessEqual). Without depth clamping, back faces beyond the far plane would be clipped
-        // and their pixels miss the light, so the depth test is dropped instead. Front faces,
-        // kept where they lie at or in front of the stored surface (GreaterEqual); clipping
-        // one beyond the far plane loses nothing (no surface there is inside the light).
+        // and their pixels miss the light, so the depth test is dropped instead.
         let unclipped_depth = device.features().contains(wgpu::Features::DEPTH_CLIP_CONTROL);
-        let back_compare =
+        let compare =
             if unclipped_depth { wgpu::CompareFunction::LessEqual } else { wgpu::CompareFunction::Always };
         let additive = wgpu::BlendComponent {
             src_factor: wgpu::BlendFactor::One,
@@ -105,45 +92,40 @@ impl LightVolumesPipeline {
             operation: wgpu::BlendOperation::Add,
         };
         let volume_entry = format!("fs_volume_{suffix}");
-        let volume = |label, cull, compare, unclipped_depth| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(&pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_volume"),
-                    compilation_options: options(),
-                    buffers: &[Some(wgpu::VertexBufferLayout {
-                        array_stride: 12,
-                        step_mode: wgpu::VertexStepMode::Vertex,
-                        attributes: &wgpu::vertex_attr_array![0 => Float32x3],
-                    })],
-                },
-                primitive: wgpu::PrimitiveState {
-                    front_face: wgpu::FrontFace::Ccw,
-                    cull_mode: Some(cull),
-                    unclipped_depth,
-                    ..Default::default()
-                },
-                depth_stencil: depth(compare),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some(&volume_entry),
-                    compilation_options: options(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: accumulation,
-                        blend: Some(wgpu::BlendState { color: additive, alpha: additive }),
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        };
-        let volume_front =
-            volume("light_volumes_front", wgpu::Face::Back, wgpu::CompareFunction::GreaterEqual, false);
-        let volume_back = volume("light_volumes_back", wgpu::Face::Front, back_compare, unclipped_depth);
+        let volume = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("light_volumes"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_volume"),
+                compilation_options: options(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: 12,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &wgpu::vertex_attr_array![0 => Float32x3],
+                })],
+            },
+            primitive: wgpu::PrimitiveState {
+                front_face: wgpu::FrontFace::Ccw,
+                cull_mode: Some(wgpu::Face::Front),
+                unclipped_depth,
+                ..Default::default()
+            },
+            depth_stencil: depth(compare),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some(&volume_entry),
+                compilation_options: options(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: accumulation,
+                    blend: Some(wgpu::BlendState { color: additive, alpha: additive }),
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
         let resolve = if accumulation != HDR_FORMAT {
             let accum_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("light_accum"),
@@ -183,13 +165,9 @@ impl LightVolumesPipeline {
             contents: bytemuck::cast_slice(&index_data),
             usage: wgpu::BufferUsages::INDEX,
         });
-        let proxy_reach = proxy.positions.iter().map(|p| p.length()).fold(0.0, f32::max);
         Ok(LightVolumesPipeline {
             ambient,
-            volume_front,
-            volume_back,
-            order_layout,
-            proxy_reach,
+            volume,
             resolve,
             gbuffer_layout,
             vertices,
@@ -268,27 +246,6 @@ impl Pass for LightVolumesPass {
             });
             (resolve, accum)
         });
-        let order = (!scene.light_spheres.is_empty()).then(|| {
-            let view = &scene.view;
-            let eye = view.camera_position.truncate();
-            let (order, outside) = volume_order(
-                &scene.light_spheres,
-                eye,
-                near_reach(&view.world_from_clip, eye),
-                pipeline.proxy_reach,
-            );
-            let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("light_volume_order"),
-                contents: bytemuck::cast_slice(&order),
-                usage: wgpu::BufferUsages::STORAGE,
-            });
-            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("light_volume_order"),
-                layout: &pipeline.order_layout,
-                entries: &[wgpu::BindGroupEntry { binding: 1, resource: buffer.as_entire_binding() }],
-            });
-            (group, outside)
-        });
         let timestamps = ctx.render_timestamps(true, resolve.is_none());
         let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("light_volumes"),
@@ -307,19 +264,11 @@ impl Pass for LightVolumesPass {
         pass.set_bind_group(1, &gbuffer, &[]);
         pass.set_pipeline(&pipeline.ambient);
         pass.draw(0..3, 0..1);
-        if let Some((order, outside)) = &order {
-            pass.set_bind_group(2, order, &[]);
+        if scene.light_count > 0 {
+            pass.set_pipeline(&pipeline.volume);
             pass.set_vertex_buffer(0, pipeline.vertices.slice(..));
             pass.set_index_buffer(pipeline.indices.slice(..), wgpu::IndexFormat::Uint16);
-            let count = scene.light_spheres.len() as u32;
-            if *outside > 0 {
-                pass.set_pipeline(&pipeline.volume_front);
-                pass.draw_indexed(0..pipeline.index_count, 0, 0..*outside);
-            }
-            if *outside < count {
-                pass.set_pipeline(&pipeline.volume_back);
-                pass.draw_indexed(0..pipeline.index_count, 0, *outside..count);
-            }
+            pass.draw_indexed(0..pipeline.index_count, 0, 0..scene.light_count);
         }
         drop(pass);
         if let Some((resolve, accum)) = resolve {
@@ -328,68 +277,5 @@ impl Pass for LightVolumesPass {
             draw_fullscreen(ctx.encoder, "light_volumes_resolve", hdr, timestamps, resolve, &groups);
         }
         Ok(())
-    }
-}
-
-/// The largest distance from `eye` to a corner of the near plane's rectangle (reverse-Z: the
-/// near plane is NDC depth 1): a sphere farther than this from the eye cannot cross the part of
-/// the near plane that the image sees.
-pub fn near_reach(world_from_clip: &Mat4, eye: Vec3) -> f32 {
-    [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)]
-        .into_iter()
-        .map(|(x, y)| (world_from_clip.project_point3(Vec3::new(x, y, 1.0)) - eye).length())
-        .fold(0.0, f32::max)
-}
-
-/// The order the volume draws take the lights in (indices into the light buffer, whose lights
-/// `spheres` lists as world centre and radius), and how many come first as "outside" lights:
-/// those whose proxy (`proxy_reach` × radius from the centre) stays farther than `near_reach`
-/// from the eye, so its front faces cover every pixel it reaches. The rest contain the eye or
-/// may cross the near plane, and are drawn by their back faces. Non-finite distances count as
-/// inside (the always-correct draw).
-pub fn volume_order(
-    spheres: &[(Vec3, f32)],
-    eye: Vec3,
-    near_reach: f32,
-    proxy_reach: f32,
-) -> (Vec<u32>, u32) {
-    let outside =
-        |&(centre, radius): &(Vec3, f32)| (centre - eye).length() > radius * proxy_reach + near_reach;
-    let mut order: Vec<u32> = (0..spheres.len() as u32).filter(|&i| outside(&spheres[i as usize])).collect();
-    let count = order.len() as u32;
-    order.extend((0..spheres.len() as u32).filter(|&i| !outside(&spheres[i as usize])));
-    (order, count)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use manylight_core::camera::Projection;
-
-    #[test]
-    fn lights_around_the_eye_or_across_the_near_plane_are_drawn_inside() {
-        let eye = Vec3::new(1.0, 2.0, 3.0);
-        let reach = 0.2;
-        let spheres = [
-            (eye, 0.0),                     // at the eye, zero radius: inside
-            (eye + Vec3::X * 5.0, 1.0),     // well away: outside
-            (eye + Vec3::X * 1.2, 1.0),     // proxy reaches within the near reach
-            (eye + Vec3::Z * 100.0, 200.0), // contains the eye
-            (Vec3::splat(f32::NAN), 1.0),   // never uploaded, but safe: inside
-            (eye - Vec3::Y * 1.3, 1.0),     // 1.3 > 1.05 + 0.2: outside
-        ];
-        let (order, outside) = volume_order(&spheres, eye, reach, 1.05);
-        assert_eq!(outside, 2);
-        assert_eq!(order, [1, 5, 0, 2, 3, 4]);
-    }
-
-    #[test]
-    fn near_reach_is_the_distance_to_the_near_planes_corners() {
-        let proj = Projection { fov_y: 90f32.to_radians(), near: 0.5, far: 100.0 };
-        let world_from_view = Mat4::from_translation(Vec3::new(3.0, 0.0, 0.0));
-        let clip_from_world = proj.matrix(1.0) * world_from_view.inverse();
-        let reach = near_reach(&clip_from_world.inverse(), Vec3::new(3.0, 0.0, 0.0));
-        // Corners at (±0.5, ±0.5, -0.5) in view space.
-        assert!((reach - 0.5 * 3f32.sqrt()).abs() < 1e-4, "{reach}");
     }
 }
