@@ -83,13 +83,8 @@ impl TransientPool {
         self.entries.len()
     }
 
-    /// Bytes held by live textures: texel size × pixels (drivers may pad or compress).
-    pub fn live_bytes(&self) -> u64 {
-        self.entries.iter().map(Entry::bytes).sum()
-    }
-
-    /// Bytes of the textures handed out this frame: what the frame's graph needs, whatever
-    /// earlier frames left in the pool.
+    /// Bytes of the textures handed out this frame (texel size × pixels; drivers may pad or
+    /// compress): what the frame's graph needs, whatever earlier frames left in the pool.
     pub fn frame_bytes(&self) -> u64 {
         self.entries.iter().filter(|e| e.last_used == self.frame).map(Entry::bytes).sum()
     }
