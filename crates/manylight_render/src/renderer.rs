@@ -182,7 +182,7 @@ impl Renderer {
         if !errors.is_empty() {
             return Err(RenderError::Device(errors.join("; ")));
         }
-        let nonfinite_pixels = match passes.iter().any(|p| p.name == "tonemap") {
+        let nonfinite_pixels = match passes.iter().any(|p| p.name == crate::passes::tonemap::TONEMAP) {
             true => Some(self.scene.nonfinite.read(&self.gpu)?),
             false => None,
         };

@@ -381,7 +381,7 @@ fn timings_ui(ui: &mut egui::Ui, world: &mut World, history: &VecDeque<Sample>, 
         return;
     };
     ui.monospace(format!(
-        "{} lights, {} instances, {}×{}, {} transient textures ({:.1} MiB this frame)",
+        "{} lights, {} instances, {}×{}, {} transient textures alive, {:.1} MiB used this frame",
         report.light_count,
         report.instance_count,
         report.width,

@@ -6,6 +6,9 @@ use crate::context::RenderError;
 use crate::graph::{OUTPUT, Pass, PassContext, ResourceName};
 use crate::pipelines::format_key;
 
+/// The tone map's pass name (the renderer reads the non-finite count after it ran).
+pub const TONEMAP: &str = "tonemap";
+
 /// The pipeline of [`TonemapPass`] for one output format.
 pub struct TonemapPipeline {
     pipeline: wgpu::RenderPipeline,
@@ -33,7 +36,7 @@ pub struct TonemapPass;
 
 impl Pass for TonemapPass {
     fn name(&self) -> &'static str {
-        "tonemap"
+        TONEMAP
     }
     fn reads(&self) -> Vec<ResourceName> {
         vec![HDR]
