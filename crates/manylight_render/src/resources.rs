@@ -128,7 +128,7 @@ impl NonFiniteCounter {
     /// The count of the last frame that ran the tone map (waits for the GPU).
     pub fn read(&self, gpu: &GpuContext) -> Result<u32, RenderError> {
         let bytes = crate::readback::read_buffer(gpu, &self.readback, 0, 4)?;
-        Ok(u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]))
+        Ok(bytemuck::pod_read_unaligned(&bytes[..4]))
     }
 }
 
