@@ -1,9 +1,11 @@
-//! manylight: many-light rendering (naive forward today; Forward+, clustered and deferred
-//! pipelines next) as a `bevy_app` plugin on wgpu.
+//! manylight: rendering scenes lit by thousands of moving point lights, as a `bevy_app` plugin
+//! on wgpu. Five pipelines produce the same image: naive forward (the reference), tiled
+//! Forward+, clustered forward (the default), clustered deferred and deferred light volumes.
 //!
 //! Add [`prelude::ManyLightPlugin`] to an `App`, spawn entities with `Transform`, `Camera3d`,
 //! `PointLight`, `Mesh3d` and `Material`, and run: you get a window, or a headless image.
-//! See `examples/add_as_plugin.rs`.
+//! See `examples/add_as_plugin.rs` and `docs/architecture.md`.
+#![warn(missing_docs)]
 
 pub use manylight_app as app;
 pub use manylight_core as core;

@@ -7,14 +7,14 @@ mod support;
 use manylight::app::RenderSettings;
 use manylight::prelude::*;
 use manylight::scene::SceneLight;
-use support::{STRICT, Tolerance, assert_similar, gpu, render_scene as render, shared_asset};
+use support::{STRICT, Tolerance, assert_similar, asset, gpu, render_scene as render};
 
 fn with_pipeline(pipeline: PipelineKind) -> RenderSettings {
     RenderSettings { pipeline, ..RenderSettings::default() }
 }
 
 fn cornell() -> Scene {
-    load_gltf(&shared_asset("CornellBox/CornellBoxManyLights.gltf"), &LoadOptions::default()).expect("loads")
+    load_gltf(&asset("CornellBox/CornellBoxManyLights.gltf"), &LoadOptions::default()).expect("loads")
 }
 
 /// The tolerance a layout and codec are held to against naive forward. The approximations

@@ -4,7 +4,7 @@ mod support;
 
 use manylight::app::RenderSettings;
 use manylight::prelude::*;
-use support::{STRICT, assert_matches_reference, assert_similar, gpu, render_scene as render, shared_asset};
+use support::{STRICT, assert_matches_reference, assert_similar, asset, gpu, render_scene as render};
 
 #[test]
 fn default_scene_matches_reference() {
@@ -16,7 +16,7 @@ fn default_scene_matches_reference() {
 #[test]
 fn gltf_scene_matches_reference() {
     let _gpu = gpu();
-    let path = shared_asset("CornellBox/CornellBoxManyLights.gltf");
+    let path = asset("CornellBox/CornellBoxManyLights.gltf");
     let scene = load_gltf(&path, &LoadOptions::default()).expect("CornellBoxManyLights loads");
     let settings = RenderSettings { exposure: 4.0, ..with_pipeline(PipelineKind::NaiveForward) };
     let frame = render(scene, UVec2::new(128, 128), 0, settings);
@@ -56,10 +56,8 @@ fn tiled_and_clustered_pipelines_match_naive_forward() {
     let _gpu = gpu();
     let size = UVec2::new(256, 144);
     let naive = render(default_scene(), size, 128, with_pipeline(PipelineKind::NaiveForward));
-    let cornell = || {
-        load_gltf(&shared_asset("CornellBox/CornellBoxManyLights.gltf"), &LoadOptions::default())
-            .expect("loads")
-    };
+    let cornell =
+        || load_gltf(&asset("CornellBox/CornellBoxManyLights.gltf"), &LoadOptions::default()).expect("loads");
     let small = UVec2::new(128, 128);
     let bright = |p| RenderSettings { exposure: 4.0, ..with_pipeline(p) };
     let naive_cornell = render(cornell(), small, 0, bright(PipelineKind::NaiveForward));

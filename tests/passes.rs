@@ -137,7 +137,7 @@ fn other_debug_views_need_only_their_data() {
     let p = Point { lights: true, bloom: true, motion_blur: false, deferred: false, debug: false };
     let mut s = snapshot(p);
     if let Some(c) = &mut s.camera {
-        c.bloom = Some(BloomSettings::seed());
+        c.bloom = Some(BloomSettings::full_resolution());
     }
     let names = plan_passes(s).expect("plan");
     assert_eq!(names.iter().filter(|n| n.starts_with("bloom_blur")).count(), 10, "{names:?}");

@@ -83,7 +83,7 @@ fn bloom_spreads_a_bright_lights_energy_and_is_off_by_default() {
     let _gpu = gpu();
     let plain = render(Setup { one_bright_light: true, ..Setup::default() }, 1);
     assert!(!passes(&plain).iter().any(|n| n.starts_with("bloom")), "off by default: {:?}", passes(&plain));
-    for bloom in [Bloom::default(), Bloom::seed()] {
+    for bloom in [Bloom::default(), Bloom::full_resolution()] {
         let bloomed = render(Setup { one_bright_light: true, bloom: Some(bloom), ..Setup::default() }, 1);
         assert!(passes(&bloomed).contains(&"bloom_composite".to_string()), "{:?}", passes(&bloomed));
         let out = support::output_dir();

@@ -105,9 +105,9 @@ pub fn assert_matches_reference(name: &str, actual: &RgbaImage, tol: Tolerance) 
     assert_similar(name, &expected, actual, tol)
 }
 
-/// The shared test assets (`../shared/assets` beside the checkout).
-pub fn shared_asset(rel: &str) -> PathBuf {
-    let p = root().join("..").join("shared").join("assets").join(rel);
+/// A scene of the repository's `assets/` folder.
+pub fn asset(rel: &str) -> PathBuf {
+    let p = root().join("assets").join(rel);
     assert!(p.exists(), "test asset {} is missing", p.display());
     p
 }

@@ -125,7 +125,7 @@ pub struct Bloom {
     pub intensity: f32,
     /// Blur iterations (two passes each), 1 to 6.
     pub iterations: u32,
-    /// Downsampled chain (default) or seed 002's full-resolution 1×9/9×1 kernels.
+    /// Downsampled chain (default) or full-resolution separable 1×9/9×1 kernels.
     pub chain: manylight_render::BloomChain,
 }
 
@@ -148,9 +148,9 @@ impl From<manylight_render::BloomSettings> for Bloom {
 }
 
 impl Bloom {
-    /// Seed 002's variant: 1×9 / 9×1 kernels × 5 iterations at full resolution.
-    pub fn seed() -> Bloom {
-        Bloom::from(manylight_render::BloomSettings::seed())
+    /// Full-resolution separable blur: 1×9 / 9×1 kernels × 5 iterations at the viewport's size.
+    pub fn full_resolution() -> Bloom {
+        Bloom::from(manylight_render::BloomSettings::full_resolution())
     }
 
     /// The render side's copy.

@@ -11,6 +11,7 @@
 //!     })
 //!     .run();
 //! ```
+#![warn(missing_docs)]
 
 pub mod backend;
 pub mod cli;

@@ -2,9 +2,9 @@
 //! and timed end to end (prepare, record, submit, wait), written as CSV.
 
 use crate::direct::{measure_culling, snapshot};
+use crate::progress::Progress;
 use anyhow::{Context, Result};
 use glam::UVec2;
-use indicatif::{ProgressBar, ProgressStyle};
 use manylight_app::render_world::HeadlessRenderer;
 use manylight_render::{FrameReport, FrameSettings, GBufferLayout, PipelineKind};
 use manylight_scene::{Scene, light_rig};
@@ -57,8 +57,8 @@ pub struct Sweep {
     pub settings: FrameSettings,
 }
 
-/// Runs the sweep on `scene` and returns the CSV text.
-pub fn run(scene: &Scene, sweep: &Sweep) -> Result<String> {
+/// Runs the sweep on `scene` (called `scene_name` in the CSV) and returns the CSV text.
+pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
     let mut renderer = HeadlessRenderer::new()?;
     let adapter = renderer.render_world.gpu().info.name.clone();
     let configs: Vec<(PipelineKind, Option<GBufferLayout>, usize)> = sweep
@@ -76,14 +76,14 @@ pub fn run(scene: &Scene, sweep: &Sweep) -> Result<String> {
         })
         .filter(|&(p, _, n)| p != PipelineKind::NaiveForward || n <= sweep.naive_max_lights)
         .collect();
-    let bar = ProgressBar::new(configs.len() as u64 * u64::from(sweep.warmup + sweep.frames));
-    bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} frames, {elapsed} [{msg}]")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    let mut progress = Progress::new(configs.len() as u64, "configurations");
     let mut rows = Vec::new();
     for (pipeline, gbuffer, lights) in configs {
-        bar.set_message(format!("{} {lights}", pipeline.name()));
+        let label = match gbuffer {
+            Some(g) => format!("{} ({} G-buffer), {lights} lights", pipeline.name(), g.name()),
+            None => format!("{}, {lights} lights", pipeline.name()),
+        };
+        progress.set_message(label.clone());
         let rig = light_rig(lights, scene.bounds(), 1);
         let settings =
             FrameSettings { pipeline, gbuffer: gbuffer.unwrap_or(sweep.settings.gbuffer), ..sweep.settings };
@@ -98,7 +98,6 @@ pub fn run(scene: &Scene, sweep: &Sweep) -> Result<String> {
                 frame_ms.push(ms);
             }
             last = Some(report);
-            bar.inc(1);
         }
         let culling = if sweep.culling_efficiency && pipeline.uses_clusters() && lights > 0 {
             let snap = snapshot(scene, &rig, 0.0, sweep.size, settings, 0);
@@ -106,10 +105,39 @@ pub fn run(scene: &Scene, sweep: &Sweep) -> Result<String> {
         } else {
             None
         };
+        let median_ms = median(&frame_ms);
+        progress.step(|| format!("{label}: {median_ms:.1} ms"));
         rows.push(Row { pipeline, gbuffer, lights, frame_ms, last: last.context("no frame")?, culling });
     }
-    bar.finish_and_clear();
-    Ok(csv(&rows, sweep.size, &adapter))
+    progress.finish();
+    Ok(csv(&rows, scene_name, sweep.size, &adapter))
+}
+
+/// Every pass name of `reports`, in order of first appearance (a pass that runs several times
+/// in a frame, like a blur iteration, is named once).
+pub fn pass_names<'a>(reports: impl Iterator<Item = &'a FrameReport>) -> Vec<String> {
+    let mut names: Vec<String> = Vec::new();
+    for r in reports {
+        for p in &r.passes {
+            if !names.contains(&p.name) {
+                names.push(p.name.clone());
+            }
+        }
+    }
+    names
+}
+
+/// GPU milliseconds of each of `names` in `report` (summed over repeats; empty where the pass
+/// did not run or has no time), as CSV fields.
+pub fn pass_times(report: &FrameReport, names: &[String]) -> Vec<String> {
+    names
+        .iter()
+        .map(|name| {
+            let times: Vec<f64> =
+                report.passes.iter().filter(|p| p.name == *name).filter_map(|p| p.gpu_ms).collect();
+            if times.is_empty() { String::new() } else { format!("{:.3}", times.iter().sum::<f64>()) }
+        })
+        .collect()
 }
 
 /// Bytes in MiB.
@@ -117,9 +145,11 @@ pub fn mib(bytes: u64) -> f64 {
     bytes as f64 / (1024.0 * 1024.0)
 }
 
-fn csv(rows: &[Row], size: UVec2, adapter: &str) -> String {
+fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
+    // Quoted fields: a `"` inside is doubled.
+    let (adapter, scene) = (adapter.replace('"', "\"\""), scene.replace('"', "\"\""));
     let mut out = String::from(
-        "adapter,pipeline,gbuffer,gbuffer_bytes_per_pixel,lights,width,height,frames,frame_ms_median,\
+        "adapter,scene,pipeline,gbuffer,gbuffer_bytes_per_pixel,lights,width,height,frames,frame_ms_median,\
          frame_ms_mean,depth_prepass_gpu_ms,cluster_build_gpu_ms,cluster_build_gpu_trusted,\
          forward_gpu_ms,clustered_forward_gpu_ms,gbuffer_gpu_ms,deferred_lighting_gpu_ms,light_volumes_gpu_ms,tonemap_gpu_ms,clusters,non_empty_clusters,list_entries,\
          max_per_cluster,mean_per_non_empty,dropped_pairs,culling_ratio,transient_mib,cluster_buffer_mib\n",
@@ -135,7 +165,7 @@ fn csv(rows: &[Row], size: UVec2, adapter: &str) -> String {
         let mean = r.frame_ms.iter().sum::<f64>() / r.frame_ms.len().max(1) as f64;
         let _ = writeln!(
             out,
-            "\"{adapter}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{}",
+            "\"{adapter}\",\"{scene}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{}",
             r.pipeline.name(),
             r.gbuffer.map_or("", |g| g.name()),
             r.gbuffer.map_or(String::new(), |g| g.bytes_per_pixel().to_string()),

@@ -1,4 +1,6 @@
-//! `manylight`: render a scene to PNG, check a glTF file, and (later) benchmark pipelines.
+//! `manylight`: render a scene to PNG, check a glTF file, benchmark pipelines, and measure
+//! what accuracy and post stages cost, with tables, CSV and plots.
+#![warn(missing_docs)]
 
 use anyhow::{Context, Result, bail};
 use bevy_app::Startup;
@@ -22,8 +24,12 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 mod bench;
+mod codec_accuracy;
+mod depth_precision;
 mod direct;
+mod plot;
 mod post;
+mod progress;
 mod report;
 
 #[derive(Parser)]
@@ -50,6 +56,28 @@ enum Command {
     /// What bloom and motion blur cost per frame: the same frame without post stages, with
     /// each bloom chain, with motion blur and with both, in one run, as a markdown table.
     Post(ReportArgs),
+    /// Draw the figures of a CSV that `bench`, `report` or `post` wrote.
+    Plot {
+        /// The CSV file.
+        csv: PathBuf,
+        /// Folder for the PNG figures.
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// How accurately positions come back from a reverse-Z and a conventional f32 depth
+    /// buffer, per decade of distance, as markdown tables (CPU only).
+    DepthPrecision {
+        /// Log-spaced depths per decade (each at five pixels).
+        #[arg(long, default_value_t = 2000)]
+        samples: usize,
+    },
+    /// Worst and mean angular error of every normal codec over the sphere, as a markdown
+    /// table (CPU only).
+    CodecAccuracy {
+        /// Fibonacci points over the sphere.
+        #[arg(long, default_value_t = 4_000_000)]
+        samples: usize,
+    },
 }
 
 #[derive(clap::Args)]
@@ -68,6 +96,9 @@ struct ReportArgs {
     frames: u32,
     #[command(flatten)]
     clusters: ClusterArgs,
+    /// Also write the results as CSV and PNG figures into this folder.
+    #[arg(long)]
+    plot: Option<PathBuf>,
 }
 
 #[derive(clap::Args)]
@@ -109,6 +140,9 @@ struct BenchArgs {
     /// CSV output.
     #[arg(long)]
     out: PathBuf,
+    /// Also draw PNG figures of the CSV into this folder.
+    #[arg(long)]
+    plot: Option<PathBuf>,
 }
 
 #[derive(clap::Args)]
@@ -170,7 +204,7 @@ struct PostArgs {
     #[arg(long)]
     bloom: bool,
     /// Bloom chain: downsampled (halves the resolution per iteration) or full-resolution
-    /// (seed 002: 1×9/9×1 kernels at full size).
+    /// (separable 1×9/9×1 kernels, every iteration at full size).
     #[arg(long, default_value = "downsampled", value_parser = parse_bloom_chain)]
     bloom_chain: BloomChain,
     /// Camera-motion blur on the camera; the camera turns between frames so it shows (at least
@@ -428,17 +462,66 @@ fn check(path: PathBuf) -> Result<()> {
     Ok(())
 }
 
+/// The scene's name in tables and figure titles: the preset's name, or the file's stem.
+fn scene_name(spec: &str) -> String {
+    match spec {
+        "default" | "sphere-shell" => spec.to_string(),
+        path => std::path::Path::new(path)
+            .file_stem()
+            .map_or_else(|| path.to_string(), |s| s.to_string_lossy().into_owned()),
+    }
+}
+
+/// Writes `csv` as `<dir>/<name>.csv` and its figures beside it; prints what it wrote.
+fn write_plots(dir: &std::path::Path, name: &str, csv: &str) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let path = dir.join(format!("{name}.csv"));
+    std::fs::write(&path, csv).with_context(|| format!("cannot write {}", path.display()))?;
+    eprintln!("wrote {}", path.display());
+    for figure in plot::figures(csv, dir)? {
+        eprintln!("wrote {}", figure.display());
+    }
+    Ok(())
+}
+
 fn report_cmd(args: ReportArgs) -> Result<()> {
     let scene = load_scene(&args.scene, &LoadOptions::default())?;
     let base = manylight_render::FrameSettings { clusters: args.clusters.settings(), ..Default::default() };
-    print!("{}", report::run(&scene, args.lights, args.size, args.frames.max(1), base)?);
+    let name = scene_name(&args.scene);
+    let report = report::run(&scene, &name, args.lights, args.size, args.frames.max(1), base)?;
+    print!("{}", report.markdown);
+    if let Some(dir) = &args.plot {
+        write_plots(dir, "report", &report.csv)?;
+    }
     Ok(())
 }
 
 fn post_cmd(args: ReportArgs) -> Result<()> {
     let scene = load_scene(&args.scene, &LoadOptions::default())?;
     let base = manylight_render::FrameSettings { clusters: args.clusters.settings(), ..Default::default() };
-    print!("{}", post::run(&scene, args.lights, args.size, args.frames.max(1), base)?);
+    let name = scene_name(&args.scene);
+    let report = post::run(&scene, &name, args.lights, args.size, args.frames.max(1), base)?;
+    print!("{}", report.markdown);
+    if let Some(dir) = &args.plot {
+        write_plots(dir, "post", &report.csv)?;
+    }
+    Ok(())
+}
+
+fn plot_cmd(csv: PathBuf, out: PathBuf) -> Result<()> {
+    let text = std::fs::read_to_string(&csv).with_context(|| format!("cannot read {}", csv.display()))?;
+    for figure in plot::figures(&text, &out).with_context(|| format!("{}", csv.display()))? {
+        eprintln!("wrote {}", figure.display());
+    }
+    Ok(())
+}
+
+fn codec_accuracy_cmd(samples: usize) -> Result<()> {
+    let mut progress =
+        progress::Progress::new(manylight_core::codec::NormalCodec::ALL.len() as u64 + 2, "codecs");
+    let table = codec_accuracy::table(samples, |label| progress.step(|| label.to_string()));
+    progress.finish();
+    print!("{table}");
     Ok(())
 }
 
@@ -460,13 +543,18 @@ fn bench_cmd(args: BenchArgs) -> Result<()> {
             ..Default::default()
         },
     };
-    let csv = bench::run(&scene, &sweep)?;
+    let csv = bench::run(&scene, &scene_name(&args.scene), &sweep)?;
     if let Some(parent) = args.out.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent).with_context(|| format!("cannot create {}", parent.display()))?;
     }
     std::fs::write(&args.out, &csv).with_context(|| format!("cannot write {}", args.out.display()))?;
     print!("{csv}");
     eprintln!("wrote {}", args.out.display());
+    if let Some(dir) = &args.plot {
+        for figure in plot::figures(&csv, dir)? {
+            eprintln!("wrote {}", figure.display());
+        }
+    }
     Ok(())
 }
 
@@ -485,6 +573,12 @@ fn main() -> ExitCode {
         Command::Bench(args) => bench_cmd(args),
         Command::Report(args) => report_cmd(args),
         Command::Post(args) => post_cmd(args),
+        Command::Plot { csv, out } => plot_cmd(csv, out),
+        Command::DepthPrecision { samples } => {
+            print!("{}", depth_precision::tables(samples.max(1)));
+            Ok(())
+        }
+        Command::CodecAccuracy { samples } => codec_accuracy_cmd(samples.max(1)),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -4,6 +4,7 @@
 //! the frame without post stages, and the post passes' GPU time.
 
 use crate::direct::snapshot;
+use crate::progress::Progress;
 use anyhow::Result;
 use glam::{Mat4, UVec2};
 use manylight_app::render_world::HeadlessRenderer;
@@ -31,7 +32,12 @@ fn configurations() -> Vec<Config> {
     vec![
         c("no post stages", None, None, false),
         c("bloom, downsampled chain (5 levels, 1/2 … 1/32)", Some(BloomSettings::default()), None, false),
-        c("bloom, seed 002 (1×9 + 9×1 × 5, full resolution)", Some(BloomSettings::seed()), None, false),
+        c(
+            "bloom, full-resolution separable blur (1×9 + 9×1 × 5)",
+            Some(BloomSettings::full_resolution()),
+            None,
+            false,
+        ),
         c("motion blur (8 samples), turning camera", None, mb, true),
         c("motion blur (8 samples), still camera", None, mb, false),
         c("bloom (downsampled) + motion blur, turning camera", Some(BloomSettings::default()), mb, true),
@@ -77,10 +83,36 @@ fn post_gpu_ms(report: &FrameReport) -> (f64, Vec<(String, f64, u32)>) {
     (grouped.iter().fold(0.0, |sum, g| sum + g.1), grouped)
 }
 
-/// Runs every configuration on `scene` with `lights` rig lights and returns the table. Each
-/// configuration has its own renderer (so its transient textures stay pooled), and the
-/// configurations take turns frame by frame, so a change in machine load hits them alike.
-pub fn run(scene: &Scene, lights: usize, size: UVec2, frames: u32, base: FrameSettings) -> Result<String> {
+/// One configuration's medians.
+struct PostRow {
+    name: &'static str,
+    frame_ms: f64,
+    post_gpu_ms: f64,
+    /// Per post pass: name, median GPU ms (summed over its repeats), repeats per frame.
+    passes: Vec<(String, f64, u32)>,
+    transient_bytes: u64,
+}
+
+/// The post-stage costs: a markdown table for the terminal and the same figures as CSV.
+pub struct PostReport {
+    /// The markdown table with a line of context above it.
+    pub markdown: String,
+    /// One CSV row per configuration.
+    pub csv: String,
+}
+
+/// Runs every configuration on `scene` (called `scene_name` in the output) with `lights` rig
+/// lights. Each configuration has its own renderer (so its transient textures stay pooled),
+/// and the configurations take turns frame by frame, so a change in machine load hits them
+/// alike.
+pub fn run(
+    scene: &Scene,
+    scene_name: &str,
+    lights: usize,
+    size: UVec2,
+    frames: u32,
+    base: FrameSettings,
+) -> Result<PostReport> {
     let rig = light_rig(lights, scene.bounds(), 1);
     let configs = configurations();
     let mut renderers = configs.iter().map(|_| HeadlessRenderer::new()).collect::<Result<Vec<_>, _>>()?;
@@ -89,8 +121,10 @@ pub fn run(scene: &Scene, lights: usize, size: UVec2, frames: u32, base: FrameSe
     let mut times: Vec<Vec<f64>> = vec![Vec::new(); configs.len()];
     let mut passes: Vec<Vec<Vec<(String, f64, u32)>>> = vec![Vec::new(); configs.len()];
     let mut texture_bytes = vec![0u64; configs.len()];
+    let mut progress = Progress::new(u64::from(frames) + 1, "rounds of every configuration");
     for f in 0..=frames {
         for (i, (config, renderer)) in configs.iter().zip(&mut renderers).enumerate() {
+            progress.set_message(config.name);
             let snap = apply(snapshot(scene, &rig, 0.0, size, base, f as u64), config);
             let start = Instant::now();
             let (report, _) = renderer.render(snap, false)?;
@@ -101,58 +135,134 @@ pub fn run(scene: &Scene, lights: usize, size: UVec2, frames: u32, base: FrameSe
             }
             texture_bytes[i] = report.transient_bytes;
         }
+        progress.step(|| if f == 0 { "warm-up".to_string() } else { format!("frame {f}") });
     }
-    let mut out = String::new();
-    writeln!(
-        out,
-        "{}×{}, {} rig lights + {} scene lights, {}, median of {frames} frames after 1 warm-up \
-         (configurations interleaved frame by frame), adapter {adapter}\n",
+    progress.finish();
+    let rows: Vec<PostRow> = configs
+        .iter()
+        .zip(times)
+        .zip(passes)
+        .zip(texture_bytes)
+        .map(|(((config, times), passes), transient_bytes)| {
+            let post_gpu_ms =
+                median(passes.iter().map(|frame| frame.iter().fold(0.0, |sum, p| sum + p.1)).collect());
+            let per_pass = passes
+                .first()
+                .map(|first| {
+                    first
+                        .iter()
+                        .map(|(name, _, count)| {
+                            let v = median(
+                                passes
+                                    .iter()
+                                    .filter_map(|frame| frame.iter().find(|p| p.0 == *name).map(|p| p.1))
+                                    .collect(),
+                            );
+                            (name.clone(), v, *count)
+                        })
+                        .collect()
+                })
+                .unwrap_or_default();
+            PostRow {
+                name: config.name,
+                frame_ms: median(times),
+                post_gpu_ms,
+                passes: per_pass,
+                transient_bytes,
+            }
+        })
+        .collect();
+    let context = format!(
+        "{}×{}, {scene_name}, {} rig lights + {} scene lights, {}, median of {frames} frames after 1 warm-up \
+         (configurations interleaved frame by frame), adapter {adapter}",
         size.x,
         size.y,
         lights,
         scene.lights.len(),
         base.pipeline.name()
-    )?;
+    );
+    Ok(PostReport { markdown: markdown(&rows, &context)?, csv: csv(&rows, scene_name, size, &adapter)? })
+}
+
+fn markdown(rows: &[PostRow], context: &str) -> Result<String> {
+    let mut out = String::new();
+    writeln!(out, "{context}\n")?;
     writeln!(
         out,
         "| configuration | frame ms | vs none | post passes GPU ms | transient texture MiB | per pass GPU ms |"
     )?;
     writeln!(out, "|---|---:|---:|---:|---:|---|")?;
-    let none = median(times.first().cloned().unwrap_or_default());
-    for (((config, times), passes), bytes) in configs.iter().zip(times).zip(passes).zip(texture_bytes) {
-        let ms = median(times);
-        let total = median(passes.iter().map(|frame| frame.iter().fold(0.0, |sum, p| sum + p.1)).collect());
-        let per_pass = passes
-            .first()
-            .map(|first| {
-                first
-                    .iter()
-                    .map(|(name, _, count)| {
-                        let v = median(
-                            passes
-                                .iter()
-                                .filter_map(|frame| frame.iter().find(|p| p.0 == *name).map(|p| p.1))
-                                .collect(),
-                        );
-                        if *count > 1 {
-                            format!("{name} {v:.2} ({count}×)")
-                        } else {
-                            format!("{name} {v:.2}")
-                        }
-                    })
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            })
-            .filter(|s| !s.is_empty())
-            .unwrap_or_else(|| "–".to_string());
+    let none = rows.first().map_or(f64::NAN, |r| r.frame_ms);
+    for r in rows {
+        let per_pass = r
+            .passes
+            .iter()
+            .map(
+                |(name, v, count)| {
+                    if *count > 1 { format!("{name} {v:.2} ({count}×)") } else { format!("{name} {v:.2}") }
+                },
+            )
+            .collect::<Vec<_>>()
+            .join(", ");
         writeln!(
             out,
-            "| {} | {ms:.1} | {:+.1} ({:+.0} %) | {total:.2} | {:.1} | {per_pass} |",
-            config.name,
-            ms - none,
-            (ms / none - 1.0) * 100.0,
-            crate::bench::mib(bytes),
+            "| {} | {:.1} | {:+.1} ({:+.0} %) | {:.2} | {:.1} | {} |",
+            r.name,
+            r.frame_ms,
+            r.frame_ms - none,
+            (r.frame_ms / none - 1.0) * 100.0,
+            r.post_gpu_ms,
+            crate::bench::mib(r.transient_bytes),
+            if per_pass.is_empty() { "–" } else { &per_pass },
         )?;
     }
     Ok(out)
+}
+
+fn csv(rows: &[PostRow], scene: &str, size: UVec2, adapter: &str) -> Result<String> {
+    let mut names: Vec<&str> = Vec::new();
+    for r in rows {
+        for (name, _, _) in &r.passes {
+            if !names.contains(&name.as_str()) {
+                names.push(name);
+            }
+        }
+    }
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut header: Vec<String> = [
+        "adapter",
+        "scene",
+        "width",
+        "height",
+        "configuration",
+        "frame_ms_median",
+        "vs_none_ms",
+        "post_gpu_ms",
+        "transient_mib",
+    ]
+    .map(String::from)
+    .to_vec();
+    header.extend(names.iter().map(|n| format!("{n}_gpu_ms")));
+    w.write_record(&header)?;
+    let none = rows.first().map_or(f64::NAN, |r| r.frame_ms);
+    for r in rows {
+        let mut record = vec![
+            adapter.to_string(),
+            scene.to_string(),
+            size.x.to_string(),
+            size.y.to_string(),
+            r.name.to_string(),
+            format!("{:.3}", r.frame_ms),
+            format!("{:.3}", r.frame_ms - none),
+            format!("{:.3}", r.post_gpu_ms),
+            format!("{:.3}", crate::bench::mib(r.transient_bytes)),
+        ];
+        record.extend(
+            names.iter().map(|n| {
+                r.passes.iter().find(|p| p.0 == *n).map_or(String::new(), |p| format!("{:.3}", p.1))
+            }),
+        );
+        w.write_record(&record)?;
+    }
+    Ok(String::from_utf8(w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?)?)
 }

@@ -4,6 +4,7 @@
 //! per-pass GPU time.
 
 use crate::direct::snapshot;
+use crate::progress::Progress;
 use anyhow::Result;
 use glam::UVec2;
 use manylight_app::render_world::HeadlessRenderer;
@@ -86,60 +87,178 @@ fn configurations(base: FrameSettings) -> Vec<(String, FrameSettings)> {
     configs
 }
 
-/// Runs the comparison and returns the markdown table.
-pub fn run(scene: &Scene, lights: usize, size: UVec2, frames: u32, base: FrameSettings) -> Result<String> {
+/// One configuration's result.
+struct ReportRow {
+    name: String,
+    settings: Option<FrameSettings>,
+    frame_ms: f64,
+    report: FrameReport,
+    flip_mean: f64,
+    flip_p99: f64,
+}
+
+/// The report: a markdown table for the terminal and the same figures as CSV (for `--plot`).
+pub struct Report {
+    /// The markdown table with a line of context above it.
+    pub markdown: String,
+    /// One CSV row per configuration, naive forward first.
+    pub csv: String,
+}
+
+/// Runs the comparison on `scene` (called `scene_name` in the output).
+pub fn run(
+    scene: &Scene,
+    scene_name: &str,
+    lights: usize,
+    size: UVec2,
+    frames: u32,
+    base: FrameSettings,
+) -> Result<Report> {
     let mut renderer = HeadlessRenderer::new()?;
     let adapter = renderer.render_world.gpu().info.name.clone();
+    let configs = configurations(base);
+    let mut progress = Progress::new(configs.len() as u64 + 1, "configurations");
+    progress.set_message("naive forward (reference)");
     let naive = FrameSettings { pipeline: PipelineKind::NaiveForward, ..base };
     let (naive_ms, naive_report, reference) = measure(&mut renderer, scene, lights, size, naive, frames)?;
-    let configs = configurations(base);
-    let passes = |r: &FrameReport| {
-        r.passes
-            .iter()
-            .map(|p| match p.gpu_ms {
-                Some(ms) if p.gpu_trusted => format!("{} {ms:.1}", p.name),
-                Some(ms) => format!("{} {ms:.1}*", p.name),
-                None => p.name.clone(),
-            })
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "{} lights (+ the scene's own), {}x{}, {adapter}; median of {frames} frames\n",
-        lights, size.x, size.y
+    progress.step(|| format!("naive forward (reference): {naive_ms:.0} ms"));
+    let mut rows = vec![ReportRow {
+        name: "naive forward (reference)".into(),
+        settings: None,
+        frame_ms: naive_ms,
+        report: naive_report,
+        flip_mean: 0.0,
+        flip_p99: 0.0,
+    }];
+    for (name, settings) in configs {
+        progress.set_message(name.clone());
+        let (ms, report, image) = measure(&mut renderer, scene, lights, size, settings, frames)?;
+        let (flip, _) =
+            flip_compare(reference.dimensions(), reference.as_raw(), image.dimensions(), image.as_raw())?;
+        progress.step(|| format!("{name}: {ms:.0} ms, FLIP mean {:.5}", flip.mean));
+        rows.push(ReportRow {
+            name,
+            settings: Some(settings),
+            frame_ms: ms,
+            report,
+            flip_mean: f64::from(flip.mean),
+            flip_p99: f64::from(flip.p99),
+        });
+    }
+    progress.finish();
+    let context = format!(
+        "{lights} lights (+ the scene's own), {}x{}, {scene_name}, {adapter}; median of {frames} frames",
+        size.x, size.y
     );
+    Ok(Report { markdown: markdown(&rows, &context), csv: csv(&rows, scene_name, size, &adapter)? })
+}
+
+fn passes(r: &FrameReport) -> String {
+    r.passes
+        .iter()
+        .map(|p| match p.gpu_ms {
+            Some(ms) if p.gpu_trusted => format!("{} {ms:.1}", p.name),
+            Some(ms) => format!("{} {ms:.1}*", p.name),
+            None => p.name.clone(),
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+fn markdown(rows: &[ReportRow], context: &str) -> String {
+    let mut out = String::new();
+    let _ = writeln!(out, "{context}\n");
     let _ = writeln!(
         out,
         "| pipeline | G-buffer bytes/px | transient texture MiB | FLIP mean | FLIP p99 | dropped light-cluster pairs | frame ms | speed-up | passes (GPU ms; * = untrusted) |"
     );
     let _ = writeln!(out, "|---|---:|---:|---:|---:|---:|---:|---:|---|");
-    let _ = writeln!(
-        out,
-        "| naive forward (reference) | – | {:.1} | 0 | 0 | 0 | {naive_ms:.0} | 1.0× | {} |",
-        crate::bench::mib(naive_report.transient_bytes),
-        passes(&naive_report)
-    );
-    for (name, settings) in configs {
-        let (ms, report, image) = measure(&mut renderer, scene, lights, size, settings, frames)?;
-        let (flip, _) =
-            flip_compare(reference.dimensions(), reference.as_raw(), image.dimensions(), image.as_raw())?;
-        let bytes = if settings.pipeline.is_deferred() {
-            settings.gbuffer.bytes_per_pixel().to_string()
-        } else {
-            "–".into()
+    let naive_ms = rows.first().map_or(f64::NAN, |r| r.frame_ms);
+    for r in rows {
+        let bytes = match r.settings {
+            Some(s) if s.pipeline.is_deferred() => s.gbuffer.bytes_per_pixel().to_string(),
+            _ => "–".into(),
         };
-        let dropped = report.clusters.as_ref().map_or(0, |c| c.dropped_pairs);
+        let dropped = r.report.clusters.as_ref().map_or(0, |c| c.dropped_pairs);
+        let (mean, p99) = if r.settings.is_none() {
+            ("0".to_string(), "0".to_string())
+        } else {
+            (format!("{:.5}", r.flip_mean), format!("{:.5}", r.flip_p99))
+        };
         let _ = writeln!(
             out,
-            "| {name} | {bytes} | {:.1} | {:.5} | {:.5} | {dropped} | {ms:.0} | {:.1}× | {} |",
-            crate::bench::mib(report.transient_bytes),
-            flip.mean,
-            flip.p99,
-            naive_ms / ms,
-            passes(&report)
+            "| {} | {bytes} | {:.1} | {mean} | {p99} | {dropped} | {:.0} | {:.1}× | {} |",
+            r.name,
+            crate::bench::mib(r.report.transient_bytes),
+            r.frame_ms,
+            naive_ms / r.frame_ms,
+            passes(&r.report)
         );
     }
-    Ok(out)
+    out
+}
+
+fn csv(rows: &[ReportRow], scene: &str, size: UVec2, adapter: &str) -> Result<String> {
+    let pass_names = crate::bench::pass_names(rows.iter().map(|r| &r.report));
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut header: Vec<String> = [
+        "adapter",
+        "scene",
+        "width",
+        "height",
+        "configuration",
+        "pipeline",
+        "gbuffer",
+        "gbuffer_bytes_per_pixel",
+        "normal_codec",
+        "flip_mean",
+        "flip_p99",
+        "dropped_pairs",
+        "frame_ms_median",
+        "speedup",
+        "transient_mib",
+        "cluster_buffer_mib",
+        "untrusted_passes",
+    ]
+    .map(String::from)
+    .to_vec();
+    header.extend(pass_names.iter().map(|p| format!("{p}_gpu_ms")));
+    w.write_record(&header)?;
+    let naive_ms = rows.first().map_or(f64::NAN, |r| r.frame_ms);
+    for r in rows {
+        let deferred = r.settings.filter(|s| s.pipeline.is_deferred());
+        let mut record = vec![
+            adapter.to_string(),
+            scene.to_string(),
+            size.x.to_string(),
+            size.y.to_string(),
+            r.name.clone(),
+            r.report.pipeline.clone(),
+            deferred.map_or(String::new(), |s| s.gbuffer.name().to_string()),
+            deferred.map_or(String::new(), |s| s.gbuffer.bytes_per_pixel().to_string()),
+            deferred
+                .filter(|s| s.gbuffer.uses_codec())
+                .map_or(String::new(), |s| s.normal_codec.name().to_string()),
+            format!("{:.6}", r.flip_mean),
+            format!("{:.6}", r.flip_p99),
+            r.report.clusters.as_ref().map_or(0, |c| c.dropped_pairs).to_string(),
+            format!("{:.3}", r.frame_ms),
+            format!("{:.3}", naive_ms / r.frame_ms),
+            format!("{:.3}", crate::bench::mib(r.report.transient_bytes)),
+            r.report
+                .clusters
+                .as_ref()
+                .map_or(String::new(), |c| format!("{:.3}", crate::bench::mib(c.buffer_bytes))),
+            r.report
+                .passes
+                .iter()
+                .filter(|p| p.gpu_ms.is_some() && !p.gpu_trusted)
+                .map(|p| p.name.as_str())
+                .collect::<Vec<_>>()
+                .join(";"),
+        ];
+        record.extend(crate::bench::pass_times(&r.report, &pass_names));
+        w.write_record(&record)?;
+    }
+    Ok(String::from_utf8(w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?)?)
 }

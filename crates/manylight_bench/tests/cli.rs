@@ -48,7 +48,7 @@ fn check_rejects_every_malformed_file_with_a_typed_error() {
 #[test]
 fn check_accepts_real_assets() {
     let _gpu = GPU.lock().unwrap_or_else(|e| e.into_inner());
-    let assets = root().join("../shared/assets");
+    let assets = root().join("assets");
     for rel in
         ["DamagedHelmet/DamagedHelmet.glb", "CornellBox/CornellBox.gltf", "BoxTextured/BoxTextured.gltf"]
     {
@@ -121,6 +121,8 @@ fn bad_arguments_are_refused_with_a_message() {
 fn bench_writes_a_csv_row_per_configuration() {
     let _gpu = GPU.lock().unwrap_or_else(|e| e.into_inner());
     let csv = root().join("target/cli-tests/bench.csv");
+    let plots = root().join("target/cli-tests/bench-plots");
+    let _ = std::fs::remove_dir_all(&plots);
     let out = manylight(&[
         "bench",
         "--lights",
@@ -134,16 +136,20 @@ fn bench_writes_a_csv_row_per_configuration() {
         "--culling-efficiency",
         "--out",
         csv.to_str().expect("utf-8"),
+        "--plot",
+        plots.to_str().expect("utf-8"),
     ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let text = std::fs::read_to_string(&csv).expect("csv");
+    assert_figures(&plots, &["bench_frame_time", "bench_culling_ratio", "bench_passes", "bench_memory"]);
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(
         lines.len(),
         1 + 10,
         "header + (3 pipelines + deferred x 2 layouts) x 2 light counts:\n{text}"
     );
-    assert!(lines[0].starts_with("adapter,pipeline,gbuffer,"));
+    assert!(lines[0].starts_with("adapter,scene,pipeline,gbuffer,"), "{}", lines[0]);
+    assert!(lines[1..].iter().all(|l| l.contains(",\"default\",")), "{text}");
     assert!(lines.iter().any(|l| l.contains(",clustered-deferred,compact,20,32,")), "{text}");
     let header: Vec<&str> = lines[0].split(',').collect();
     let column =
@@ -163,4 +169,58 @@ fn bench_writes_a_csv_row_per_configuration() {
         "{textures}"
     );
     assert!(field(clustered, "cluster_buffer_mib").parse::<f64>().is_ok_and(|m| m > 0.0));
+}
+
+/// The figures `names` exist in `dir` as PNGs with something drawn on them.
+fn assert_figures(dir: &Path, names: &[&str]) {
+    for name in names {
+        let path = dir.join(format!("{name}.png"));
+        let img = image::open(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).to_rgb8();
+        assert!(img.width() >= 1000 && img.height() >= 400, "{}: {:?}", path.display(), img.dimensions());
+        let drawn = img.pixels().filter(|p| p.0 != [255, 255, 255]).count();
+        assert!(drawn > 5000, "{}: only {drawn} pixels drawn", path.display());
+    }
+}
+
+#[test]
+fn report_writes_csv_and_figures() {
+    let _gpu = GPU.lock().unwrap_or_else(|e| e.into_inner());
+    let plots = root().join("target/cli-tests/report-plots");
+    let _ = std::fs::remove_dir_all(&plots);
+    let out = manylight(&[
+        "report",
+        "--lights",
+        "8",
+        "--size",
+        "48x32",
+        "--frames",
+        "1",
+        "--plot",
+        plots.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let markdown = String::from_utf8_lossy(&out.stdout);
+    let text = std::fs::read_to_string(plots.join("report.csv")).expect("report.csv");
+    let rows: Vec<&str> = text.lines().collect();
+    // The markdown table and the CSV hold the same configurations.
+    let table_rows = markdown.lines().filter(|l| l.starts_with("| ") && !l.starts_with("| pipeline")).count();
+    assert_eq!(rows.len() - 1, table_rows, "{text}\n{markdown}");
+    assert!(rows[0].contains("flip_mean") && rows[0].contains("frame_ms_median"), "{}", rows[0]);
+    assert!(rows[1].contains("naive forward (reference)"), "{}", rows[1]);
+    assert_figures(&plots, &["report_accuracy_vs_time", "report_passes", "report_memory"]);
+    // `plot` draws the same figures again from the CSV alone.
+    let again = root().join("target/cli-tests/report-plots-again");
+    let _ = std::fs::remove_dir_all(&again);
+    let out = manylight(&[
+        "plot",
+        plots.join("report.csv").to_str().expect("utf-8"),
+        "--out",
+        again.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    for name in ["report_accuracy_vs_time", "report_passes", "report_memory"] {
+        let a = std::fs::read(plots.join(format!("{name}.png"))).expect("figure");
+        let b = std::fs::read(again.join(format!("{name}.png"))).expect("figure again");
+        assert!(a == b, "{name}: the figure drawn from the CSV differs from the one drawn with it");
+    }
 }

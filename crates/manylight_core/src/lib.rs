@@ -2,12 +2,12 @@
 //!
 //! Everything here is unit- and property-tested without a device; the WGSL in `shaders/`
 //! mirrors these functions and GPU tests compare the two.
+#![warn(missing_docs)]
 
 pub mod attenuation;
 pub mod camera;
 pub mod cluster;
 pub mod codec;
-pub mod depth_precision;
 pub mod efficiency;
 pub mod icosphere;
 pub mod image_metrics;

@@ -21,7 +21,14 @@ pub struct Vertex {
 pub enum MeshError {
     /// An index points past the vertex array.
     #[error("index {index} at position {at} is out of range (mesh has {vertices} vertices)")]
-    IndexOutOfRange { index: u32, at: usize, vertices: usize },
+    IndexOutOfRange {
+        /// The index value.
+        index: u32,
+        /// Its position in the index list.
+        at: usize,
+        /// Vertices the mesh has.
+        vertices: usize,
+    },
     /// The index count is not a multiple of three.
     #[error("index count {0} is not a multiple of 3")]
     NotTriangles(usize),

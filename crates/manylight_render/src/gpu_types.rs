@@ -1,5 +1,6 @@
 //! Structs and constants shared with WGSL. Each struct here has a twin in `shaders/common/`;
-//! `tests/layout.rs` reflects the WGSL with naga and checks sizes and offsets agree.
+//! `crates/manylight_render/tests/shaders.rs` (`shared_structs_match_rust`) reflects the WGSL
+//! with naga and checks that sizes and offsets agree.
 //! Constants are written into every shader by [`crate::shaders::constants_preamble`], so this
 //! file is their single source.
 

@@ -2,6 +2,7 @@
 //!
 //! It consumes a plain [`FrameSnapshot`] and knows nothing of bevy: tests and benchmarks can
 //! drive it directly. The app crate decides which passes a frame needs.
+#![warn(missing_docs)]
 
 pub mod clusters;
 pub mod context;

@@ -2,6 +2,7 @@
 //!
 //! A [`Scene`] is plain data (meshes, materials, instances, lights, cameras) that the app turns
 //! into ECS entities; mesh and texture data are `Arc`s so they travel to the render thread once.
+#![warn(missing_docs)]
 
 mod default_scene;
 mod error;

@@ -253,34 +253,6 @@ fn false_positive_rates() {
     assert_eq!(rates[0].1, rates[1].1);
 }
 
-/// `cargo test -p manylight_core --release -- --ignored --nocapture assign_timing`
-#[test]
-#[ignore]
-fn assign_timing() {
-    let g = ClusterGrid::new(
-        UVec2::new(1280, 720),
-        &Projection { fov_y: 60f32.to_radians(), near: 0.1, far: 100.0 },
-        &GridConfig::default(),
-    );
-    let lights = fp_scene(&mut Rng::new(2), &g, 16384);
-    for test in CullTest::ALL {
-        let start = std::time::Instant::now();
-        let runs = 5;
-        let mut a = ClusterAssignment::default();
-        for _ in 0..runs {
-            a = assign_lights(&g, &lights, test, None);
-        }
-        let s = a.stats();
-        eprintln!(
-            "assign_lights {:>6}: {:.1} ms per run, {} entries, max {} per cluster",
-            test.name(),
-            start.elapsed().as_secs_f64() * 1e3 / runs as f64,
-            s.total_entries,
-            s.max_per_cluster
-        );
-    }
-}
-
 #[test]
 fn default_grid_matches_brute_force() {
     let mut rng = Rng::new(11);

@@ -5,8 +5,8 @@ use super::*;
 use glam::Vec3;
 use proptest::prelude::*;
 
-/// Asserted worst-case errors in degrees: the measured value (1M Fibonacci points + hard
-/// points + local search, `codec_accuracy_table`) plus a little slack.
+/// Asserted worst-case errors in degrees: the measured value (4M Fibonacci points + hard
+/// points + local search, `manylight codec-accuracy`) plus a little slack.
 ///
 /// - `Octa16`: measured 0.00247°; the analytic worst, `√2 / 32767` rad = 0.002473° at the
 ///   octahedron's face centres, is below the bound. The issue asks for ≤ 0.01°.
@@ -266,44 +266,4 @@ proptest! {
         let n = unpack_spherical16(p);
         prop_assert!(angle_deg(n, unpack_spherical16(pack_spherical16(n))) < 1e-4);
     }
-}
-
-/// `v` with four significant digits, in plain decimal.
-fn significant(v: f64) -> String {
-    let decimals = if v > 0.0 { (3 - v.log10().floor() as i32).max(1) } else { 1 };
-    format!("{v:.*}", decimals as usize)
-}
-
-/// `cargo test -p manylight_core --release -- --ignored --nocapture codec_accuracy_table`
-///
-/// Prints the table in `docs/accuracy.md`.
-#[test]
-#[ignore]
-fn codec_accuracy_table() {
-    const SAMPLES: usize = 4_000_000;
-    let mut table =
-        String::from("| codec | bits per normal | worst ° | mean ° | worst at |\n|---|---|---|---|---|\n");
-    let mut row = |label: &str, bits: u32, e: CodecError| {
-        let at = e.worst_at.normalize_or_zero();
-        table += &format!(
-            "| {label} | {bits} | {} | {} | ({:.4}, {:.4}, {:.4}) |\n",
-            significant(e.worst_deg),
-            significant(e.mean_deg),
-            at.x,
-            at.y,
-            at.z
-        );
-    };
-    for codec in NormalCodec::ALL {
-        let start = std::time::Instant::now();
-        let e = measure_error(codec, SAMPLES);
-        eprintln!("{}: {:.2} s", codec.name(), start.elapsed().as_secs_f64());
-        row(codec.name(), codec.bits_per_normal(), e);
-    }
-    for (label, region) in
-        [("xyz, z ≥ 0 only", SphereRegion::FrontFacing), ("xyz, z < 0 only", SphereRegion::BackFacing)]
-    {
-        row(label, 64, measure_error_in(NormalCodec::Xyz, SAMPLES, region));
-    }
-    println!("{SAMPLES} Fibonacci samples over the sphere, plus hard points and a local search:\n\n{table}");
 }

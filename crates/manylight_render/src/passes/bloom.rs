@@ -1,11 +1,11 @@
 //! Bloom: light above a threshold spreads into its surroundings. Three kinds of pass, all in
 //! `shaders/bloom.wgsl`, added only when the camera has bloom:
 //! 1. [`BloomBrightPass`]: the soft-thresholded HDR colour into level 0 (half resolution in the
-//!    downsampled chain, full resolution in the seed's chain);
+//!    downsampled chain, full resolution in the full-resolution chain);
 //! 2. [`BloomBlurPass`] × 2 per iteration: a separable 9-tap gaussian, horizontal then
 //!    vertical. In the downsampled chain iteration `k` reads level `k − 1` (twice its size, so the
 //!    bilinear taps also box-filter it down) and writes level `k` at `1/2^(k+1)` of the viewport;
-//!    in the seed's chain every iteration blurs level 0 again at full resolution;
+//!    in the full-resolution chain every iteration blurs level 0 again at full resolution;
 //! 3. [`BloomUpsamplePass`] (downsampled chain only), from the smallest level up: level `k` is
 //!    added (bilinear, blend One + One) to level `k − 1`, so level 0 ends up holding the sum of
 //!    all levels at a fraction of the cost of sampling each at full resolution;
@@ -36,7 +36,8 @@ pub enum BloomChain {
     /// Each iteration halves the resolution (1/2, 1/4, …); the composite sums every level.
     #[default]
     Downsampled,
-    /// Seed 002's variant: every iteration blurs at full resolution (1×9 then 9×1).
+    /// Every iteration blurs at full resolution (separable 9-tap: 1×9 then 9×1): the
+    /// straightforward layout, several times the cost of the downsampled chain.
     FullResolution,
 }
 
@@ -61,7 +62,7 @@ pub struct BloomSettings {
     pub intensity: f32,
     /// Blur iterations (levels of the chain), 1 to [`MAX_BLOOM_LEVELS`].
     pub iterations: u32,
-    /// Downsampled chain or the seed's full-resolution one.
+    /// Downsampled chain or the full-resolution one.
     pub chain: BloomChain,
 }
 
@@ -72,8 +73,9 @@ impl Default for BloomSettings {
 }
 
 impl BloomSettings {
-    /// Seed 002's bloom: 1×9 / 9×1 kernels, 5 iterations, full resolution.
-    pub fn seed() -> Self {
+    /// Full-resolution separable blur: 1×9 / 9×1 kernels, 5 iterations, every one at the
+    /// viewport's size.
+    pub fn full_resolution() -> Self {
         Self { chain: BloomChain::FullResolution, iterations: 5, ..Self::default() }
     }
 

@@ -1,4 +1,5 @@
-//! How accurately a world position comes back from a stored `Depth32Float` depth: the error of
+//! `manylight depth-precision`: how accurately a world position comes back from a stored
+//! `Depth32Float` depth: the error of
 //! the Compact G-buffer's position-from-depth (`gbuffer_position_from_depth` in
 //! `shaders/common/gbuffer_read.wgsl`), measured across the depth range.
 //!
@@ -20,8 +21,8 @@
 //! [`Projection::matrix`]: depth 1 at near, 0 at far) and, for comparison, a conventional
 //! projection (0 at near, 1 at far) stored in the same f32 format.
 
-use crate::camera::Projection;
 use glam::{DVec3, Mat4, Quat, Vec3, Vec4};
+use manylight_core::camera::Projection;
 use std::fmt::Write as _;
 
 /// Which way depth runs in the stored buffer.
@@ -47,7 +48,7 @@ pub struct DepthSetup {
 }
 
 impl DepthSetup {
-    /// The setup: near 0.1, far 1000, `fov_y_deg`, 1280×720, camera at the origin
+    /// Near 0.1, far 1000, `fov_y_deg`, 1280×720, camera at the origin
     /// looking down -Z (world = view space, so only the depth path is measured).
     pub fn at_origin(fov_y_deg: f32) -> DepthSetup {
         DepthSetup {
@@ -206,6 +207,24 @@ pub fn measure(
     out
 }
 
+/// The tables of `docs/accuracy.md` ("Position from depth"): three camera setups, each a
+/// [`markdown_table`] with `samples_per_decade` depths per decade.
+pub fn tables(samples_per_decade: usize) -> String {
+    let mut out = String::new();
+    for (name, setup) in [
+        ("camera at the origin, 60° fov", DepthSetup::at_origin(60.0)),
+        ("camera at the origin, 45° fov", DepthSetup::at_origin(45.0)),
+        ("camera at (40, 12, -75), turned, 60° fov", DepthSetup::moved(60.0)),
+    ] {
+        let _ = writeln!(
+            out,
+            "{name}, near 0.1, far 1000, 1280x720:\n\n{}",
+            markdown_table(&setup, samples_per_decade)
+        );
+    }
+    out
+}
+
 /// A markdown table of [`measure`] for reverse-Z and conventional depth side by side.
 pub fn markdown_table(setup: &DepthSetup, samples_per_decade: usize) -> String {
     let reverse = measure(setup, DepthConvention::ReverseZ, samples_per_decade);
@@ -281,18 +300,5 @@ mod tests {
         let conventional = measure(&setup, DepthConvention::Conventional, SAMPLES);
         let (r, c) = (reverse[3], conventional[3]);
         assert!(c.max_rel > 100.0 * r.max_rel, "reverse {r:?}, conventional {c:?}");
-    }
-
-    /// Prints the tables of docs/accuracy.md ("Position from depth"):
-    /// `cargo test -p manylight_core --release depth_precision_table -- --nocapture`
-    #[test]
-    fn depth_precision_table() {
-        for (name, setup) in [
-            ("camera at the origin, 60° fov", DepthSetup::at_origin(60.0)),
-            ("camera at the origin, 45° fov", DepthSetup::at_origin(45.0)),
-            ("camera at (40, 12, -75), turned, 60° fov", DepthSetup::moved(60.0)),
-        ] {
-            println!("\n{name}, near 0.1, far 1000, 1280x720:\n\n{}", markdown_table(&setup, SAMPLES));
-        }
     }
 }
