@@ -15,6 +15,7 @@
 mod data;
 mod materials;
 mod nodes;
+mod uri;
 
 pub use materials::blinn_phong_from_pbr;
 
@@ -171,7 +172,7 @@ fn load_inner(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
 struct Ctx<'a> {
     /// The glTF file (for error messages).
     path: &'a Path,
-    /// Folder that relative URIs resolve against.
+    /// Folder that URIs resolve in; they may not leave it.
     base_dir: PathBuf,
     /// The parsed, unvalidated JSON.
     root: &'a gltf::json::Root,
