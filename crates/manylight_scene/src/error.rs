@@ -105,6 +105,56 @@ pub enum SceneError {
         #[source]
         source: std::io::Error,
     },
+    /// A buffer or image URI names a file outside the glTF file's folder (absolute path, `..`
+    /// component, Windows drive or UNC path, or a symlink pointing outside); it is not read.
+    #[error(
+        "`{}`: {what}: URI `{uri}` reaches outside the folder `{}`: {reason}",
+        .path.display(),
+        .folder.display()
+    )]
+    UriOutsideFolder {
+        /// The glTF file.
+        path: PathBuf,
+        /// The object with the URI, e.g. "buffer 0".
+        what: String,
+        /// The URI (shortened when long).
+        uri: String,
+        /// The folder URIs resolve in (the glTF file's folder).
+        folder: PathBuf,
+        /// How the URI leaves the folder.
+        reason: String,
+    },
+    /// A file named by a buffer or image URI is not a regular file (directory, FIFO, device, ...).
+    #[error("`{}`: {what}: `{}` is a {kind}, not a regular file", .path.display(), .file.display())]
+    NotARegularFile {
+        /// The glTF file.
+        path: PathBuf,
+        /// The object with the URI, e.g. "image 3".
+        what: String,
+        /// The resolved file path.
+        file: PathBuf,
+        /// What it is instead, e.g. "FIFO (named pipe)".
+        kind: &'static str,
+    },
+    /// A file named by an image URI is larger than the loader reads.
+    #[error(
+        "`{}`: {what}: `{}` is {size} bytes, over the limit of {} MiB for image files",
+        .path.display(),
+        .file.display(),
+        .limit >> 20
+    )]
+    ReferencedFileTooLarge {
+        /// The glTF file.
+        path: PathBuf,
+        /// The object with the URI, e.g. "image 3".
+        what: String,
+        /// The resolved file path.
+        file: PathBuf,
+        /// Its size in bytes.
+        size: u64,
+        /// The limit in bytes.
+        limit: u64,
+    },
     /// A buffer has fewer bytes than its declared `byteLength`, or has no data at all.
     #[error("`{}`: buffer {buffer}: {problem}", .path.display())]
     BadBuffer {

@@ -4,8 +4,17 @@
 //! 1. The container is split by hand (GLB header and chunk lengths are checked against the
 //!    file size) and the JSON is parsed without `gltf`'s validation; every index is looked up
 //!    with a bounds check that turns into a [`SceneError::MissingReference`].
-//! 2. Buffers are loaded from the GLB chunk, `data:` URIs or local files (never the network)
-//!    and cut to their `byteLength`; views and accessors are range-checked before reading.
+//! 2. Buffers are loaded from the GLB chunk, `data:` URIs or local files (never the network);
+//!    of a file only `byteLength` bytes are read. Views and accessors are range-checked
+//!    before reading.
+//!
+//!    A buffer or image `uri` is either a base64 `data:` URI or a relative path that stays
+//!    inside the glTF file's folder: after percent-decoding it may not be absolute, contain a
+//!    `..` component, a Windows drive letter or a backslash (UNC paths), or use any other
+//!    scheme (`http:`, `file:`, ...); its canonical path must lie under the folder's, so a
+//!    symlink pointing outside is refused too. Only regular files are read (never a FIFO,
+//!    device or directory), image files up to 256 MiB ([`SceneError::UriOutsideFolder`],
+//!    [`SceneError::NotARegularFile`], [`SceneError::ReferencedFileTooLarge`]).
 //! 3. The node tree of the chosen scene is walked iteratively, rejecting cycles and
 //!    non-finite transforms; each mesh primitive, material and image is converted once and
 //!    shared.
@@ -15,6 +24,7 @@
 mod data;
 mod materials;
 mod nodes;
+mod uri;
 
 pub use materials::blinn_phong_from_pbr;
 
@@ -52,7 +62,7 @@ const UNSUPPORTED_REQUIRED: &[&str] = &[
 /// Loads a `.gltf` or `.glb` file into a [`Scene`].
 ///
 /// Every malformed input is reported as a [`SceneError`] naming the file; nothing is fetched
-/// over the network.
+/// over the network and no file outside the glTF file's folder is read.
 pub fn load_gltf(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
     let start = std::time::Instant::now();
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| load_inner(path, options)));
@@ -171,7 +181,7 @@ fn load_inner(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
 struct Ctx<'a> {
     /// The glTF file (for error messages).
     path: &'a Path,
-    /// Folder that relative URIs resolve against.
+    /// Folder that URIs resolve in; they may not leave it.
     base_dir: PathBuf,
     /// The parsed, unvalidated JSON.
     root: &'a gltf::json::Root,

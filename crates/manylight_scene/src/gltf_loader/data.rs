@@ -1,112 +1,19 @@
-//! Binary data of a glTF file: buffers (GLB chunk, `data:` URIs, files next to the glTF),
-//! buffer views and accessors, each range-checked before a byte is read.
+//! Binary data of a glTF file: buffers (GLB chunk, `data:` URIs, files in the glTF file's
+//! folder), buffer views and accessors, each range-checked before a byte is read.
 
 use super::Ctx;
+use super::uri::{UriSource, resolve_uri};
 use crate::SceneError;
-use base64::Engine as _;
 use gltf::json::accessor::{ComponentType, Type};
 use gltf::json::validation::Checked;
 use std::borrow::Cow;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Largest accessor (in bytes) that is materialised without backing data (all zeros or sparse).
 const MAX_SYNTHETIC_ACCESSOR_BYTES: u64 = 256 << 20;
 
-/// Where the bytes named by a `uri` come from.
-pub(super) enum UriSource {
-    /// Decoded `data:` URI payload, with its media type.
-    Data { bytes: Vec<u8>, media_type: String },
-    /// A local file, resolved against the glTF file's folder.
-    File(PathBuf),
-}
-
-/// Shortens long URIs (e.g. `data:` URIs) for error messages.
-fn short_uri(uri: &str) -> String {
-    if uri.len() <= 80 {
-        return uri.to_owned();
-    }
-    let cut = (0..=77).rev().find(|&i| uri.is_char_boundary(i)).unwrap_or(0);
-    format!("{}...", &uri[..cut])
-}
-
-/// Decodes `%XX` escapes of a relative URI reference.
-fn percent_decode(uri: &str) -> Option<String> {
-    let bytes = uri.as_bytes();
-    let mut out = Vec::with_capacity(bytes.len());
-    let mut i = 0;
-    while i < bytes.len() {
-        if bytes[i] == b'%' {
-            let hex = std::str::from_utf8(bytes.get(i + 1..i + 3)?).ok()?;
-            out.push(u8::from_str_radix(hex, 16).ok()?);
-            i += 3;
-        } else {
-            out.push(bytes[i]);
-            i += 1;
-        }
-    }
-    String::from_utf8(out).ok()
-}
-
-/// Interprets a buffer or image URI: `data:` URIs are decoded, `http(s)://` and other schemes
-/// are refused (nothing is ever fetched), anything else is a path relative to `base_dir`.
-pub(super) fn resolve_uri(
-    path: &Path,
-    base_dir: &Path,
-    what: &str,
-    uri: &str,
-) -> Result<UriSource, SceneError> {
-    let bad = |reason: &str| SceneError::BadUri {
-        path: path.to_owned(),
-        what: what.to_owned(),
-        uri: short_uri(uri),
-        reason: reason.to_owned(),
-    };
-    let lower = uri.get(..8).unwrap_or(uri).to_ascii_lowercase();
-    if lower.starts_with("http://") || lower.starts_with("https://") || uri.starts_with("//") {
-        return Err(SceneError::ExternalUri {
-            path: path.to_owned(),
-            what: what.to_owned(),
-            uri: short_uri(uri),
-        });
-    }
-    if lower.starts_with("data:") {
-        let rest = &uri[5..];
-        let (header, payload) = rest.split_once(',').ok_or_else(|| bad("data URI without ','"))?;
-        let Some(media_type) = header.strip_suffix(";base64") else {
-            return Err(bad("only base64 data URIs are supported"));
-        };
-        let bytes = base64::engine::general_purpose::STANDARD
-            .decode(payload.trim_end())
-            .map_err(|e| bad(&format!("invalid base64: {e}")))?;
-        return Ok(UriSource::Data { bytes, media_type: media_type.to_ascii_lowercase() });
-    }
-    // A scheme is letters/digits/+/-/. before the first ':' that comes before any '/'.
-    if let Some(colon) = uri.find(':') {
-        let scheme = &uri[..colon];
-        let looks_like_scheme =
-            scheme.len() > 1 && scheme.chars().all(|c| c.is_ascii_alphanumeric() || "+-.".contains(c));
-        if looks_like_scheme {
-            return Err(bad(&format!("unsupported URI scheme `{scheme}:`")));
-        }
-    }
-    if uri.is_empty() {
-        return Err(bad("empty URI"));
-    }
-    let decoded = percent_decode(uri).ok_or_else(|| bad("invalid percent escape"))?;
-    Ok(UriSource::File(base_dir.join(decoded)))
-}
-
-/// Reads a file named by a URI.
-pub(super) fn read_referenced(path: &Path, what: &str, file: &Path) -> Result<Vec<u8>, SceneError> {
-    std::fs::read(file).map_err(|source| SceneError::ReferencedFile {
-        path: path.to_owned(),
-        what: what.to_owned(),
-        file: file.to_owned(),
-        source,
-    })
-}
-
-/// Loads every buffer of the file; each is cut to its declared `byteLength`.
+/// Loads every buffer of the file; each is cut to its declared `byteLength` (of a file, only
+/// that many bytes are read: the file may be longer, not shorter).
 pub(super) fn load_buffers<'a>(
     path: &Path,
     base_dir: &Path,
@@ -120,7 +27,20 @@ pub(super) fn load_buffers<'a>(
         let data: Cow<'a, [u8]> = match &buffer.uri {
             Some(uri) => match resolve_uri(path, base_dir, &what, uri)? {
                 UriSource::Data { bytes, .. } => Cow::Owned(bytes),
-                UriSource::File(file) => Cow::Owned(read_referenced(path, &what, &file)?),
+                UriSource::File(file) => {
+                    if file.size < declared {
+                        return Err(SceneError::BadBuffer {
+                            path: path.to_owned(),
+                            buffer: i,
+                            problem: format!(
+                                "`{}` has {} bytes but its byteLength is {declared}",
+                                file.path.display(),
+                                file.size
+                            ),
+                        });
+                    }
+                    Cow::Owned(file.read_prefix(path, &what, declared)?)
+                }
             },
             None if i == 0 => Cow::Borrowed(glb_bin.ok_or_else(|| SceneError::BadBuffer {
                 path: path.to_owned(),

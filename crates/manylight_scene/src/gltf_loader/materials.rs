@@ -5,13 +5,16 @@
 //! is decoded, so a tiny file that declares a huge image costs nothing.
 
 use super::Ctx;
-use super::data::{UriSource, read_referenced, resolve_uri};
+use super::uri::{UriSource, resolve_uri};
 use crate::SceneError;
 use glam::Vec4;
 use image::{ImageDecoder, ImageFormat, ImageReader, Limits};
 use manylight_core::{MaterialData, TextureData};
 use std::io::Cursor;
 use std::sync::Arc;
+
+/// Largest image file (in bytes) read from a URI; larger files are refused before reading.
+const MAX_IMAGE_FILE_BYTES: u64 = 256 << 20;
 
 /// Blinn-Phong exponent and specular strength for a metallic-roughness material.
 ///
@@ -90,8 +93,17 @@ impl Ctx<'_> {
                     (bytes, format!("{} image {index}", self.file_name()))
                 }
                 UriSource::File(file) => {
-                    let bytes = read_referenced(self.path, &what, &file)?;
-                    (bytes, file.display().to_string())
+                    if file.size > MAX_IMAGE_FILE_BYTES {
+                        return Err(SceneError::ReferencedFileTooLarge {
+                            path: self.path.to_owned(),
+                            what,
+                            file: file.path,
+                            size: file.size,
+                            limit: MAX_IMAGE_FILE_BYTES,
+                        });
+                    }
+                    let label = file.path.display().to_string();
+                    (file.read_prefix(self.path, &what, MAX_IMAGE_FILE_BYTES)?, label)
                 }
             },
             (None, Some(view)) => {

@@ -1,0 +1,395 @@
+//! Buffer and image URIs: `data:` URIs are decoded; any other URI must name a regular file
+//! inside the glTF file's folder.
+//!
+//! Confinement is checked on the text and on the file system:
+//! 1. After percent-decoding, the URI must be a relative path made of plain names: no scheme
+//!    other than `data:` (network URIs are never fetched), no absolute path, no `..`
+//!    component, no Windows drive letter, backslash or UNC form.
+//! 2. The joined path is canonicalized and must stay under the canonicalized folder, which
+//!    also refuses symlinks that point outside it.
+//! 3. Only regular files are opened: the type is checked before opening and again on the
+//!    opened handle, which is opened non-blocking on Linux so that a FIFO swapped in between
+//!    cannot stall the load. On unix the opened file must be the one that was checked; on
+//!    Linux its real path (from `/proc/self/fd`) must still lie in the folder.
+//!
+//! Callers learn the file's size before reading and read at most what they need
+//! ([`LocalFile::read_prefix`]).
+
+use crate::SceneError;
+use base64::Engine as _;
+use std::fs::File;
+use std::io::Read;
+use std::path::{Component, Path, PathBuf};
+
+/// Where the bytes named by a `uri` come from.
+pub(super) enum UriSource {
+    /// Decoded `data:` URI payload, with its media type.
+    Data { bytes: Vec<u8>, media_type: String },
+    /// An opened regular file inside the glTF file's folder.
+    File(LocalFile),
+}
+
+/// A regular file inside the glTF file's folder, opened and checked, not yet read.
+pub(super) struct LocalFile {
+    /// Its canonical path.
+    pub(super) path: PathBuf,
+    /// Its size in bytes when it was opened.
+    pub(super) size: u64,
+    handle: File,
+}
+
+impl LocalFile {
+    /// Reads at most the first `limit` bytes (fewer when the file is shorter).
+    pub(super) fn read_prefix(self, gltf: &Path, what: &str, limit: u64) -> Result<Vec<u8>, SceneError> {
+        let io_err = |source| SceneError::ReferencedFile {
+            path: gltf.to_owned(),
+            what: what.to_owned(),
+            file: self.path.clone(),
+            source,
+        };
+        // The capacity is bounded by the file's actual size; a size the allocator cannot
+        // provide is an error, not an abort.
+        let expected = usize::try_from(limit.min(self.size)).unwrap_or(usize::MAX);
+        let mut bytes = Vec::new();
+        bytes
+            .try_reserve_exact(expected)
+            .map_err(|_| io_err(std::io::Error::from(std::io::ErrorKind::OutOfMemory)))?;
+        (&self.handle).take(limit).read_to_end(&mut bytes).map_err(io_err)?;
+        Ok(bytes)
+    }
+}
+
+/// Shortens long URIs (e.g. `data:` URIs) for error messages.
+fn short_uri(uri: &str) -> String {
+    if uri.len() <= 80 {
+        return uri.to_owned();
+    }
+    let cut = (0..=77).rev().find(|&i| uri.is_char_boundary(i)).unwrap_or(0);
+    format!("{}...", &uri[..cut])
+}
+
+/// Decodes `%XX` escapes of a relative URI reference.
+fn percent_decode(uri: &str) -> Option<String> {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%' {
+            let hex = std::str::from_utf8(bytes.get(i + 1..i + 3)?).ok()?;
+            out.push(u8::from_str_radix(hex, 16).ok()?);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(out).ok()
+}
+
+/// Whether `s` starts with a Windows drive letter (`C:`).
+fn has_drive_letter(s: &str) -> bool {
+    let b = s.as_bytes();
+    b.len() >= 2 && b[0].is_ascii_alphabetic() && b[1] == b':'
+}
+
+/// The relative path named by a percent-decoded URI, or why it would leave the folder.
+///
+/// Only `/` separates components; empty and `.` components are dropped, every other one must
+/// be a plain name on this platform.
+fn relative_path(decoded: &str) -> Result<PathBuf, String> {
+    if decoded.starts_with('/') {
+        return Err("it is an absolute path".into());
+    }
+    if has_drive_letter(decoded) {
+        return Err("it is a Windows drive path".into());
+    }
+    if decoded.contains('\\') {
+        return Err("it contains a backslash (a Windows path separator or UNC path)".into());
+    }
+    let mut out = PathBuf::new();
+    for part in decoded.split('/') {
+        match part {
+            "" | "." => {}
+            ".." => return Err("it has a `..` component".into()),
+            _ => {
+                // On Windows a component such as `C:` parses as a prefix, not a name.
+                let mut components = Path::new(part).components();
+                match (components.next(), components.next()) {
+                    (Some(Component::Normal(_)), None) => out.push(part),
+                    _ => return Err(format!("its component `{part}` is not a plain file name")),
+                }
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// A readable name for a file type that is not a regular file.
+fn file_kind(ty: std::fs::FileType) -> &'static str {
+    if ty.is_dir() {
+        return "directory";
+    }
+    if ty.is_symlink() {
+        return "symbolic link";
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if ty.is_fifo() {
+            return "FIFO (named pipe)";
+        }
+        if ty.is_char_device() {
+            return "character device";
+        }
+        if ty.is_block_device() {
+            return "block device";
+        }
+        if ty.is_socket() {
+            return "socket";
+        }
+    }
+    "special file"
+}
+
+/// `O_NONBLOCK` on Linux targets whose value is the generic `0o4000` (opening a FIFO with it
+/// returns at once instead of waiting for a writer; reads of regular files ignore it).
+#[cfg(all(
+    any(target_os = "linux", target_os = "android"),
+    any(
+        target_arch = "x86",
+        target_arch = "x86_64",
+        target_arch = "arm",
+        target_arch = "aarch64",
+        target_arch = "riscv32",
+        target_arch = "riscv64",
+        target_arch = "loongarch64",
+        target_arch = "powerpc",
+        target_arch = "powerpc64",
+        target_arch = "s390x"
+    )
+))]
+const OPEN_FLAGS: i32 = 0o4000;
+/// No extra open flags where `O_NONBLOCK`'s value is not the generic one.
+#[cfg(all(
+    unix,
+    not(all(
+        any(target_os = "linux", target_os = "android"),
+        any(
+            target_arch = "x86",
+            target_arch = "x86_64",
+            target_arch = "arm",
+            target_arch = "aarch64",
+            target_arch = "riscv32",
+            target_arch = "riscv64",
+            target_arch = "loongarch64",
+            target_arch = "powerpc",
+            target_arch = "powerpc64",
+            target_arch = "s390x"
+        )
+    ))
+))]
+const OPEN_FLAGS: i32 = 0;
+
+/// Read-only, and on unix with [`OPEN_FLAGS`].
+fn open_options() -> std::fs::OpenOptions {
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(OPEN_FLAGS);
+    }
+    options
+}
+
+/// Interprets a buffer or image URI of glTF file `path`: `data:` URIs are decoded,
+/// `http(s)://` and other schemes are refused (nothing is ever fetched), anything else must
+/// name a regular file inside `base_dir`, which is opened (see the module documentation).
+pub(super) fn resolve_uri(
+    path: &Path,
+    base_dir: &Path,
+    what: &str,
+    uri: &str,
+) -> Result<UriSource, SceneError> {
+    let bad = |reason: &str| SceneError::BadUri {
+        path: path.to_owned(),
+        what: what.to_owned(),
+        uri: short_uri(uri),
+        reason: reason.to_owned(),
+    };
+    let base_dir = if base_dir.as_os_str().is_empty() { Path::new(".") } else { base_dir };
+    let outside = |reason: String| SceneError::UriOutsideFolder {
+        path: path.to_owned(),
+        what: what.to_owned(),
+        uri: short_uri(uri),
+        folder: base_dir.to_owned(),
+        reason,
+    };
+    let lower = uri.get(..8).unwrap_or(uri).to_ascii_lowercase();
+    if lower.starts_with("http://") || lower.starts_with("https://") || uri.starts_with("//") {
+        return Err(SceneError::ExternalUri {
+            path: path.to_owned(),
+            what: what.to_owned(),
+            uri: short_uri(uri),
+        });
+    }
+    if lower.starts_with("data:") {
+        let rest = &uri[5..];
+        let (header, payload) = rest.split_once(',').ok_or_else(|| bad("data URI without ','"))?;
+        let Some(media_type) = header.strip_suffix(";base64") else {
+            return Err(bad("only base64 data URIs are supported"));
+        };
+        let bytes = base64::engine::general_purpose::STANDARD
+            .decode(payload.trim_end())
+            .map_err(|e| bad(&format!("invalid base64: {e}")))?;
+        return Ok(UriSource::Data { bytes, media_type: media_type.to_ascii_lowercase() });
+    }
+    // A scheme is letters/digits/+/-/. before the first ':' that comes before any '/'; a
+    // single letter there is a Windows drive.
+    if let Some(colon) = uri.find(':') {
+        let scheme = &uri[..colon];
+        if has_drive_letter(uri) {
+            return Err(outside("it is a Windows drive path".into()));
+        }
+        let looks_like_scheme =
+            !scheme.is_empty() && scheme.chars().all(|c| c.is_ascii_alphanumeric() || "+-.".contains(c));
+        if looks_like_scheme {
+            return Err(bad(&format!("unsupported URI scheme `{scheme}:`")));
+        }
+    }
+    if uri.is_empty() {
+        return Err(bad("empty URI"));
+    }
+    let decoded = percent_decode(uri).ok_or_else(|| bad("invalid percent escape"))?;
+    if decoded.contains('\0') {
+        return Err(bad("NUL byte in path"));
+    }
+    let joined = base_dir.join(relative_path(&decoded).map_err(outside)?);
+    let io_err = |file: &Path, source| SceneError::ReferencedFile {
+        path: path.to_owned(),
+        what: what.to_owned(),
+        file: file.to_owned(),
+        source,
+    };
+    let folder = base_dir.canonicalize().map_err(|e| io_err(base_dir, e))?;
+    let file = joined.canonicalize().map_err(|e| io_err(&joined, e))?;
+    if !file.starts_with(&folder) {
+        return Err(outside(format!("it resolves outside the folder (symlink) to `{}`", file.display())));
+    }
+    open_regular(path, what, file, &folder).map(UriSource::File).map_err(|e| match e {
+        OpenError::Outside(reason) => outside(reason),
+        OpenError::Scene(e) => e,
+    })
+}
+
+/// Why [`open_regular`] refused a file.
+enum OpenError {
+    /// The opened file is not the checked one inside the folder.
+    #[cfg_attr(not(unix), allow(dead_code))]
+    Outside(String),
+    /// Any other refusal, already typed.
+    Scene(SceneError),
+}
+
+/// Opens `file` (canonical, inside the canonical `folder`) if it is a regular file.
+fn open_regular(gltf: &Path, what: &str, file: PathBuf, folder: &Path) -> Result<LocalFile, OpenError> {
+    let io_err = |file: &Path, source| {
+        OpenError::Scene(SceneError::ReferencedFile {
+            path: gltf.to_owned(),
+            what: what.to_owned(),
+            file: file.to_owned(),
+            source,
+        })
+    };
+    let not_regular = |file: &Path, ty| {
+        OpenError::Scene(SceneError::NotARegularFile {
+            path: gltf.to_owned(),
+            what: what.to_owned(),
+            file: file.to_owned(),
+            kind: file_kind(ty),
+        })
+    };
+    // The canonical path has no symlinks left; checking without following one means a FIFO or
+    // device is refused before `open` could block on it or read from it.
+    let before = std::fs::symlink_metadata(&file).map_err(|e| io_err(&file, e))?;
+    if !before.is_file() {
+        return Err(not_regular(&file, before.file_type()));
+    }
+    let handle = open_options().open(&file).map_err(|e| io_err(&file, e))?;
+    // The file may have been replaced between the check and the open: check the handle.
+    let meta = handle.metadata().map_err(|e| io_err(&file, e))?;
+    if !meta.is_file() {
+        return Err(not_regular(&file, meta.file_type()));
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if (meta.dev(), meta.ino()) != (before.dev(), before.ino()) {
+            return Err(OpenError::Outside(format!("`{}` was replaced while it was opened", file.display())));
+        }
+    }
+    #[cfg(target_os = "linux")]
+    {
+        use std::os::fd::AsRawFd;
+        // A folder on the way may have been swapped for a symlink after canonicalization; the
+        // kernel knows where the opened file really is. Without `/proc` this check is skipped.
+        if let Ok(real) = std::fs::read_link(format!("/proc/self/fd/{}", handle.as_raw_fd()))
+            && !real.starts_with(folder)
+        {
+            return Err(OpenError::Outside(format!("the opened file is `{}`", real.display())));
+        }
+    }
+    #[cfg(not(target_os = "linux"))]
+    let _ = folder;
+    Ok(LocalFile { path: file, size: meta.len(), handle })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn plain_relative_paths_are_kept() {
+        assert_eq!(relative_path("bin/data.bin"), Ok(PathBuf::from("bin").join("data.bin")));
+        assert_eq!(relative_path("./a//b/./c.png"), Ok(PathBuf::from("a").join("b").join("c.png")));
+        assert_eq!(relative_path("x/a:b.png").is_err(), cfg!(windows));
+    }
+
+    #[test]
+    fn escaping_paths_are_refused() {
+        for p in ["/etc/passwd", "../x", "a/../../x", "a/..", "C:/x", "c:x", r"\\host\share\x", r"a\..\x"] {
+            assert!(relative_path(p).is_err(), "{p}");
+        }
+    }
+
+    /// Where `O_NONBLOCK` is known, opening a FIFO without a writer returns at once.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn opening_a_fifo_does_not_block() {
+        if OPEN_FLAGS == 0 {
+            return;
+        }
+        let dir = std::env::temp_dir().join(format!("manylight_scene_fifo_open_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let fifo = dir.join("pipe");
+        let _ = std::fs::remove_file(&fifo);
+        let status = std::process::Command::new("mkfifo").arg(&fifo).status().expect("run mkfifo");
+        assert!(status.success());
+        let (tx, rx) = std::sync::mpsc::channel();
+        let path = fifo.clone();
+        std::thread::spawn(move || {
+            let _ = tx.send(open_options().open(&path).map(|f| f.metadata().map(|m| m.file_type())));
+        });
+        let opened = rx.recv_timeout(std::time::Duration::from_secs(10)).expect("open returns at once");
+        let ty = opened.expect("open").expect("metadata");
+        assert_eq!(file_kind(ty), "FIFO (named pipe)");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn percent_escapes_are_decoded() {
+        assert_eq!(percent_decode("a%20b%2F..").as_deref(), Some("a b/.."));
+        assert_eq!(percent_decode("%zz"), None);
+        assert_eq!(percent_decode("%4"), None);
+    }
+}
