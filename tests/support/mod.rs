@@ -32,7 +32,7 @@ pub struct Tolerance {
     pub p99: f32,
 }
 
-/// The tolerance the issues ask of pipelines compared with each other and of stored references.
+/// The tolerance of pipelines compared with each other and of stored references.
 pub const STRICT: Tolerance = Tolerance { mean: 0.005, p99: 0.05 };
 
 fn root() -> PathBuf {

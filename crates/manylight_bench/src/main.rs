@@ -150,12 +150,12 @@ struct RenderArgs {
     /// `default` (embedded hall), `sphere-shell`, or a path to a .gltf/.glb file.
     #[arg(long, default_value = "default")]
     scene: String,
-    /// Pipeline: naive, forward-plus, clustered-forward or clustered-deferred.
+    /// Pipeline: naive, forward-plus, clustered-forward, clustered-deferred or light-volumes.
     #[arg(long, default_value = "clustered-forward", value_parser = parse_pipeline)]
     pipeline: PipelineKind,
     #[command(flatten)]
     clusters: ClusterArgs,
-    /// Shading model for materials without their own: lambert or blinn-phong.
+    /// Shading model for materials without their own: lambert, blinn-phong or toon.
     #[arg(long, default_value = "blinn-phong", value_parser = parse_shading)]
     shading: ShadingModel,
     /// Animated lights added to the scene's own lights (default: 64 for a scene that has no

@@ -17,8 +17,8 @@ pub const CLUSTER_NO_CAP: u32 = 0xffff_ffff;
 /// Lights one invocation of the cluster build's level 1 tests against its tile. Each
 /// invocation handles one (tile, chunk of lights) pair, because lavapipe (Mesa 22.3's llvmpipe)
 /// silently stops a shader invocation after 65 535 loop iterations in total: a loop over all
-/// lights lost every light past the ~16 000th. 4096 lights × (1 + 6 plane-test iterations)
-/// stays well below that.
+/// lights lost every light past the ~16 000th. 4096 iterations (the plane test has no loop)
+/// stay well below that.
 pub const TILE_LIGHT_CHUNK: u32 = 4096;
 /// Workgroup size of the prefix-sum step of the cluster build (one workgroup scans all).
 pub const SCAN_WORKGROUP_SIZE: u32 = 256;
@@ -157,7 +157,7 @@ pub struct GpuClusterParams {
     pub light_count: u32,
     /// Per-cluster cap or [`CLUSTER_NO_CAP`].
     pub cap: u32,
-    /// [`CULL_AABB`] or [`CULL_PLANES`].
+    /// [`CULL_AABB`], [`CULL_PLANES`] or [`CULL_BOTH`].
     pub cull_test: u32,
     /// Entries the index list can hold.
     pub index_capacity: u32,

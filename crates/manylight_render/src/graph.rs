@@ -5,8 +5,8 @@
 //! 1. systems add passes ([`RenderGraph::add`]) for the effects the frame calls for;
 //! 2. [`RenderGraph::compile`] keeps the passes that contribute to [`OUTPUT`] and orders them
 //!    so that every reader comes after the writers of what it reads (ties keep insertion order);
-//! 3. the [`crate::executor::GraphExecutor`] allocates transient textures from its pool, records
-//!    each pass inside timestamp queries, and submits.
+//! 3. [`crate::renderer::Renderer::execute`] allocates transient textures from its pool,
+//!    records each pass inside timestamp queries, and submits.
 
 use crate::context::{GpuContext, RenderError};
 use crate::pipelines::PipelineCache;

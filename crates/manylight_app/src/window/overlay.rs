@@ -5,7 +5,7 @@
 //! How it runs, frame by frame:
 //! 1. The runner hands each window event to egui first ([`egui_winit::State`]); an event egui
 //!    uses (a click on the panel, a key while a widget has focus) does not reach the app.
-//! 2. Before `App::update`, [`OverlayHost::run`] builds the UI against the app's world. A changed
+//! 2. Before `App::update`, `OverlayHost::run` builds the UI against the app's world. A changed
 //!    setting is written to its resource or camera component there, so the same frame's extract
 //!    sees it. The UI is tessellated on the main thread and left in a slot shared with the sink.
 //! 3. The surface sink renders the frame, then [`OverlayPainter::paint`] draws the latest UI as

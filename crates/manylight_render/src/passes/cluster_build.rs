@@ -6,7 +6,7 @@ use super::CLUSTERS;
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName};
 
-/// The three compute pipelines of the build, for one workgroup size.
+/// The six compute pipelines of the build (three per level), for one workgroup size.
 pub struct ClusterBuildPipelines {
     tile_count: wgpu::ComputePipeline,
     tile_scan: wgpu::ComputePipeline,

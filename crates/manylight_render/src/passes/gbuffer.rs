@@ -16,7 +16,7 @@ use manylight_core::codec::NormalCodec;
 /// The G-buffer targets of a layout: name and format.
 pub fn targets(layout: GBufferLayout) -> &'static [(ResourceName, wgpu::TextureFormat)] {
     match layout {
-        // Albedo is rgba16f, not the rgba8 of ARCHITECTURE.md: with 8 bits (even sRGB-encoded)
+        // Albedo is rgba16f, not rgba8: with 8 bits (even sRGB-encoded)
         // the image differed from naive forward by FLIP mean 0.015, with 16-bit floats 0.0035.
         GBufferLayout::Full => &[
             (GBUFFER_POSITION, wgpu::TextureFormat::Rgba32Float),
