@@ -6,6 +6,7 @@
 use bevy_ecs::prelude::*;
 use crossbeam_channel::{Receiver, Sender, bounded, unbounded};
 use manylight_render::{FrameReport, FrameSnapshot, RenderError};
+use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::thread::JoinHandle;
 
 /// What a rendered frame gives back: its report and, if asked, its image.
@@ -31,6 +32,24 @@ impl FrameSink for crate::render_world::HeadlessRenderer {
     }
 }
 
+/// The message of a panic payload (`panic!` with a string or a formatted message).
+fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "a panic without a message".to_string())
+}
+
+/// Renders one frame, turning a panic of the renderer into an error (the renderer is not used
+/// again after one).
+fn render_caught(sink: &mut dyn FrameSink, snapshot: FrameSnapshot, readback: bool) -> FrameResult {
+    match catch_unwind(AssertUnwindSafe(|| sink.render_frame(snapshot, readback))) {
+        Ok(result) => result.map_err(|e| e.to_string()),
+        Err(payload) => Err(format!("the renderer panicked: {}", panic_message(payload.as_ref()))),
+    }
+}
+
 enum Message {
     Frame(Box<FrameSnapshot>, bool),
 }
@@ -50,7 +69,7 @@ impl RenderThread {
         let handle = std::thread::Builder::new().name("manylight-render".into()).spawn(move || {
             // Ends when the sender is dropped (app shut down) or a frame fails.
             while let Ok(Message::Frame(snapshot, readback)) = frame_rx.recv() {
-                let result = sink.render_frame(*snapshot, readback).map_err(|e| e.to_string());
+                let result = render_caught(sink.as_mut(), *snapshot, readback);
                 let failed = result.is_err();
                 if result_tx.send(result).is_err() || failed {
                     break;
@@ -61,20 +80,22 @@ impl RenderThread {
         Ok(RenderThread { frames: Some(frame_tx), results: result_rx, handle: Some(handle) })
     }
 
-    /// Stops the thread after the frame in flight and waits for it.
-    pub fn shutdown(&mut self) {
+    /// Stops the thread after the frame in flight and waits for it; a panic that ended the
+    /// thread comes back as its message.
+    pub fn shutdown(&mut self) -> Option<String> {
         self.frames.take();
-        if let Some(h) = self.handle.take()
-            && h.join().is_err()
-        {
-            tracing::error!("the render thread panicked");
-        }
+        let panic = self.handle.take().and_then(|h| h.join().err()).map(|payload| {
+            let message = format!("the render thread panicked: {}", panic_message(payload.as_ref()));
+            tracing::error!("{message}");
+            message
+        });
+        panic
     }
 }
 
 impl Drop for RenderThread {
     fn drop(&mut self) {
-        self.shutdown();
+        let _ = self.shutdown();
     }
 }
 
@@ -102,7 +123,7 @@ impl RenderBackend {
         match self {
             RenderBackend::Pending => {}
             RenderBackend::Sync { sink, pending } => {
-                pending.push(sink.render_frame(snapshot, readback).map_err(|e| e.to_string()));
+                pending.push(render_caught(sink.as_mut(), snapshot, readback));
             }
             RenderBackend::Pipelined(thread) => {
                 let sent = thread
@@ -127,8 +148,10 @@ impl RenderBackend {
                 // panicked, or it stopped after an error already reported above).
                 let ended = thread.handle.as_ref().is_some_and(|h| h.is_finished());
                 if ended && thread.frames.is_some() && !results.iter().any(|r| r.is_err()) {
-                    thread.frames.take();
-                    results.push(Err("the render thread stopped unexpectedly".into()));
+                    let message = thread.shutdown();
+                    results.push(Err(
+                        message.unwrap_or_else(|| "the render thread stopped unexpectedly".into())
+                    ));
                 }
                 results
             }
@@ -140,14 +163,20 @@ impl RenderBackend {
         }
     }
 
-    /// Waits for every frame in flight (pipelined mode) and returns their results.
+    /// Waits for every frame in flight (pipelined mode) and returns their results; a render
+    /// thread that panicked adds an error with the panic's message, so a run never ends in a
+    /// success with a frame missing.
     pub fn flush(&mut self) -> Vec<FrameResult> {
-        if let RenderBackend::Pipelined(thread) = self {
-            thread.frames.take();
-            if let Some(h) = thread.handle.take() {
-                let _ = h.join();
-            }
+        let panic = match self {
+            RenderBackend::Pipelined(thread) => thread.shutdown(),
+            _ => None,
+        };
+        let mut results = self.drain();
+        if let Some(message) = panic
+            && !results.iter().any(|r| r.is_err())
+        {
+            results.push(Err(message));
         }
-        self.drain()
+        results
     }
 }
