@@ -113,14 +113,20 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
     Ok(csv(&rows, scene_name, sweep.size, &adapter))
 }
 
-/// Every pass name of `reports`, in order of first appearance (a pass that runs several times
-/// in a frame, like a blur iteration, is named once).
+/// Every pass name of `reports` in an order that keeps each frame's order (a pass first seen
+/// goes right after the pass before it in its frame, so the tone map stays last); a pass that
+/// runs several times in a frame, like a blur iteration, is named once.
 pub fn pass_names<'a>(reports: impl Iterator<Item = &'a FrameReport>) -> Vec<String> {
     let mut names: Vec<String> = Vec::new();
     for r in reports {
+        let mut next = 0;
         for p in &r.passes {
-            if !names.contains(&p.name) {
-                names.push(p.name.clone());
+            match names.iter().position(|n| *n == p.name) {
+                Some(i) => next = i + 1,
+                None => {
+                    names.insert(next, p.name.clone());
+                    next += 1;
+                }
             }
         }
     }

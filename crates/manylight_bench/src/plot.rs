@@ -13,7 +13,8 @@ use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::Once;
 
-/// Font family every figure uses (Ubuntu Light, embedded, so no system fonts are needed).
+/// Font family every figure uses (Hack, embedded, so no system fonts are needed; its letters
+/// stay distinct at small sizes, where a light sans font merges "cl" into "d").
 const FONT: &str = "sans-serif";
 
 /// Series colours: distinguishable on white, in a fixed order.
@@ -40,7 +41,7 @@ fn register_font() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         // The embedded font is valid; an error here would leave text undrawn, not crash.
-        let _ = plotters::style::register_font(FONT, FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT);
+        let _ = plotters::style::register_font(FONT, FontStyle::Normal, epaint_default_fonts::HACK_REGULAR);
     });
 }
 
@@ -181,6 +182,20 @@ pub fn pass_bars(table: &Table) -> Vec<Bar> {
         .collect()
 }
 
+/// The bars without those more than 10× the median total (the naive reference beside the
+/// fast pipelines would flatten every other bar), and "label: total" of each one left out.
+pub fn without_outliers(bars: Vec<Bar>) -> (Vec<Bar>, Vec<String>) {
+    let total = |b: &Bar| b.1.iter().map(|(_, v)| v.max(0.0)).sum::<f64>();
+    let mut totals: Vec<f64> = bars.iter().map(total).collect();
+    totals.sort_by(f64::total_cmp);
+    let median = totals.get(totals.len() / 2).copied().unwrap_or(0.0);
+    if median <= 0.0 {
+        return (bars, Vec::new());
+    }
+    let (kept, out): (Vec<Bar>, Vec<Bar>) = bars.into_iter().partition(|b| total(b) <= 10.0 * median);
+    (kept, out.iter().map(|b| format!("{} {:.0} ms", b.0, total(b))).collect())
+}
+
 /// Frame textures and cluster buffers of each configuration, MiB.
 pub fn memory_bars(table: &Table) -> Vec<Bar> {
     bar_rows(table)
@@ -311,10 +326,17 @@ where
 {
     for (i, (label, points)) in series.iter().enumerate() {
         let c = color(i);
+        // A series equal to an earlier one (pipelines sharing one light list) hides under
+        // it; the legend says so.
+        let twin = series[..i].iter().find(|(_, p)| p == points).map(|(l, _)| l.as_str());
+        let label = match twin {
+            Some(t) => format!("{label} (same as {t})"),
+            None => label.clone(),
+        };
         chart
             .draw_series(LineSeries::new(points.iter().copied(), c.stroke_width(3)))
             .map_err(drawing)?
-            .label(label.as_str())
+            .label(label)
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], c.stroke_width(3)));
         chart.draw_series(points.iter().map(|&p| Circle::new(p, 5, c.filled()))).map_err(drawing)?;
     }
@@ -348,11 +370,16 @@ where
         .map_err(drawing)
 }
 
-/// Horizontal stacked bars, first bar at the top, one colour per segment name.
-fn stacked_bars(path: &Path, title: &str, x_desc: &str, bars: &[Bar]) -> Result<()> {
+/// Horizontal stacked bars, first bar at the top, one colour per segment name; `note` is
+/// written under the chart.
+fn stacked_bars(path: &Path, title: &str, x_desc: &str, bars: &[Bar], note: Option<&str>) -> Result<()> {
     let n = bars.len().max(1);
-    let height = (170 + 44 * n as u32).max(420);
+    let height = (200 + 44 * n as u32).max(450);
     save(path, (1400, height), |root| {
+        if let Some(note) = note {
+            root.draw(&Text::new(note.to_string(), (20, height as i32 - 28), (FONT, 16).into_font()))
+                .map_err(drawing)?;
+        }
         let mut names: Vec<&str> = Vec::new();
         for (_, segments) in bars {
             for (name, _) in segments {
@@ -364,13 +391,14 @@ fn stacked_bars(path: &Path, title: &str, x_desc: &str, bars: &[Bar]) -> Result<
         let widest =
             bars.iter().map(|(_, s)| s.iter().map(|(_, v)| v.max(0.0)).sum::<f64>()).fold(0.0, f64::max);
         let labels: Vec<String> = bars.iter().map(|(l, _)| l.clone()).collect();
-        let label_width = labels.iter().map(|l| l.chars().count()).max().unwrap_or(10) as u32 * 9 + 20;
+        let label_width = labels.iter().map(|l| l.chars().count()).max().unwrap_or(10) as u32 * 10 + 24;
         let mut chart = ChartBuilder::on(root)
             .caption(title, (FONT, 26))
             .margin(20)
+            .margin_bottom(44)
             .x_label_area_size(60)
-            .y_label_area_size(label_width.min(620))
-            .build_cartesian_2d(0.0..(widest * 1.3).max(1e-3), (0..n as i32).into_segmented())
+            .y_label_area_size(label_width.min(640))
+            .build_cartesian_2d(0.0..(widest * 1.6).max(1e-3), (0..n as i32 - 1).into_segmented())
             .map_err(drawing)?;
         let row_of = |i: usize| (n - 1 - i) as i32;
         chart
@@ -378,8 +406,8 @@ fn stacked_bars(path: &Path, title: &str, x_desc: &str, bars: &[Bar]) -> Result<
             .disable_y_mesh()
             .y_labels(n)
             .y_label_formatter(&|v| match v {
-                SegmentValue::CenterOf(i) => {
-                    labels.get(n - 1 - (*i).clamp(0, n as i32 - 1) as usize).cloned().unwrap_or_default()
+                SegmentValue::CenterOf(i) if (0..n as i32).contains(i) => {
+                    labels.get(n - 1 - *i as usize).cloned().unwrap_or_default()
                 }
                 _ => String::new(),
             })
@@ -437,7 +465,7 @@ fn accuracy_chart(path: &Path, title: &str, points: &[AccuracyPoint]) -> Result<
     // A zero error (the reference itself) is drawn on the bottom of the log axis.
     const FLOOR: f64 = 1e-5;
     let height = (200 + 26 * points.len() as u32).max(800);
-    save(path, (1600, height), |root| {
+    save(path, (1900, height), |root| {
         let (left, right) = root.split_horizontally(1000);
         let xs = log_range(points.iter().map(|p| p.frame_ms));
         let ys = log_range(points.iter().map(|p| p.flip_mean.max(FLOOR)));
@@ -464,7 +492,11 @@ fn accuracy_chart(path: &Path, title: &str, points: &[AccuracyPoint]) -> Result<
                 .draw_series(std::iter::once(
                     EmptyElement::at(at(p))
                         + Circle::new((0, 0), 7, marker)
-                        + Text::new(format!("{}", i + 1), (8, -20), (FONT, 18)),
+                        + Text::new(
+                            format!("{}", i + 1),
+                            if i % 2 == 0 { (8, -20) } else { (-18, 8) },
+                            (FONT, 16),
+                        ),
                 ))
                 .map_err(drawing)?;
         }
@@ -478,13 +510,11 @@ fn accuracy_chart(path: &Path, title: &str, points: &[AccuracyPoint]) -> Result<
             .map_err(drawing)?;
         // The key: number, configuration, figures; Pareto-optimal ones marked.
         let style = TextStyle::from((FONT, 16).into_font()).color(&BLACK);
-        right
-            .draw(&Text::new("configuration (● on the Pareto front)", (10, 40), (FONT, 18).into_font()))
-            .map_err(drawing)?;
+        let heading = "configuration (* on the Pareto front): frame ms, FLIP mean";
+        right.draw(&Text::new(heading, (10, 40), (FONT, 17).into_font())).map_err(drawing)?;
         for (i, p) in points.iter().enumerate() {
-            let mark = if front.contains(&i) { "●" } else { "○" };
-            let line =
-                format!("{mark} {:>2}  {}  ({:.0} ms, {:.4})", i + 1, p.label, p.frame_ms, p.flip_mean);
+            let mark = if front.contains(&i) { "*" } else { " " };
+            let line = format!("{mark}{:>2} {}: {:.0} ms, {:.4}", i + 1, p.label, p.frame_ms, p.flip_mean);
             right.draw(&Text::new(line, (10, 72 + 26 * i as i32), style.clone())).map_err(drawing)?;
         }
         Ok(())
@@ -575,23 +605,25 @@ pub fn figures(csv: &str, dir: &Path) -> Result<Vec<PathBuf>> {
         Some(lights) => format!(" at {lights} lights"),
         None => String::new(),
     };
-    let passes = pass_bars(&table);
+    let (passes, left_out) = without_outliers(pass_bars(&table));
     if passes.iter().any(|(_, s)| !s.is_empty()) {
         let path = file("passes");
         let untrusted = table.rows.iter().any(|r| table.text(r, "cluster_build_gpu_trusted") == "false")
             || table.rows.iter().any(|r| !table.text(r, "untrusted_passes").is_empty());
         let x_desc = if untrusted {
-            "GPU time per pass (ms; compute timestamps are unreliable on this adapter)"
+            "GPU ms per pass (compute timestamps are unreliable on this adapter)"
         } else {
-            "GPU time per pass (ms)"
+            "GPU ms per pass"
         };
-        stacked_bars(&path, &format!("GPU time per pass{at} — {setting}"), x_desc, &passes)?;
+        let note =
+            (!left_out.is_empty()).then(|| format!("Not drawn (off the scale): {}", left_out.join(", ")));
+        stacked_bars(&path, &format!("GPU time per pass{at} — {setting}"), x_desc, &passes, note.as_deref())?;
         written.push(path);
     }
     let memory = memory_bars(&table);
     if memory.iter().any(|(_, s)| !s.is_empty()) {
         let path = file("memory");
-        stacked_bars(&path, &format!("Memory per configuration{at} — {setting}"), "MiB", &memory)?;
+        stacked_bars(&path, &format!("Memory per configuration{at} — {setting}"), "MiB", &memory, None)?;
         written.push(path);
     }
     Ok(written)

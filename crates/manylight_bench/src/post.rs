@@ -237,7 +237,7 @@ fn csv(rows: &[PostRow], scene: &str, size: UVec2, adapter: &str) -> Result<Stri
         "configuration",
         "frame_ms_median",
         "vs_none_ms",
-        "post_gpu_ms",
+        "post_passes_ms",
         "transient_mib",
     ]
     .map(String::from)
