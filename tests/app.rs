@@ -114,6 +114,11 @@ fn invalid_lights_are_dropped_and_counted_and_the_image_stays_finite() {
                 Transform::from_xyz(0.0, 1.0, 0.0),
                 PointLight { intensity: -1.0, ..PointLight::default() },
             ));
+            // Finite colour and intensity whose product overflows to infinity.
+            commands.spawn((
+                Transform::from_xyz(0.0, 1.0, 0.0),
+                PointLight { color: Vec3::splat(1e30), intensity: 1e30, ..PointLight::default() },
+            ));
             // Valid edge cases: radius 0 (lights nothing) and a huge radius.
             commands.spawn((
                 Transform::from_xyz(0.0, 1.0, 0.0),
@@ -128,7 +133,7 @@ fn invalid_lights_are_dropped_and_counted_and_the_image_stays_finite() {
     .expect("renders");
     support::assert_finite(&frame);
     let report = frame.stats.last.expect("a report");
-    assert_eq!(report.invalid_lights, 3);
+    assert_eq!(report.invalid_lights, 4);
     assert_eq!(report.light_count as usize, default_scene().lights.len() + 2);
     assert!(frame.image.pixels().any(|p| p.0[0] > 10), "the frame is lit");
 }

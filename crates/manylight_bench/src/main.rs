@@ -25,6 +25,7 @@ use std::process::ExitCode;
 
 mod bench;
 mod codec_accuracy;
+mod culling_tests;
 mod depth_precision;
 mod direct;
 mod plot;
@@ -70,6 +71,16 @@ enum Command {
         /// Log-spaced depths per decade (each at five pixels).
         #[arg(long, default_value_t = 2000)]
         samples: usize,
+    },
+    /// False-positive rates of the sphere–cluster tests (AABB, planes, both) against an exact
+    /// test, as a markdown table (CPU only).
+    CullingTests {
+        /// Random lights.
+        #[arg(long, default_value_t = 1024)]
+        lights: usize,
+        /// Seed of the light placement.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
     },
     /// Worst and mean angular error of every normal codec over the sphere, as a markdown
     /// table (CPU only).
@@ -579,6 +590,10 @@ fn main() -> ExitCode {
             Ok(())
         }
         Command::CodecAccuracy { samples } => codec_accuracy_cmd(samples.max(1)),
+        Command::CullingTests { lights, seed } => {
+            print!("{}", culling_tests::table(lights, seed));
+            Ok(())
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -21,12 +21,17 @@ impl Default for Projection {
 }
 
 impl Projection {
-    /// Clamps parameters into their valid ranges so the matrix is always finite.
+    /// Clamps parameters into their valid ranges so the matrix is always finite: a NaN,
+    /// infinite or non-positive near plane becomes 0.1, a near plane so large that no finite
+    /// far plane fits beyond it is lowered, and a missing, NaN or too-close far plane becomes
+    /// `near × 10⁴` (at most `f32::MAX`).
     pub fn sanitized(self) -> Projection {
+        /// Largest near plane that leaves room for a far plane a factor of 2 beyond it.
+        const MAX_NEAR: f32 = f32::MAX / 4.0;
         let fov_y =
             if self.fov_y.is_finite() { self.fov_y.clamp(1e-4, std::f32::consts::PI - 1e-4) } else { 1.0 };
-        let near = if self.near.is_finite() && self.near > 0.0 { self.near } else { 0.1 };
-        let far = if self.far.is_finite() && self.far > near { self.far } else { near * 1e4 };
+        let near = if self.near.is_finite() && self.near > 0.0 { self.near.min(MAX_NEAR) } else { 0.1 };
+        let far = if self.far.is_finite() && self.far > near { self.far } else { (near * 1e4).min(f32::MAX) };
         Projection { fov_y, near, far }
     }
 
@@ -57,6 +62,40 @@ pub fn linearize_depth_reverse_z(depth: f32, near: f32, far: f32) -> f32 {
 mod tests {
     use super::*;
     use glam::Vec4;
+
+    /// Extreme and invalid parameters never give a non-finite matrix: a huge near plane with
+    /// no far plane used to make `far` infinite and the depth terms `inf × 0 = NaN`.
+    #[test]
+    fn extreme_parameters_give_a_finite_matrix() {
+        let values = [
+            0.0,
+            -1.0,
+            1e-6,
+            0.1,
+            1.0,
+            1e6,
+            1e30,
+            f32::MAX / 8.0,
+            f32::MAX,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+        ];
+        let fovs = [0.0, 1e-6, 1.0, std::f32::consts::PI - 1e-6, std::f32::consts::PI, f32::NAN];
+        for &near in &values {
+            for &far in &values {
+                for &fov_y in &fovs {
+                    for aspect in [0.0, 1e-6, 16.0 / 9.0, f32::NAN] {
+                        let p = Projection { fov_y, near, far };
+                        let s = p.sanitized();
+                        assert!(s.near > 0.0 && s.far > s.near && s.far.is_finite(), "{p:?} -> {s:?}");
+                        let m = p.matrix(aspect);
+                        assert!(m.is_finite(), "{p:?} aspect {aspect}: {m:?}");
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn reverse_z_maps_near_to_one_and_far_to_zero() {

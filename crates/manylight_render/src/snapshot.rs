@@ -357,11 +357,13 @@ pub struct ExtractedPointLight {
 }
 
 impl ExtractedPointLight {
-    /// True when every parameter is finite and the radius and intensity are not negative.
+    /// True when every parameter is finite, the radius and intensity are not negative, and the
+    /// emitted colour (`color × intensity`) does not overflow to infinity.
     pub fn is_valid(&self) -> bool {
         self.position.is_finite()
             && self.color.is_finite()
             && self.intensity.is_finite()
+            && (self.color * self.intensity).is_finite()
             && self.radius.is_finite()
             && self.radius >= 0.0
             && self.intensity >= 0.0
