@@ -5,29 +5,13 @@
 use glam::{UVec2, Vec3};
 use manylight_core::Projection;
 use manylight_core::cluster::{ClusterGrid, CullTest, GridConfig, ViewSphere, false_positive_counts};
+use manylight_scene::SplitMix64;
 use std::fmt::Write as _;
-
-/// splitmix64: a small deterministic generator (the same scene on every machine).
-struct SplitMix(u64);
-
-impl SplitMix {
-    fn unit(&mut self) -> f32 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-    }
-
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.unit()
-    }
-}
 
 /// `lights` random lights spread over the first 100 units of depth (radius 0.5–5), a little
 /// beyond the view's sides, as view-space spheres.
 pub fn scene(grid: &ClusterGrid, lights: usize, seed: u64) -> Vec<ViewSphere> {
-    let mut rng = SplitMix(seed ^ 0x9E37_79B9_7F4A_7C15);
+    let mut rng = SplitMix64(seed ^ 0x9E37_79B9_7F4A_7C15);
     let tan = grid.tan_half_fov();
     (0..lights)
         .map(|_| {

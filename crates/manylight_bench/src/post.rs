@@ -5,6 +5,7 @@
 
 use crate::direct::snapshot;
 use crate::progress::Progress;
+use crate::report::Report;
 use anyhow::Result;
 use glam::{Mat4, UVec2};
 use manylight_app::render_world::HeadlessRenderer;
@@ -93,14 +94,6 @@ struct PostRow {
     transient_bytes: u64,
 }
 
-/// The post-stage costs: a markdown table for the terminal and the same figures as CSV.
-pub struct PostReport {
-    /// The markdown table with a line of context above it.
-    pub markdown: String,
-    /// One CSV row per configuration.
-    pub csv: String,
-}
-
 /// Runs every configuration on `scene` (called `scene_name` in the output) with `lights` rig
 /// lights. Each configuration has its own renderer (so its transient textures stay pooled),
 /// and the configurations take turns frame by frame, so a change in machine load hits them
@@ -112,7 +105,7 @@ pub fn run(
     size: UVec2,
     frames: u32,
     base: FrameSettings,
-) -> Result<PostReport> {
+) -> Result<Report> {
     let rig = light_rig(lights, scene.bounds(), 1);
     let configs = configurations();
     let mut renderers = configs.iter().map(|_| HeadlessRenderer::new()).collect::<Result<Vec<_>, _>>()?;
@@ -181,7 +174,7 @@ pub fn run(
         scene.lights.len(),
         base.pipeline.name()
     );
-    Ok(PostReport { markdown: markdown(&rows, &context)?, csv: csv(&rows, scene_name, size, &adapter)? })
+    Ok(Report { markdown: markdown(&rows, &context)?, csv: csv(&rows, scene_name, size, &adapter)? })
 }
 
 fn markdown(rows: &[PostRow], context: &str) -> Result<String> {

@@ -97,11 +97,12 @@ struct ReportRow {
     flip_p99: f64,
 }
 
-/// The report: a markdown table for the terminal and the same figures as CSV (for `--plot`).
+/// What a measuring command prints: a markdown table for the terminal and the same figures as
+/// CSV (for `--plot`), one row per configuration.
 pub struct Report {
     /// The markdown table with a line of context above it.
     pub markdown: String,
-    /// One CSV row per configuration, naive forward first.
+    /// The CSV text.
     pub csv: String,
 }
 

@@ -16,7 +16,8 @@ pub use default_scene::default_scene;
 pub use error::SceneError;
 pub use gltf_loader::{LoadOptions, blinn_phong_from_pbr, load_gltf};
 pub use light_rig::{
-    AnimatedLight, RIG_RADIUS_K, intensity_for_radius, light_rig, sphere_shell_lights, sphere_shell_scene,
+    AnimatedLight, RIG_RADIUS_K, SplitMix64, intensity_for_radius, light_rig, sphere_shell_lights,
+    sphere_shell_scene,
 };
 pub use scene_ops::{camera_looking_at, load_scene};
 

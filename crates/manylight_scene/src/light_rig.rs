@@ -96,11 +96,13 @@ impl AnimatedLight {
     }
 }
 
-/// splitmix64: a tiny, well-mixed deterministic generator.
-struct SplitMix64(u64);
+/// splitmix64: a tiny, well-mixed deterministic generator (the same sequence on every
+/// machine, so scenes built from a seed are reproducible).
+pub struct SplitMix64(pub u64);
 
 impl SplitMix64 {
-    fn next_u64(&mut self) -> u64 {
+    /// The next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
@@ -109,12 +111,12 @@ impl SplitMix64 {
     }
 
     /// Uniform in [0, 1).
-    fn f32(&mut self) -> f32 {
+    pub fn f32(&mut self) -> f32 {
         (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
     }
 
     /// Uniform in [lo, hi).
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
+    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
         lo + (hi - lo) * self.f32()
     }
 }
