@@ -52,7 +52,23 @@ pub enum RenderError {
     /// The device reported a validation or out-of-memory error.
     #[error("GPU error: {0}")]
     Device(String),
+    /// The GPU did not finish submitted work within [`GPU_WAIT_TIMEOUT`] (a hung or lost
+    /// device); the frame is abandoned instead of freezing the caller.
+    #[error(
+        "the GPU did not finish its work within {seconds} s (GPU_WAIT_TIMEOUT): hung or lost device ({message})"
+    )]
+    GpuTimeout {
+        /// The limit that was reached.
+        seconds: u64,
+        /// What the driver said.
+        message: String,
+    },
 }
+
+/// Longest wait for the GPU to finish submitted work. Generous, because a CPU rasteriser
+/// (lavapipe) takes minutes for naive forward with a hundred thousand lights; past it a
+/// frame fails with [`RenderError::GpuTimeout`] instead of freezing the app.
+pub const GPU_WAIT_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(600);
 
 /// Instance, adapter, device and queue, shared by every part of the renderer.
 #[derive(Clone)]
@@ -74,6 +90,17 @@ pub struct GpuContext {
 }
 
 impl GpuContext {
+    /// Waits until the GPU has finished all submitted work, at most [`GPU_WAIT_TIMEOUT`].
+    pub fn wait_idle(&self) -> Result<(), RenderError> {
+        self.device
+            .poll(wgpu::PollType::Wait { submission_index: None, timeout: Some(GPU_WAIT_TIMEOUT) })
+            .map(|_| ())
+            .map_err(|e| RenderError::GpuTimeout {
+                seconds: GPU_WAIT_TIMEOUT.as_secs(),
+                message: e.to_string(),
+            })
+    }
+
     /// Creates a context without a surface (headless rendering, tests, benchmarks).
     pub fn headless() -> Result<GpuContext, RenderError> {
         let instance = new_instance();

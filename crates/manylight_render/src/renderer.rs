@@ -171,12 +171,12 @@ impl Renderer {
             t.resolve(&mut encoder, order.len() as u32);
         }
         self.gpu.queue.submit([encoder.finish()]);
+        self.gpu.wait_idle()?;
         if let Some(t) = &self.timer {
             for (p, ms) in passes.iter_mut().zip(t.read(&self.gpu.device, &written)) {
                 p.gpu_ms = ms;
             }
         }
-        let _ = self.gpu.device.poll(wgpu::PollType::wait_indefinitely());
         self.last_textures = textures;
         let errors = self.gpu.take_errors();
         if !errors.is_empty() {

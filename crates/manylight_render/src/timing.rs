@@ -68,7 +68,10 @@ impl GpuTimer {
         slice.map_async(wgpu::MapMode::Read, move |r| {
             let _ = tx.send(r);
         });
-        let _ = device.poll(wgpu::PollType::wait_indefinitely());
+        // The frame's work is finished (the renderer waited); this only maps the results. A
+        // failed wait leaves the figures unknown (`None`), not the frame failed.
+        let timeout = Some(crate::context::GPU_WAIT_TIMEOUT);
+        let _ = device.poll(wgpu::PollType::Wait { submission_index: None, timeout });
         let mapped_ok = matches!(rx.recv(), Ok(Ok(())));
         let mut out = vec![None; written.len()];
         if mapped_ok {
