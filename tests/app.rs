@@ -275,3 +275,85 @@ fn each_pipeline_builds_exactly_its_passes() {
         assert_eq!(stats(&app).pass_names(), expected, "{pipeline:?}, lights: {lights}");
     }
 }
+
+#[test]
+fn an_invalid_camera_renders_nothing_and_is_counted() {
+    let _gpu = gpu();
+    let cameras = [
+        Transform::from_xyz(f32::NAN, 1.0, 5.0),
+        Transform::from_xyz(0.0, f32::INFINITY, 5.0),
+        Transform {
+            rotation: Quat::from_xyzw(f32::NAN, 0.0, 0.0, 1.0),
+            ..Transform::from_xyz(0.0, 1.0, 5.0)
+        },
+    ];
+    for camera in cameras {
+        let mut app = App::new();
+        app.add_plugins(ManyLightPlugin::headless(SIZE)).add_systems(
+            Startup,
+            move |mut commands: Commands| {
+                let scene = default_scene();
+                spawn_scene(&mut commands, &scene, false, 1.5);
+                spawn_light_rig(&mut commands, 8, scene.bounds(), 1);
+                commands.spawn((camera, Camera3d::default()));
+            },
+        );
+        app.update();
+        let s = stats(&app);
+        let report = s.last.as_ref().expect("a report");
+        assert_eq!(report.invalid_cameras, 1, "{camera:?}");
+        assert!(report.passes.is_empty(), "{camera:?}: {:?}", report.pass_names());
+        assert!(app.world().resource::<RenderFailure>().0.is_none(), "{camera:?}");
+    }
+}
+
+#[test]
+fn extreme_projections_render_finite_images() {
+    let _gpu = gpu();
+    let projections = [
+        (1e-6, 1e-6, 1000.0),
+        (std::f32::consts::PI - 1e-6, 0.1, 1000.0),
+        (0.0, 0.0, 0.0),
+        (1.0, 1e-6, f32::INFINITY),
+        (1.0, 1e30, f32::NAN),
+        (1.0, f32::MAX, f32::MAX),
+        (f32::NAN, f32::NAN, f32::NAN),
+        (1.0, 10.0, 1.0),
+    ];
+    for (fov_y, near, far) in projections {
+        let frame = render_headless(SIZE, 1, move |app| {
+            app.add_systems(Startup, move |mut commands: Commands| {
+                let scene = default_scene();
+                spawn_scene(&mut commands, &scene, false, 1.5);
+                spawn_light_rig(&mut commands, 8, scene.bounds(), 1);
+                commands.spawn((
+                    Transform::from_xyz(0.0, 2.0, 8.0).looking_at(Vec3::ZERO, Vec3::Y),
+                    Camera3d { fov_y, near, far },
+                ));
+            });
+        })
+        .unwrap_or_else(|e| panic!("fov {fov_y} near {near} far {far}: {e}"));
+        support::assert_finite(&frame);
+    }
+}
+
+#[test]
+fn a_target_beyond_the_device_limit_is_refused_with_the_limit_named() {
+    let _gpu = gpu();
+    let mut renderer = manylight::app::render_world::HeadlessRenderer::new().expect("adapter");
+    let limit = renderer.render_world.gpu().device.limits().max_texture_dimension_2d;
+    let scene = default_scene();
+    let snapshot = manylight::app::scene::scene_snapshot(
+        &scene,
+        Vec::new(),
+        UVec2::new(limit + 1, 16),
+        manylight::render::FrameSettings::default(),
+        0,
+    );
+    let err = renderer.render(snapshot, false).expect_err("refused");
+    let message = err.to_string();
+    assert!(
+        message.contains("max_texture_dimension_2d") && message.contains(&limit.to_string()),
+        "{message}"
+    );
+}

@@ -99,6 +99,8 @@ impl RenderWorld {
         output: &wgpu::TextureView,
         format: wgpu::TextureFormat,
     ) -> Result<FrameReport, RenderError> {
+        let mut snapshot = snapshot;
+        let invalid_cameras = snapshot.reject_invalid_camera();
         self.world.insert_resource(CurrentSnapshot(snapshot));
         self.world.insert_resource(OutputTarget { view: output.clone(), format });
         self.world.resource_mut::<FrameGraph>().0.clear();
@@ -107,7 +109,7 @@ impl RenderWorld {
         let outcome = std::mem::take(&mut *self.world.resource_mut::<FrameOutcome>());
         match (outcome.error, outcome.report) {
             (Some(e), _) => Err(e),
-            (None, Some(r)) => Ok(r),
+            (None, Some(r)) => Ok(FrameReport { invalid_cameras, ..r }),
             (None, None) => Err(RenderError::Graph("the frame produced no report".into())),
         }
     }
@@ -321,11 +323,18 @@ impl HeadlessRenderer {
         snapshot: FrameSnapshot,
         readback: bool,
     ) -> Result<(FrameReport, Option<image::RgbaImage>), RenderError> {
+        let mut snapshot = snapshot;
+        let invalid_cameras = snapshot.reject_invalid_camera();
         let size = snapshot.viewport;
         if size.x == 0 || size.y == 0 || snapshot.camera.is_none() {
-            return Ok((empty_report(&snapshot), None)); // nothing to look through or at
+            // Nothing to look through or at.
+            return Ok((FrameReport { invalid_cameras, ..empty_report(&snapshot) }, None));
         }
         let gpu = self.render_world.gpu().clone();
+        let limit = gpu.device.limits().max_texture_dimension_2d;
+        if size.x > limit || size.y > limit {
+            return Err(RenderError::TargetTooLarge { width: size.x, height: size.y, limit });
+        }
         if self.target.as_ref().map(|t| t.size()) != Some((size.x, size.y)) {
             self.target = Some(HeadlessTarget::new(&gpu, size.x, size.y));
         }

@@ -52,6 +52,18 @@ pub enum RenderError {
     /// The device reported a validation or out-of-memory error.
     #[error("GPU error: {0}")]
     Device(String),
+    /// A render target larger than the device's largest 2D texture.
+    #[error(
+        "a {width}x{height} render target exceeds this device's limit of {limit} pixels per side (max_texture_dimension_2d)"
+    )]
+    TargetTooLarge {
+        /// Requested width.
+        width: u32,
+        /// Requested height.
+        height: u32,
+        /// The device's limit.
+        limit: u32,
+    },
     /// The GPU did not finish submitted work within [`GPU_WAIT_TIMEOUT`] (a hung or lost
     /// device); the frame is abandoned instead of freezing the caller.
     #[error(

@@ -200,6 +200,7 @@ impl Renderer {
             frame_cpu_ms: frame_start.elapsed().as_secs_f64() * 1e3,
             light_count: self.scene.light_count,
             invalid_lights: self.scene.invalid_lights,
+            invalid_cameras: 0,
             nonfinite_pixels,
             instance_count: self.scene.draws.len() as u32,
             transient_textures: self.pool.live() as u32,

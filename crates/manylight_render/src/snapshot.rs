@@ -311,6 +311,16 @@ pub struct ExtractedCamera {
 }
 
 impl ExtractedCamera {
+    /// True when the camera can be looked through: its transform (and last frame's matrix,
+    /// if any) is finite and invertible. A NaN position or a zero scale is not.
+    pub fn is_valid(&self) -> bool {
+        let det = self.world_from_view.determinant();
+        self.world_from_view.is_finite()
+            && det.is_finite()
+            && det.abs() > f32::MIN_POSITIVE
+            && self.prev_clip_from_world.is_none_or(|m| m.is_finite())
+    }
+
     /// View-from-world matrix.
     pub fn view_from_world(&self) -> Mat4 {
         self.world_from_view.inverse()
@@ -388,6 +398,20 @@ pub struct FrameSnapshot {
 }
 
 impl FrameSnapshot {
+    /// Removes a camera that [`ExtractedCamera::is_valid`] refuses (the frame then renders
+    /// nothing) and returns how many were removed, for [`crate::FrameReport::invalid_cameras`].
+    pub fn reject_invalid_camera(&mut self) -> u32 {
+        if self.camera.as_ref().is_some_and(|c| !c.is_valid()) {
+            tracing::warn!(
+                "the camera's transform is not finite or not invertible: nothing is rendered this frame"
+            );
+            self.camera = None;
+            1
+        } else {
+            0
+        }
+    }
+
     /// True when at least one light has valid parameters.
     pub fn has_lights(&self) -> bool {
         self.lights.iter().any(|l| l.is_valid())

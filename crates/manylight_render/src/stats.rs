@@ -36,6 +36,9 @@ pub struct FrameReport {
     pub light_count: u32,
     /// Lights dropped because a parameter was NaN, infinite or negative.
     pub invalid_lights: u32,
+    /// Cameras refused because their transform was not finite or not invertible (the frame
+    /// rendered nothing).
+    pub invalid_cameras: u32,
     /// Pixels whose HDR colour was NaN or infinite (counted by the tone map, shown black);
     /// `None` when the frame had no tone map (a debug view replaced it).
     pub nonfinite_pixels: Option<u32>,
