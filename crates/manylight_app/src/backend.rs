@@ -84,12 +84,11 @@ impl RenderThread {
     /// thread comes back as its message.
     pub fn shutdown(&mut self) -> Option<String> {
         self.frames.take();
-        let panic = self.handle.take().and_then(|h| h.join().err()).map(|payload| {
+        self.handle.take().and_then(|h| h.join().err()).map(|payload| {
             let message = format!("the render thread panicked: {}", panic_message(payload.as_ref()));
             tracing::error!("{message}");
             message
-        });
-        panic
+        })
     }
 }
 
