@@ -35,6 +35,7 @@ fn variant(e: &SceneError) -> &'static str {
         SceneError::UnsupportedImage { .. } => "UnsupportedImage",
         SceneError::ImageDecode { .. } => "ImageDecode",
         SceneError::TextureTooLarge { .. } => "TextureTooLarge",
+        SceneError::OverBudget { .. } => "OverBudget",
         SceneError::NonFiniteTransform { .. } => "NonFiniteTransform",
         SceneError::NodeHierarchy { .. } => "NodeHierarchy",
         SceneError::BadLight { .. } => "BadLight",
@@ -132,7 +133,8 @@ fn a_directory_is_an_io_error() {
 #[test]
 fn the_texture_limit_is_configurable() {
     let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/png16.gltf"));
-    let err = load_gltf(path, &LoadOptions { max_texture_size: 2 }).expect_err("4x4 > 2");
+    let err =
+        load_gltf(path, &LoadOptions { max_texture_size: 2, ..LoadOptions::default() }).expect_err("4x4 > 2");
     assert_eq!(variant(&err), "TextureTooLarge");
     assert!(err.to_string().contains("4x4"));
 }

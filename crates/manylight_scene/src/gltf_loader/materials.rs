@@ -1,11 +1,12 @@
 //! glTF materials and their base-colour images.
 //!
 //! Images are decoded once each (cached by image index) to sRGB RGBA8. Dimensions are read
-//! from the image header and checked against `LoadOptions::max_texture_size` before any pixel
-//! is decoded, so a tiny file that declares a huge image costs nothing.
+//! from the image header and checked against `LoadOptions::max_texture_size` and the
+//! `LoadOptions::max_image_bytes` budget before any pixel is decoded, so a tiny file that
+//! declares a huge image costs nothing.
 
-use super::Ctx;
 use super::uri::{UriSource, resolve_uri};
+use super::{Ctx, over_budget};
 use crate::SceneError;
 use glam::Vec4;
 use image::{ImageDecoder, ImageFormat, ImageReader, Limits};
@@ -129,6 +130,7 @@ impl Ctx<'_> {
             Err(_) => return Err(unsupported("unrecognised data".into())),
         };
         let data = self.decode(index, &bytes, format, label)?;
+        self.used.image_bytes += data.rgba8.len() as u64;
         let data = Arc::new(data);
         self.textures.insert(index, data.clone());
         Ok(data)
@@ -166,6 +168,13 @@ impl Ctx<'_> {
                 image: index,
                 message: "image has zero size".into(),
             });
+        }
+        // Decoded as RGBA8; counted with the images decoded before it.
+        let needed = self.used.image_bytes.saturating_add(width as u64 * height as u64 * 4);
+        if needed > self.options.max_image_bytes {
+            let what = format!("image {index} (with the images decoded before it)");
+            let (unit, limit) = ("bytes of decoded images", self.options.max_image_bytes);
+            return Err(over_budget(self.path, what, needed, unit, limit, "max_image_bytes"));
         }
         let mut limits = Limits::default();
         limits.max_image_width = Some(max);

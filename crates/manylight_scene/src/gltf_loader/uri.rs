@@ -125,7 +125,7 @@ fn relative_path(decoded: &str) -> Result<PathBuf, String> {
 }
 
 /// A readable name for a file type that is not a regular file.
-fn file_kind(ty: std::fs::FileType) -> &'static str {
+pub(super) fn file_kind(ty: std::fs::FileType) -> &'static str {
     if ty.is_dir() {
         return "directory";
     }
@@ -191,7 +191,7 @@ const OPEN_FLAGS: i32 = 0o4000;
 const OPEN_FLAGS: i32 = 0;
 
 /// Read-only, and on unix with [`OPEN_FLAGS`].
-fn open_options() -> std::fs::OpenOptions {
+pub(super) fn open_options() -> std::fs::OpenOptions {
     let mut options = std::fs::OpenOptions::new();
     options.read(true);
     #[cfg(unix)]
