@@ -27,8 +27,8 @@
 //!    create are counted against `max_instances` and `max_lights`. Then it is walked again,
 //!    rejecting non-finite transforms; each mesh primitive and material is converted once
 //!    and shared, after its accessor counts were checked against `max_vertices`,
-//!    `max_indices` and `max_accessor_bytes`; each image is decoded once, after its header
-//!    was checked against `max_texture_size` and `max_image_bytes`.
+//!    `max_indices` and `max_accessor_bytes`; each image source is decoded once, after its
+//!    header was checked against `max_texture_size` and `max_image_bytes`.
 //! 4. The whole load runs under `catch_unwind`, so even a loader bug cannot take the caller
 //!    down ([`SceneError::Internal`]).
 //!
@@ -103,8 +103,10 @@ pub struct LoadOptions {
     /// The node tree is walked without recursion, so depth costs no stack; the limit refuses
     /// degenerate chains whose transforms lose all precision. Default 1024.
     pub max_node_depth: u32,
-    /// Most bytes of all decoded images together (RGBA8: width × height × 4 each); each
-    /// image is checked from its header before decoding. Default 1 GiB.
+    /// Most bytes of all decoded images together (RGBA8: width × height × 4 each). Images
+    /// are decoded once per distinct source (the same resolved file, the same `data:` URI or
+    /// the same buffer view), however many `images` entries name it; each new source is
+    /// checked from its header before decoding. Default 1 GiB.
     pub max_image_bytes: u64,
 }
 
@@ -358,6 +360,7 @@ fn load_inner(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
         buffers,
         options,
         textures: HashMap::new(),
+        images: HashMap::new(),
         meshes: HashMap::new(),
         materials: HashMap::new(),
         used: Used::default(),
@@ -397,6 +400,8 @@ struct Ctx<'a> {
     options: &'a LoadOptions,
     /// Decoded images by image index.
     textures: HashMap<usize, Arc<TextureData>>,
+    /// Decoded images by source: `images` entries naming the same source share one decode.
+    images: HashMap<materials::ImageSource<'a>, Arc<TextureData>>,
     /// Scene mesh index by (POSITION, NORMAL, TEXCOORD_0, indices) accessors (`None`: the
     /// primitive has no triangles and is skipped).
     meshes: HashMap<[Option<usize>; 4], Option<usize>>,

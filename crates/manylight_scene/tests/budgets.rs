@@ -320,6 +320,47 @@ fn distinct_textures(scene: &Scene) -> usize {
 }
 
 #[test]
+fn one_image_named_by_many_entries_is_decoded_once() {
+    let _serial = serial();
+    // A 2048 x 2048 PNG is 16 MiB decoded; 200 entries naming it used to cost 3.2 GB.
+    let sandbox = Sandbox::new("images");
+    let png = solid_png(2048, [200, 100, 50, 255]);
+    sandbox.write("big.png", &png);
+    sandbox.write("big.bin", &png);
+    let by_file: Vec<Value> =
+        (0..200).map(|i| json!({ "uri": if i % 2 == 0 { "big.png" } else { "./big.png" } })).collect();
+    let by_data: Vec<Value> = (0..200)
+        .map(|_| {
+            json!({ "uri": format!("data:image/png;base64,{}", {
+        use base64::Engine as _;
+        base64::engine::general_purpose::STANDARD.encode(&png)
+    }) })
+        })
+        .collect();
+    let by_view: Vec<Value> = (0..200).map(|_| json!({ "bufferView": 2, "mimeType": "image/png" })).collect();
+    let buffers = json!([{ "byteLength": png.len(), "uri": "big.bin" }]);
+    let views = json!([{ "buffer": 1, "byteLength": png.len() }]);
+    for (name, images, buffers, views) in [
+        ("file.gltf", by_file, Value::Null, Value::Null),
+        ("data.gltf", by_data, Value::Null, Value::Null),
+        ("view.gltf", by_view, buffers, views),
+    ] {
+        let path = sandbox.write_json(name, &many_images_doc(images, buffers, views));
+        // One decode (16 MiB) and the JSON (the `data:` URIs are in it, twice once parsed).
+        let json_size = std::fs::metadata(&path).expect("size").len() as usize;
+        let out = load(&path, LoadOptions::default());
+        let bound = 32 * MIB + 3 * json_size;
+        assert!(out.peak < bound, "{name}: peak {:.1} MiB", out.peak as f64 / MIB as f64);
+        let scene = out.scene();
+        assert_eq!(scene.materials.len(), 200, "{name}");
+        assert_eq!(distinct_textures(&scene), 1, "{name}");
+        // One decode of 16 MiB fits a budget of exactly 16 MiB.
+        let exact = LoadOptions { max_image_bytes: 2048 * 2048 * 4, ..LoadOptions::default() };
+        assert_eq!(distinct_textures(&load(&path, exact).scene()), 1);
+    }
+}
+
+#[test]
 fn distinct_images_count_against_the_decoded_bytes_budget() {
     let _serial = serial();
     let sandbox = Sandbox::new("image_budget");
