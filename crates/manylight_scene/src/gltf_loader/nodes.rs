@@ -354,15 +354,18 @@ impl Ctx<'_> {
                     Some(f) if f.is_finite() && f > p.znear => f,
                     Some(_) => return Err(bad("zfar must be finite and greater than znear")),
                 };
+                // A huge znear overflows the default zfar (or the depth terms) to infinity,
+                // and the projection matrix to NaN.
+                let projection = Projection { fov_y: p.yfov, near: p.znear, far };
+                if !far.is_finite() || !projection.matrix(1.0).is_finite() {
+                    return Err(bad("znear and zfar give a projection with non-finite terms"));
+                }
                 let (_, rotation, translation) = world.to_scale_rotation_translation();
                 let transform = Mat4::from_rotation_translation(rotation.normalize(), translation);
                 if !transform.is_finite() {
                     return Err(bad(&format!("node {node} gives it a degenerate transform")));
                 }
-                self.scene.cameras.push(SceneCamera {
-                    transform,
-                    projection: Projection { fov_y: p.yfov, near: p.znear, far }.sanitized(),
-                });
+                self.scene.cameras.push(SceneCamera { transform, projection: projection.sanitized() });
             }
             (Checked::Valid(CameraType::Perspective), None) => {
                 return Err(bad("perspective camera without perspective parameters"));
