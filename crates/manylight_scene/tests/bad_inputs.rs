@@ -82,6 +82,10 @@ const EXPECTED: &[(&str, &str, &str)] = &[
     ("corrupt_png.gltf", "ImageDecode", "image 0"),
     ("https_image.gltf", "ExternalUri", "https://example.com"),
     ("huge_texture.gltf", "TextureTooLarge", "20000x20000"),
+    ("too_many_instances.gltf", "OverBudget", "needs 1001000 instances, over the limit of 1000000"),
+    ("zero_filled_accessor.gltf", "OverBudget", "needs 22369620 vertices, over the limit of 16000000"),
+    ("deep_node_chain.gltf", "OverBudget", "node 1024 needs 1025 levels of node nesting"),
+    ("huge_buffer.gltf", "OverBudget", "buffer 0 needs 1099511627776 bytes of buffers"),
 ];
 
 #[test]
