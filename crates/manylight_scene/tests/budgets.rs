@@ -592,3 +592,38 @@ fn the_defaults_are_documented_values() {
     assert_eq!(d.max_node_depth, 1024);
     assert_eq!(d.max_image_bytes, 1 << 30);
 }
+
+#[test]
+fn deeply_nested_json_is_refused_or_skipped_without_recursion() {
+    let _serial = serial();
+    let sandbox = Sandbox::new("nesting");
+    let deep = format!("{}{}", "[".repeat(500_000), "]".repeat(500_000));
+    // Node `extras` (any JSON value, kept as text) and an accessor's `min` (parsed as a JSON
+    // tree), each nested 500 000 deep: 1 MB of brackets.
+    for (name, pointer) in [("extras.gltf", "/nodes/0/extras"), ("min.gltf", "/accessors/0/min")] {
+        let mut doc = triangle_doc(
+            vec![json!({ "mesh": 0 })],
+            vec![json!({ "primitives": [
+            { "attributes": { "POSITION": 0 }, "indices": 1 }
+        ] })],
+            vec![0],
+        );
+        let (parent, key) = pointer.rsplit_once('/').expect("pointer");
+        doc.pointer_mut(parent)
+            .and_then(Value::as_object_mut)
+            .expect("parent")
+            .insert(key.into(), json!("@@"));
+        let text = serde_json::to_string(&doc).expect("serialize").replace("\"@@\"", &deep);
+        let path = sandbox.write(name, text.as_bytes());
+        // The load runs on a thread with the default 2 MiB stack.
+        let out = load(&path, LoadOptions::default());
+        assert!(out.peak < 32 * MIB, "{name}: peak {}", out.peak);
+        match out.result {
+            Ok(scene) if name == "extras.gltf" => assert_eq!(scene.instances.len(), 1),
+            Err(SceneError::Json { message, .. }) if name == "min.gltf" => {
+                assert!(message.contains("recursion limit"), "{message}");
+            }
+            other => panic!("{name}: {:?}", other.map(|s| s.instances.len())),
+        }
+    }
+}
