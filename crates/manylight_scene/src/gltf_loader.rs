@@ -261,7 +261,7 @@ fn read_scene_file(path: &Path, options: &LoadOptions) -> Result<Vec<u8>, SceneE
     }
     // The size is within the budget; a file that grows meanwhile is cut at one byte over it.
     bytes
-        .try_reserve_exact(meta.len() as usize)
+        .try_reserve_exact(usize::try_from(meta.len()).unwrap_or(usize::MAX))
         .map_err(|_| io_err(std::io::Error::from(std::io::ErrorKind::OutOfMemory)))?;
     (&file)
         .take(limit.saturating_add(1).saturating_sub(bytes.len() as u64))
