@@ -287,6 +287,27 @@ pub enum SceneError {
         /// The limit.
         max: u32,
     },
+    /// The file needs more of a resource than a [`LoadOptions`](crate::LoadOptions) budget
+    /// allows (instances, vertices, decoded image bytes, ...). Detected from declared counts,
+    /// lengths and image headers before the memory is allocated.
+    #[error(
+        "`{}`: {what} needs {needed} {unit}, over the limit of {limit} (LoadOptions::{option})",
+        .path.display()
+    )]
+    OverBudget {
+        /// The file.
+        path: PathBuf,
+        /// What needs it, e.g. "the node tree" or "accessor 3".
+        what: String,
+        /// How much it needs (with what was already used, for budgets over the whole file).
+        needed: u64,
+        /// The unit of `needed` and `limit`, e.g. "instances" or "bytes".
+        unit: &'static str,
+        /// The limit.
+        limit: u64,
+        /// The [`LoadOptions`](crate::LoadOptions) field that sets the limit.
+        option: &'static str,
+    },
     /// A node's local or world transform has NaN or infinite entries.
     #[error("`{}`: node {node} has a non-finite transform", .path.display())]
     NonFiniteTransform {

@@ -1,12 +1,18 @@
 //! glTF 2.0 loading (`.gltf` with external or `data:` buffers and images, and `.glb`).
 //!
 //! The loader never trusts the file:
-//! 1. The container is split by hand (GLB header and chunk lengths are checked against the
-//!    file size) and the JSON is parsed without `gltf`'s validation; every index is looked up
-//!    with a bounds check that turns into a [`SceneError::MissingReference`].
+//! 1. The file itself is opened without blocking and read only if it is a regular file (never
+//!    a FIFO or a device such as `/dev/zero`) within the size budget ([`LoadOptions`]'s
+//!    `max_json_bytes` for `.gltf`, `max_glb_bytes` for `.glb`). The container is split by
+//!    hand (GLB header and chunk lengths are checked against the file size), the JSON's
+//!    values are counted by a scan before it is parsed (`max_json_values`: parsing turns a
+//!    few bytes of text into a struct of hundreds), and it is parsed without `gltf`'s
+//!    validation; every index is looked up with a bounds check that turns into a
+//!    [`SceneError::MissingReference`].
 //! 2. Buffers are loaded from the GLB chunk, `data:` URIs or local files (never the network);
-//!    of a file only `byteLength` bytes are read. Views and accessors are range-checked
-//!    before reading.
+//!    their declared lengths count against `max_buffer_bytes` before each is read, and of a
+//!    file only `byteLength` bytes are read. Views and accessors are range-checked before
+//!    reading.
 //!
 //!    A buffer or image `uri` is either a base64 `data:` URI or a relative path that stays
 //!    inside the glTF file's folder: after percent-decoding it may not be absolute, contain a
@@ -15,11 +21,19 @@
 //!    symlink pointing outside is refused too. Only regular files are read (never a FIFO,
 //!    device or directory), image files up to 256 MiB ([`SceneError::UriOutsideFolder`],
 //!    [`SceneError::NotARegularFile`], [`SceneError::ReferencedFileTooLarge`]).
-//! 3. The node tree of the chosen scene is walked iteratively, rejecting cycles and
-//!    non-finite transforms; each mesh primitive, material and image is converted once and
-//!    shared.
+//! 3. The node tree of the chosen scene is walked iteratively, first without creating
+//!    anything: cycles, shared children and nesting deeper than `max_node_depth` are refused,
+//!    and the instances (nodes × triangle primitives of their meshes) and lights it would
+//!    create are counted against `max_instances` and `max_lights`. Then it is walked again,
+//!    rejecting non-finite transforms; each mesh primitive and material is converted once
+//!    and shared, after its accessor counts were checked against `max_vertices`,
+//!    `max_indices` and `max_accessor_bytes`; each image source is decoded once, after its
+//!    header was checked against `max_texture_size` and `max_image_bytes`.
 //! 4. The whole load runs under `catch_unwind`, so even a loader bug cannot take the caller
 //!    down ([`SceneError::Internal`]).
+//!
+//! Every budget that is exceeded is a [`SceneError::OverBudget`] naming the file, what needs
+//! how much, the limit and the [`LoadOptions`] field.
 
 mod data;
 mod materials;
@@ -35,17 +49,83 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-/// Options of [`load_gltf`].
+/// Options of [`load_gltf`]: the largest texture and the budgets a file may use.
+///
+/// Every budget is checked before the memory it guards is allocated (from a declared count,
+/// length or image header), so a small file that declares a huge amount of data is refused
+/// cheaply with a [`SceneError::OverBudget`] that names the file, what it needs and the
+/// option that limits it. The defaults accept every scene in the repository's `assets/` with
+/// a wide margin; lower them for untrusted files, raise them for very large scenes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LoadOptions {
     /// Largest accepted texture width or height in pixels; a larger image is an error
     /// ([`SceneError::TextureTooLarge`]), detected from its header before decoding.
+    /// Default 8192.
     pub max_texture_size: u32,
+    /// Largest size in bytes of a `.gltf` file, and of the JSON chunk of a `.glb` file;
+    /// checked against the file's size before it is read. Default 64 MiB.
+    pub max_json_bytes: u64,
+    /// Most JSON values (objects, arrays, strings, numbers, literals) in the glTF JSON,
+    /// counted by a scan of the text before it is parsed. Parsing turns each value into a
+    /// typed struct of up to a few hundred bytes (an empty node `{}`, three bytes of text,
+    /// takes over 200), so this bounds the parsed document's memory where
+    /// `max_json_bytes` alone would not. Default 2 000 000 (real files average 10 to 20
+    /// bytes of JSON per value).
+    pub max_json_values: u64,
+    /// Largest `.glb` file in bytes (header, JSON and binary chunk together); checked against
+    /// the file's size before it is read. Default 1 GiB + 64 MiB: room for a JSON chunk of the
+    /// default `max_json_bytes` and a binary chunk of the default `max_buffer_bytes`.
+    pub max_glb_bytes: u64,
+    /// Most bytes of all buffers together (the sum of their `byteLength`s, whether the data
+    /// come from the GLB binary chunk, `data:` URIs or files); checked before a buffer is read,
+    /// so a file that names the same large file many times is refused. Default 1 GiB.
+    pub max_buffer_bytes: u64,
+    /// Most bytes of one accessor once unpacked (`count` × element size), whether it reads a
+    /// buffer view or is zero-filled (no `bufferView`, e.g. sparse); checked before it is
+    /// read. Default 256 MiB.
+    pub max_accessor_bytes: u64,
+    /// Most vertices of all meshes together; each distinct combination of POSITION, NORMAL,
+    /// TEXCOORD_0 and index accessors becomes one mesh, and its POSITION `count` is checked
+    /// before any attribute is read. A vertex takes 32 bytes once loaded. Default 16 000 000.
+    pub max_vertices: u64,
+    /// Most indices of all meshes together (an unindexed primitive counts one per vertex);
+    /// checked before the index accessor is read. Default 48 000 000 (16 million triangles).
+    pub max_indices: u64,
+    /// Most mesh instances (drawn objects): every triangle primitive of the mesh of every node
+    /// in the scene's node tree is one, so 5 000 nodes sharing a mesh of 5 000 primitives
+    /// make 25 million. Counted over the node tree before any instance is created.
+    /// Default 1 000 000.
+    pub max_instances: u64,
+    /// Most `KHR_lights_punctual` lights placed by nodes of the scene's node tree; counted
+    /// before any light is created. Default 1 000 000.
+    pub max_lights: u64,
+    /// Deepest node nesting: a root node is at depth 1, its children at depth 2, ...
+    /// The node tree is walked without recursion, so depth costs no stack; the limit refuses
+    /// degenerate chains whose transforms lose all precision. Default 1024.
+    pub max_node_depth: u32,
+    /// Most bytes of all decoded images together (RGBA8: width × height × 4 each). Images
+    /// are decoded once per distinct source (the same resolved file, the same `data:` URI or
+    /// the same buffer view), however many `images` entries name it; each new source is
+    /// checked from its header before decoding. Default 1 GiB.
+    pub max_image_bytes: u64,
 }
 
 impl Default for LoadOptions {
     fn default() -> Self {
-        Self { max_texture_size: 8192 }
+        Self {
+            max_texture_size: 8192,
+            max_json_bytes: 64 << 20,
+            max_json_values: 2_000_000,
+            max_glb_bytes: (1 << 30) + (64 << 20),
+            max_buffer_bytes: 1 << 30,
+            max_accessor_bytes: 256 << 20,
+            max_vertices: 16_000_000,
+            max_indices: 48_000_000,
+            max_instances: 1_000_000,
+            max_lights: 1_000_000,
+            max_node_depth: 1024,
+            max_image_bytes: 1 << 30,
+        }
     }
 }
 
@@ -136,13 +216,129 @@ fn split_glb<'a>(path: &Path, bytes: &'a [u8]) -> Result<(&'a [u8], Option<&'a [
     Ok((json, bin))
 }
 
+/// A [`SceneError::OverBudget`] for file `path`.
+fn over_budget(
+    path: &Path,
+    what: impl Into<String>,
+    needed: u64,
+    unit: &'static str,
+    limit: u64,
+    option: &'static str,
+) -> SceneError {
+    SceneError::OverBudget { path: path.to_owned(), what: what.into(), needed, unit, limit, option }
+}
+
+/// Reads the glTF or GLB file itself: only a regular file (a FIFO or device such as
+/// `/dev/zero` is refused before a byte is read), and only when its size is within
+/// `max_json_bytes` (`.gltf`) or `max_glb_bytes` (a file starting with the GLB magic).
+fn read_scene_file(path: &Path, options: &LoadOptions) -> Result<Vec<u8>, SceneError> {
+    use std::io::Read as _;
+    let io_err = |source| SceneError::Io { path: path.to_owned(), source };
+    // Non-blocking on Linux, so opening a FIFO without a writer returns at once.
+    let file = uri::open_options().open(path).map_err(io_err)?;
+    let meta = file.metadata().map_err(io_err)?;
+    if meta.is_dir() {
+        return Err(io_err(std::io::Error::from(std::io::ErrorKind::IsADirectory)));
+    }
+    if !meta.is_file() {
+        return Err(SceneError::NotARegularFile {
+            path: path.to_owned(),
+            what: "the scene file".into(),
+            file: path.to_owned(),
+            kind: uri::file_kind(meta.file_type()),
+        });
+    }
+    let mut bytes = Vec::new();
+    (&file).take(4).read_to_end(&mut bytes).map_err(io_err)?;
+    let (limit, option) = if bytes == b"glTF" {
+        (options.max_glb_bytes, "max_glb_bytes")
+    } else {
+        (options.max_json_bytes, "max_json_bytes")
+    };
+    let too_large = |size: u64| over_budget(path, "the file", size, "bytes", limit, option);
+    if meta.len() > limit {
+        return Err(too_large(meta.len()));
+    }
+    // The size is within the budget; a file that grows meanwhile is cut at one byte over it.
+    bytes
+        .try_reserve_exact(usize::try_from(meta.len()).unwrap_or(usize::MAX))
+        .map_err(|_| io_err(std::io::Error::from(std::io::ErrorKind::OutOfMemory)))?;
+    (&file)
+        .take(limit.saturating_add(1).saturating_sub(bytes.len() as u64))
+        .read_to_end(&mut bytes)
+        .map_err(io_err)?;
+    if bytes.len() as u64 > limit {
+        return Err(too_large(bytes.len() as u64));
+    }
+    Ok(bytes)
+}
+
+/// How many JSON values (objects, arrays, strings including keys, numbers, literals) `json`
+/// holds, by a scan that tracks only strings and token boundaries (it does not validate).
+fn count_json_values(json: &[u8]) -> u64 {
+    let (mut count, mut in_string, mut escaped, mut in_scalar) = (0u64, false, false, false);
+    for &b in json {
+        if in_string {
+            if escaped {
+                escaped = false;
+            } else if b == b'\\' {
+                escaped = true;
+            } else if b == b'"' {
+                in_string = false;
+            }
+            continue;
+        }
+        match b {
+            b'"' => {
+                count += 1;
+                in_string = true;
+                in_scalar = false;
+            }
+            b'{' | b'[' => {
+                count += 1;
+                in_scalar = false;
+            }
+            b'}' | b']' | b',' | b':' | b' ' | b'\t' | b'\n' | b'\r' => in_scalar = false,
+            _ => {
+                if !in_scalar {
+                    count += 1;
+                    in_scalar = true;
+                }
+            }
+        }
+    }
+    count
+}
+
 fn load_inner(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io { path: path.to_owned(), source })?;
+    let bytes = read_scene_file(path, options)?;
     if bytes.iter().all(|b| b.is_ascii_whitespace()) {
         return Err(SceneError::Empty { path: path.to_owned() });
     }
     let (json_bytes, glb_bin) =
         if bytes.starts_with(b"glTF") { split_glb(path, &bytes)? } else { (&bytes[..], None) };
+    if json_bytes.len() as u64 > options.max_json_bytes {
+        let what = "the GLB JSON chunk";
+        return Err(over_budget(
+            path,
+            what,
+            json_bytes.len() as u64,
+            "bytes",
+            options.max_json_bytes,
+            "max_json_bytes",
+        ));
+    }
+    let values = count_json_values(json_bytes);
+    if values > options.max_json_values {
+        return Err(over_budget(
+            path,
+            "the glTF JSON",
+            values,
+            "JSON values",
+            options.max_json_values,
+            "max_json_values",
+        ));
+    }
     // A UTF-8 byte-order mark is not valid JSON but harmless; accept it.
     let json_bytes = json_bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(json_bytes);
     let root: gltf::json::Root = gltf::json::deserialize::from_slice(json_bytes)
@@ -156,7 +352,7 @@ fn load_inner(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
         }
     }
     let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let buffers = data::load_buffers(path, &base_dir, &root, glb_bin)?;
+    let buffers = data::load_buffers(path, &base_dir, &root, glb_bin, options)?;
     let mut ctx = Ctx {
         path,
         base_dir,
@@ -164,8 +360,10 @@ fn load_inner(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
         buffers,
         options,
         textures: HashMap::new(),
+        images: HashMap::new(),
         meshes: HashMap::new(),
         materials: HashMap::new(),
+        used: Used::default(),
         scene: Scene {
             name: path
                 .file_name()
@@ -175,6 +373,17 @@ fn load_inner(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
     };
     ctx.walk_scene()?;
     Ok(ctx.scene)
+}
+
+/// How much of the whole-file budgets the load has used so far.
+#[derive(Default)]
+struct Used {
+    /// Vertices of the scene's meshes.
+    vertices: u64,
+    /// Indices of the scene's meshes.
+    indices: u64,
+    /// Bytes of decoded images.
+    image_bytes: u64,
 }
 
 /// Everything the loading steps share.
@@ -191,10 +400,15 @@ struct Ctx<'a> {
     options: &'a LoadOptions,
     /// Decoded images by image index.
     textures: HashMap<usize, Arc<TextureData>>,
-    /// Scene mesh index by (POSITION, NORMAL, TEXCOORD_0, indices) accessors.
-    meshes: HashMap<[Option<usize>; 4], usize>,
+    /// Decoded images by source: `images` entries naming the same source share one decode.
+    images: HashMap<materials::ImageSource<'a>, Arc<TextureData>>,
+    /// Scene mesh index by (POSITION, NORMAL, TEXCOORD_0, indices) accessors (`None`: the
+    /// primitive has no triangles and is skipped).
+    meshes: HashMap<[Option<usize>; 4], Option<usize>>,
     /// Scene material index by glTF material index (`None`: the default material).
     materials: HashMap<Option<usize>, usize>,
+    /// Budget use so far.
+    used: Used,
     /// The scene being built.
     scene: Scene,
 }

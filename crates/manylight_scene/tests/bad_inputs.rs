@@ -35,6 +35,7 @@ fn variant(e: &SceneError) -> &'static str {
         SceneError::UnsupportedImage { .. } => "UnsupportedImage",
         SceneError::ImageDecode { .. } => "ImageDecode",
         SceneError::TextureTooLarge { .. } => "TextureTooLarge",
+        SceneError::OverBudget { .. } => "OverBudget",
         SceneError::NonFiniteTransform { .. } => "NonFiniteTransform",
         SceneError::NodeHierarchy { .. } => "NodeHierarchy",
         SceneError::BadLight { .. } => "BadLight",
@@ -73,6 +74,7 @@ const EXPECTED: &[(&str, &str, &str)] = &[
     ("negative_light_color.gltf", "BadLight", "color"),
     ("zero_light_range.gltf", "BadLight", "range"),
     ("bad_camera.gltf", "BadCamera", "yfov"),
+    ("huge_znear.gltf", "BadCamera", "znear and zfar give a projection with non-finite terms"),
     ("missing_image.gltf", "ReferencedFile", "missing.png"),
     ("unsupported_image.gltf", "UnsupportedImage", "image/gif"),
     ("webp_mime.gltf", "UnsupportedImage", "image/webp"),
@@ -80,6 +82,10 @@ const EXPECTED: &[(&str, &str, &str)] = &[
     ("corrupt_png.gltf", "ImageDecode", "image 0"),
     ("https_image.gltf", "ExternalUri", "https://example.com"),
     ("huge_texture.gltf", "TextureTooLarge", "20000x20000"),
+    ("too_many_instances.gltf", "OverBudget", "needs 1001000 instances, over the limit of 1000000"),
+    ("zero_filled_accessor.gltf", "OverBudget", "needs 22369620 vertices, over the limit of 16000000"),
+    ("deep_node_chain.gltf", "OverBudget", "node 1024 needs 1025 levels of node nesting"),
+    ("huge_buffer.gltf", "OverBudget", "buffer 0 needs 1099511627776 bytes of buffers"),
 ];
 
 #[test]
@@ -132,7 +138,8 @@ fn a_directory_is_an_io_error() {
 #[test]
 fn the_texture_limit_is_configurable() {
     let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/png16.gltf"));
-    let err = load_gltf(path, &LoadOptions { max_texture_size: 2 }).expect_err("4x4 > 2");
+    let err =
+        load_gltf(path, &LoadOptions { max_texture_size: 2, ..LoadOptions::default() }).expect_err("4x4 > 2");
     assert_eq!(variant(&err), "TextureTooLarge");
     assert!(err.to_string().contains("4x4"));
 }

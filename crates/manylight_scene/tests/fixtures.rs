@@ -83,3 +83,12 @@ fn hierarchy_lights_and_cameras_without_a_scene_list() {
     let forward = c.transform.transform_vector3(Vec3::NEG_Z);
     assert!((forward - Vec3::NEG_X).length() < 1e-5, "{forward:?}");
 }
+
+#[test]
+fn extras_of_any_json_type_are_accepted() {
+    // glTF allows any JSON value as `extras` (objects are only recommended).
+    let s = load_gltf(&fixture("extras_any_type.gltf"), &LoadOptions::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.instances.len(), 1);
+    s.validate().expect("valid");
+}

@@ -140,6 +140,11 @@ def main():
     d["cameras"] = [{"type": "perspective", "perspective": {"yfov": 0, "znear": 0.1}}]
     d["nodes"][0]["camera"] = 0
     write_json("bad_camera.gltf", d)
+    # znear near f32::MAX and no zfar: the default zfar (znear x 10000) overflows to infinity.
+    d = base_doc()
+    d["cameras"] = [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 3.4e38}}]
+    d["nodes"][0]["camera"] = 0
+    write_json("huge_znear.gltf", d)
 
     write_json("missing_image.gltf", with_texture(base_doc(), {"uri": "missing.png"}))
     gif = b"GIF89a\x01\x00\x01\x00\x00\x00\x00;"
@@ -151,6 +156,26 @@ def main():
     # 20000 x 20000 declared in a valid IHDR, with a tiny IDAT: must fail before decoding.
     huge = png(20000, 20000, color_type=2, idat=zlib.compress(b"\0" * 64))
     write_json("huge_texture.gltf", with_texture(base_doc(), {"uri": data_uri(huge, "image/png")}))
+
+    # Over the default LoadOptions budgets, each from a few kilobytes.
+    # 1001 nodes x a mesh of 1000 primitives = 1 001 000 instances (limit 1 000 000).
+    d = base_doc()
+    d["meshes"][0]["primitives"] = d["meshes"][0]["primitives"] * 1000
+    d["nodes"] = [{"mesh": 0}] * 1001
+    d["scenes"][0]["nodes"] = list(range(1001))
+    write_json("too_many_instances.gltf", d)
+    # POSITION without a buffer view: 22 369 620 zero-filled vertices (limit 16 000 000).
+    d = base_doc()
+    del d["accessors"][0]["bufferView"]
+    d["accessors"][0]["count"] = 22369620
+    write_json("zero_filled_accessor.gltf", d)
+    # A chain of 1025 nodes (limit 1024 levels).
+    d = base_doc()
+    d["nodes"] = [{"children": [i + 1]} for i in range(1024)] + [{"mesh": 0}]
+    write_json("deep_node_chain.gltf", d)
+    # A buffer declaring a terabyte (limit 1 GiB of buffers): refused before it is read.
+    d = base_doc(); d["buffers"][0]["byteLength"] = 1 << 40
+    write_json("huge_buffer.gltf", d)
 
 
 if __name__ == "__main__":

@@ -1,29 +1,35 @@
 //! Binary data of a glTF file: buffers (GLB chunk, `data:` URIs, files in the glTF file's
 //! folder), buffer views and accessors, each range-checked before a byte is read.
 
-use super::Ctx;
 use super::uri::{UriSource, resolve_uri};
+use super::{Ctx, LoadOptions, over_budget};
 use crate::SceneError;
 use gltf::json::accessor::{ComponentType, Type};
 use gltf::json::validation::Checked;
 use std::borrow::Cow;
 use std::path::Path;
 
-/// Largest accessor (in bytes) that is materialised without backing data (all zeros or sparse).
-const MAX_SYNTHETIC_ACCESSOR_BYTES: u64 = 256 << 20;
-
 /// Loads every buffer of the file; each is cut to its declared `byteLength` (of a file, only
-/// that many bytes are read: the file may be longer, not shorter).
+/// that many bytes are read: the file may be longer, not shorter). The declared lengths count
+/// against `LoadOptions::max_buffer_bytes` before each buffer is read.
 pub(super) fn load_buffers<'a>(
     path: &Path,
     base_dir: &Path,
     root: &gltf::json::Root,
     glb_bin: Option<&'a [u8]>,
+    options: &LoadOptions,
 ) -> Result<Vec<Cow<'a, [u8]>>, SceneError> {
     let mut out = Vec::with_capacity(root.buffers.len());
+    let mut total = 0u64;
     for (i, buffer) in root.buffers.iter().enumerate() {
         let what = format!("buffer {i}");
         let declared = buffer.byte_length.0;
+        total = total.saturating_add(declared);
+        if total > options.max_buffer_bytes {
+            let what = if i == 0 { what } else { format!("{what} (with the buffers before it)") };
+            let limit = options.max_buffer_bytes;
+            return Err(over_budget(path, what, total, "bytes of buffers", limit, "max_buffer_bytes"));
+        }
         let data: Cow<'a, [u8]> = match &buffer.uri {
             Some(uri) => match resolve_uri(path, base_dir, &what, uri)? {
                 UriSource::Data { bytes, .. } => Cow::Owned(bytes),
@@ -102,8 +108,9 @@ fn type_name(t: Type) -> &'static str {
 
 /// Shape of one accessor after its type was checked.
 #[derive(Clone, Copy)]
-struct Layout {
-    count: usize,
+pub(super) struct Layout {
+    /// Number of elements.
+    pub(super) count: usize,
     components: usize,
     component: ComponentType,
     normalized: bool,
@@ -175,7 +182,12 @@ impl Ctx<'_> {
         let a = &self.root.accessors[index]; // `layout` checked the index
         let elem = layout.element_size() as u64;
         let count = layout.count as u64;
-        let total = count.checked_mul(elem).ok_or_else(|| self.bad_accessor(index, "count is too large"))?;
+        let total = count.saturating_mul(elem);
+        let limit = self.options.max_accessor_bytes;
+        if total > limit {
+            let what = format!("accessor {index}");
+            return Err(over_budget(self.path, what, total, "bytes", limit, "max_accessor_bytes"));
+        }
         let mut out;
         if let Some(view_index) = a.buffer_view {
             let view_index = view_index.value();
@@ -223,9 +235,7 @@ impl Ctx<'_> {
                 }
             }
         } else {
-            if total > MAX_SYNTHETIC_ACCESSOR_BYTES {
-                return Err(self.bad_accessor(index, "has no buffer view and is too large"));
-            }
+            // Zero-filled (typically the base of a sparse accessor); `total` is within budget.
             out = vec![0; total as usize];
         }
         if let Some(sparse) = &a.sparse {
@@ -282,20 +292,19 @@ impl Ctx<'_> {
         Ok(())
     }
 
-    /// Reads a `VEC3` `FLOAT` accessor (positions, normals).
-    pub(super) fn read_vec3(
-        &self,
-        index: usize,
-        what: &str,
-        usage: &str,
-    ) -> Result<Vec<glam::Vec3>, SceneError> {
-        let layout = self.layout(
+    /// Checks that accessor `index` is a `VEC3` of `FLOAT` (positions, normals).
+    pub(super) fn vec3_layout(&self, index: usize, what: &str, usage: &str) -> Result<Layout, SceneError> {
+        self.layout(
             index,
             what,
             usage,
             &|t, c, _| t == Type::Vec3 && c == ComponentType::F32,
             "VEC3 of FLOAT",
-        )?;
+        )
+    }
+
+    /// Reads a `VEC3` `FLOAT` accessor checked by [`Ctx::vec3_layout`].
+    pub(super) fn read_vec3(&self, index: usize, layout: Layout) -> Result<Vec<glam::Vec3>, SceneError> {
         let bytes = self.packed(index, layout)?;
         Ok(bytes
             .chunks_exact(12)
@@ -303,9 +312,10 @@ impl Ctx<'_> {
             .collect())
     }
 
-    /// Reads a texture-coordinate accessor (`VEC2` of `FLOAT` or normalized unsigned ints).
-    pub(super) fn read_uv(&self, index: usize, what: &str) -> Result<Vec<glam::Vec2>, SceneError> {
-        let layout = self.layout(
+    /// Checks that accessor `index` is a texture-coordinate accessor (`VEC2` of `FLOAT` or
+    /// normalized unsigned ints).
+    pub(super) fn uv_layout(&self, index: usize, what: &str) -> Result<Layout, SceneError> {
+        self.layout(
             index,
             what,
             "TEXCOORD_0",
@@ -314,7 +324,11 @@ impl Ctx<'_> {
                     && (c == ComponentType::F32 || (n && matches!(c, ComponentType::U8 | ComponentType::U16)))
             },
             "VEC2 of FLOAT, normalized UNSIGNED_BYTE or normalized UNSIGNED_SHORT",
-        )?;
+        )
+    }
+
+    /// Reads a texture-coordinate accessor checked by [`Ctx::uv_layout`].
+    pub(super) fn read_uv(&self, index: usize, layout: Layout) -> Result<Vec<glam::Vec2>, SceneError> {
         let bytes = self.packed(index, layout)?;
         let cs = layout.component.size();
         let read = |b: &[u8]| match layout.component {
@@ -326,9 +340,9 @@ impl Ctx<'_> {
         Ok(bytes.chunks_exact(2 * cs).map(|c| glam::Vec2::new(read(c), read(&c[cs..]))).collect())
     }
 
-    /// Reads an index accessor (`SCALAR` of unsigned ints).
-    pub(super) fn read_indices(&self, index: usize, what: &str) -> Result<Vec<u32>, SceneError> {
-        let layout = self.layout(
+    /// Checks that accessor `index` is an index accessor (`SCALAR` of unsigned ints).
+    pub(super) fn index_layout(&self, index: usize, what: &str) -> Result<Layout, SceneError> {
+        self.layout(
             index,
             what,
             "indices",
@@ -336,7 +350,11 @@ impl Ctx<'_> {
                 t == Type::Scalar && matches!(c, ComponentType::U8 | ComponentType::U16 | ComponentType::U32)
             },
             "SCALAR of UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT",
-        )?;
+        )
+    }
+
+    /// Reads an index accessor checked by [`Ctx::index_layout`].
+    pub(super) fn read_indices(&self, index: usize, layout: Layout) -> Result<Vec<u32>, SceneError> {
         let bytes = self.packed(index, layout)?;
         let cs = layout.component.size();
         Ok(bytes.chunks_exact(cs).map(|c| read_uint(layout.component, c)).collect())

@@ -1,20 +1,46 @@
 //! glTF materials and their base-colour images.
 //!
-//! Images are decoded once each (cached by image index) to sRGB RGBA8. Dimensions are read
-//! from the image header and checked against `LoadOptions::max_texture_size` before any pixel
-//! is decoded, so a tiny file that declares a huge image costs nothing.
+//! Images are decoded to sRGB RGBA8 once per distinct source (the same resolved file, the same
+//! `data:` URI or the same buffer view), however many `images` entries name it. Dimensions
+//! are read from the image header and checked against `LoadOptions::max_texture_size` and
+//! the `LoadOptions::max_image_bytes` budget before any pixel is decoded, so a tiny file that
+//! declares a huge image, or names one image many times, costs nothing.
 
-use super::Ctx;
 use super::uri::{UriSource, resolve_uri};
+use super::{Ctx, over_budget};
 use crate::SceneError;
 use glam::Vec4;
 use image::{ImageDecoder, ImageFormat, ImageReader, Limits};
 use manylight_core::{MaterialData, TextureData};
+use std::borrow::Cow;
 use std::io::Cursor;
+use std::path::PathBuf;
 use std::sync::Arc;
 
 /// Largest image file (in bytes) read from a URI; larger files are refused before reading.
 const MAX_IMAGE_FILE_BYTES: u64 = 256 << 20;
+
+/// Where an image's encoded bytes come from; images with the same source share one decode.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub(super) enum ImageSource<'a> {
+    /// A `data:` URI, by its text.
+    Data(&'a str),
+    /// A file in the glTF file's folder, by its canonical path.
+    File(PathBuf),
+    /// A buffer view, by index.
+    View(usize),
+}
+
+/// Whether `uri` is a `data:` URI (the scheme is case-insensitive).
+fn is_data_uri(uri: &str) -> bool {
+    uri.get(..5).is_some_and(|s| s.eq_ignore_ascii_case("data:"))
+}
+
+/// The lower-cased media type of a `data:` URI (empty when it has none).
+fn data_media_type(uri: &str) -> String {
+    let header = uri.get(5..).and_then(|r| r.split_once(',')).map_or("", |(h, _)| h);
+    header.strip_suffix(";base64").unwrap_or(header).to_ascii_lowercase()
+}
 
 /// Blinn-Phong exponent and specular strength for a metallic-roughness material.
 ///
@@ -28,7 +54,7 @@ pub fn blinn_phong_from_pbr(roughness: f32, metallic: f32) -> (f32, f32) {
     (shininess, specular)
 }
 
-impl Ctx<'_> {
+impl<'a> Ctx<'a> {
     /// Converts material `index` (its base colour, base-colour texture and roughness).
     pub(super) fn material(&mut self, index: usize) -> Result<MaterialData, SceneError> {
         let root = self.root;
@@ -70,12 +96,13 @@ impl Ctx<'_> {
         })
     }
 
-    /// Decodes image `index` (cached), checking format and size first.
+    /// Decodes image `index` (cached by index and by source), checking format, size and the
+    /// decoded-bytes budget first.
     fn image(&mut self, index: usize) -> Result<Arc<TextureData>, SceneError> {
         if let Some(t) = self.textures.get(&index) {
             return Ok(t.clone());
         }
-        let root = self.root;
+        let root: &'a gltf::json::Root = self.root;
         let img = &root.images[index]; // the caller checked the index
         let what = format!("image {index}");
         let unsupported = |format: String| SceneError::UnsupportedImage {
@@ -83,33 +110,15 @@ impl Ctx<'_> {
             image: index,
             format,
         };
-        let mut mime = img.mime_type.as_ref().map(|m| m.0.to_ascii_lowercase());
-        let (bytes, label) = match (&img.uri, img.buffer_view) {
+        // Resolve the source (a file is opened and checked, not read).
+        let (source, file) = match (&img.uri, img.buffer_view) {
+            (Some(uri), _) if is_data_uri(uri) => (ImageSource::Data(uri.as_str()), None),
             (Some(uri), _) => match resolve_uri(self.path, &self.base_dir, &what, uri)? {
-                UriSource::Data { bytes, media_type } => {
-                    if !media_type.is_empty() {
-                        mime = Some(media_type);
-                    }
-                    (bytes, format!("{} image {index}", self.file_name()))
-                }
-                UriSource::File(file) => {
-                    if file.size > MAX_IMAGE_FILE_BYTES {
-                        return Err(SceneError::ReferencedFileTooLarge {
-                            path: self.path.to_owned(),
-                            what,
-                            file: file.path,
-                            size: file.size,
-                            limit: MAX_IMAGE_FILE_BYTES,
-                        });
-                    }
-                    let label = file.path.display().to_string();
-                    (file.read_prefix(self.path, &what, MAX_IMAGE_FILE_BYTES)?, label)
-                }
+                UriSource::File(file) => (ImageSource::File(file.path.clone()), Some(file)),
+                // `resolve_uri` decodes only `data:` URIs, handled above.
+                UriSource::Data { .. } => (ImageSource::Data(uri.as_str()), None),
             },
-            (None, Some(view)) => {
-                let bytes = self.view_bytes(view.value(), &what)?.to_vec();
-                (bytes, format!("{} image {index}", self.file_name()))
-            }
+            (None, Some(view)) => (ImageSource::View(view.value()), None),
             (None, None) => {
                 return Err(SceneError::ImageDecode {
                     path: self.path.to_owned(),
@@ -118,19 +127,61 @@ impl Ctx<'_> {
                 });
             }
         };
+        // The media type of a `data:` URI wins over `mimeType`; checked for every entry.
+        let mut mime = img.mime_type.as_ref().map(|m| m.0.to_ascii_lowercase());
+        if let ImageSource::Data(uri) = source {
+            let media_type = data_media_type(uri);
+            if !media_type.is_empty() {
+                mime = Some(media_type);
+            }
+        }
         if let Some(mime) = &mime
             && !matches!(mime.as_str(), "image/png" | "image/jpeg" | "image/jpg")
         {
             return Err(unsupported(format!("MIME type {mime}")));
         }
+        if let Some(t) = self.images.get(&source) {
+            let t = t.clone();
+            self.textures.insert(index, t.clone());
+            return Ok(t);
+        }
+        let (bytes, label): (Cow<'_, [u8]>, String) = match (&source, file) {
+            (_, Some(file)) => {
+                if file.size > MAX_IMAGE_FILE_BYTES {
+                    return Err(SceneError::ReferencedFileTooLarge {
+                        path: self.path.to_owned(),
+                        what,
+                        file: file.path,
+                        size: file.size,
+                        limit: MAX_IMAGE_FILE_BYTES,
+                    });
+                }
+                let label = file.path.display().to_string();
+                (Cow::Owned(file.read_prefix(self.path, &what, MAX_IMAGE_FILE_BYTES)?), label)
+            }
+            (ImageSource::View(view), None) => {
+                (Cow::Borrowed(self.view_bytes(*view, &what)?), format!("{} image {index}", self.file_name()))
+            }
+            (_, None) => {
+                let uri = img.uri.as_deref().unwrap_or_default();
+                let bytes = match resolve_uri(self.path, &self.base_dir, &what, uri)? {
+                    UriSource::Data { bytes, .. } => bytes,
+                    UriSource::File(file) => file.read_prefix(self.path, &what, MAX_IMAGE_FILE_BYTES)?,
+                };
+                (Cow::Owned(bytes), format!("{} image {index}", self.file_name()))
+            }
+        };
         let format = match image::guess_format(&bytes) {
             Ok(f @ (ImageFormat::Png | ImageFormat::Jpeg)) => f,
             Ok(other) => return Err(unsupported(format!("{other:?} data"))),
             Err(_) => return Err(unsupported("unrecognised data".into())),
         };
         let data = self.decode(index, &bytes, format, label)?;
+        drop(bytes);
+        self.used.image_bytes += data.rgba8.len() as u64;
         let data = Arc::new(data);
         self.textures.insert(index, data.clone());
+        self.images.insert(source, data.clone());
         Ok(data)
     }
 
@@ -166,6 +217,13 @@ impl Ctx<'_> {
                 image: index,
                 message: "image has zero size".into(),
             });
+        }
+        // Decoded as RGBA8; counted with the images decoded before it.
+        let needed = self.used.image_bytes.saturating_add(width as u64 * height as u64 * 4);
+        if needed > self.options.max_image_bytes {
+            let what = format!("image {index} (with the images decoded before it)");
+            let (unit, limit) = ("bytes of decoded images", self.options.max_image_bytes);
+            return Err(over_budget(self.path, what, needed, unit, limit, "max_image_bytes"));
         }
         let mut limits = Limits::default();
         limits.max_image_width = Some(max);

@@ -1,6 +1,6 @@
 //! The node tree of a glTF scene: transforms, mesh instances, point lights and cameras.
 
-use super::Ctx;
+use super::{Ctx, over_budget};
 use crate::{SceneCamera, SceneError, SceneInstance, SceneLight};
 use glam::{Mat4, Quat, Vec3};
 use gltf::json::camera::Type as CameraType;
@@ -12,7 +12,8 @@ use std::sync::Arc;
 
 impl Ctx<'_> {
     /// Walks the default scene (or scene 0, or every root node when there is no scene) and
-    /// adds instances, lights and cameras for each node.
+    /// adds instances, lights and cameras for each node, after [`Ctx::check_node_tree`]
+    /// accepted the tree.
     pub(super) fn walk_scene(&mut self) -> Result<(), SceneError> {
         let root = self.root;
         let roots: Vec<usize> = match (root.scene, root.scenes.first()) {
@@ -33,6 +34,7 @@ impl Ctx<'_> {
                 (0..root.nodes.len()).filter(|&i| !is_child[i]).collect()
             }
         };
+        self.check_node_tree(&roots)?;
         let mut visited = vec![false; root.nodes.len()];
         let mut stack: Vec<(usize, Mat4, String)> =
             roots.into_iter().rev().map(|n| (n, Mat4::IDENTITY, "the scene".to_owned())).collect();
@@ -57,6 +59,73 @@ impl Ctx<'_> {
             for child in node.children.iter().flatten().rev() {
                 stack.push((child.value(), world, format!("node {index}")));
             }
+        }
+        Ok(())
+    }
+
+    /// Walks the node tree below `roots` once without reading any data or creating anything:
+    /// refuses a node reached twice (cycle or shared child), nesting deeper than
+    /// `LoadOptions::max_node_depth`, and a tree that would create more instances or lights
+    /// than `LoadOptions::max_instances` and `LoadOptions::max_lights` allow (instances
+    /// multiply: every triangle primitive of every node's mesh is one).
+    fn check_node_tree(&self, roots: &[usize]) -> Result<(), SceneError> {
+        let root = self.root;
+        let options = self.options;
+        // Per mesh, the primitives that become instances (triangles with a POSITION).
+        let drawn: Vec<u64> = (root.meshes.iter())
+            .map(|m| {
+                let drawn = |p: &&gltf::json::mesh::Primitive| {
+                    p.mode == Checked::Valid(Mode::Triangles)
+                        && p.attributes.contains_key(&Checked::Valid(Semantic::Positions))
+                };
+                m.primitives.iter().filter(drawn).count() as u64
+            })
+            .collect();
+        let mut visited = vec![false; root.nodes.len()];
+        // (node, depth, parent)
+        let mut stack: Vec<(usize, u32, Option<usize>)> = roots.iter().rev().map(|&n| (n, 1, None)).collect();
+        let (mut instances, mut lights) = (0u64, 0u64);
+        while let Some((index, depth, parent)) = stack.pop() {
+            let referrer = parent.map_or_else(|| "the scene".to_owned(), |p| format!("node {p}"));
+            let node = self.lookup(&root.nodes, index, &referrer, "node")?;
+            if std::mem::replace(&mut visited[index], true) {
+                return Err(SceneError::NodeHierarchy { path: self.path.to_owned(), node: index });
+            }
+            if depth > options.max_node_depth {
+                let (limit, unit) = (options.max_node_depth.into(), "levels of node nesting");
+                return Err(over_budget(
+                    self.path,
+                    format!("node {index}"),
+                    depth.into(),
+                    unit,
+                    limit,
+                    "max_node_depth",
+                ));
+            }
+            if let Some(mesh) = node.mesh {
+                instances += *self.lookup(&drawn, mesh.value(), &format!("node {index}"), "mesh")?;
+            }
+            if node.extensions.as_ref().is_some_and(|e| e.khr_lights_punctual.is_some()) {
+                lights += 1;
+            }
+            for child in node.children.iter().flatten().rev() {
+                stack.push((child.value(), depth.saturating_add(1), Some(index)));
+            }
+        }
+        if instances > options.max_instances {
+            let limit = options.max_instances;
+            return Err(over_budget(
+                self.path,
+                "the node tree",
+                instances,
+                "instances",
+                limit,
+                "max_instances",
+            ));
+        }
+        if lights > options.max_lights {
+            let limit = options.max_lights;
+            return Err(over_budget(self.path, "the node tree", lights, "lights", limit, "max_lights"));
         }
         Ok(())
     }
@@ -104,7 +173,9 @@ impl Ctx<'_> {
     }
 
     /// Scene mesh for primitive `p` of mesh `mesh`, converted once per accessor combination.
-    /// `None` for primitives without positions or without triangles.
+    /// `None` for primitives without positions or without triangles. The accessors' types and
+    /// counts are checked, and the vertices and indices counted against
+    /// `LoadOptions::max_vertices` and `LoadOptions::max_indices`, before any is read.
     fn primitive_mesh(&mut self, mesh: usize, p: usize) -> Result<Option<usize>, SceneError> {
         let root = self.root;
         let prim = &root.meshes[mesh].primitives[p];
@@ -121,38 +192,60 @@ impl Ctx<'_> {
             prim.indices.map(|i| i.value()),
         ];
         if let Some(&index) = self.meshes.get(&key) {
-            return Ok(Some(index));
+            return Ok(index);
         }
-        let positions = self.read_vec3(pos, &what, "POSITION")?;
         let bad = |problem: String| SceneError::BadPrimitive {
             path: self.path.to_owned(),
             mesh,
             primitive: p,
             problem,
         };
-        let mut normals = match key[1] {
-            Some(a) => Some(self.read_vec3(a, &what, "NORMAL")?),
-            None => None,
-        };
-        let mut uvs = match key[2] {
-            Some(a) => Some(self.read_uv(a, &what)?),
-            None => None,
-        };
-        let indices = match key[3] {
-            Some(a) => Some(self.read_indices(a, &what)?),
-            None => None,
-        };
-        if let Some(n) = &normals
-            && n.len() != positions.len()
+        // Types and counts first, then the budgets, and only then read anything.
+        let pos_layout = self.vec3_layout(pos, &what, "POSITION")?;
+        let normal_layout = key[1].map(|a| self.vec3_layout(a, &what, "NORMAL")).transpose()?;
+        let uv_layout = key[2].map(|a| self.uv_layout(a, &what)).transpose()?;
+        let index_layout = key[3].map(|a| self.index_layout(a, &what)).transpose()?;
+        let vertices = pos_layout.count;
+        if let Some(n) = normal_layout
+            && n.count != vertices
         {
-            return Err(bad(format!("{} normals for {} positions", n.len(), positions.len())));
+            return Err(bad(format!("{} normals for {vertices} positions", n.count)));
         }
-        if let Some(u) = &uvs
-            && u.len() != positions.len()
+        if let Some(u) = uv_layout
+            && u.count != vertices
         {
-            return Err(bad(format!("{} TEXCOORD_0 values for {} positions", u.len(), positions.len())));
+            return Err(bad(format!("{} TEXCOORD_0 values for {vertices} positions", u.count)));
         }
-        // Broken normals or uvs are repaired (they only shade wrong); broken positions are errors.
+        let indices = index_layout.map_or(vertices, |l| l.count);
+        let options = self.options;
+        let (used_vertices, used_indices) = (
+            self.used.vertices.saturating_add(vertices as u64),
+            self.used.indices.saturating_add(indices as u64),
+        );
+        let what_all = || format!("{what} (with the meshes before it)");
+        if used_vertices > options.max_vertices {
+            let limit = options.max_vertices;
+            return Err(over_budget(self.path, what_all(), used_vertices, "vertices", limit, "max_vertices"));
+        }
+        if used_indices > options.max_indices {
+            let limit = options.max_indices;
+            return Err(over_budget(self.path, what_all(), used_indices, "indices", limit, "max_indices"));
+        }
+        self.used.vertices = used_vertices;
+        self.used.indices = used_indices;
+        let positions = self.read_vec3(pos, pos_layout)?;
+        let mut normals = match (key[1], normal_layout) {
+            (Some(a), Some(l)) => Some(self.read_vec3(a, l)?),
+            _ => None,
+        };
+        let mut uvs = match (key[2], uv_layout) {
+            (Some(a), Some(l)) => Some(self.read_uv(a, l)?),
+            _ => None,
+        };
+        let indices = match (key[3], index_layout) {
+            (Some(a), Some(l)) => Some(self.read_indices(a, l)?),
+            _ => None,
+        };
         if let Some(n) = normals.as_mut().filter(|n| n.iter().any(|v| !v.is_finite())) {
             tracing::warn!(file = %self.path.display(), mesh, primitive = p, "non-finite normals replaced");
             n.iter_mut().filter(|v| !v.is_finite()).for_each(|v| *v = Vec3::ZERO);
@@ -164,6 +257,8 @@ impl Ctx<'_> {
         let count = indices.as_ref().map_or(positions.len(), Vec::len);
         if count == 0 {
             tracing::warn!(file = %self.path.display(), mesh, primitive = p, "primitive has no triangles, skipped");
+            // Remembered, so that other nodes sharing it do not read its accessors again.
+            self.meshes.insert(key, None);
             return Ok(None);
         }
         let label = match &root.meshes[mesh].name {
@@ -174,7 +269,7 @@ impl Ctx<'_> {
             .map_err(|source| SceneError::Mesh { path: self.path.to_owned(), mesh, primitive: p, source })?;
         self.scene.meshes.push(Arc::new(data));
         let index = self.scene.meshes.len() - 1;
-        self.meshes.insert(key, index);
+        self.meshes.insert(key, Some(index));
         Ok(Some(index))
     }
 
@@ -259,15 +354,18 @@ impl Ctx<'_> {
                     Some(f) if f.is_finite() && f > p.znear => f,
                     Some(_) => return Err(bad("zfar must be finite and greater than znear")),
                 };
+                // A huge znear overflows the default zfar (or the depth terms) to infinity,
+                // and the projection matrix to NaN.
+                let projection = Projection { fov_y: p.yfov, near: p.znear, far };
+                if !far.is_finite() || !projection.matrix(1.0).is_finite() {
+                    return Err(bad("znear and zfar give a projection with non-finite terms"));
+                }
                 let (_, rotation, translation) = world.to_scale_rotation_translation();
                 let transform = Mat4::from_rotation_translation(rotation.normalize(), translation);
                 if !transform.is_finite() {
                     return Err(bad(&format!("node {node} gives it a degenerate transform")));
                 }
-                self.scene.cameras.push(SceneCamera {
-                    transform,
-                    projection: Projection { fov_y: p.yfov, near: p.znear, far }.sanitized(),
-                });
+                self.scene.cameras.push(SceneCamera { transform, projection: projection.sanitized() });
             }
             (Checked::Valid(CameraType::Perspective), None) => {
                 return Err(bad("perspective camera without perspective parameters"));

@@ -23,8 +23,8 @@ use std::path::{Component, Path, PathBuf};
 
 /// Where the bytes named by a `uri` come from.
 pub(super) enum UriSource {
-    /// Decoded `data:` URI payload, with its media type.
-    Data { bytes: Vec<u8>, media_type: String },
+    /// Decoded `data:` URI payload.
+    Data { bytes: Vec<u8> },
     /// An opened regular file inside the glTF file's folder.
     File(LocalFile),
 }
@@ -125,7 +125,7 @@ fn relative_path(decoded: &str) -> Result<PathBuf, String> {
 }
 
 /// A readable name for a file type that is not a regular file.
-fn file_kind(ty: std::fs::FileType) -> &'static str {
+pub(super) fn file_kind(ty: std::fs::FileType) -> &'static str {
     if ty.is_dir() {
         return "directory";
     }
@@ -191,7 +191,7 @@ const OPEN_FLAGS: i32 = 0o4000;
 const OPEN_FLAGS: i32 = 0;
 
 /// Read-only, and on unix with [`OPEN_FLAGS`].
-fn open_options() -> std::fs::OpenOptions {
+pub(super) fn open_options() -> std::fs::OpenOptions {
     let mut options = std::fs::OpenOptions::new();
     options.read(true);
     #[cfg(unix)]
@@ -236,13 +236,13 @@ pub(super) fn resolve_uri(
     if lower.starts_with("data:") {
         let rest = &uri[5..];
         let (header, payload) = rest.split_once(',').ok_or_else(|| bad("data URI without ','"))?;
-        let Some(media_type) = header.strip_suffix(";base64") else {
+        if !header.ends_with(";base64") {
             return Err(bad("only base64 data URIs are supported"));
-        };
+        }
         let bytes = base64::engine::general_purpose::STANDARD
             .decode(payload.trim_end())
             .map_err(|e| bad(&format!("invalid base64: {e}")))?;
-        return Ok(UriSource::Data { bytes, media_type: media_type.to_ascii_lowercase() });
+        return Ok(UriSource::Data { bytes });
     }
     // A scheme is letters/digits/+/-/. before the first ':' that comes before any '/'; a
     // single letter there is a Windows drive.

@@ -7,6 +7,8 @@
   a POINTS primitive (skipped), a point light without range, a spot light (skipped), a camera
   with infinite zfar and a primitive without material.
 - triangle.glb: a textured triangle in a GLB whose 8-bit PNG texture lives in a buffer view.
+- extras_any_type.gltf: a triangle whose `extras` are a string, an array, a number, `null`,
+  `true` and a nested object (the spec allows any JSON value there).
 """
 import base64, json, struct, zlib
 from pathlib import Path
@@ -101,6 +103,18 @@ def main():
         "buffers": [{"byteLength": 36, "uri": data_uri(POSITIONS)}],
     }
     (HERE / "features.gltf").write_text(json.dumps(doc, indent=1))
+
+    doc = triangle(POSITIONS + INDICES, [dict(POS_ACC, extras=None), dict(IDX_ACC, extras=[1, 2])],
+                   [{"buffer": 0, "byteLength": 36, "extras": 5},
+                    {"buffer": 0, "byteOffset": 36, "byteLength": 6}],
+                   {"POSITION": 0})
+    doc["extras"] = "a string"
+    doc["asset"]["extras"] = {"nested": {"deeper": [1, {"x": True}]}}
+    doc["nodes"][0]["extras"] = True
+    doc["meshes"][0]["extras"] = [[], {}]
+    doc["meshes"][0]["primitives"][0]["extras"] = 0.5
+    doc["scenes"][0]["extras"] = None
+    (HERE / "extras_any_type.gltf").write_text(json.dumps(doc, indent=1))
 
     image = png8(2, 2, (0, 255, 0, 255))
     image += b"\0" * (-len(image) % 4)
