@@ -41,8 +41,8 @@ fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
         .unwrap_or_else(|| "a panic without a message".to_string())
 }
 
-/// Renders one frame, turning a panic of the renderer into an error (the renderer is not used
-/// again after one).
+/// Renders one frame, turning a panic of the renderer into an error like any other failed
+/// frame (the app ends on it; the render thread stops).
 fn render_caught(sink: &mut dyn FrameSink, snapshot: FrameSnapshot, readback: bool) -> FrameResult {
     match catch_unwind(AssertUnwindSafe(|| sink.render_frame(snapshot, readback))) {
         Ok(result) => result.map_err(|e| e.to_string()),
