@@ -2,7 +2,7 @@
 //! cluster's light list instead of every light.
 
 use super::common::{MeshPipelineDesc, clear_color, color_attachment, mesh_pipeline};
-use super::forward::record_scene_pass;
+use super::scene_draw::record_scene_pass;
 use super::{CLUSTERS, DEPTH, HDR};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};

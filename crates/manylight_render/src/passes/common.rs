@@ -1,9 +1,9 @@
 //! What the passes share: pipeline construction for mesh and full-screen passes, the attachments
 //! they use, and bind-group-layout entries.
 
-use super::forward::vertex_layout;
 use crate::context::RenderError;
 use crate::resources::DEPTH_FORMAT;
+use manylight_core::Vertex;
 
 /// A uniform-buffer layout entry.
 pub fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
@@ -263,4 +263,15 @@ pub fn draw_fullscreen(
         pass.set_bind_group(i as u32, *group, &[]);
     }
     pass.draw(0..3, 0..1);
+}
+
+/// The vertex buffer layout of [`Vertex`].
+pub fn vertex_layout() -> wgpu::VertexBufferLayout<'static> {
+    const ATTRIBUTES: [wgpu::VertexAttribute; 3] =
+        wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2];
+    wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<Vertex>() as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &ATTRIBUTES,
+    }
 }

@@ -2,7 +2,7 @@
 
 use super::DEPTH;
 use super::common::{MeshPipelineDesc, mesh_pipeline};
-use super::forward::record_scene_pass;
+use super::scene_draw::record_scene_pass;
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::resources::{DEPTH_FORMAT, SceneResources};

@@ -2,53 +2,14 @@
 //! normal, albedo, shading parameters) in the chosen [`GBufferLayout`].
 
 use super::common::{MeshPipelineDesc, color_attachment, mesh_pipeline_with_constants};
-use super::forward::record_scene_pass;
-use super::{
-    DEPTH, DEPTH_USAGE, GBUFFER_ALBEDO, GBUFFER_COMPACT, GBUFFER_NORMAL, GBUFFER_PACKED_ALBEDO,
-    GBUFFER_PACKED_POSITION, GBUFFER_POSITION,
-};
+use super::gbuffer_layout::{codec_constants, fragment_entry, targets, variant_key};
+use super::scene_draw::record_scene_pass;
+use super::{DEPTH, DEPTH_USAGE};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::resources::{DEPTH_FORMAT, SceneResources};
 use crate::snapshot::GBufferLayout;
 use manylight_core::codec::NormalCodec;
-
-/// The G-buffer targets of a layout: name and format.
-pub fn targets(layout: GBufferLayout) -> &'static [(ResourceName, wgpu::TextureFormat)] {
-    match layout {
-        // Albedo is rgba16f, not rgba8: with 8 bits (even sRGB-encoded)
-        // the image differed from naive forward by FLIP mean 0.015, with 16-bit floats 0.0035.
-        GBufferLayout::Full => &[
-            (GBUFFER_POSITION, wgpu::TextureFormat::Rgba32Float),
-            (GBUFFER_NORMAL, wgpu::TextureFormat::Rgba16Float),
-            (GBUFFER_ALBEDO, wgpu::TextureFormat::Rgba16Float),
-        ],
-        GBufferLayout::Packed => &[
-            (GBUFFER_PACKED_ALBEDO, wgpu::TextureFormat::Rgba32Float),
-            (GBUFFER_PACKED_POSITION, wgpu::TextureFormat::Rgba32Float),
-        ],
-        GBufferLayout::Compact => &[(GBUFFER_COMPACT, wgpu::TextureFormat::Rgba32Uint)],
-    }
-}
-
-/// The fragment entry point of `gbuffer.wgsl` and `deferred_lighting.wgsl` for a layout.
-pub fn fragment_entry(layout: GBufferLayout) -> &'static str {
-    match layout {
-        GBufferLayout::Full => "fs_full",
-        GBufferLayout::Packed => "fs_packed",
-        GBufferLayout::Compact => "fs_compact",
-    }
-}
-
-/// The `override` constants selecting `codec` in the G-buffer shaders.
-pub fn codec_constants(codec: NormalCodec) -> [(&'static str, f64); 1] {
-    [("NORMAL_CODEC", codec.gpu_id() as f64)]
-}
-
-/// Pipeline-cache key of a (layout, codec) pair.
-pub fn variant_key(layout: GBufferLayout, codec: NormalCodec) -> u64 {
-    (layout as u64) << 8 | codec.gpu_id() as u64
-}
 
 /// The pipeline of [`GBufferPass`] for one layout and codec.
 pub struct GBufferPipeline {

@@ -5,8 +5,9 @@
 
 use super::common::{FullscreenPipelineDesc, fullscreen_pipeline_desc, texture_entry};
 use super::common::{clear_color, color_attachment, draw_fullscreen};
-use super::deferred_lighting::{gbuffer_read_bind_group, gbuffer_read_layout};
-use super::gbuffer::{codec_constants, targets, variant_key};
+use super::gbuffer_layout::{
+    codec_constants, gbuffer_read_bind_group, gbuffer_read_layout, targets, variant_key,
+};
 use super::{DEPTH, HDR, LIGHT_ACCUM};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};

@@ -1,5 +1,9 @@
 //! One module per pass. Each pass declares its reads and writes and records itself; its
-//! pipeline is created on first use through the [`crate::pipelines::PipelineCache`].
+//! pipeline is created on first use through the [`crate::pipelines::PipelineCache`]. What
+//! several passes share lives in shared modules, never in a pass: [`common`] (pipeline,
+//! attachment and layout helpers), [`scene_draw`] (drawing the scene's instances) and
+//! [`gbuffer_layout`] (G-buffer targets and the bind group that reads them). No pass module
+//! imports another.
 
 pub mod bloom;
 pub mod cluster_build;
@@ -10,8 +14,10 @@ pub mod deferred_lighting;
 pub mod depth_prepass;
 pub mod forward;
 pub mod gbuffer;
+pub mod gbuffer_layout;
 pub mod light_volumes;
 pub mod motion_blur;
+pub mod scene_draw;
 pub mod tonemap;
 
 pub use bloom::{BloomBlurPass, BloomBrightPass, BloomCompositePass, BloomUpsamplePass};
