@@ -48,6 +48,13 @@ const TILE_PREFILTER_INFLATION: f32 = 1.001;
 
 override WORKGROUP_SIZE: u32 = 64u;
 
+// The linear index of an invocation. Dispatches wider than the device's workgroups per
+// dimension (65 535 by default) are split into rows: x runs over at most that many workgroups,
+// y counts the rows (Rust: `cluster_build::dispatch_size`).
+fn linear_index(id: vec3<u32>, groups: vec3<u32>) -> u32 {
+    return id.x + id.y * groups.x * WORKGROUP_SIZE;
+}
+
 // The cluster's bounds are loaded once per invocation (`b`), not once per light.
 fn touches(b: GpuClusterBounds, light: u32) -> bool {
     return touches_sphere(b, spheres[light]);
@@ -85,8 +92,8 @@ fn chunk_lights(e: u32) -> vec2<u32> {
 }
 
 @compute @workgroup_size(WORKGROUP_SIZE)
-fn tile_count(@builtin(global_invocation_id) id: vec3<u32>) {
-    let e = id.x;
+fn tile_count(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let e = linear_index(id, groups);
     if e >= tile_entry_total() {
         return;
     }
@@ -102,8 +109,8 @@ fn tile_count(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 @compute @workgroup_size(WORKGROUP_SIZE)
-fn tile_fill(@builtin(global_invocation_id) id: vec3<u32>) {
-    let e = id.x;
+fn tile_fill(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let e = linear_index(id, groups);
     if e >= tile_entry_total() {
         return;
     }
@@ -134,8 +141,8 @@ fn tile_lights(cluster: u32) -> vec2<u32> {
 }
 
 @compute @workgroup_size(WORKGROUP_SIZE)
-fn count(@builtin(global_invocation_id) id: vec3<u32>) {
-    let cluster = id.x;
+fn count(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let cluster = linear_index(id, groups);
     if cluster >= params.dims.w {
         return;
     }
@@ -220,8 +227,8 @@ fn scan(@builtin(local_invocation_index) t: u32) {
 }
 
 @compute @workgroup_size(WORKGROUP_SIZE)
-fn fill(@builtin(global_invocation_id) id: vec3<u32>) {
-    let cluster = id.x;
+fn fill(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let cluster = linear_index(id, groups);
     if cluster >= params.dims.w {
         return;
     }

@@ -240,3 +240,22 @@ fn gpu_lists_keep_every_light_of_a_large_rig() {
     let last = (0..gpu.ranges.len() as u32).flat_map(|c| gpu.lights_of(c).to_vec()).max().unwrap_or(0);
     assert!(last >= 65_536, "lights past index 65 535 must be assigned (largest: {last})");
 }
+
+/// More workgroups than a dispatch may have in one dimension (65 535): with a workgroup size
+/// of 1, 65 536 tiles and 131 072 clusters are split into rows, and every tile and cluster is
+/// still built exactly once.
+#[test]
+fn gpu_lists_are_exact_past_the_workgroups_per_dimension_limit() {
+    let _gpu = gpu();
+    let mut r = HeadlessRenderer::new().expect("adapter");
+    let scene = default_scene();
+    let mut settings = clustered(CullTest::Both, ZSlicing::Exponential, None);
+    settings.clusters.workgroup_size = 1;
+    settings.clusters.grid.dims = Some(glam::UVec3::new(256, 256, 2));
+    let snapshot = scene_snapshot(&scene, UVec2::new(512, 512), rig(&scene, 256, 3), settings);
+    let (report, gpu, cpu) = gpu_and_cpu(&mut r, snapshot);
+    let c = report.clusters.as_ref().expect("cluster report");
+    assert_eq!(gpu.ranges.len(), 256 * 256 * 2);
+    assert!(c.total_entries > 0, "{c:?}");
+    assert_same_lists("256×256×2 grid, workgroup size 1", &gpu, &cpu);
+}

@@ -59,6 +59,31 @@ pub struct ClusterBuildPass {
     pub workgroup_size: u32,
 }
 
+/// Workgroups `[x, y]` for `invocations` invocations of `workgroup_size`: one row while it fits
+/// in `max_per_dimension` (the device's `max_compute_workgroups_per_dimension`), else rows of
+/// `max_per_dimension` workgroups (the shader's `linear_index` undoes the split; invocations
+/// past the end return at once). Refused, naming the limit, past `max_per_dimension²`.
+pub fn dispatch_size(
+    invocations: u32,
+    workgroup_size: u32,
+    max_per_dimension: u32,
+) -> Result<[u32; 2], RenderError> {
+    let groups = invocations.div_ceil(workgroup_size.max(1)).max(1);
+    let max = max_per_dimension.max(1);
+    if groups <= max {
+        return Ok([groups, 1]);
+    }
+    let rows = groups.div_ceil(max);
+    // The padded grid's linear indices must stay below 2^32, or they would wrap onto real ones.
+    let padded = u64::from(max) * u64::from(rows) * u64::from(workgroup_size.max(1));
+    if rows > max || padded > 1 << 32 {
+        return Err(RenderError::UnsupportedSettings(format!(
+            "the cluster build needs {groups} workgroups, more than {max}² (max_compute_workgroups_per_dimension)"
+        )));
+    }
+    Ok([max, rows])
+}
+
 impl Pass for ClusterBuildPass {
     fn name(&self) -> &'static str {
         "cluster_build"
@@ -80,10 +105,17 @@ impl Pass for ClusterBuildPass {
         let pipelines = ctx
             .pipelines
             .get_or_create(wg as u64, || ClusterBuildPipelines::new(&ctx.gpu.device, layout, wg))?;
-        let groups = clusters.params.dims[3].div_ceil(wg);
+        let max_groups = ctx.gpu.device.limits().max_compute_workgroups_per_dimension;
+        let groups = dispatch_size(clusters.params.dims[3], wg, max_groups)?;
         // Level 1 runs one invocation per (tile, chunk of lights).
-        let tile_entries = clusters.params.dims[0] * clusters.params.dims[1] * clusters.params.tile_chunks;
-        let tile_groups = tile_entries.div_ceil(wg);
+        let tiles = u64::from(clusters.params.dims[0]) * u64::from(clusters.params.dims[1]);
+        let tile_entries = u32::try_from(tiles * u64::from(clusters.params.tile_chunks)).map_err(|_| {
+            RenderError::UnsupportedSettings(format!(
+                "{tiles} tiles × {} light chunks exceed 2^32 cluster-build invocations",
+                clusters.params.tile_chunks
+            ))
+        })?;
+        let tile_groups = dispatch_size(tile_entries, wg, max_groups)?;
         let timestamps = ctx.compute_timestamps(true, true);
         {
             let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -95,18 +127,39 @@ impl Pass for ClusterBuildPass {
             // as one workgroup.
             let steps = [
                 (&pipelines.tile_count, tile_groups),
-                (&pipelines.tile_scan, 1),
+                (&pipelines.tile_scan, [1, 1]),
                 (&pipelines.tile_fill, tile_groups),
                 (&pipelines.count, groups),
-                (&pipelines.scan, 1),
+                (&pipelines.scan, [1, 1]),
                 (&pipelines.fill, groups),
             ];
             for (pipeline, workgroups) in steps {
                 pass.set_pipeline(pipeline);
-                pass.dispatch_workgroups(workgroups, 1, 1);
+                pass.dispatch_workgroups(workgroups[0], workgroups[1], 1);
             }
         }
         clusters.copy_counters(ctx.encoder);
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::dispatch_size;
+
+    #[test]
+    fn dispatches_split_into_rows_past_the_limit() {
+        assert_eq!(dispatch_size(0, 64, 65_535).ok(), Some([1, 1]));
+        assert_eq!(dispatch_size(64 * 65_535, 64, 65_535).ok(), Some([65_535, 1]));
+        assert_eq!(dispatch_size(64 * 65_535 + 1, 64, 65_535).ok(), Some([65_535, 2]));
+        assert_eq!(dispatch_size(1 << 20, 1, 65_535).ok(), Some([65_535, 17]));
+        // Every invocation is covered, and the rows are not more than one short of full.
+        for (n, wg, max) in [(1_000_003u32, 7u32, 1000u32), (u32::MAX / 2, 2, 65_535), (4, 1, 2)] {
+            let [x, y] = dispatch_size(n, wg, max).expect("fits");
+            assert!(x <= max && y <= max);
+            assert!(u64::from(x) * u64::from(y) * u64::from(wg) >= u64::from(n));
+        }
+        assert!(dispatch_size(u32::MAX, 1, 1000).is_err());
+        assert!(dispatch_size(u32::MAX, 1, 65_535).is_err(), "more than 65 535² workgroups");
     }
 }
