@@ -280,7 +280,7 @@ impl ClusterResources {
                     }
                 }
             }
-            self.bounds.write(device, queue, bytemuck::cast_slice(&bounds));
+            self.bounds.write(device, queue, bytemuck::cast_slice(&bounds))?;
             // Level 1 of the build: the same tiles with one slice from near to far.
             let tile_grid = ClusterGrid::new(
                 snapshot.viewport,
@@ -301,21 +301,21 @@ impl ClusterResources {
                     });
                 }
             }
-            self.tile_bounds.write(device, queue, bytemuck::cast_slice(&tiles));
+            self.tile_bounds.write(device, queue, bytemuck::cast_slice(&tiles))?;
             self.bounds_of = Some(self.grid);
         }
         self.view_spheres = view_spheres(view_from_world, lights.iter().copied());
         let spheres: Vec<[f32; 4]> =
             self.view_spheres.iter().map(|s| s.center.extend(s.radius).to_array()).collect();
         if spheres.is_empty() {
-            self.spheres.write(device, queue, &[0u8; 16]);
+            self.spheres.write(device, queue, &[0u8; 16])?;
         } else {
-            self.spheres.write(device, queue, bytemuck::cast_slice(&spheres));
+            self.spheres.write(device, queue, bytemuck::cast_slice(&spheres))?;
         }
-        self.ranges.reserve(device, count as u64 * 8);
+        self.ranges.reserve(device, count as u64 * 8)?;
         let tiles = self.grid.dims.x as u64 * self.grid.dims.y as u64;
         let tile_chunks = (spheres.len() as u32).div_ceil(TILE_LIGHT_CHUNK).max(1);
-        self.tile_ranges.reserve(device, tiles * tile_chunks as u64 * 8);
+        self.tile_ranges.reserve(device, tiles * tile_chunks as u64 * 8)?;
         let p = projection.sanitized();
         self.params = GpuClusterParams {
             dims: [self.grid.dims.x, self.grid.dims.y, self.grid.dims.z, count],
@@ -350,26 +350,37 @@ impl ClusterResources {
         Ok(bytemuck::pod_read_unaligned(&bytes[..std::mem::size_of::<GpuClusterCounters>()]))
     }
 
-    /// True when the index lists are too small for what the frame needed (`counters`); grows
-    /// them (to the next power of two) so the frame can be rendered again.
-    pub fn grow_if_needed(&mut self, gpu: &GpuContext, counters: &GpuClusterCounters) -> bool {
+    /// True when the index lists are too small for what the frame needed (`counters`).
+    pub fn lists_short(&self, counters: &GpuClusterCounters) -> bool {
+        counters.tile_entries > self.params.tile_index_capacity
+            || counters.total_entries > self.params.index_capacity
+    }
+
+    /// True when the index lists were too small for what the frame needed (`counters`); grows
+    /// them (to the next power of two, at most the device's binding limit) so the frame can be
+    /// rendered again. A list the device cannot bind is refused, naming the limit.
+    pub fn grow_if_needed(
+        &mut self,
+        gpu: &GpuContext,
+        counters: &GpuClusterCounters,
+    ) -> Result<bool, RenderError> {
         let tiles_short = counters.tile_entries > self.params.tile_index_capacity;
         let clusters_short = counters.total_entries > self.params.index_capacity;
         if !tiles_short && !clusters_short {
-            return false;
+            return Ok(false);
         }
         if tiles_short {
-            self.tile_indices.reserve(&gpu.device, counters.tile_entries as u64 * 4);
+            self.tile_indices.reserve(&gpu.device, counters.tile_entries as u64 * 4)?;
             self.params.tile_index_capacity = (self.tile_indices.capacity() / 4).min(u32::MAX as u64) as u32;
         }
         if clusters_short {
-            self.indices.reserve(&gpu.device, counters.total_entries as u64 * 4);
+            self.indices.reserve(&gpu.device, counters.total_entries as u64 * 4)?;
             self.params.index_capacity = (self.indices.capacity() / 4).min(u32::MAX as u64) as u32;
         }
         gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
         gpu.queue.write_buffer(&self.counters, 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
         self.rebind_if_grown(&gpu.device);
-        true
+        Ok(true)
     }
 
     /// The report of a frame from its counters.

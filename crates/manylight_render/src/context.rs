@@ -52,6 +52,31 @@ pub enum RenderError {
     /// The device reported a validation or out-of-memory error.
     #[error("GPU error: {0}")]
     Device(String),
+    /// A buffer (lights, instances, cluster lists) would exceed what the device can bind.
+    #[error(
+        "`{label}` needs {bytes} bytes, more than this device's max_storage_buffer_binding_size of {limit} bytes"
+    )]
+    BufferTooLarge {
+        /// The buffer's label.
+        label: &'static str,
+        /// Bytes the frame needs.
+        bytes: u64,
+        /// The device's limit.
+        limit: u64,
+    },
+    /// The cluster build still found its light-index lists too small after growing them (a
+    /// frame is never shown with lights missing).
+    #[error(
+        "the cluster light lists were still too small after {regrows} regrowths ({needed} entries needed, {capacity} available)"
+    )]
+    ListsTooSmall {
+        /// Regrowths tried.
+        regrows: u32,
+        /// Entries the frame needed.
+        needed: u64,
+        /// Entries available.
+        capacity: u64,
+    },
     /// A render target larger than the device's largest 2D texture.
     #[error(
         "a {width}x{height} render target exceeds this device's limit of {limit} pixels per side (max_texture_dimension_2d)"

@@ -1,4 +1,6 @@
-//! Transient textures, pooled by descriptor and reused across frames.
+//! Transient textures, pooled by descriptor and reused across frames, and growable buffers.
+
+use crate::context::RenderError;
 
 /// What a transient texture is: the pool's key.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -115,6 +117,15 @@ pub struct GrowableBuffer {
     buffer: wgpu::Buffer,
     capacity: u64,
     generation: u64,
+    /// Largest size the device can bind (`max_storage_buffer_binding_size`, at most
+    /// `max_buffer_size`).
+    max_bytes: u64,
+}
+
+/// The largest buffer `device` can bind as storage, in bytes (a multiple of 4).
+fn max_binding_bytes(device: &wgpu::Device) -> u64 {
+    let limits = device.limits();
+    limits.max_storage_buffer_binding_size.min(limits.max_buffer_size) & !3
 }
 
 impl GrowableBuffer {
@@ -125,36 +136,48 @@ impl GrowableBuffer {
         usage: wgpu::BufferUsages,
         min_bytes: u64,
     ) -> Self {
-        let capacity = min_bytes.max(16).next_power_of_two();
+        let max_bytes = max_binding_bytes(device);
+        // Powers of two keep regrowth rare; near the device's limit the buffer takes the limit.
+        let capacity =
+            min_bytes.max(16).next_power_of_two().min(max_bytes.max(16)).max(min_bytes.min(max_bytes));
         let buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
             size: capacity,
             usage: usage | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        Self { label, usage, buffer, capacity, generation: 0 }
+        Self { label, usage, buffer, capacity, generation: 0, max_bytes }
     }
 
     /// Uploads `data`, growing the buffer (to the next power of two) when it does not fit.
     /// Returns true when the buffer was re-created (bind groups that use it must be rebuilt).
-    pub fn write(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, data: &[u8]) -> bool {
-        let grew = self.reserve(device, data.len() as u64);
+    pub fn write(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        data: &[u8],
+    ) -> Result<bool, RenderError> {
+        let grew = self.reserve(device, data.len() as u64)?;
         if !data.is_empty() {
             queue.write_buffer(&self.buffer, 0, data);
         }
-        grew
+        Ok(grew)
     }
 
     /// Makes room for `bytes`; returns true when the buffer was re-created.
-    pub fn reserve(&mut self, device: &wgpu::Device, bytes: u64) -> bool {
+    /// Refused, naming the limit, when `bytes` exceed what the device can bind.
+    pub fn reserve(&mut self, device: &wgpu::Device, bytes: u64) -> Result<bool, RenderError> {
         if bytes <= self.capacity {
-            return false;
+            return Ok(false);
+        }
+        if bytes > self.max_bytes {
+            return Err(RenderError::BufferTooLarge { label: self.label, bytes, limit: self.max_bytes });
         }
         *self = GrowableBuffer {
             generation: self.generation + 1,
             ..Self::new(device, self.label, self.usage, bytes)
         };
-        true
+        Ok(true)
     }
 
     /// The buffer.

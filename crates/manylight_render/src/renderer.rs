@@ -101,10 +101,20 @@ impl Renderer {
                 return Ok(report);
             };
             let counters = clusters.read_counters(&self.gpu)?;
-            if regrows < 4 && clusters.grow_if_needed(&self.gpu, &counters) {
+            if regrows < 4 && clusters.grow_if_needed(&self.gpu, &counters)? {
                 regrows += 1;
                 tracing::debug!("light-index list grew to {} entries", clusters.params.index_capacity);
                 continue;
+            }
+            if clusters.lists_short(&counters) {
+                // Never show a frame with lights missing from the lists.
+                return Err(RenderError::ListsTooSmall {
+                    regrows,
+                    needed: u64::from(counters.total_entries.max(counters.tile_entries)),
+                    capacity: u64::from(
+                        clusters.params.index_capacity.min(clusters.params.tile_index_capacity),
+                    ),
+                });
             }
             report.clusters = Some(clusters.report(&counters, regrows));
             return Ok(report);

@@ -316,7 +316,7 @@ impl SceneResources {
         self.view.light_count = self.light_count;
         let light_bytes: &[u8] =
             if gpu_lights.is_empty() { &[0u8; 32] } else { bytemuck::cast_slice(&gpu_lights) };
-        self.lights.write(device, queue, light_bytes);
+        self.lights.write(device, queue, light_bytes)?;
         queue.write_buffer(&self.view_buffer, 0, bytemuck::bytes_of(&self.view));
 
         // Meshes, materials, instances.
@@ -339,7 +339,7 @@ impl SceneResources {
         if instance_data.is_empty() {
             instance_data.push(GpuInstance::new(Mat4::IDENTITY));
         }
-        self.instances.write(device, queue, bytemuck::cast_slice(&instance_data));
+        self.instances.write(device, queue, bytemuck::cast_slice(&instance_data))?;
 
         let generations = (self.lights.generation(), self.instances.generation());
         if generations != self.bound_generations {
