@@ -15,7 +15,7 @@ use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 #[global_allocator]
 static ALLOC: counting_alloc::Counting = counting_alloc::Counting;
@@ -67,18 +67,9 @@ impl Outcome {
 /// Loads `path` on a worker thread, measuring its peak heap growth and time.
 fn load(path: &Path, options: LoadOptions) -> Outcome {
     counting_alloc::set_cap(4 << 30);
-    let (tx, rx) = std::sync::mpsc::channel();
     let owned = path.to_owned();
-    let base = counting_alloc::reset_peak();
-    let start = Instant::now();
-    std::thread::spawn(move || {
-        let _ = tx.send(load_gltf(&owned, &options));
-    });
-    let result = rx
-        .recv_timeout(LOAD_TIMEOUT)
-        .unwrap_or_else(|_| panic!("loading {} took over {LOAD_TIMEOUT:?}", path.display()));
-    let elapsed = start.elapsed();
-    let peak = counting_alloc::peak().saturating_sub(base);
+    let (result, peak, elapsed) = counting_alloc::measure(LOAD_TIMEOUT, move || load_gltf(&owned, &options))
+        .unwrap_or_else(|| panic!("loading {} took over {LOAD_TIMEOUT:?}", path.display()));
     eprintln!("{}: peak {:.1} MiB, {elapsed:?}", path.display(), peak as f64 / MIB as f64);
     Outcome { result, peak, elapsed }
 }

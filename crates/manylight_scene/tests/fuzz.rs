@@ -875,15 +875,9 @@ struct Outcome {
 }
 
 fn load_timed(path: &Path, options: LoadOptions) -> Option<Outcome> {
-    let (tx, rx) = std::sync::mpsc::channel();
     let owned = path.to_owned();
-    let base = counting_alloc::reset_peak();
-    let start = Instant::now();
-    std::thread::spawn(move || {
-        let _ = tx.send(load_gltf(&owned, &options));
-    });
-    let result = rx.recv_timeout(CASE_TIMEOUT).ok()?;
-    Some(Outcome { result, peak: counting_alloc::peak().saturating_sub(base), elapsed: start.elapsed() })
+    let (result, peak, elapsed) = counting_alloc::measure(CASE_TIMEOUT, move || load_gltf(&owned, &options))?;
+    Some(Outcome { result, peak, elapsed })
 }
 
 /// Checks everything a loaded scene must satisfy under `o`.

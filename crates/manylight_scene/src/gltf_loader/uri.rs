@@ -152,8 +152,10 @@ pub(super) fn file_kind(ty: std::fs::FileType) -> &'static str {
 }
 
 /// `O_NONBLOCK` on Linux targets whose value is the generic `0o4000` (opening a FIFO with it
-/// returns at once instead of waiting for a writer; reads of regular files ignore it).
-#[cfg(all(
+/// returns at once instead of waiting for a writer; reads of regular files ignore it); no extra
+/// open flags where `O_NONBLOCK`'s value is not the generic one.
+#[cfg(unix)]
+const OPEN_FLAGS: i32 = if cfg!(all(
     any(target_os = "linux", target_os = "android"),
     any(
         target_arch = "x86",
@@ -167,28 +169,11 @@ pub(super) fn file_kind(ty: std::fs::FileType) -> &'static str {
         target_arch = "powerpc64",
         target_arch = "s390x"
     )
-))]
-const OPEN_FLAGS: i32 = 0o4000;
-/// No extra open flags where `O_NONBLOCK`'s value is not the generic one.
-#[cfg(all(
-    unix,
-    not(all(
-        any(target_os = "linux", target_os = "android"),
-        any(
-            target_arch = "x86",
-            target_arch = "x86_64",
-            target_arch = "arm",
-            target_arch = "aarch64",
-            target_arch = "riscv32",
-            target_arch = "riscv64",
-            target_arch = "loongarch64",
-            target_arch = "powerpc",
-            target_arch = "powerpc64",
-            target_arch = "s390x"
-        )
-    ))
-))]
-const OPEN_FLAGS: i32 = 0;
+)) {
+    0o4000
+} else {
+    0
+};
 
 /// Read-only, and on unix with [`OPEN_FLAGS`].
 pub(super) fn open_options() -> std::fs::OpenOptions {

@@ -108,3 +108,20 @@ pub fn peak() -> usize {
 pub fn set_cap(bytes: usize) {
     CAP.store(bytes, Relaxed);
 }
+
+/// Runs `work` on a worker thread and returns its result with the peak heap growth (bytes above
+/// the live total when it started) and the time it took; `None` when it did not finish within
+/// `timeout` (the worker is left behind, so a hang fails the caller instead of freezing it).
+pub fn measure<T: Send + 'static>(
+    timeout: std::time::Duration,
+    work: impl FnOnce() -> T + Send + 'static,
+) -> Option<(T, usize, std::time::Duration)> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    let base = reset_peak();
+    let start = std::time::Instant::now();
+    std::thread::spawn(move || {
+        let _ = tx.send(work());
+    });
+    let result = rx.recv_timeout(timeout).ok()?;
+    Some((result, peak().saturating_sub(base), start.elapsed()))
+}
