@@ -3,6 +3,8 @@
 //! overlaps the rendering of frame N; the channel holds one frame, so the simulation never runs
 //! more than one frame ahead).
 
+use crate::render_world::DeviceLoss;
+use crate::resources::{FrameStats, HeadlessCapture, RenderFailure};
 use bevy_ecs::prelude::*;
 use crossbeam_channel::{Receiver, Sender, bounded, unbounded};
 use manylight_render::{FrameReport, FrameSnapshot, RenderError};
@@ -10,7 +12,24 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::thread::JoinHandle;
 
 /// What a rendered frame gives back: its report and, if asked, its image.
-pub type FrameResult = Result<(FrameReport, Option<image::RgbaImage>), String>;
+pub type FrameResult = Result<(FrameReport, Option<image::RgbaImage>), RenderFailed>;
+
+/// Why rendering stopped: sent as a message (`MessageReader<RenderFailed>`) in the update that
+/// learns of it, before the app exits with `AppExit::error()`; its text is also kept in
+/// [`crate::RenderFailure`].
+#[derive(Message, Clone, Debug, thiserror::Error)]
+pub enum RenderFailed {
+    /// The renderer returned an error (a lost device it could not recreate is
+    /// [`RenderError::DeviceLost`]).
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    /// The renderer panicked; the message is the panic's.
+    #[error("the renderer panicked: {0}")]
+    Panic(String),
+    /// The render thread ended outside a frame.
+    #[error("{0}")]
+    Stopped(String),
+}
 
 /// Something that renders snapshots: the headless renderer or a window surface.
 pub trait FrameSink: Send + Sync + 'static {
@@ -20,6 +39,13 @@ pub trait FrameSink: Send + Sync + 'static {
         snapshot: FrameSnapshot,
         readback: bool,
     ) -> Result<(FrameReport, Option<image::RgbaImage>), RenderError>;
+
+    /// Destroys the GPU device, as a driver reset would, at the point `when` says; the renderer
+    /// finds it lost and recreates it. For fault-injection tests and the soak run; sinks
+    /// without a device ignore it.
+    fn lose_device(&mut self, when: DeviceLoss) {
+        let _ = when;
+    }
 }
 
 impl FrameSink for crate::render_world::HeadlessRenderer {
@@ -29,6 +55,10 @@ impl FrameSink for crate::render_world::HeadlessRenderer {
         readback: bool,
     ) -> Result<(FrameReport, Option<image::RgbaImage>), RenderError> {
         self.render(snapshot, readback)
+    }
+
+    fn lose_device(&mut self, when: DeviceLoss) {
+        self.render_world.lose_device(when);
     }
 }
 
@@ -45,18 +75,19 @@ fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
 /// frame (the app ends on it; the render thread stops).
 fn render_caught(sink: &mut dyn FrameSink, snapshot: FrameSnapshot, readback: bool) -> FrameResult {
     match catch_unwind(AssertUnwindSafe(|| sink.render_frame(snapshot, readback))) {
-        Ok(result) => result.map_err(|e| e.to_string()),
-        Err(payload) => Err(format!("the renderer panicked: {}", panic_message(payload.as_ref()))),
+        Ok(result) => result.map_err(RenderFailed::Render),
+        Err(payload) => Err(RenderFailed::Panic(panic_message(payload.as_ref()))),
     }
 }
 
-enum Message {
+enum ToRenderThread {
     Frame(Box<FrameSnapshot>, bool),
+    LoseDevice(DeviceLoss),
 }
 
 /// The render thread: receives snapshots, renders them, sends results back.
 pub struct RenderThread {
-    frames: Option<Sender<Message>>,
+    frames: Option<Sender<ToRenderThread>>,
     results: Receiver<FrameResult>,
     handle: Option<JoinHandle<()>>,
 }
@@ -64,11 +95,18 @@ pub struct RenderThread {
 impl RenderThread {
     /// Starts a render thread around `sink`.
     pub fn spawn(mut sink: Box<dyn FrameSink>) -> std::io::Result<RenderThread> {
-        let (frame_tx, frame_rx) = bounded::<Message>(1);
+        let (frame_tx, frame_rx) = bounded::<ToRenderThread>(1);
         let (result_tx, result_rx) = unbounded::<FrameResult>();
         let handle = std::thread::Builder::new().name("manylight-render".into()).spawn(move || {
             // Ends when the sender is dropped (app shut down) or a frame fails.
-            while let Ok(Message::Frame(snapshot, readback)) = frame_rx.recv() {
+            while let Ok(message) = frame_rx.recv() {
+                let (snapshot, readback) = match message {
+                    ToRenderThread::Frame(snapshot, readback) => (snapshot, readback),
+                    ToRenderThread::LoseDevice(when) => {
+                        sink.lose_device(when);
+                        continue;
+                    }
+                };
                 let result = render_caught(sink.as_mut(), *snapshot, readback);
                 let failed = result.is_err();
                 if result_tx.send(result).is_err() || failed {
@@ -128,12 +166,28 @@ impl RenderBackend {
                 let sent = thread
                     .frames
                     .as_ref()
-                    .is_some_and(|tx| tx.send(Message::Frame(Box::new(snapshot), readback)).is_ok());
+                    .is_some_and(|tx| tx.send(ToRenderThread::Frame(Box::new(snapshot), readback)).is_ok());
                 if !sent {
                     tracing::debug!("render thread has stopped; frame dropped");
                 }
             }
             RenderBackend::Failed(_) => {}
+        }
+    }
+
+    /// Destroys the renderer's GPU device, as a driver reset would, between frames or during
+    /// the next one ([`DeviceLoss`]): the renderer finds the device lost, recreates it and
+    /// goes on (counted in [`FrameReport::device_recoveries`]). Fault injection for tests and
+    /// the soak run.
+    pub fn lose_device(&mut self, when: DeviceLoss) {
+        match self {
+            RenderBackend::Sync { sink, .. } => sink.lose_device(when),
+            RenderBackend::Pipelined(thread) => {
+                if let Some(tx) = thread.frames.as_ref() {
+                    let _ = tx.send(ToRenderThread::LoseDevice(when));
+                }
+            }
+            RenderBackend::Pending | RenderBackend::Failed(_) => {}
         }
     }
 
@@ -148,15 +202,15 @@ impl RenderBackend {
                 let ended = thread.handle.as_ref().is_some_and(|h| h.is_finished());
                 if ended && thread.frames.is_some() && !results.iter().any(|r| r.is_err()) {
                     let message = thread.shutdown();
-                    results.push(Err(
-                        message.unwrap_or_else(|| "the render thread stopped unexpectedly".into())
-                    ));
+                    results.push(Err(RenderFailed::Stopped(
+                        message.unwrap_or_else(|| "the render thread stopped unexpectedly".into()),
+                    )));
                 }
                 results
             }
             RenderBackend::Failed(message) => {
                 let m = std::mem::take(message);
-                if m.is_empty() { Vec::new() } else { vec![Err(m)] }
+                if m.is_empty() { Vec::new() } else { vec![Err(RenderFailed::Stopped(m))] }
             }
             RenderBackend::Pending => Vec::new(),
         }
@@ -174,8 +228,37 @@ impl RenderBackend {
         if let Some(message) = panic
             && !results.iter().any(|r| r.is_err())
         {
-            results.push(Err(message));
+            results.push(Err(RenderFailed::Stopped(message)));
         }
         results
     }
+}
+
+/// Stores finished frames in the world: each report in [`FrameStats`], a read-back image in
+/// [`HeadlessCapture`]; a failure goes to [`RenderFailure`] and is sent as a [`RenderFailed`]
+/// message. Returns true when a frame failed (the caller ends the app with an error).
+pub fn record_results(world: &mut World, results: Vec<FrameResult>) -> bool {
+    let mut failed = false;
+    for result in results {
+        match result {
+            Ok((report, image)) => {
+                if let Some(mut stats) = world.get_resource_mut::<FrameStats>() {
+                    stats.record(report);
+                }
+                if let (Some(image), Some(mut capture)) = (image, world.get_resource_mut::<HeadlessCapture>())
+                {
+                    capture.image = Some(image);
+                }
+            }
+            Err(failure) => {
+                tracing::error!("rendering failed: {failure}");
+                world.insert_resource(RenderFailure(Some(failure.to_string())));
+                if world.contains_resource::<bevy_ecs::message::Messages<RenderFailed>>() {
+                    world.write_message(failure);
+                }
+                failed = true;
+            }
+        }
+    }
+    failed
 }

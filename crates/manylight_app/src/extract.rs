@@ -1,7 +1,7 @@
 //! Extract: copy what rendering needs out of the ECS world into a [`FrameSnapshot`] and hand
 //! it to the render side. Mesh and material data travel as `Arc`s (no copy of the data).
 
-use crate::backend::RenderBackend;
+use crate::backend::{RenderBackend, RenderFailed};
 use crate::components::{
     Bloom, Camera3d, LightAnimation, Material, Mesh3d, MotionBlur, PointLight, Transform,
 };
@@ -97,6 +97,7 @@ pub fn extract_and_render(
     mut stats: ResMut<FrameStats>,
     mut capture: ResMut<HeadlessCapture>,
     mut failure: ResMut<RenderFailure>,
+    mut failed: MessageWriter<RenderFailed>,
     mut exit: MessageWriter<AppExit>,
 ) {
     if failure.0.is_some() {
@@ -107,16 +108,15 @@ pub fn extract_and_render(
     for result in backend.drain() {
         match result {
             Ok((report, image)) => {
-                // Skipped frames (0×0 viewport, no camera, surface not ready) ran no pass.
-                stats.frames_rendered += u64::from(!report.passes.is_empty());
-                stats.last = Some(report);
+                stats.record(report);
                 if image.is_some() {
                     capture.image = image;
                 }
             }
-            Err(message) => {
-                tracing::error!("rendering failed: {message}");
-                failure.0 = Some(message);
+            Err(failure_message) => {
+                tracing::error!("rendering failed: {failure_message}");
+                failure.0 = Some(failure_message.to_string());
+                failed.write(failure_message);
                 exit.write(AppExit::error());
             }
         }

@@ -46,19 +46,7 @@ pub fn finish_plugins(app: &mut App) {
 pub fn finish_frames(app: &mut App) {
     let world = app.world_mut();
     let results = world.resource_mut::<RenderBackend>().flush();
-    for result in results {
-        match result {
-            Ok((report, image)) => {
-                let mut stats = world.resource_mut::<FrameStats>();
-                stats.frames_rendered += u64::from(!report.passes.is_empty());
-                stats.last = Some(report);
-                if image.is_some() {
-                    world.resource_mut::<HeadlessCapture>().image = image;
-                }
-            }
-            Err(e) => world.resource_mut::<RenderFailure>().0 = Some(e),
-        }
-    }
+    crate::backend::record_results(world, results);
 }
 
 /// Writes an image as PNG, creating parent folders.

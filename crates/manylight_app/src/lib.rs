@@ -24,6 +24,7 @@ pub mod resources;
 pub mod scene;
 pub mod window;
 
+pub use backend::RenderFailed;
 pub use components::{Bloom, Camera3d, LightAnimation, Material, Mesh3d, MotionBlur, PointLight, Transform};
 pub use plugin::{HeadlessConfig, ManyLightPlugin, ManyLightSet, OutputMode};
 pub use resources::{

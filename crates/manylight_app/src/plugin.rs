@@ -102,6 +102,7 @@ impl Plugin for ManyLightPlugin {
             .init_resource::<DebugView>()
             .init_resource::<FrameStats>()
             .init_resource::<RenderFailure>()
+            .add_message::<crate::backend::RenderFailed>()
             .init_resource::<crate::window::WindowRequests>()
             .init_resource::<crate::window::PressedKeys>()
             .configure_sets(Update, ManyLightSet::Animate)

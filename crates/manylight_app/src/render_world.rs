@@ -59,11 +59,59 @@ pub struct FrameOutcome {
     pub error: Option<RenderError>,
 }
 
+/// A lost device is recreated at most this many times within [`DEVICE_LOSS_WINDOW`] frames;
+/// one more loss ends rendering with [`RenderError::DeviceLost`] instead of a device that keeps
+/// dying being recreated forever.
+pub const MAX_DEVICE_LOSSES: usize = 3;
+
+/// Frames over which [`MAX_DEVICE_LOSSES`] is counted.
+pub const DEVICE_LOSS_WINDOW: u64 = 600;
+
+/// Frames in which the device was lost lately.
+#[derive(Default)]
+struct LossHistory {
+    frames: std::collections::VecDeque<u64>,
+}
+
+impl LossHistory {
+    /// Counts a loss in `frame`; `Err` when it is one too many.
+    fn admit(&mut self, frame: u64, reason: &str) -> Result<(), RenderError> {
+        while self.frames.front().is_some_and(|&f| frame.saturating_sub(f) >= DEVICE_LOSS_WINDOW) {
+            self.frames.pop_front();
+        }
+        if self.frames.len() >= MAX_DEVICE_LOSSES {
+            return Err(RenderError::DeviceLost {
+                reason: reason.to_string(),
+                why: format!(
+                    "it was lost {} times within {DEVICE_LOSS_WINDOW} frames (MAX_DEVICE_LOSSES is {MAX_DEVICE_LOSSES})",
+                    self.frames.len() + 1
+                ),
+            });
+        }
+        self.frames.push_back(frame);
+        Ok(())
+    }
+}
+
+/// When an injected device loss happens (fault injection for tests and the soak run).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DeviceLoss {
+    /// The device is destroyed at once, between frames: the next frame finds it lost before
+    /// it starts, recreates it and renders on the new device.
+    BetweenFrames,
+    /// The device is destroyed during the next frame, after its work was submitted: that
+    /// frame's read-back and presentation meet a lost device, the frame is reported with no
+    /// passes, and the frame after it renders on a new device.
+    InFrame,
+}
+
 /// A render world with its schedule.
 pub struct RenderWorld {
     /// The world holding the render resources.
     pub world: World,
     schedule: Schedule,
+    losses: LossHistory,
+    lose_in_frame: bool,
 }
 
 impl RenderWorld {
@@ -79,7 +127,38 @@ impl RenderWorld {
         schedule.add_systems(prepare.in_set(RenderSet::Prepare));
         add_graph_systems(&mut schedule);
         schedule.add_systems(execute.in_set(RenderSet::Execute));
-        RenderWorld { world, schedule }
+        RenderWorld { world, schedule, losses: LossHistory::default(), lose_in_frame: false }
+    }
+
+    /// Destroys the device as a driver reset would, now or during the next frame.
+    pub fn lose_device(&mut self, when: DeviceLoss) {
+        match when {
+            DeviceLoss::BetweenFrames => self.gpu().device.destroy(),
+            DeviceLoss::InFrame => self.lose_in_frame = true,
+        }
+    }
+
+    /// Recreates the device after it was lost (`reason`, found in `frame`): a new device on the
+    /// same instance (able to present to `surface`, if given) and a new renderer on it, whose
+    /// scene resources, pipelines and cluster buffers are built again from the next snapshot.
+    /// Fails with [`RenderError::DeviceLost`] when no device can be created or when the device
+    /// was lost more than [`MAX_DEVICE_LOSSES`] times within [`DEVICE_LOSS_WINDOW`] frames.
+    pub fn recover_device(
+        &mut self,
+        reason: String,
+        frame: u64,
+        surface: Option<&wgpu::Surface<'_>>,
+    ) -> Result<(), RenderError> {
+        self.losses.admit(frame, &reason)?;
+        let gpu = self
+            .gpu()
+            .recreate(surface)
+            .map_err(|e| RenderError::DeviceLost { reason: reason.clone(), why: e.to_string() })?;
+        tracing::warn!("the GPU device was {reason} in frame {frame}; recreated it on `{}`", gpu.info.name);
+        let losses = std::mem::take(&mut self.losses);
+        *self = RenderWorld::new(gpu);
+        self.losses = losses;
+        Ok(())
     }
 
     /// The GPU context.
@@ -106,6 +185,9 @@ impl RenderWorld {
         self.world.resource_mut::<FrameGraph>().0.clear();
         *self.world.resource_mut::<FrameOutcome>() = FrameOutcome::default();
         self.schedule.run(&mut self.world);
+        if std::mem::take(&mut self.lose_in_frame) {
+            self.gpu().device.destroy();
+        }
         let outcome = std::mem::take(&mut *self.world.resource_mut::<FrameOutcome>());
         match (outcome.error, outcome.report) {
             (Some(e), _) => Err(e),
@@ -303,6 +385,51 @@ fn execute(
     }
 }
 
+/// A renderer on a device that can be lost: it renders a frame on its device and recreates the
+/// device after a loss; [`DeviceSink::render_recovering`] puts the two together.
+pub(crate) trait DeviceSink {
+    /// The current device.
+    fn gpu(&self) -> &GpuContext;
+    /// Recreates the device after it was lost (`reason`, found in `frame`).
+    fn recover(&mut self, reason: String, frame: u64) -> Result<(), RenderError>;
+    /// Renders one frame on the current device.
+    fn render_on_device(
+        &mut self,
+        snapshot: FrameSnapshot,
+        readback: bool,
+    ) -> Result<(FrameReport, Option<image::RgbaImage>), RenderError>;
+
+    /// Renders one frame, recreating the device first if it was lost since the last frame, or
+    /// after the frame if it was lost during it. That frame's work went to the lost device: it
+    /// is reported with no passes, and rendering goes on from the next frame.
+    fn render_recovering(
+        &mut self,
+        snapshot: FrameSnapshot,
+        readback: bool,
+    ) -> Result<(FrameReport, Option<image::RgbaImage>), RenderError> {
+        let frame = snapshot.frame_index;
+        let mut recoveries = 0;
+        if let Some(reason) = self.gpu().lost() {
+            self.recover(reason, frame)?;
+            recoveries += 1;
+        }
+        let lost_frame = empty_report(&snapshot);
+        let result = self.render_on_device(snapshot, readback);
+        match self.gpu().lost() {
+            Some(reason) => {
+                if let Err(e) = &result {
+                    tracing::warn!("frame {frame} failed on the lost device: {e}");
+                }
+                self.recover(reason, frame)?;
+                Ok((FrameReport { device_recoveries: recoveries + 1, ..lost_frame }, None))
+            }
+            None => {
+                result.map(|(report, image)| (FrameReport { device_recoveries: recoveries, ..report }, image))
+            }
+        }
+    }
+}
+
 /// Synchronous headless rendering: a render world plus an offscreen target that follows the
 /// snapshot's viewport size.
 pub struct HeadlessRenderer {
@@ -317,8 +444,30 @@ impl HeadlessRenderer {
         Ok(HeadlessRenderer { render_world: RenderWorld::new(GpuContext::headless()?), target: None })
     }
 
-    /// Renders a snapshot; when `readback` is set, returns the image too.
+    /// Renders a snapshot; when `readback` is set, returns the image too. A device found lost
+    /// is recreated (see [`RenderWorld::recover_device`]); the frame in which the loss is found
+    /// renders nothing and says so in [`FrameReport::device_recoveries`].
     pub fn render(
+        &mut self,
+        snapshot: FrameSnapshot,
+        readback: bool,
+    ) -> Result<(FrameReport, Option<image::RgbaImage>), RenderError> {
+        self.render_recovering(snapshot, readback)
+    }
+}
+
+impl DeviceSink for HeadlessRenderer {
+    fn gpu(&self) -> &GpuContext {
+        self.render_world.gpu()
+    }
+
+    fn recover(&mut self, reason: String, frame: u64) -> Result<(), RenderError> {
+        self.render_world.recover_device(reason, frame, None)?;
+        self.target = None;
+        Ok(())
+    }
+
+    fn render_on_device(
         &mut self,
         snapshot: FrameSnapshot,
         readback: bool,

@@ -119,9 +119,20 @@ pub struct FrameStats {
     pub frames_rendered: u64,
     /// CPU time of the main-world update that produced the last snapshot.
     pub simulation_cpu_ms: f64,
+    /// Times the GPU device was lost and recreated since start-up.
+    pub device_recoveries: u64,
 }
 
 impl FrameStats {
+    /// Takes a finished frame's report: the last report, frames rendered (a frame that ran no
+    /// pass, such as a 0×0 viewport or the frame a lost device was found in, is not counted)
+    /// and device recoveries.
+    pub fn record(&mut self, report: FrameReport) {
+        self.frames_rendered += u64::from(!report.passes.is_empty());
+        self.device_recoveries += u64::from(report.device_recoveries);
+        self.last = Some(report);
+    }
+
     /// Pass names of the last frame in the order they ran.
     pub fn pass_names(&self) -> Vec<String> {
         self.last.as_ref().map(|r| r.passes.iter().map(|p| p.name.clone()).collect()).unwrap_or_default()

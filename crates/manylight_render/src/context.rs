@@ -9,7 +9,7 @@ OpenGL. On Debian/Ubuntu without a GPU install the software Vulkan driver (lavap
 `sudo apt-get install -y mesa-vulkan-drivers`; with a GPU, install its vendor driver";
 
 /// Errors of the GPU side.
-#[derive(Debug, Error)]
+#[derive(Clone, Debug, Error)]
 pub enum RenderError {
     /// No adapter could be found.
     #[error("{NO_ADAPTER_HELP} ({0})")]
@@ -89,6 +89,15 @@ pub enum RenderError {
         /// The device's limit.
         limit: u32,
     },
+    /// The GPU device was lost (driver reset, device removed, `Device::destroy`) and the
+    /// renderer could not go on: recreating it failed, or it was lost too often.
+    #[error("the GPU device was lost ({reason}) and could not be recreated: {why}")]
+    DeviceLost {
+        /// What the driver said when the device was lost.
+        reason: String,
+        /// Why the renderer gave up.
+        why: String,
+    },
     /// The GPU did not finish submitted work within [`GPU_WAIT_TIMEOUT`] (a hung or lost
     /// device); the frame is abandoned instead of freezing the caller.
     #[error(
@@ -122,8 +131,10 @@ pub struct GpuContext {
     pub info: wgpu::AdapterInfo,
     /// True when render-pass timestamp queries are available.
     pub timestamps: bool,
-    /// Device-lost or uncaptured errors, recorded by the error callback.
+    /// Uncaptured errors, recorded by the error callback.
     pub errors: Arc<std::sync::Mutex<Vec<String>>>,
+    /// Set by the device-lost callback: why the device was lost.
+    lost: Arc<std::sync::Mutex<Option<String>>>,
 }
 
 impl GpuContext {
@@ -196,6 +207,19 @@ impl GpuContext {
                 v.push(e.to_string());
             }
         }));
+        let lost = Arc::new(std::sync::Mutex::new(None));
+        let lost_sink = lost.clone();
+        device.set_device_lost_callback(move |reason, message| {
+            let what = match reason {
+                wgpu::DeviceLostReason::Destroyed => "destroyed".to_string(),
+                wgpu::DeviceLostReason::Unknown if message.is_empty() => "lost by the driver".to_string(),
+                wgpu::DeviceLostReason::Unknown => format!("lost by the driver: {message}"),
+            };
+            tracing::error!("the GPU device was {what}");
+            if let Ok(mut slot) = lost_sink.lock() {
+                slot.get_or_insert(what);
+            }
+        });
         tracing::info!(
             "GPU adapter: {} ({:?}, {:?}, driver {}), timestamps: {timestamps}",
             info.name,
@@ -203,7 +227,28 @@ impl GpuContext {
             info.backend,
             info.driver_info
         );
-        Ok(GpuContext { instance, adapter, device, queue, info, timestamps, errors })
+        Ok(GpuContext { instance, adapter, device, queue, info, timestamps, errors, lost })
+    }
+
+    /// A new device and queue on the same instance, after this one was lost; `surface`, when
+    /// given, is a window surface the new adapter must be able to present to.
+    pub fn recreate(&self, surface: Option<&wgpu::Surface<'_>>) -> Result<GpuContext, RenderError> {
+        Self::with_instance(self.instance.clone(), surface)
+    }
+
+    /// Why the device was lost, if it was. Polls the device without waiting first, so a loss
+    /// that the driver reported since the last wait is seen.
+    pub fn lost(&self) -> Option<String> {
+        if let Some(reason) = self.lost_reason() {
+            return Some(reason);
+        }
+        // A lost device may answer the poll with an error; the callback has fired by then.
+        let _ = self.device.poll(wgpu::PollType::Poll);
+        self.lost_reason()
+    }
+
+    fn lost_reason(&self) -> Option<String> {
+        self.lost.lock().ok().and_then(|slot| slot.clone())
     }
 
     /// Largest 2D texture side this device accepts.

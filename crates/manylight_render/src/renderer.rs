@@ -217,6 +217,7 @@ impl Renderer {
             transient_bytes: self.pool.frame_bytes(),
             transient_allocations: self.pool.allocations(),
             clusters: None,
+            device_recoveries: 0,
         })
     }
 }

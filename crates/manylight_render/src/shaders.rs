@@ -35,7 +35,7 @@ pub const SOURCES: &[(&str, &str)] = &[
 ];
 
 /// A shader could not be composed.
-#[derive(Debug, thiserror::Error, PartialEq)]
+#[derive(Clone, Debug, thiserror::Error, PartialEq)]
 pub enum ShaderError {
     /// The named file is not in [`SOURCES`].
     #[error("shader `{0}` is not embedded (add it to manylight_render::shaders::SOURCES)")]

@@ -53,6 +53,10 @@ pub struct FrameReport {
     pub transient_allocations: u64,
     /// Cluster statistics, when the frame built clusters.
     pub clusters: Option<crate::clusters::ClusterReport>,
+    /// Times the GPU device was found lost and recreated while this frame was rendered (0
+    /// normally). A frame in which the loss was found reports no passes: its work went to the
+    /// lost device, and the next frame renders on the new one.
+    pub device_recoveries: u32,
 }
 
 impl FrameReport {

@@ -24,7 +24,7 @@ pub use overlay::{OVERLAY_PASS, Overlay};
 pub use surface::SurfaceSink;
 
 use crate::backend::{RenderBackend, RenderThread};
-use crate::resources::{FrameStats, HeadlessCapture, RenderFailure, ViewportSize};
+use crate::resources::{RenderFailure, ViewportSize};
 use bevy_app::{App, AppExit, PluginsState};
 use bevy_ecs::prelude::*;
 use glam::UVec2;
@@ -263,27 +263,9 @@ impl WinitRunner {
         let results = backend.flush();
         drop(backend);
         world.insert_resource(RenderBackend::Pending);
-        for result in results {
-            match result {
-                Ok((report, image)) => {
-                    if let Some(mut stats) = world.get_resource_mut::<FrameStats>() {
-                        stats.frames_rendered += u64::from(!report.passes.is_empty());
-                        stats.last = Some(report);
-                    }
-                    if let (Some(image), Some(mut capture)) =
-                        (image, world.get_resource_mut::<HeadlessCapture>())
-                    {
-                        capture.image = Some(image);
-                    }
-                }
-                Err(message) => {
-                    tracing::error!("rendering failed: {message}");
-                    world.insert_resource(RenderFailure(Some(message)));
-                    if self.exit.as_ref().is_none_or(|e| e.is_success()) {
-                        self.exit = Some(AppExit::error());
-                    }
-                }
-            }
+        if crate::backend::record_results(world, results) && self.exit.as_ref().is_none_or(|e| e.is_success())
+        {
+            self.exit = Some(AppExit::error());
         }
     }
 }

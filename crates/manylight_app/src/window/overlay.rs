@@ -111,6 +111,7 @@ impl OverlayHost {
             renderer: None,
             primitives: Vec::new(),
             pixels_per_point: 1.0,
+            texture_log: std::collections::HashMap::new(),
         };
         let host = OverlayHost {
             ctx,
@@ -454,9 +455,18 @@ pub struct OverlayPainter {
     renderer: Option<(egui_wgpu::Renderer, wgpu::TextureFormat, Option<GpuTimer>)>,
     primitives: Vec<ClippedPrimitive>,
     pixels_per_point: f32,
+    /// Every texture's uploads since its last full image, replayed into a new renderer after
+    /// the device was recreated (egui sends its font atlas only once).
+    texture_log: std::collections::HashMap<egui::TextureId, Vec<egui::epaint::ImageDelta>>,
 }
 
 impl OverlayPainter {
+    /// Forgets the GPU side after the device was recreated; the next paint builds a new egui
+    /// renderer on the new device and uploads every texture again.
+    pub fn reset_device(&mut self) {
+        self.renderer = None;
+    }
+
     /// Draws the latest UI onto `view` (the presented image, `size` pixels) as the pass
     /// [`OVERLAY_PASS`]; returns its timing, or `None` when nothing was drawn.
     pub fn paint(
@@ -484,14 +494,26 @@ impl OverlayPainter {
             textures.clear();
             return None;
         }
+        let log = &mut self.texture_log;
         let (renderer, _, timer) = self.renderer.get_or_insert_with(|| {
-            let renderer = egui_wgpu::Renderer::new(device, format, egui_wgpu::RendererOptions::default());
+            let mut renderer =
+                egui_wgpu::Renderer::new(device, format, egui_wgpu::RendererOptions::default());
+            for (id, deltas) in log.iter() {
+                for delta in deltas {
+                    renderer.update_texture(device, queue, *id, delta);
+                }
+            }
             let stamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
             (renderer, format, GpuTimer::new(device, queue, stamps))
         });
         for (id, deltas) in &textures.set {
             for delta in deltas {
                 renderer.update_texture(device, queue, *id, delta);
+                let entry = log.entry(*id).or_default();
+                if delta.is_whole() {
+                    entry.clear();
+                }
+                entry.push(delta.clone());
             }
         }
         let drawn = !self.primitives.is_empty();
@@ -534,6 +556,7 @@ impl OverlayPainter {
         }
         for id in &textures.free {
             renderer.free_texture(id);
+            log.remove(id);
         }
         textures.clear();
         drawn.then(|| PassTiming {

@@ -4,7 +4,7 @@
 
 use super::overlay::OverlayPainter;
 use crate::backend::FrameSink;
-use crate::render_world::{RenderWorld, empty_report};
+use crate::render_world::{DeviceSink, RenderWorld, empty_report};
 use glam::UVec2;
 use manylight_render::{FrameReport, FrameSnapshot, GpuContext, RenderError};
 use std::sync::Arc;
@@ -125,7 +125,36 @@ impl SurfaceSink {
 }
 
 impl FrameSink for SurfaceSink {
+    fn lose_device(&mut self, when: crate::render_world::DeviceLoss) {
+        self.render_world.lose_device(when);
+    }
+
     fn render_frame(
+        &mut self,
+        snapshot: FrameSnapshot,
+        readback: bool,
+    ) -> Result<(FrameReport, Option<image::RgbaImage>), RenderError> {
+        self.render_recovering(snapshot, readback)
+    }
+}
+
+impl DeviceSink for SurfaceSink {
+    fn gpu(&self) -> &GpuContext {
+        self.render_world.gpu()
+    }
+
+    /// A new render world on a device that can present to this surface, the surface
+    /// configured again, the overlay's GPU side rebuilt.
+    fn recover(&mut self, reason: String, frame: u64) -> Result<(), RenderError> {
+        self.render_world.recover_device(reason, frame, Some(&self.surface))?;
+        self.config = None;
+        if let Some(painter) = self.overlay.as_mut() {
+            painter.reset_device();
+        }
+        Ok(())
+    }
+
+    fn render_on_device(
         &mut self,
         snapshot: FrameSnapshot,
         _readback: bool,
