@@ -16,6 +16,9 @@
 //    stores the count (capped if a cap is set) and updates the counters;
 // 5. `scan`: prefix sum of the cluster counts, and the total the index list needs;
 // 6. `fill`: writes the first `count` hits, in ascending light order, at the cluster's offset.
+// Sums and offsets saturate at 2^32 - 1 instead of wrapping (`add_saturating`), so a frame
+// with more pairs than a u32 counts is seen as too large (PAIR_COUNT_SATURATED) rather than as
+// a small total whose lists would silently miss lights.
 // A fill whose list is too small is skipped; the renderer reads the totals back, grows the
 // lists and renders the frame again, so nothing is lost. The result is the same compacted
 // structure as manylight_core::cluster::assign_lights.
@@ -53,6 +56,18 @@ override WORKGROUP_SIZE: u32 = 64u;
 // y counts the rows (Rust: `cluster_build::dispatch_size`).
 fn linear_index(id: vec3<u32>, groups: vec3<u32>) -> u32 {
     return id.x + id.y * groups.x * WORKGROUP_SIZE;
+}
+
+// a + b, or PAIR_COUNT_SATURATED when the sum does not fit in a u32.
+fn add_saturating(a: u32, b: u32) -> u32 {
+    let sum = a + b;
+    return select(sum, PAIR_COUNT_SATURATED, sum < a);
+}
+
+// True when the list `range` (offset, count) lies within `capacity` entries, without the
+// wrap-around of `range.x + range.y`.
+fn fits(range: vec2<u32>, capacity: u32) -> bool {
+    return range.y <= capacity && range.x <= capacity - range.y;
 }
 
 // The cluster's bounds are loaded once per invocation (`b`), not once per light.
@@ -115,7 +130,7 @@ fn tile_fill(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgrou
         return;
     }
     let range = tile_ranges[e];
-    if range.x + range.y > params.tile_index_capacity {
+    if !fits(range, params.tile_index_capacity) {
         return;
     }
     let b = tile_bounds[e / params.tile_chunks];
@@ -135,9 +150,9 @@ fn tile_lights(cluster: u32) -> vec2<u32> {
     let first = (cluster % tile_count_total()) * params.tile_chunks;
     let a = tile_ranges[first];
     let z = tile_ranges[first + params.tile_chunks - 1u];
-    let range = vec2<u32>(a.x, z.x + z.y - a.x);
+    let range = vec2<u32>(a.x, add_saturating(z.x, z.y) - a.x);
     // A tile list that did not fit this frame is empty; the frame is rendered again.
-    return select(vec2<u32>(0u), range, range.x + range.y <= params.tile_index_capacity);
+    return select(vec2<u32>(0u), range, fits(range, params.tile_index_capacity));
 }
 
 @compute @workgroup_size(WORKGROUP_SIZE)
@@ -178,7 +193,7 @@ fn scan_ranges(tiles: bool, t: u32) -> u32 {
     let end = min(begin + chunk, total_entries);
     var sum = 0u;
     for (var c = begin; c < end; c++) {
-        sum += select(ranges[c].y, tile_ranges[c].y, tiles);
+        sum = add_saturating(sum, select(ranges[c].y, tile_ranges[c].y, tiles));
     }
     partial_sums[t] = sum;
     workgroupBarrier();
@@ -187,7 +202,7 @@ fn scan_ranges(tiles: bool, t: u32) -> u32 {
         for (var i = 0u; i < SCAN_WORKGROUP_SIZE; i++) {
             let v = partial_sums[i];
             partial_sums[i] = running;
-            running += v;
+            running = add_saturating(running, v);
         }
         // The total goes where every invocation can read it after the barrier.
         scan_total = running;
@@ -198,11 +213,11 @@ fn scan_ranges(tiles: bool, t: u32) -> u32 {
         if tiles {
             let n = tile_ranges[c].y;
             tile_ranges[c].x = offset;
-            offset += n;
+            offset = add_saturating(offset, n);
         } else {
             let n = ranges[c].y;
             ranges[c].x = offset;
-            offset += n;
+            offset = add_saturating(offset, n);
         }
     }
     return scan_total;
@@ -233,7 +248,7 @@ fn fill(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
         return;
     }
     let range = ranges[cluster];
-    if range.x + range.y > params.index_capacity {
+    if !fits(range, params.index_capacity) {
         return; // the list is too small this frame; the renderer grows it and renders again
     }
     let b = bounds[cluster];

@@ -37,9 +37,40 @@ impl Transform {
         Transform { translation, ..Self::IDENTITY }
     }
 
-    /// Decomposes a matrix (e.g. from a glTF node).
+    /// Decomposes a matrix (e.g. from a glTF node) into translation, rotation and scale. A
+    /// singular matrix (a zero scale on some axes, of the node or a parent) keeps its zero
+    /// scales and a valid rotation, where a plain decomposition divides by zero and gives NaN;
+    /// shear is lost.
     pub fn from_matrix(m: Mat4) -> Transform {
-        let (scale, rotation, translation) = m.to_scale_rotation_translation();
+        let translation = m.w_axis.truncate();
+        let m3 = glam::Mat3::from_mat4(m);
+        let mut scale = Vec3::new(m3.x_axis.length(), m3.y_axis.length(), m3.z_axis.length());
+        if m3.determinant() < 0.0 {
+            scale.x = -scale.x;
+        }
+        let axis = |col: Vec3, s: f32| (s != 0.0 && s.is_finite()).then(|| col / s);
+        let (x, y, z) = (axis(m3.x_axis, scale.x), axis(m3.y_axis, scale.y), axis(m3.z_axis, scale.z));
+        // Axes of zero length are completed to a right-handed orthonormal frame.
+        let (x, y, z) = match (x, y, z) {
+            (Some(x), Some(y), Some(z)) => (x, y, z),
+            (None, Some(y), Some(z)) => (y.cross(z), y, z),
+            (Some(x), None, Some(z)) => (x, z.cross(x), z),
+            (Some(x), Some(y), None) => (x, y, x.cross(y)),
+            (Some(x), None, None) => {
+                let y = x.any_orthonormal_vector();
+                (x, y, x.cross(y))
+            }
+            (None, Some(y), None) => {
+                let z = y.any_orthonormal_vector();
+                (y.cross(z), y, z)
+            }
+            (None, None, Some(z)) => {
+                let x = z.any_orthonormal_vector();
+                (x, z.cross(x), z)
+            }
+            (None, None, None) => (Vec3::X, Vec3::Y, Vec3::Z),
+        };
+        let rotation = Quat::from_mat3(&glam::Mat3::from_cols(x, y, z)).normalize();
         Transform { translation, rotation, scale }
     }
 
@@ -192,6 +223,33 @@ impl MotionBlur {
             samples: self.samples,
             strength: self.strength,
             max_pixels: self.max_pixels,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn from_matrix_gives_back_the_matrix_also_when_it_is_singular() {
+        let rotation = Quat::from_euler(glam::EulerRot::YXZ, 0.7, -0.3, 1.1);
+        let translation = Vec3::new(1.0, -2.0, 3.0);
+        for scale in [
+            Vec3::new(1.0, 2.0, 3.0),
+            Vec3::new(-1.0, 2.0, 3.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(0.0, 1.0, 1.0),
+            Vec3::new(1.0, 0.0, 1.0),
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 2.0, 0.0),
+            Vec3::new(0.0, 0.0, 2.0),
+            Vec3::ZERO,
+        ] {
+            let m = Mat4::from_scale_rotation_translation(scale, rotation, translation);
+            let t = Transform::from_matrix(m);
+            assert!(t.rotation.is_finite() && t.scale.is_finite(), "{scale}: {t:?}");
+            assert!(t.to_matrix().abs_diff_eq(m, 1e-5), "{scale}: {:?} vs {m:?}", t.to_matrix());
         }
     }
 }

@@ -350,6 +350,18 @@ impl ClusterResources {
         Ok(bytemuck::pod_read_unaligned(&bytes[..std::mem::size_of::<GpuClusterCounters>()]))
     }
 
+    /// Refuses a frame whose pair totals saturated the build's u32 sums.
+    pub fn check_saturation(counters: &GpuClusterCounters) -> Result<(), RenderError> {
+        use crate::gpu_types::PAIR_COUNT_SATURATED;
+        if counters.tile_entries == PAIR_COUNT_SATURATED {
+            return Err(RenderError::TooManyPairs { what: "light–tile" });
+        }
+        if counters.total_entries == PAIR_COUNT_SATURATED {
+            return Err(RenderError::TooManyPairs { what: "light–cluster" });
+        }
+        Ok(())
+    }
+
     /// True when the index lists are too small for what the frame needed (`counters`).
     pub fn lists_short(&self, counters: &GpuClusterCounters) -> bool {
         counters.tile_entries > self.params.tile_index_capacity
@@ -364,6 +376,7 @@ impl ClusterResources {
         gpu: &GpuContext,
         counters: &GpuClusterCounters,
     ) -> Result<bool, RenderError> {
+        Self::check_saturation(counters)?;
         let tiles_short = counters.tile_entries > self.params.tile_index_capacity;
         let clusters_short = counters.total_entries > self.params.index_capacity;
         if !tiles_short && !clusters_short {

@@ -52,17 +52,18 @@ pub enum RenderError {
     /// The device reported a validation or out-of-memory error.
     #[error("GPU error: {0}")]
     Device(String),
-    /// A buffer (lights, instances, cluster lists) would exceed what the device can bind.
-    #[error(
-        "`{label}` needs {bytes} bytes, more than this device's max_storage_buffer_binding_size of {limit} bytes"
-    )]
+    /// A buffer (lights, instances, cluster lists, a mesh) would exceed what the device can
+    /// bind or allocate.
+    #[error("`{label}` needs {bytes} bytes, more than this device's {limit_name} of {limit} bytes")]
     BufferTooLarge {
         /// The buffer's label.
-        label: &'static str,
+        label: String,
         /// Bytes the frame needs.
         bytes: u64,
         /// The device's limit.
         limit: u64,
+        /// Which limit: `max_storage_buffer_binding_size` or `max_buffer_size`.
+        limit_name: &'static str,
     },
     /// The cluster build still found its light-index lists too small after growing them (a
     /// frame is never shown with lights missing).
@@ -76,6 +77,16 @@ pub enum RenderError {
         needed: u64,
         /// Entries available.
         capacity: u64,
+    },
+    /// The frame has 2³² − 1 or more light–cluster (or light–tile) pairs: more than the cluster
+    /// build's u32 counters and offsets hold. Refused rather than built from a wrapped total.
+    #[error(
+        "the frame has at least {} {what} pairs, more than the cluster build's 32-bit counters hold (PAIR_COUNT_SATURATED); use fewer or smaller lights, or a coarser grid",
+        u32::MAX
+    )]
+    TooManyPairs {
+        /// `light–cluster` or `light–tile`.
+        what: &'static str,
     },
     /// A render target larger than the device's largest 2D texture.
     #[error(

@@ -20,6 +20,10 @@ pub const CLUSTER_NO_CAP: u32 = 0xffff_ffff;
 /// lights lost every light past the ~16 000th. 4096 iterations (the plane test has no loop)
 /// stay well below that.
 pub const TILE_LIGHT_CHUNK: u32 = 4096;
+/// The value the cluster build's saturating sums stop at: a total of light–cluster (or
+/// light–tile) pairs that reaches it did not fit in the u32 counters, and the frame is refused
+/// ([`crate::RenderError::TooManyPairs`]) instead of being built from a wrapped total.
+pub const PAIR_COUNT_SATURATED: u32 = u32::MAX;
 /// Workgroup size of the prefix-sum step of the cluster build (one workgroup scans all).
 pub const SCAN_WORKGROUP_SIZE: u32 = 256;
 /// `GpuClusterParams::cull_test` values.
@@ -44,6 +48,7 @@ pub fn shared_u32_constants() -> Vec<(&'static str, u32)> {
         ("NORMAL_CODEC_OCTA8", NormalCodec::Octa8.gpu_id()),
         ("SHADING_GLOBAL", SHADING_GLOBAL),
         ("CLUSTER_NO_CAP", CLUSTER_NO_CAP),
+        ("PAIR_COUNT_SATURATED", PAIR_COUNT_SATURATED),
         ("SCAN_WORKGROUP_SIZE", SCAN_WORKGROUP_SIZE),
         ("TILE_LIGHT_CHUNK", TILE_LIGHT_CHUNK),
         ("CULL_AABB", CULL_AABB),
@@ -113,12 +118,38 @@ pub struct GpuInstance {
 impl GpuInstance {
     /// Builds the instance data for a world-from-local transform.
     pub fn new(world_from_local: Mat4) -> GpuInstance {
-        let m3 = glam::Mat3::from_mat4(world_from_local);
-        let det = m3.determinant();
-        let normal =
-            if det.abs() > f32::MIN_POSITIVE && det.is_finite() { m3.inverse().transpose() } else { m3 };
-        GpuInstance { world_from_local, normal_from_local: Mat4::from_mat3(normal) }
+        GpuInstance { world_from_local, normal_from_local: Mat4::from_mat3(normal_matrix(world_from_local)) }
     }
+
+    /// True when `world_from_local` flattens every triangle to a line or a point (its 3×3 part
+    /// has rank 1 or 0, e.g. a zero scale on two axes): such an instance covers no pixel.
+    pub fn collapses(world_from_local: &Mat4) -> bool {
+        cofactor(glam::Mat3::from_mat4(*world_from_local)) == glam::Mat3::ZERO
+    }
+}
+
+/// The cofactor matrix of `m`: columns `b × c`, `c × a`, `a × b` (`det(m) · m⁻ᵀ` when `m` is
+/// invertible, and still the map of normals when it is not).
+fn cofactor(m: glam::Mat3) -> glam::Mat3 {
+    glam::Mat3::from_cols(m.y_axis.cross(m.z_axis), m.z_axis.cross(m.x_axis), m.x_axis.cross(m.y_axis))
+}
+
+/// The matrix that carries object-space normals to world space: the inverse transpose of the
+/// 3×3 part, or, when that part is singular (a zero scale on one axis flattens the mesh to a
+/// plane), its cofactor matrix scaled to a largest element of 1, which still gives the plane's
+/// normal where the inverse transpose would be infinite. Shaders normalise the result.
+pub fn normal_matrix(world_from_local: Mat4) -> glam::Mat3 {
+    let m3 = glam::Mat3::from_mat4(world_from_local);
+    let det = m3.determinant();
+    if det.is_finite() && det.abs() > f32::MIN_POSITIVE {
+        let n = m3.inverse().transpose();
+        if n.is_finite() {
+            return n;
+        }
+    }
+    let c = cofactor(m3);
+    let largest = c.to_cols_array().iter().fold(0.0f32, |a, v| a.max(v.abs()));
+    if largest > 0.0 && largest.is_finite() { c * (1.0 / largest) } else { c }
 }
 
 /// Per-material constants (`GpuMaterial` in `shaders/common/mesh.wgsl`).

@@ -120,12 +120,19 @@ pub struct GrowableBuffer {
     /// Largest size the device can bind (`max_storage_buffer_binding_size`, at most
     /// `max_buffer_size`).
     max_bytes: u64,
+    /// The name of the limit `max_bytes` comes from.
+    limit_name: &'static str,
 }
 
-/// The largest buffer `device` can bind as storage, in bytes (a multiple of 4).
-fn max_binding_bytes(device: &wgpu::Device) -> u64 {
+/// The largest buffer `device` can bind as storage, in bytes (a multiple of 4), and the name of
+/// the limit that sets it.
+fn max_binding_bytes(device: &wgpu::Device) -> (u64, &'static str) {
     let limits = device.limits();
-    limits.max_storage_buffer_binding_size.min(limits.max_buffer_size) & !3
+    if limits.max_storage_buffer_binding_size <= limits.max_buffer_size {
+        (limits.max_storage_buffer_binding_size & !3, "max_storage_buffer_binding_size")
+    } else {
+        (limits.max_buffer_size & !3, "max_buffer_size")
+    }
 }
 
 impl GrowableBuffer {
@@ -136,7 +143,7 @@ impl GrowableBuffer {
         usage: wgpu::BufferUsages,
         min_bytes: u64,
     ) -> Self {
-        let max_bytes = max_binding_bytes(device);
+        let (max_bytes, limit_name) = max_binding_bytes(device);
         // Powers of two keep regrowth rare; near the device's limit the buffer takes the limit.
         let capacity =
             min_bytes.max(16).next_power_of_two().min(max_bytes.max(16)).max(min_bytes.min(max_bytes));
@@ -146,7 +153,7 @@ impl GrowableBuffer {
             usage: usage | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        Self { label, usage, buffer, capacity, generation: 0, max_bytes }
+        Self { label, usage, buffer, capacity, generation: 0, max_bytes, limit_name }
     }
 
     /// Uploads `data`, growing the buffer (to the next power of two) when it does not fit.
@@ -171,7 +178,12 @@ impl GrowableBuffer {
             return Ok(false);
         }
         if bytes > self.max_bytes {
-            return Err(RenderError::BufferTooLarge { label: self.label, bytes, limit: self.max_bytes });
+            return Err(RenderError::BufferTooLarge {
+                label: self.label.to_string(),
+                bytes,
+                limit: self.max_bytes,
+                limit_name: self.limit_name,
+            });
         }
         *self = GrowableBuffer {
             generation: self.generation + 1,

@@ -213,6 +213,8 @@ impl Renderer {
             invalid_cameras: 0,
             nonfinite_pixels,
             instance_count: self.scene.draws.len() as u32,
+            invalid_instances: self.scene.invalid_instances,
+            collapsed_instances: self.scene.collapsed_instances,
             transient_textures: self.pool.live() as u32,
             transient_bytes: self.pool.frame_bytes(),
             transient_allocations: self.pool.allocations(),

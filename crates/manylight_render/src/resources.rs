@@ -81,6 +81,11 @@ pub struct SceneResources {
     pub light_count: u32,
     /// Lights dropped for invalid parameters this frame.
     pub invalid_lights: u32,
+    /// Instances not drawn this frame because their transform is not finite.
+    pub invalid_instances: u32,
+    /// Instances not drawn this frame because their transform collapses the mesh to a line or
+    /// a point (a zero scale on two or three axes, on the mesh or a parent): they cover no pixel.
+    pub collapsed_instances: u32,
     /// (position, radius) of the uploaded lights, in light-buffer order.
     pub light_spheres: Vec<(glam::Vec3, f32)>,
     /// The tone map's count of non-finite HDR pixels.
@@ -236,6 +241,8 @@ impl SceneResources {
             view: ViewUniform::zeroed_default(),
             light_count: 0,
             invalid_lights: 0,
+            invalid_instances: 0,
+            collapsed_instances: 0,
             light_spheres: Vec::new(),
             nonfinite: NonFiniteCounter::new(device),
             meshes: HashMap::new(),
@@ -322,15 +329,21 @@ impl SceneResources {
         // Meshes, materials, instances.
         let mut instance_data = Vec::with_capacity(snapshot.instances.len());
         self.draws.clear();
+        (self.invalid_instances, self.collapsed_instances) = (0, 0);
         for inst in &snapshot.instances {
             if !inst.world_from_local.is_finite() {
-                tracing::warn!("skipping instance of `{}`: non-finite transform", inst.mesh.label);
+                tracing::debug!("skipping instance of `{}`: non-finite transform", inst.mesh.label);
+                self.invalid_instances += 1;
+                continue;
+            }
+            if GpuInstance::collapses(&inst.world_from_local) {
+                self.collapsed_instances += 1;
                 continue;
             }
             if inst.mesh.indices.is_empty() {
                 continue;
             }
-            let mesh = self.mesh_entry(device, &inst.mesh);
+            let mesh = self.mesh_entry(device, &inst.mesh)?;
             let material = self.material_entry(gpu, &inst.material)?;
             self.draws.push(Draw { mesh, material, instance: instance_data.len() as u32 });
             instance_data.push(GpuInstance::new(inst.world_from_local));
@@ -360,9 +373,26 @@ impl SceneResources {
         Ok(())
     }
 
-    fn mesh_entry(&mut self, device: &wgpu::Device, mesh: &Arc<MeshData>) -> usize {
+    /// The mesh's GPU buffers, uploaded on first use; refused, naming the limit, when a buffer
+    /// would exceed the device's `max_buffer_size`.
+    fn mesh_entry(&mut self, device: &wgpu::Device, mesh: &Arc<MeshData>) -> Result<usize, RenderError> {
         let k = key(mesh);
         let frame = self.frame;
+        if !self.meshes.contains_key(&k) {
+            let limit = device.limits().max_buffer_size;
+            let vertex_bytes = std::mem::size_of_val(mesh.vertices.as_slice()) as u64;
+            let index_bytes = std::mem::size_of_val(mesh.indices.as_slice()) as u64;
+            for (what, bytes) in [("vertex", vertex_bytes), ("index", index_bytes)] {
+                if bytes > limit {
+                    return Err(RenderError::BufferTooLarge {
+                        label: format!("{} ({what} buffer of mesh `{}`)", what, mesh.label),
+                        bytes,
+                        limit,
+                        limit_name: "max_buffer_size",
+                    });
+                }
+            }
+        }
         self.meshes
             .entry(k)
             .or_insert_with(|| GpuMesh {
@@ -381,7 +411,7 @@ impl SceneResources {
                 last_used: frame,
             })
             .last_used = frame;
-        k
+        Ok(k)
     }
 
     fn material_entry(

@@ -44,6 +44,11 @@ pub struct FrameReport {
     pub nonfinite_pixels: Option<u32>,
     /// Mesh instances drawn.
     pub instance_count: u32,
+    /// Instances not drawn because their transform is NaN or infinite.
+    pub invalid_instances: u32,
+    /// Instances not drawn because their transform collapses the mesh to a line or a point (a
+    /// zero scale on two or three axes, of the mesh or of a parent node): they cover no pixel.
+    pub collapsed_instances: u32,
     /// Transient textures alive in the pool after the frame.
     pub transient_textures: u32,
     /// Bytes of the transient textures this frame used (render targets, G-buffer, post-stage

@@ -58,10 +58,14 @@ use std::sync::Arc;
 /// a wide margin; lower them for untrusted files, raise them for very large scenes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LoadOptions {
-    /// Largest accepted texture width or height in pixels; a larger image is an error
-    /// ([`SceneError::TextureTooLarge`]), detected from its header before decoding.
-    /// Default 8192.
+    /// Largest texture width or height in pixels; what happens to a larger image is
+    /// [`LoadOptions::oversized_textures`]. Set it to the device's limit
+    /// (`GpuContext::max_texture_size`) to load only what the renderer can upload. Default 8192.
     pub max_texture_size: u32,
+    /// What a texture larger than `max_texture_size` does: refuse the file (the default;
+    /// [`SceneError::TextureTooLarge`], detected from the image header before decoding) or
+    /// be downscaled to fit.
+    pub oversized_textures: OversizedTextures,
     /// Largest size in bytes of a `.gltf` file, and of the JSON chunk of a `.glb` file;
     /// checked against the file's size before it is read. Default 64 MiB.
     pub max_json_bytes: u64,
@@ -110,10 +114,27 @@ pub struct LoadOptions {
     pub max_image_bytes: u64,
 }
 
+/// What the loader does with an image larger than [`LoadOptions::max_texture_size`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum OversizedTextures {
+    /// The file is refused with [`SceneError::TextureTooLarge`] (the default).
+    #[default]
+    Refuse,
+    /// The image is decoded and downscaled (aspect kept, triangle filter) so that its larger
+    /// side is `max_texture_size`; its decoded size still counts against `max_image_bytes`.
+    /// Images whose header declares more than [`MAX_DOWNSCALED_SOURCE`] pixels per side are
+    /// still refused.
+    Downscale,
+}
+
+/// Largest side of an image that [`OversizedTextures::Downscale`] decodes to scale it down.
+pub const MAX_DOWNSCALED_SOURCE: u32 = 65_536;
+
 impl Default for LoadOptions {
     fn default() -> Self {
         Self {
             max_texture_size: 8192,
+            oversized_textures: OversizedTextures::Refuse,
             max_json_bytes: 64 << 20,
             max_json_values: 2_000_000,
             max_glb_bytes: (1 << 30) + (64 << 20),

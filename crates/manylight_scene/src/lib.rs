@@ -14,7 +14,9 @@ mod textures;
 
 pub use default_scene::default_scene;
 pub use error::SceneError;
-pub use gltf_loader::{LoadOptions, blinn_phong_from_pbr, load_gltf};
+pub use gltf_loader::{
+    LoadOptions, MAX_DOWNSCALED_SOURCE, OversizedTextures, blinn_phong_from_pbr, load_gltf,
+};
 pub use light_rig::{
     AnimatedLight, RIG_RADIUS_K, SplitMix64, intensity_for_radius, light_rig, sphere_shell_lights,
     sphere_shell_scene,

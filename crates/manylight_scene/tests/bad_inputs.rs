@@ -142,6 +142,19 @@ fn the_texture_limit_is_configurable() {
         load_gltf(path, &LoadOptions { max_texture_size: 2, ..LoadOptions::default() }).expect_err("4x4 > 2");
     assert_eq!(variant(&err), "TextureTooLarge");
     assert!(err.to_string().contains("4x4"));
+    // Or downscaled to fit, when the options say so.
+    let options = LoadOptions {
+        max_texture_size: 2,
+        oversized_textures: manylight_scene::OversizedTextures::Downscale,
+        ..LoadOptions::default()
+    };
+    let scene = load_gltf(path, &options).expect("downscaled");
+    let textures: Vec<_> = scene.materials.iter().filter_map(|m| m.base_color_texture.as_ref()).collect();
+    assert!(!textures.is_empty());
+    for t in textures {
+        assert_eq!((t.width, t.height), (2, 2), "{}", t.label);
+        assert_eq!(t.rgba8.len(), 2 * 2 * 4);
+    }
 }
 
 /// Truncating a valid file at every length must give an error (or a scene), never a panic.

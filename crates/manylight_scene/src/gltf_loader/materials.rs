@@ -7,7 +7,7 @@
 //! declares a huge image, or names one image many times, costs nothing.
 
 use super::uri::{UriSource, resolve_uri};
-use super::{Ctx, over_budget};
+use super::{Ctx, MAX_DOWNSCALED_SOURCE, OversizedTextures, over_budget};
 use crate::SceneError;
 use glam::Vec4;
 use image::{ImageDecoder, ImageFormat, ImageReader, Limits};
@@ -199,10 +199,13 @@ impl<'a> Ctx<'a> {
             message: e.to_string(),
         };
         let max = self.options.max_texture_size;
+        let downscale = self.options.oversized_textures == OversizedTextures::Downscale;
+        // The largest side decoded: the limit itself, or the largest source a downscale takes.
+        let decoded_max = if downscale { max.max(MAX_DOWNSCALED_SOURCE) } else { max };
         let mut decoder =
             ImageReader::with_format(Cursor::new(bytes), format).into_decoder().map_err(decode_err)?;
         let (width, height) = decoder.dimensions();
-        if width > max || height > max {
+        if width > decoded_max || height > decoded_max {
             return Err(SceneError::TextureTooLarge {
                 path: self.path.to_owned(),
                 image: index,
@@ -226,12 +229,24 @@ impl<'a> Ctx<'a> {
             return Err(over_budget(self.path, what, needed, unit, limit, "max_image_bytes"));
         }
         let mut limits = Limits::default();
-        limits.max_image_width = Some(max);
-        limits.max_image_height = Some(max);
+        limits.max_image_width = Some(decoded_max);
+        limits.max_image_height = Some(decoded_max);
         // Room for the decoded image at 16 bits per channel plus decoder scratch.
         limits.max_alloc = Some((width as u64 * height as u64 * 8 * 2).max(512 << 20));
         decoder.set_limits(limits).map_err(decode_err)?;
-        let rgba = image::DynamicImage::from_decoder(decoder).map_err(decode_err)?.into_rgba8();
+        let mut rgba = image::DynamicImage::from_decoder(decoder).map_err(decode_err)?.into_rgba8();
+        if width > max || height > max {
+            // Only with OversizedTextures::Downscale: the larger side becomes `max`.
+            let scale = max as f64 / width.max(height) as f64;
+            let w = ((width as f64 * scale).round() as u32).clamp(1, max);
+            let h = ((height as f64 * scale).round() as u32).clamp(1, max);
+            tracing::info!(
+                "{}: image {index} is {width}x{height}, downscaled to {w}x{h}",
+                self.path.display()
+            );
+            rgba = image::imageops::resize(&rgba, w, h, image::imageops::FilterType::Triangle);
+        }
+        let (width, height) = rgba.dimensions();
         Ok(TextureData { label, width, height, rgba8: rgba.into_raw(), srgb: true })
     }
 }
