@@ -259,3 +259,25 @@ fn gpu_lists_are_exact_past_the_workgroups_per_dimension_limit() {
     assert!(c.total_entries > 0, "{c:?}");
     assert_same_lists("256×256×2 grid, workgroup size 1", &gpu, &cpu);
 }
+
+/// 4 194 304 lights (this device's binding limit on lavapipe) that each cover every one of
+/// 32 × 32 tiles make 2³² light–tile pairs, one more than the build's u32 sums hold. A wrapped
+/// sum would be 0 and pass every capacity check with empty lists; the saturating sums refuse
+/// the frame instead, naming the limit.
+#[test]
+fn more_pairs_than_32_bits_hold_are_refused_not_wrapped() {
+    let _gpu = gpu();
+    let mut r = HeadlessRenderer::new().expect("adapter");
+    let scene = default_scene();
+    let mut settings = clustered(CullTest::Aabb, ZSlicing::Exponential, None);
+    settings.clusters.grid.dims = Some(glam::UVec3::new(32, 32, 1));
+    let count = 1usize << 22;
+    let center = scene.bounds().center();
+    let lights = vec![light(center, 1e6); count];
+    let snapshot = scene_snapshot(&scene, UVec2::new(64, 64), lights, settings);
+    let start = std::time::Instant::now();
+    let err = r.render(snapshot, false).expect_err("2^32 pairs are refused");
+    eprintln!("refused in {:.1} s: {err}", start.elapsed().as_secs_f64());
+    assert!(matches!(err, manylight::render::RenderError::TooManyPairs { .. }), "{err}");
+    assert!(err.to_string().contains("PAIR_COUNT_SATURATED"), "{err}");
+}

@@ -4,11 +4,11 @@
 
 mod support;
 
+use glam::Vec4;
 use manylight::app::headless::render_headless;
 use manylight::core::{MaterialData, MeshData, TextureData, Vertex};
 use manylight::prelude::*;
 use manylight::render::GpuContext;
-use glam::Vec4;
 use std::sync::Arc;
 use support::{STRICT, assert_finite, assert_similar, gpu};
 
