@@ -334,6 +334,13 @@ fn extreme_projections_render_finite_images() {
         })
         .unwrap_or_else(|e| panic!("fov {fov_y} near {near} far {far}: {e}"));
         support::assert_finite(&frame);
+        let report = frame.stats.last.as_ref().expect("a report");
+        let valid = fov_y > 1e-4
+            && fov_y < std::f32::consts::PI - 1e-4
+            && near > 0.0
+            && far > near
+            && far.is_finite();
+        assert_eq!(report.sanitized_cameras, u32::from(!valid), "fov {fov_y} near {near} far {far}");
     }
 }
 

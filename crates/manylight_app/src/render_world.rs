@@ -180,6 +180,7 @@ impl RenderWorld {
     ) -> Result<FrameReport, RenderError> {
         let mut snapshot = snapshot;
         let invalid_cameras = snapshot.reject_invalid_camera();
+        let sanitized_cameras = snapshot.sanitized_cameras();
         self.world.insert_resource(CurrentSnapshot(snapshot));
         self.world.insert_resource(OutputTarget { view: output.clone(), format });
         self.world.resource_mut::<FrameGraph>().0.clear();
@@ -191,7 +192,7 @@ impl RenderWorld {
         let outcome = std::mem::take(&mut *self.world.resource_mut::<FrameOutcome>());
         match (outcome.error, outcome.report) {
             (Some(e), _) => Err(e),
-            (None, Some(r)) => Ok(FrameReport { invalid_cameras, ..r }),
+            (None, Some(r)) => Ok(FrameReport { invalid_cameras, sanitized_cameras, ..r }),
             (None, None) => Err(RenderError::Graph("the frame produced no report".into())),
         }
     }

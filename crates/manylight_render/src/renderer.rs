@@ -211,6 +211,7 @@ impl Renderer {
             light_count: self.scene.light_count,
             invalid_lights: self.scene.invalid_lights,
             invalid_cameras: 0,
+            sanitized_cameras: 0,
             nonfinite_pixels,
             instance_count: self.scene.draws.len() as u32,
             invalid_instances: self.scene.invalid_instances,

@@ -412,6 +412,22 @@ impl FrameSnapshot {
         }
     }
 
+    /// Cameras whose projection [`Projection::sanitized`](manylight_core::Projection::sanitized)
+    /// changes (0 or 1), for [`crate::FrameReport::sanitized_cameras`].
+    pub fn sanitized_cameras(&self) -> u32 {
+        let changed = self.camera.as_ref().is_some_and(|c| {
+            let p = c.projection;
+            let s = p.sanitized();
+            // Compared bit for bit, so a NaN parameter counts as changed.
+            (p.fov_y.to_bits(), p.near.to_bits(), p.far.to_bits())
+                != (s.fov_y.to_bits(), s.near.to_bits(), s.far.to_bits())
+        });
+        if changed {
+            tracing::debug!("the camera's projection was sanitised to render");
+        }
+        u32::from(changed)
+    }
+
     /// True when at least one light has valid parameters.
     pub fn has_lights(&self) -> bool {
         self.lights.iter().any(|l| l.is_valid())

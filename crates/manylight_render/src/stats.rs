@@ -39,6 +39,10 @@ pub struct FrameReport {
     /// Cameras refused because their transform was not finite or not invertible (the frame
     /// rendered nothing).
     pub invalid_cameras: u32,
+    /// Cameras whose projection was changed to render (see `Projection::sanitized`): a NaN or
+    /// infinite parameter, a near plane ≤ 0, a far plane missing or not beyond the near plane,
+    /// a field of view outside [10⁻⁴, π − 10⁻⁴]. The frame renders with the changed projection.
+    pub sanitized_cameras: u32,
     /// Pixels whose HDR colour was NaN or infinite (counted by the tone map, shown black);
     /// `None` when the frame had no tone map (a debug view replaced it).
     pub nonfinite_pixels: Option<u32>,
