@@ -3,8 +3,8 @@
 //! pipeline, G-buffer layout and normal codec, against the same plane tessellated into rings
 //! that grow geometrically with the distance from the camera's foot point (the reference: no
 //! triangle's vertices lie much farther from the camera than the pixels it covers), which is
-//! itself checked against the floor shaded analytically on the CPU. Measured figures are in
-//! docs/reliability.md ("Very large surfaces").
+//! itself checked against the floor shaded analytically on the CPU. The figures before and after
+//! shading `surface_point` are in docs/reliability.md (very large surfaces).
 
 mod support;
 
