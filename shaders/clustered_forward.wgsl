@@ -10,15 +10,15 @@
 
 @fragment
 fn fs_main(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    let p = surface_point(view, in.clip_position.xy, in.camera_offset);
     let albedo = surface_albedo(material, base_color_texture, base_color_sampler, in.uv);
     let s = surface_params(material, view.shading_model, albedo.rgb, in.world_normal, front_facing);
-    let view_dir = normalize(view.camera_position.xyz - in.world_position);
-    let view_distance = -(view.view_from_world * vec4<f32>(in.world_position, 1.0)).z;
-    let cluster = cluster_index(cluster_params, in.clip_position.xy, view_distance);
+    let view_dir = normalize(view.camera_position.xyz - p.world_position);
+    let cluster = cluster_index(cluster_params, in.clip_position.xy, p.view_depth);
     let range = cluster_ranges[cluster];
     var color = albedo.rgb * view.params.w;
     for (var i = 0u; i < range.y; i++) {
-        color += shade_point_light(s, in.world_position, view_dir, lights[cluster_indices[range.x + i]]);
+        color += shade_point_light(s, p.world_position, view_dir, lights[cluster_indices[range.x + i]]);
     }
     return vec4<f32>(color, 1.0);
 }

@@ -48,9 +48,8 @@ fn fs_packed(in: FullscreenOut) -> @location(0) vec4<f32> {
 @fragment
 fn fs_compact(in: FullscreenOut) -> @location(0) vec4<f32> {
     let px = vec2<i32>(in.position.xy);
-    let depth = gbuffer_depth(px);
-    if depth <= 0.0 {
+    if gbuffer_depth(px) <= 0.0 {
         return clear_color;
     }
-    return shade(gbuffer_read_compact(px, depth), in.position.xy);
+    return shade(gbuffer_read_compact(px), in.position.xy);
 }

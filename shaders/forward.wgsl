@@ -4,22 +4,23 @@
 
 @fragment
 fn fs_main(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    let p = surface_point(view, in.clip_position.xy, in.camera_offset);
     let albedo = surface_albedo(material, base_color_texture, base_color_sampler, in.uv);
     let s = surface_params(material, view.shading_model, albedo.rgb, in.world_normal, front_facing);
-    let view_dir = normalize(view.camera_position.xyz - in.world_position);
+    let view_dir = normalize(view.camera_position.xyz - p.world_position);
     var color = albedo.rgb * view.params.w;
     // Four lights per iteration, added in order: lavapipe stops an invocation after 65 535 loop
     // iterations, which would drop every light past the 65 535th of the reference.
     let n = view.light_count;
     var i = 0u;
     for (; i + 4u <= n; i += 4u) {
-        color += shade_point_light(s, in.world_position, view_dir, lights[i]);
-        color += shade_point_light(s, in.world_position, view_dir, lights[i + 1u]);
-        color += shade_point_light(s, in.world_position, view_dir, lights[i + 2u]);
-        color += shade_point_light(s, in.world_position, view_dir, lights[i + 3u]);
+        color += shade_point_light(s, p.world_position, view_dir, lights[i]);
+        color += shade_point_light(s, p.world_position, view_dir, lights[i + 1u]);
+        color += shade_point_light(s, p.world_position, view_dir, lights[i + 2u]);
+        color += shade_point_light(s, p.world_position, view_dir, lights[i + 3u]);
     }
     for (; i < n; i++) {
-        color += shade_point_light(s, in.world_position, view_dir, lights[i]);
+        color += shade_point_light(s, p.world_position, view_dir, lights[i]);
     }
     return vec4<f32>(color, 1.0);
 }

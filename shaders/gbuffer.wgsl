@@ -5,9 +5,13 @@
 //   shininess), albedo rgba16f (rgb, a = specular);
 // - Packed (2 x rgba32f): (albedo.rgb + material parameters in the integer parts, n.a) and
 //   (position.xyz, n.b);
-// - Compact (1 x rgba32uint): x = albedo rgba8 (sRGB-encoded, so dark colours keep their
-//   precision), y = the normal codec's word, z = shininess (f16) | specular (f16),
-//   w = shading model; position comes from depth.
+// - Compact (1 x rgba32uint): x = albedo rgb8 (sRGB-encoded, so dark colours keep their
+//   precision) with the shading model in the top byte, y = the normal codec's word,
+//   z = shininess (f16) | specular (f16), w = the reverse-Z depth of the shading position
+//   (f32 bits); the lighting pass rebuilds the position from that depth.
+// Every layout stores the shading position of `surface_point` (common/surface.wgsl), not the
+// rasteriser's interpolation or depth, which drift on triangles much larger than their
+// distance from the camera.
 //!include common/mesh_pass.wgsl
 //!include common/gbuffer_codec.wgsl
 
@@ -24,9 +28,10 @@ fn surface_of(in: SurfaceVertexOut, front_facing: bool) -> SurfaceParams {
 
 @fragment
 fn fs_full(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> FullOut {
+    let p = surface_point(view, in.clip_position.xy, in.camera_offset);
     let s = surface_of(in, front_facing);
     var out: FullOut;
-    out.position = vec4<f32>(in.world_position, f32(s.model));
+    out.position = vec4<f32>(p.world_position, f32(s.model));
     out.normal = vec4<f32>(s.normal, s.shininess);
     out.albedo = vec4<f32>(s.albedo, saturate(s.specular));
     return out;
@@ -39,21 +44,24 @@ struct PackedOut {
 
 @fragment
 fn fs_packed(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> PackedOut {
+    let p = surface_point(view, in.clip_position.xy, in.camera_offset);
     let s = surface_of(in, front_facing);
     let n = gbuffer_encode_components(s.normal, view.view_from_world);
     var out: PackedOut;
     out.albedo = vec4<f32>(gbuffer_pack_albedo_params(s), n.x);
-    out.position = vec4<f32>(in.world_position, n.y);
+    out.position = vec4<f32>(p.world_position, n.y);
     return out;
 }
 
 @fragment
 fn fs_compact(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<u32> {
+    let p = surface_point(view, in.clip_position.xy, in.camera_offset);
     let s = surface_of(in, front_facing);
+    let clip = view.clip_from_world * vec4<f32>(p.world_position, 1.0);
     return vec4<u32>(
-        pack4x8unorm(vec4<f32>(linear_to_srgb(s.albedo), 1.0)),
+        gbuffer_pack_albedo_model(s.albedo, s.model),
         gbuffer_encode_word(s.normal),
         pack2x16float(vec2<f32>(s.shininess, s.specular)),
-        s.model,
+        bitcast<u32>(clip.z / clip.w),
     );
 }

@@ -74,11 +74,10 @@ fn fs_ambient_packed(in: FullscreenOut) -> @location(0) vec4<f32> {
 @fragment
 fn fs_ambient_compact(in: FullscreenOut) -> @location(0) vec4<f32> {
     let px = vec2<i32>(in.position.xy);
-    let depth = gbuffer_depth(px);
-    if depth <= 0.0 {
+    if gbuffer_depth(px) <= 0.0 {
         return clear_color;
     }
-    return ambient(gbuffer_read_compact(px, depth));
+    return ambient(gbuffer_read_compact(px));
 }
 
 @fragment
@@ -102,9 +101,8 @@ fn fs_volume_packed(in: VolumeOut) -> @location(0) vec4<f32> {
 @fragment
 fn fs_volume_compact(in: VolumeOut) -> @location(0) vec4<f32> {
     let px = vec2<i32>(in.clip_position.xy);
-    let depth = gbuffer_depth(px);
-    if depth <= 0.0 {
+    if gbuffer_depth(px) <= 0.0 {
         return vec4<f32>(0.0);
     }
-    return one_light(gbuffer_read_compact(px, depth), in.light_index);
+    return one_light(gbuffer_read_compact(px), in.light_index);
 }

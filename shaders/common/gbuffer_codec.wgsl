@@ -90,3 +90,18 @@ fn gbuffer_unpack_albedo_params(v: vec3<f32>) -> SurfaceParams {
     s.shininess = exp2(k.z * (1.0 / 64.0));
     return s;
 }
+
+// ---- Compact: albedo and shading model in one word ----
+
+// Albedo as rgb8 (sRGB-encoded) in bits 0-23, the shading model in bits 24-31.
+fn gbuffer_pack_albedo_model(albedo: vec3<f32>, model: u32) -> u32 {
+    return (pack4x8unorm(vec4<f32>(linear_to_srgb(albedo), 0.0)) & 0x00ffffffu) | (min(model, 255u) << 24u);
+}
+
+fn gbuffer_unpack_albedo(word: u32) -> vec3<f32> {
+    return srgb_to_linear(unpack4x8unorm(word).rgb);
+}
+
+fn gbuffer_unpack_model(word: u32) -> u32 {
+    return word >> 24u;
+}

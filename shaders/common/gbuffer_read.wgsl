@@ -61,16 +61,18 @@ fn gbuffer_position_from_depth(uv: vec2<f32>, depth: f32) -> vec3<f32> {
     return world.xyz / world.w;
 }
 
-fn gbuffer_read_compact(px: vec2<i32>, depth: f32) -> GSurface {
+// The Compact layout at `px`; its position comes from the depth it stores (the shading
+// position's, which the depth buffer only approximates on very large triangles).
+fn gbuffer_read_compact(px: vec2<i32>) -> GSurface {
     let g = textureLoad(gb_compact, px, 0);
     let params = unpack2x16float(g.z);
     var out: GSurface;
-    out.params.albedo = srgb_to_linear(unpack4x8unorm(g.x).rgb);
+    out.params.albedo = gbuffer_unpack_albedo(g.x);
     out.params.normal = gbuffer_decode_word(g.y);
     out.params.shininess = params.x;
     out.params.specular = params.y;
-    out.params.model = g.w;
+    out.params.model = gbuffer_unpack_model(g.x);
     let uv = (vec2<f32>(px) + 0.5) * view.viewport.zw;
-    out.world_position = gbuffer_position_from_depth(uv, depth);
+    out.world_position = gbuffer_position_from_depth(uv, bitcast<f32>(g.w));
     return out;
 }

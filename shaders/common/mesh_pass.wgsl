@@ -16,5 +16,5 @@
 
 @vertex
 fn vs_main(v: VertexIn, @builtin(instance_index) instance_index: u32) -> SurfaceVertexOut {
-    return surface_vertex(v, instances[instance_index], view.clip_from_world);
+    return surface_vertex(v, instances[instance_index], view.clip_from_world, view.camera_position.xyz);
 }

@@ -1,19 +1,23 @@
-// Vertex transform and surface parameters shared by every pass that shades meshes.
+// Vertex transform, shading position and surface parameters shared by every pass that shades
+// meshes.
+//!include common/view.wgsl
 //!include common/mesh.wgsl
 //!include common/brdf.wgsl
 
 struct SurfaceVertexOut {
     @invariant @builtin(position) clip_position: vec4<f32>,
-    @location(0) world_position: vec3<f32>,
+    // World position minus the camera position (camera-relative: interpolated values near the
+    // camera are small, whatever the distance from the world origin).
+    @location(0) camera_offset: vec3<f32>,
     @location(1) world_normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
 };
 
-fn surface_vertex(v: VertexIn, inst: GpuInstance, clip_from_world: mat4x4<f32>) -> SurfaceVertexOut {
+fn surface_vertex(v: VertexIn, inst: GpuInstance, clip_from_world: mat4x4<f32>, camera: vec3<f32>) -> SurfaceVertexOut {
     let world = inst.world_from_local * vec4<f32>(v.position, 1.0);
     var out: SurfaceVertexOut;
     out.clip_position = clip_from_world * world;
-    out.world_position = world.xyz;
+    out.camera_offset = world.xyz - camera;
     out.world_normal = (inst.normal_from_local * vec4<f32>(v.normal, 0.0)).xyz;
     out.uv = v.uv;
     return out;
@@ -39,4 +43,42 @@ fn surface_params(m: GpuMaterial, global_model: u32, albedo: vec3<f32>, normal: 
     s.specular = m.specular;
     s.model = select(m.shading_model, global_model, m.shading_model == SHADING_GLOBAL);
     return s;
+}
+
+// Where a fragment is shaded.
+struct SurfacePoint {
+    world_position: vec3<f32>,
+    // Distance from the camera along the view direction (view-space -z).
+    view_depth: f32,
+};
+
+// The cosine between the pixel's ray and its triangle below which `surface_point` keeps the
+// interpolated position (the ray runs within 0.06 degrees of the plane: the intersection
+// would amplify any error of the plane).
+const SURFACE_POINT_MIN_COSINE: f32 = 1e-3;
+
+// The shading position of a fragment: the pixel's ray (`view_ray`) intersected with the plane
+// of its triangle, which passes through the interpolated camera-relative position `offset`
+// with the normal cross(dpdx, dpdy) of it. Interpolation across a triangle whose vertices lie
+// far beyond the pixel (a floor 1e7 wide seen from 2 units) is off by about |vertex| * 2^-24,
+// and clipping such a triangle at the near plane puts the rasteriser's depth off as well; the
+// error lies within the triangle's plane for an axis-aligned surface, so the intersection
+// removes it, and for a small triangle it changes the interpolated point by rounding only.
+// Uses derivatives: call it in uniform control flow.
+fn surface_point(v: ViewUniform, frag: vec2<f32>, offset: vec3<f32>) -> SurfacePoint {
+    let g = cross(dpdx(offset), dpdy(offset));
+    let ray = view_ray(v, frag);
+    let denom = dot(ray, g);
+    let t = dot(offset, g) / denom;
+    let camera = v.camera_position.xyz;
+    var p: SurfacePoint;
+    // NaN (a degenerate derivative) fails every comparison and falls back.
+    if abs(denom) > SURFACE_POINT_MIN_COSINE * length(ray) * length(g) && t > 0.0 && t < 3.4e38 {
+        p.world_position = camera + ray * t;
+        p.view_depth = t;
+    } else {
+        p.world_position = camera + offset;
+        p.view_depth = -(v.view_from_world * vec4<f32>(p.world_position, 1.0)).z;
+    }
+    return p;
 }

@@ -1,5 +1,5 @@
 //! `manylight depth-precision`: how accurately a world position comes back from a stored
-//! `Depth32Float` depth: the error of
+//! f32 reverse-Z depth: the error of
 //! the Compact G-buffer's position-from-depth (`gbuffer_position_from_depth` in
 //! `shaders/common/gbuffer_read.wgsl`), measured across the depth range.
 //!
@@ -8,8 +8,9 @@
 //! 1. Take a pixel centre and a view depth `d`; the exact point on that pixel's ray (f64) is
 //!    rounded to an f32 world position, the vertex position a mesh would hold.
 //! 2. Project it as the GPU does: `clip = clip_from_world * (p, 1)` in f32, stored depth
-//!    `clip.z / clip.w` in f32 (what the rasteriser writes to `Depth32Float`; interpolation
-//!    across a triangle adds nothing for a point at a vertex).
+//!    `clip.z / clip.w` in f32 (what the rasteriser writes to `Depth32Float`, and what the
+//!    Compact G-buffer stores for its shading position; interpolation across a triangle adds
+//!    nothing for a point at a vertex).
 //! 3. Reconstruct as the lighting pass does, in f32: `uv = (px + 0.5) / size`,
 //!    `ndc = (2u - 1, 1 - 2v)`, `w = world_from_clip * (ndc, depth, 1)`, `w.xyz / w.w`, with
 //!    `world_from_clip = clip_from_world.inverse()` computed in f32 as the renderer uploads it.

@@ -79,8 +79,9 @@ pub enum GBufferLayout {
     /// normal codec's two components. The albedo channels carry the material parameters in
     /// their integer parts (`shaders/gbuffer.wgsl` explains how).
     Packed,
-    /// One rgba32uint target: albedo rgba8 (sRGB-encoded), the normal codec's 32-bit word,
-    /// shininess/specular f16, shading model; position reconstructed from depth.
+    /// One rgba32uint target: albedo rgb8 (sRGB-encoded) and the shading model, the normal
+    /// codec's 32-bit word, shininess/specular f16, the shading position's depth (f32); position
+    /// reconstructed from that depth.
     Compact,
 }
 
