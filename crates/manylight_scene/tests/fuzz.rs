@@ -47,6 +47,9 @@ const PEAK_LIMIT: usize = 64 << 20;
 fn budgets() -> LoadOptions {
     LoadOptions {
         max_texture_size: 1024,
+        // Refused rather than decoded at full size to be scaled down: the decode would not be
+        // bounded by the 1024-pixel limit.
+        oversized_textures: manylight_scene::OversizedTextures::Refuse,
         max_json_bytes: 1 << 20,
         max_json_values: 100_000,
         max_glb_bytes: 4 << 20,
