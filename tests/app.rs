@@ -313,6 +313,7 @@ fn extreme_projections_render_finite_images() {
     let projections = [
         (1e-6, 1e-6, 1000.0),
         (std::f32::consts::PI - 1e-6, 0.1, 1000.0),
+        (manylight::core::camera::MAX_FOV_Y, 0.1, 1000.0),
         (0.0, 0.0, 0.0),
         (1.0, 1e-6, f32::INFINITY),
         (1.0, 1e30, f32::NAN),
@@ -335,8 +336,7 @@ fn extreme_projections_render_finite_images() {
         .unwrap_or_else(|e| panic!("fov {fov_y} near {near} far {far}: {e}"));
         support::assert_finite(&frame);
         let report = frame.stats.last.as_ref().expect("a report");
-        let valid = fov_y > 1e-4
-            && fov_y < std::f32::consts::PI - 1e-4
+        let valid = (1e-6..=manylight::core::camera::MAX_FOV_Y).contains(&fov_y)
             && near > 0.0
             && far > near
             && far.is_finite();

@@ -3,6 +3,13 @@
 
 use glam::Mat4;
 
+/// Smallest field of view a projection keeps (radians); smaller ones are raised to it.
+pub const MIN_FOV_Y: f32 = 1e-6;
+
+/// Largest field of view a projection keeps (radians): the largest `f32` whose half lies below
+/// π/2 (`std::f32::consts::PI` rounds above π, and half of it would flip the image).
+pub const MAX_FOV_Y: f32 = 3.141_592_5;
+
 /// A perspective projection.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Projection {
@@ -21,15 +28,15 @@ impl Default for Projection {
 }
 
 impl Projection {
-    /// Clamps parameters into their valid ranges so the matrix is always finite: a NaN,
+    /// Clamps parameters into their valid ranges so the matrix is always finite: a field of view
+    /// outside [`MIN_FOV_Y`, `MAX_FOV_Y`] is clamped (NaN or infinite becomes 1 rad), a NaN,
     /// infinite or non-positive near plane becomes 0.1, a near plane so large that no finite
     /// far plane fits beyond it is lowered, and a missing, NaN or too-close far plane becomes
     /// `near × 10⁴` (at most `f32::MAX`).
     pub fn sanitized(self) -> Projection {
         /// Largest near plane that leaves room for a far plane a factor of 2 beyond it.
         const MAX_NEAR: f32 = f32::MAX / 4.0;
-        let fov_y =
-            if self.fov_y.is_finite() { self.fov_y.clamp(1e-4, std::f32::consts::PI - 1e-4) } else { 1.0 };
+        let fov_y = if self.fov_y.is_finite() { self.fov_y.clamp(MIN_FOV_Y, MAX_FOV_Y) } else { 1.0 };
         let near = if self.near.is_finite() && self.near > 0.0 { self.near.min(MAX_NEAR) } else { 0.1 };
         let far = if self.far.is_finite() && self.far > near { self.far } else { (near * 1e4).min(f32::MAX) };
         Projection { fov_y, near, far }
@@ -81,7 +88,7 @@ mod tests {
             f32::NEG_INFINITY,
             f32::NAN,
         ];
-        let fovs = [0.0, 1e-6, 1.0, std::f32::consts::PI - 1e-6, std::f32::consts::PI, f32::NAN];
+        let fovs = [0.0, 1e-6, 1.0, MAX_FOV_Y, std::f32::consts::PI - 1e-6, std::f32::consts::PI, f32::NAN];
         for &near in &values {
             for &far in &values {
                 for &fov_y in &fovs {
@@ -91,6 +98,8 @@ mod tests {
                         assert!(s.near > 0.0 && s.far > s.near && s.far.is_finite(), "{p:?} -> {s:?}");
                         let m = p.matrix(aspect);
                         assert!(m.is_finite(), "{p:?} aspect {aspect}: {m:?}");
+                        // Never a flipped image: the focal terms stay positive.
+                        assert!(m.x_axis.x > 0.0 && m.y_axis.y > 0.0, "{p:?} aspect {aspect}: {m:?}");
                     }
                 }
             }

@@ -41,7 +41,7 @@ pub struct FrameReport {
     pub invalid_cameras: u32,
     /// Cameras whose projection was changed to render (see `Projection::sanitized`): a NaN or
     /// infinite parameter, a near plane ≤ 0, a far plane missing or not beyond the near plane,
-    /// a field of view outside [10⁻⁴, π − 10⁻⁴]. The frame renders with the changed projection.
+    /// a field of view outside [`MIN_FOV_Y`, `MAX_FOV_Y`] (`manylight_core::camera`). The frame renders with the changed projection.
     pub sanitized_cameras: u32,
     /// Pixels whose HDR colour was NaN or infinite (counted by the tone map, shown black);
     /// `None` when the frame had no tone map (a debug view replaced it).
