@@ -2,14 +2,21 @@
 // the pixel's position is rebuilt from depth, projected with last frame's clip-from-world, and
 // the HDR colour is averaged along the screen-space difference. fs_copy writes the result back
 // into the HDR target.
+//
+// The tap count is a pipeline-override constant, not a uniform: lavapipe (Mesa 22.3) compiles a
+// fresh copy of a shader whose loop count it can read from a uniform buffer at every draw, and
+// never frees the copies (0.84 MB per frame).
 //!include common/view.wgsl
+
+// Taps along the motion (2 to 64; Rust: `MotionBlurSettings::samples`).
+override SAMPLES: u32 = 8u;
 //!include common/fullscreen.wgsl
 
 struct MotionBlurParams {
-    samples: u32,
     strength: f32,
     max_pixels: f32,
     _pad0: u32,
+    _pad1: u32,
 };
 
 @group(0) @binding(0) var<uniform> view: ViewUniform;
@@ -49,7 +56,7 @@ fn fs_blur(in: FullscreenOut) -> @location(0) vec4<f32> {
         return centre;
     }
     let max_px = vec2<i32>(view.viewport.xy) - vec2<i32>(1);
-    let n = max(params.samples, 2u);
+    let n = max(SAMPLES, 2u);
     var sum = vec3<f32>(0.0);
     for (var i = 0u; i < n; i++) {
         // Taps spread evenly over [-v/2, +v/2], centred on the pixel.

@@ -1,8 +1,10 @@
 //! Opens a real window (on its own Xvfb server when no display is set) and drives it through
 //! [`WindowRequests`]: resizes, a storm of resizes, minimising (0×0), resizing while minimised,
-//! restoring, then closing while a frame is in flight. Checks that every size was really
-//! rendered, that the app exits with success, that nothing panicked and that the render thread
-//! is gone when `App::run` returns.
+//! restoring, a 1×1 window with bloom and motion blur and back, then closing while a frame is in
+//! flight. Checks that every size was really rendered, that no frame had a non-finite pixel,
+//! that the frames after the 1×1 ones equal, pixel for pixel, the frame read back before them,
+//! that the app exits with success, that nothing panicked and that the render thread is gone
+//! when `App::run` returns.
 //!
 //! winit allows one event loop per process, so everything is one `#[test]`: it drives a
 //! pipelined window (render thread) itself, then runs itself again in a child process for a
@@ -11,8 +13,8 @@
 //! Without a display and without `Xvfb` the test says so loudly and passes, unless `CI=true`,
 //! where it fails.
 
-use manylight::app::ViewportSize;
 use manylight::app::window::{WindowConfig, WindowRequests};
+use manylight::app::{HeadlessCapture, ViewportSize};
 use manylight::prelude::*;
 use std::path::PathBuf;
 use std::process::{Child, Command, Stdio};
@@ -28,6 +30,12 @@ const WATCHDOG: Duration = Duration::from_secs(150);
 const MODE_VAR: &str = "MANYLIGHT_WINDOW_TEST_MODE";
 /// Updates the app must stay minimised with a 0×0 viewport.
 const MINIMISED_UPDATES: u32 = 10;
+/// Frames rendered at 1×1 before the window grows again.
+const ONE_PIXEL_FRAMES: u32 = 5;
+/// Frames read back after the 1×1 ones and compared with the reference.
+const COMPARED_FRAMES: u32 = 3;
+/// The size the 1×1 steps start from and come back to.
+const BACK: (u32, u32) = (320, 240);
 
 /// An Xvfb server this test started; killed on drop.
 struct Xvfb {
@@ -142,6 +150,16 @@ enum Step {
     Rendered(u32, u32),
     /// Wait until the viewport has been 0×0 for [`MINIMISED_UPDATES`] updates.
     StayMinimised,
+    /// Put `Bloom` and `MotionBlur` on the camera (`true`) or take them off, and read every
+    /// frame back from now on (or stop).
+    Post(bool),
+    /// Wait until this many more frames with bloom were rendered at this size.
+    RenderedFrames(u32, u32, u32),
+    /// Keep the next frame read back at [`BACK`] as the reference image.
+    CaptureReference,
+    /// Wait until [`COMPARED_FRAMES`] frames read back at [`BACK`] were compared with the
+    /// reference (every one that arrives during the step is).
+    MatchReference,
     /// Ask to close.
     Close,
 }
@@ -169,6 +187,15 @@ const SCRIPT: &[Step] = &[
     Step::Rendered(300, 200),
     Step::Resize(320, 240),
     Step::Rendered(320, 240),
+    // 1×1 with bloom (its chain halves the size five times) and motion blur, and back.
+    Step::Post(true),
+    Step::RenderedFrames(BACK.0, BACK.1, 3),
+    Step::CaptureReference,
+    Step::Resize(1, 1),
+    Step::RenderedFrames(1, 1, ONE_PIXEL_FRAMES),
+    Step::Resize(BACK.0, BACK.1),
+    Step::MatchReference,
+    Step::Post(false),
     Step::Close,
 ];
 
@@ -191,6 +218,14 @@ struct Log {
     overlay_frames: u32,
     /// When the close was requested.
     close_requested: Option<Instant>,
+    /// Frames whose report counted non-finite pixels.
+    nonfinite_frames: u32,
+    /// Passes of the last frame rendered at 1×1.
+    one_pixel_passes: Vec<String>,
+    /// Frames read back at [`BACK`] after the 1×1 ones and compared with the reference.
+    compared: u32,
+    /// How the first frame that differed from the reference differed.
+    mismatch: Option<String>,
 }
 
 #[derive(Default)]
@@ -199,19 +234,39 @@ struct ScriptState {
     step_started: Option<Instant>,
     minimised_updates: u32,
     last_seen_frame: Option<u64>,
+    /// Frames with bloom rendered at the size a `RenderedFrames` step waits for.
+    frames_at_size: u32,
+    reference: Option<image::RgbaImage>,
 }
 
+/// How `image` differs from `reference`: `None` when equal.
+fn difference(image: &image::RgbaImage, reference: &image::RgbaImage) -> Option<String> {
+    if image.dimensions() != reference.dimensions() {
+        return Some(format!("size {:?}, reference {:?}", image.dimensions(), reference.dimensions()));
+    }
+    let (mut pixels, mut largest) = (0, 0);
+    for (a, b) in image.pixels().zip(reference.pixels()) {
+        let d = a.0.iter().zip(b.0).map(|(&x, y)| x.abs_diff(y)).max().unwrap_or(0);
+        pixels += u32::from(d > 0);
+        largest = largest.max(d);
+    }
+    (pixels > 0).then(|| format!("{pixels} pixels differ, by up to {largest}/255"))
+}
+
+/// Runs the script's current step; returns `Some(on)` when bloom and motion blur go on or off
+/// the camera.
 fn run_script(
     log: &Mutex<Log>,
     state: &mut ScriptState,
     viewport: &ViewportSize,
     stats: &FrameStats,
     requests: &mut WindowRequests,
+    capture: &mut HeadlessCapture,
     exit: &mut MessageWriter<AppExit>,
-) {
+) -> Option<bool> {
     let Ok(mut log) = log.lock() else {
         exit.write(AppExit::error());
-        return;
+        return None;
     };
     // Record each newly finished frame once.
     let minimised = viewport.0.min_element() == 0;
@@ -219,6 +274,18 @@ fn run_script(
         && state.last_seen_frame != Some(report.frame_index)
     {
         state.last_seen_frame = Some(report.frame_index);
+        if report.nonfinite_pixels.is_some_and(|n| n > 0) {
+            log.nonfinite_frames += 1;
+        }
+        if let Some(Step::RenderedFrames(w, h, _)) = SCRIPT.get(state.step)
+            && (report.width, report.height) == (*w, *h)
+            && report.pass_names().contains(&"bloom_composite")
+        {
+            state.frames_at_size += 1;
+        }
+        if (report.width, report.height) == (1, 1) && !report.passes.is_empty() {
+            log.one_pixel_passes = report.passes.iter().map(|p| p.name.clone()).collect();
+        }
         if report.width == 0 || report.height == 0 {
             log.zero_sized_frames += 1;
             assert!(report.passes.is_empty(), "a 0×0 frame ran passes");
@@ -232,9 +299,10 @@ fn run_script(
     if minimised {
         log.minimised_updates += 1;
     }
-    let Some(&step) = SCRIPT.get(state.step) else {
-        return;
-    };
+    // Frames read back at the size the 1×1 steps come back to.
+    let image = capture.image.take().filter(|i| i.dimensions() == BACK);
+    let &step = SCRIPT.get(state.step)?;
+    let mut post = None;
     let started = *state.step_started.get_or_insert_with(Instant::now);
     let done = match step {
         Step::Resize(w, h) => {
@@ -259,6 +327,33 @@ fn run_script(
             }
             done
         }
+        Step::Post(on) => {
+            post = Some(on);
+            capture.enabled = on;
+            state.frames_at_size = 0;
+            true
+        }
+        Step::RenderedFrames(_, _, n) => {
+            let done = state.frames_at_size >= n;
+            if done {
+                state.frames_at_size = 0;
+            }
+            done
+        }
+        Step::CaptureReference => {
+            state.reference = image;
+            state.reference.is_some()
+        }
+        Step::MatchReference => {
+            if let (Some(image), Some(reference)) = (image, &state.reference) {
+                log.compared += 1;
+                let compared = log.compared;
+                if let Some(d) = difference(&image, reference) {
+                    log.mismatch.get_or_insert(format!("frame {compared} after 1×1: {d}"));
+                }
+            }
+            log.compared >= COMPARED_FRAMES
+        }
         Step::Close => {
             requests.request_close();
             log.frames_rendered = stats.frames_rendered;
@@ -279,6 +374,7 @@ fn run_script(
         ));
         exit.write(AppExit::error());
     }
+    post
 }
 
 /// Names of this process's threads (Linux), to check the render thread is gone.
@@ -376,8 +472,28 @@ fn drive_window(pipelined: bool) {
                   viewport: Res<ViewportSize>,
                   stats: Res<FrameStats>,
                   mut requests: ResMut<WindowRequests>,
+                  mut capture: ResMut<HeadlessCapture>,
+                  mut commands: Commands,
+                  cameras: Query<Entity, With<Camera3d>>,
                   mut exit: MessageWriter<AppExit>| {
-                run_script(&script_log, &mut state, &viewport, &stats, &mut requests, &mut exit);
+                let post = run_script(
+                    &script_log,
+                    &mut state,
+                    &viewport,
+                    &stats,
+                    &mut requests,
+                    &mut capture,
+                    &mut exit,
+                );
+                for camera in &cameras {
+                    match post {
+                        Some(true) => {
+                            commands.entity(camera).insert((Bloom::default(), MotionBlur::default()))
+                        }
+                        Some(false) => commands.entity(camera).remove::<(Bloom, MotionBlur)>(),
+                        None => continue,
+                    };
+                }
             },
         )
         .run();
@@ -390,7 +506,7 @@ fn drive_window(pipelined: bool) {
     };
     eprintln!(
         "window test ({}): {elapsed:.1?}, exit {exit:?}, {} frames, steps {}/{}, {} updates minimised, \
-         close took {:?}, {} zero-sized frames, rendered sizes {:?}",
+         close took {:?}, {} zero-sized frames, {} frames compared after 1×1, rendered sizes {:?}",
         if pipelined { "pipelined" } else { "synchronous" },
         log.frames_rendered,
         log.step,
@@ -398,6 +514,7 @@ fn drive_window(pipelined: bool) {
         log.minimised_updates,
         log.close_requested.map(|c| returned - c),
         log.zero_sized_frames,
+        log.compared,
         {
             let mut sizes = log.rendered.clone();
             sizes.dedup();
@@ -409,11 +526,21 @@ fn drive_window(pipelined: bool) {
     assert_eq!(log.step, SCRIPT.len(), "the script did not finish");
     assert!(log.frames_rendered > 0, "no frame was rendered");
     assert!(log.overlay_frames > 0, "no frame drew the egui overlay as its last pass");
-    for size in [(320, 240), (400, 300), (360, 270), (300, 200)] {
+    for size in [(320, 240), (400, 300), (360, 270), (300, 200), (1, 1)] {
         assert!(log.rendered.contains(&size), "no frame rendered at {size:?}: {:?}", log.rendered);
     }
     assert!(log.minimised_updates >= 3 * MINIMISED_UPDATES, "too few minimised updates");
     assert!(log.zero_sized_frames > 0, "no 0×0 frame reached the renderer while minimised");
+    assert_eq!(log.nonfinite_frames, 0, "frames with non-finite pixels");
+    for pass in ["cluster_build", "clustered_forward", "bloom_composite", "tonemap"] {
+        assert!(
+            log.one_pixel_passes.iter().any(|p| p == pass),
+            "no {pass} at 1×1: {:?}",
+            log.one_pixel_passes
+        );
+    }
+    assert!(log.compared >= COMPARED_FRAMES, "only {} frames compared after 1×1", log.compared);
+    assert_eq!(log.mismatch, None, "a frame after the 1×1 ones differs from the one before");
     assert_eq!(panics.load(Ordering::SeqCst), 0, "a thread panicked");
     let render_threads = thread_names().iter().filter(|n| n.starts_with("manylight-rend")).count();
     assert_eq!(render_threads, 0, "the render thread outlived App::run");

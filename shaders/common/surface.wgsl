@@ -23,12 +23,11 @@ fn surface_vertex(v: VertexIn, inst: GpuInstance, clip_from_world: mat4x4<f32>, 
     return out;
 }
 
+// Sampled always and chosen by select, never behind a branch on the material: lavapipe (Mesa
+// 22.3) compiles a shader again at every draw when it can fold a uniform-buffer branch away, and
+// keeps every copy (about 9 MB per frame in the Packed and Compact G-buffer passes).
 fn surface_albedo(m: GpuMaterial, t: texture_2d<f32>, smp: sampler, uv: vec2<f32>) -> vec4<f32> {
-    var albedo = m.base_color;
-    if m.has_texture != 0u {
-        albedo *= textureSample(t, smp, uv);
-    }
-    return albedo;
+    return m.base_color * select(vec4<f32>(1.0), textureSample(t, smp, uv), m.has_texture != 0u);
 }
 
 fn surface_params(m: GpuMaterial, global_model: u32, albedo: vec3<f32>, normal: vec3<f32>, front_facing: bool) -> SurfaceParams {

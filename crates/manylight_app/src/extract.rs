@@ -18,7 +18,8 @@ use std::sync::Arc;
 /// State the extract system keeps between frames.
 #[derive(Default)]
 pub struct ExtractState {
-    prev_clip_from_world: Option<Mat4>,
+    /// Last frame's camera: motion blur projects with its placement and projection.
+    prev_camera: Option<ExtractedCamera>,
     frame_index: u64,
     default_material: Option<Arc<MaterialData>>,
     warned_cameras: bool,
@@ -40,10 +41,13 @@ pub fn build_snapshot(
     lights: &Query<(&Transform, &PointLight)>,
 ) -> FrameSnapshot {
     let mut camera_iter = cameras.iter();
+    // Last frame's camera at this frame's viewport: a resize alone moves no pixel, so motion
+    // blur does not smear the first frame after one.
+    let prev_clip_from_world = state.prev_camera.map(|c| c.clip_from_world(viewport));
     let camera = camera_iter.next().map(|(t, c, bloom, motion_blur)| ExtractedCamera {
         world_from_view: Mat4::from_rotation_translation(t.rotation, t.translation),
         projection: c.projection(),
-        prev_clip_from_world: state.prev_clip_from_world,
+        prev_clip_from_world,
         bloom: bloom.map(Bloom::settings),
         motion_blur: motion_blur.map(MotionBlur::settings),
     });
@@ -51,7 +55,7 @@ pub fn build_snapshot(
         tracing::warn!("more than one Camera3d: rendering the first one only");
         state.warned_cameras = true;
     }
-    state.prev_clip_from_world = camera.map(|c| c.clip_from_world(viewport));
+    state.prev_camera = camera;
     let default_material =
         state.default_material.get_or_insert_with(|| Arc::new(MaterialData::default())).clone();
     let instances = meshes

@@ -184,7 +184,9 @@ impl FrameClock {
 #[derive(Resource, Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ViewportSize(pub UVec2);
 
-/// Headless output: when `enabled`, each rendered frame is read back into `image`.
+/// Frame read-back: when `enabled`, each rendered frame is read back into `image` (headless:
+/// the target; in a window: the swapchain image before the overlay is drawn, where the surface
+/// allows copies).
 #[derive(Resource, Clone, Debug, Default)]
 pub struct HeadlessCapture {
     /// Read frames back (costs a copy and a GPU wait per frame).

@@ -32,6 +32,7 @@ mod plot;
 mod post;
 mod progress;
 mod report;
+mod soak;
 
 #[derive(Parser)]
 #[command(name = "manylight", version, about = "Many-light rendering with wgpu: render, check, bench")]
@@ -57,6 +58,10 @@ enum Command {
     /// What bloom and motion blur cost per frame: the same frame without post stages, with
     /// each bloom chain, with motion blur and with both, in one run, as a markdown table.
     Post(ReportArgs),
+    /// Thousands of frames in a window while sizes, post stages, debug views and the light
+    /// count keep changing; exit 1 if memory or the transient pool grows, a frame fails or a
+    /// pixel is NaN.
+    Soak(soak::SoakArgs),
     /// Draw the figures of a CSV that `bench`, `report` or `post` wrote.
     Plot {
         /// The CSV file.
@@ -585,6 +590,7 @@ fn main() -> ExitCode {
         Command::Report(args) => report_cmd(args),
         Command::Post(args) => post_cmd(args),
         Command::Plot { csv, out } => plot_cmd(csv, out),
+        Command::Soak(args) => soak::run(args),
         Command::DepthPrecision { samples } => {
             print!("{}", depth_precision::tables(samples.max(1)));
             Ok(())

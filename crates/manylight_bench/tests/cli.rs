@@ -1,6 +1,7 @@
 //! The `manylight` binary as a user runs it: `check` on every malformed file exits 1 with one
 //! typed error naming the file (never a panic), on real assets exits 0; `render` writes the PNG
-//! and the stats JSON. Runs on a real device (lavapipe in CI), one command at a time.
+//! and the stats JSON; a short `soak` passes in a window. Runs on a real device (lavapipe in CI),
+//! one command at a time.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -109,11 +110,66 @@ fn bad_arguments_are_refused_with_a_message() {
         &["render", "--out", "x.png", "--pipeline", "magic"],
         &["render", "--out", "x.png", "--scene", "/nonexistent/scene.gltf"],
         &["check", "/nonexistent/file.glb"],
+        &["soak", "--frames", "100", "--warmup", "100"],
+        &["soak", "--sizes", "0x10"],
     ] {
         let out = manylight(args);
         assert!(!out.status.success(), "{args:?} succeeded");
         assert_ne!(out.status.code(), Some(101), "{args:?} panicked");
         assert!(!out.stderr.is_empty(), "{args:?} said nothing");
+    }
+}
+
+/// A short soak in a window: every setting changes several times in 300 frames (sizes every
+/// 50, post stages every 50, debug views every 50, light counts every 100), and it must pass.
+/// The command starts its own Xvfb when no display is set; without either the test says so
+/// loudly and passes, unless `CI=true`, where it fails.
+#[test]
+fn a_short_soak_passes() {
+    let has_display =
+        ["DISPLAY", "WAYLAND_DISPLAY"].iter().any(|v| std::env::var_os(v).is_some_and(|d| !d.is_empty()));
+    if !has_display && Command::new("Xvfb").arg("-help").output().is_err() {
+        let ci = std::env::var("CI").is_ok_and(|v| v == "true" || v == "1");
+        assert!(!ci, "CI=true but no display and no Xvfb: install Xvfb (package xvfb)");
+        eprintln!("\n\n*** SKIPPING the soak test: no DISPLAY and no Xvfb. Install Xvfb to run it. ***\n");
+        return;
+    }
+    let _gpu = GPU.lock().unwrap_or_else(|e| e.into_inner());
+    let csv = root().join("target/cli-tests/soak.csv");
+    let _ = std::fs::remove_file(&csv);
+    let started = std::time::Instant::now();
+    let out = manylight(&[
+        "soak",
+        "--frames",
+        "300",
+        "--warmup",
+        "100",
+        "--lights",
+        "1024,512",
+        "--lights-every",
+        "100",
+        "--post-every",
+        "50",
+        "--debug-every",
+        "50",
+        "--csv",
+        csv.to_str().expect("utf-8"),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    eprintln!("soak test: {:.1?}: {stdout}", started.elapsed());
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    let summary =
+        stdout.lines().find(|l| l.starts_with("soak ")).unwrap_or_else(|| panic!("no summary:\n{stdout}"));
+    assert!(summary.starts_with("soak PASS: 300 frames"), "{summary}");
+    assert!(summary.contains("0 render errors; 0 non-finite pixels"), "{summary}");
+    let text = std::fs::read_to_string(&csv).expect("csv");
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 1 + 3, "header + a sample every 100 frames:\n{text}");
+    assert!(lines[0].starts_with("frame,seconds,frame_ms,rss_kib,"), "{}", lines[0]);
+    for (line, frame) in lines[1..].iter().zip(["100,", "200,", "300,"]) {
+        assert!(line.starts_with(frame), "{line}");
+        assert!(line.ends_with(",0"), "non-finite pixels: {line}");
     }
 }
 

@@ -303,7 +303,8 @@ pub struct ExtractedCamera {
     pub world_from_view: Mat4,
     /// Projection parameters.
     pub projection: Projection,
-    /// Last frame's clip-from-world; `None` on the first frame.
+    /// Last frame's clip-from-world (its camera's placement and projection, at this frame's
+    /// viewport, so a resize alone is no motion); `None` on the first frame.
     pub prev_clip_from_world: Option<Mat4>,
     /// Bloom, when the camera has it.
     pub bloom: Option<BloomSettings>,

@@ -1,6 +1,7 @@
 //! The window surface on the render thread: configured on first use and on resize, skipped
 //! while minimised (0×0) or larger than the device allows, reconfigured when outdated and
-//! recreated when lost.
+//! recreated when lost. When the app asks for read-back ([`crate::HeadlessCapture::enabled`]),
+//! each frame's image is copied back before the overlay is drawn on it.
 
 use super::overlay::OverlayPainter;
 use crate::backend::FrameSink;
@@ -18,6 +19,7 @@ pub struct SurfaceSink {
     render_world: RenderWorld,
     vsync: bool,
     warned_too_large: bool,
+    warned_readback: bool,
     overlay: Option<OverlayPainter>,
 }
 
@@ -35,6 +37,7 @@ impl SurfaceSink {
             render_world: RenderWorld::new(gpu),
             vsync,
             warned_too_large: false,
+            warned_readback: false,
             overlay: None,
         })
     }
@@ -58,8 +61,10 @@ impl SurfaceSink {
         };
         let present_mode =
             if self.vsync { wgpu::PresentMode::AutoVsync } else { wgpu::PresentMode::AutoNoVsync };
+        // Copies out of the swapchain serve read-back, where the surface allows them.
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | (caps.usages & wgpu::TextureUsages::COPY_SRC);
         let config = wgpu::SurfaceConfiguration {
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            usage,
             format,
             width: size.x,
             height: size.y,
@@ -122,6 +127,31 @@ impl SurfaceSink {
         }
         Ok(None)
     }
+
+    /// The frame's image as RGBA8, when the surface can be copied from and is an 8-bit RGBA or
+    /// BGRA format; `None` (with one warning) otherwise.
+    fn read_back(&mut self, texture: &wgpu::Texture) -> Result<Option<image::RgbaImage>, RenderError> {
+        use wgpu::TextureFormat as F;
+        let copyable = self.config.as_ref().is_some_and(|c| c.usage.contains(wgpu::TextureUsages::COPY_SRC));
+        let format = texture.format();
+        let bgra = matches!(format, F::Bgra8Unorm | F::Bgra8UnormSrgb);
+        if !copyable || !(bgra || matches!(format, F::Rgba8Unorm | F::Rgba8UnormSrgb)) {
+            if !self.warned_readback {
+                tracing::warn!("the window surface ({format:?}) cannot be read back: no images captured");
+                self.warned_readback = true;
+            }
+            return Ok(None);
+        }
+        let gpu = self.render_world.gpu();
+        let mut image =
+            manylight_render::readback::read_texture_rgba8(gpu, texture, texture.width(), texture.height())?;
+        if bgra {
+            for pixel in image.pixels_mut() {
+                pixel.0.swap(0, 2);
+            }
+        }
+        Ok(Some(image))
+    }
 }
 
 impl FrameSink for SurfaceSink {
@@ -157,7 +187,7 @@ impl DeviceSink for SurfaceSink {
     fn render_on_device(
         &mut self,
         snapshot: FrameSnapshot,
-        _readback: bool,
+        readback: bool,
     ) -> Result<(FrameReport, Option<image::RgbaImage>), RenderError> {
         let size = snapshot.viewport;
         if size.x == 0 || size.y == 0 {
@@ -177,6 +207,7 @@ impl DeviceSink for SurfaceSink {
         let format = frame.texture.format();
         let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
         let mut report = self.render_world.render(snapshot, &view, format)?;
+        let image = if readback { self.read_back(&frame.texture)? } else { None };
         if let Some(painter) = self.overlay.as_mut()
             && let Some(timing) = painter.paint(self.render_world.gpu(), &view, format, size)
         {
@@ -184,6 +215,6 @@ impl DeviceSink for SurfaceSink {
         }
         self.window.pre_present_notify();
         self.render_world.gpu().queue.present(frame);
-        Ok((report, None))
+        Ok((report, image))
     }
 }
