@@ -13,6 +13,8 @@
 //! Without a display and without `Xvfb` the test says so loudly and passes, unless `CI=true`,
 //! where it fails.
 
+use manylight::app::backend::RenderBackend;
+use manylight::app::render_world::DeviceLoss;
 use manylight::app::window::{WindowConfig, WindowRequests};
 use manylight::app::{HeadlessCapture, ViewportSize};
 use manylight::prelude::*;
@@ -160,6 +162,9 @@ enum Step {
     /// Wait until [`COMPARED_FRAMES`] frames read back at [`BACK`] were compared with the
     /// reference (every one that arrives during the step is).
     MatchReference,
+    /// Destroy the GPU device, as a driver reset would, between frames or during the next
+    /// frame; the renderer recreates it and goes on.
+    LoseDevice(DeviceLoss),
     /// Ask to close.
     Close,
 }
@@ -195,6 +200,13 @@ const SCRIPT: &[Step] = &[
     Step::RenderedFrames(1, 1, ONE_PIXEL_FRAMES),
     Step::Resize(BACK.0, BACK.1),
     Step::MatchReference,
+    // A lost device is recreated (surface configured again, the overlay's textures uploaded
+    // again), and the frames after it are the same image.
+    Step::LoseDevice(DeviceLoss::BetweenFrames),
+    Step::RenderedFrames(BACK.0, BACK.1, 3),
+    Step::LoseDevice(DeviceLoss::InFrame),
+    Step::RenderedFrames(BACK.0, BACK.1, 3),
+    Step::MatchReference,
     Step::Post(false),
     Step::Close,
 ];
@@ -226,6 +238,8 @@ struct Log {
     compared: u32,
     /// How the first frame that differed from the reference differed.
     mismatch: Option<String>,
+    /// `FrameStats::device_recoveries` at the close request.
+    device_recoveries: u64,
 }
 
 #[derive(Default)]
@@ -237,6 +251,8 @@ struct ScriptState {
     /// Frames with bloom rendered at the size a `RenderedFrames` step waits for.
     frames_at_size: u32,
     reference: Option<image::RgbaImage>,
+    /// Frames compared with the reference in the current `MatchReference` step.
+    compared_in_step: u32,
 }
 
 /// How `image` differs from `reference`: `None` when equal.
@@ -262,6 +278,7 @@ fn run_script(
     stats: &FrameStats,
     requests: &mut WindowRequests,
     capture: &mut HeadlessCapture,
+    backend: &mut RenderBackend,
     exit: &mut MessageWriter<AppExit>,
 ) -> Option<bool> {
     let Ok(mut log) = log.lock() else {
@@ -347,16 +364,27 @@ fn run_script(
         Step::MatchReference => {
             if let (Some(image), Some(reference)) = (image, &state.reference) {
                 log.compared += 1;
+                state.compared_in_step += 1;
                 let compared = log.compared;
                 if let Some(d) = difference(&image, reference) {
-                    log.mismatch.get_or_insert(format!("frame {compared} after 1×1: {d}"));
+                    log.mismatch
+                        .get_or_insert(format!("compared frame {compared} (step {}): {d}", state.step));
                 }
             }
-            log.compared >= COMPARED_FRAMES
+            let done = state.compared_in_step >= COMPARED_FRAMES;
+            if done {
+                state.compared_in_step = 0;
+            }
+            done
+        }
+        Step::LoseDevice(when) => {
+            backend.lose_device(when);
+            true
         }
         Step::Close => {
             requests.request_close();
             log.frames_rendered = stats.frames_rendered;
+            log.device_recoveries = stats.device_recoveries;
             log.close_requested = Some(Instant::now());
             true
         }
@@ -444,6 +472,12 @@ fn window_resize_minimise_close() {
 /// Runs the script in a window, rendering on a render thread (`pipelined`) or on the main
 /// thread, and checks what it saw.
 fn drive_window(pipelined: bool) {
+    // Render errors and warnings reach the test's output.
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "warn".into()),
+        )
+        .try_init();
     let panics = Arc::new(AtomicUsize::new(0));
     let default_hook = std::panic::take_hook();
     let counter = panics.clone();
@@ -473,6 +507,7 @@ fn drive_window(pipelined: bool) {
                   stats: Res<FrameStats>,
                   mut requests: ResMut<WindowRequests>,
                   mut capture: ResMut<HeadlessCapture>,
+                  mut backend: ResMut<RenderBackend>,
                   mut commands: Commands,
                   cameras: Query<Entity, With<Camera3d>>,
                   mut exit: MessageWriter<AppExit>| {
@@ -483,6 +518,7 @@ fn drive_window(pipelined: bool) {
                     &stats,
                     &mut requests,
                     &mut capture,
+                    &mut backend,
                     &mut exit,
                 );
                 for camera in &cameras {
@@ -539,8 +575,13 @@ fn drive_window(pipelined: bool) {
             log.one_pixel_passes
         );
     }
-    assert!(log.compared >= COMPARED_FRAMES, "only {} frames compared after 1×1", log.compared);
-    assert_eq!(log.mismatch, None, "a frame after the 1×1 ones differs from the one before");
+    assert!(
+        log.compared >= 2 * COMPARED_FRAMES,
+        "only {} frames compared after 1×1 and device losses",
+        log.compared
+    );
+    assert_eq!(log.mismatch, None, "a frame after the 1×1 ones or a device loss differs from the one before");
+    assert_eq!(log.device_recoveries, 2, "the two device losses were not both recovered");
     assert_eq!(panics.load(Ordering::SeqCst), 0, "a thread panicked");
     let render_threads = thread_names().iter().filter(|n| n.starts_with("manylight-rend")).count();
     assert_eq!(render_threads, 0, "the render thread outlived App::run");

@@ -213,9 +213,11 @@ impl GpuContext {
         let errors = Arc::new(std::sync::Mutex::new(Vec::new()));
         let sink = errors.clone();
         device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
-            tracing::error!("wgpu: {e}");
+            // The display text lists the causes on the lines after the kind.
+            let message = e.to_string().split_whitespace().collect::<Vec<_>>().join(" ");
+            tracing::error!("wgpu: {message}");
             if let Ok(mut v) = sink.lock() {
-                v.push(e.to_string());
+                v.push(message);
             }
         }));
         let lost = Arc::new(std::sync::Mutex::new(None));

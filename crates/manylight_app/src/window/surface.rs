@@ -173,9 +173,12 @@ impl DeviceSink for SurfaceSink {
         self.render_world.gpu()
     }
 
-    /// A new render world on a device that can present to this surface, the surface
-    /// configured again, the overlay's GPU side rebuilt.
+    /// A new surface for the window, a new render world on a device that can present to it,
+    /// the overlay's GPU side rebuilt.
     fn recover(&mut self, reason: String, frame: u64) -> Result<(), RenderError> {
+        // A surface texture acquired on the lost device cannot be released through it, and the
+        // surface refuses to be configured again while it exists: start from a new surface.
+        self.recreate_surface()?;
         self.render_world.recover_device(reason, frame, Some(&self.surface))?;
         self.config = None;
         if let Some(painter) = self.overlay.as_mut() {
