@@ -113,7 +113,7 @@ fn a_texture_larger_than_the_device_allows_is_refused_naming_the_limit() {
             ));
         });
     });
-    let message = result.err().expect("refused");
+    let message = result.expect_err("refused");
     assert!(message.contains("wide.png") && message.contains(&limit.to_string()), "{message}");
 }
 
