@@ -31,8 +31,8 @@ struct ClusterCounters {
     max_count: atomic<u32>,
     non_empty: atomic<u32>,
     tile_entries: atomic<u32>,
-    _pad0: u32,
-    _pad1: u32,
+    max_tile_lights: atomic<u32>,
+    _pad: u32,
 };
 
 @group(0) @binding(0) var<uniform> params: ClusterParams;
@@ -163,6 +163,9 @@ fn count(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) 
     }
     let b = bounds[cluster];
     let tile = tile_lights(cluster);
+    // The longest tile list: the loops below run that often (lavapipe ends an invocation
+    // after LAVAPIPE_LOOP_LIMIT iterations, so the renderer refuses longer lists there).
+    atomicMax(&counters.max_tile_lights, tile.y);
     var n = 0u;
     for (var i = 0u; i < tile.y; i++) {
         if touches(b, tile_indices[tile.x + i]) {

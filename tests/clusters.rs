@@ -281,3 +281,29 @@ fn more_pairs_than_32_bits_hold_are_refused_not_wrapped() {
     assert!(matches!(err, manylight::render::RenderError::TooManyPairs { .. }), "{err}");
     assert!(err.to_string().contains("PAIR_COUNT_SATURATED"), "{err}");
 }
+
+/// 70 000 lights that all touch one tile make a tile list longer than lavapipe's 65 535 loop
+/// iterations per invocation: the cluster build's per-cluster loop over that list would stop
+/// early and lights would be missing from the lists without an error. On lavapipe the frame
+/// is refused naming the limit; on a device without the limit the lists equal the CPU
+/// reference.
+#[test]
+fn a_list_longer_than_lavapipes_loop_limit_is_refused_there_and_exact_elsewhere() {
+    let _gpu = gpu();
+    let mut r = HeadlessRenderer::new().expect("adapter");
+    let scene = default_scene();
+    let settings = clustered(CullTest::Both, ZSlicing::Exponential, None);
+    let center = scene.bounds().center();
+    let lights: Vec<_> = (0..70_000).map(|i| light(center + Vec3::splat(i as f32 * 1e-6), 0.5)).collect();
+    let snap = scene_snapshot(&scene, UVec2::new(128, 72), lights, settings);
+    let limited = manylight::render::gpu_types::has_loop_limit(&r.render_world.gpu().info);
+    if limited {
+        let err = r.render(snap, false).expect_err("a 70 000-light list on lavapipe");
+        let message = err.to_string();
+        assert!(matches!(err, manylight::render::RenderError::LoopLimit { .. }), "{message}");
+        assert!(message.contains("65535"), "{message}");
+    } else {
+        let (_, gpu, cpu) = gpu_and_cpu(&mut r, snap);
+        assert_same_lists("70 000 lights in one tile", &gpu, &cpu);
+    }
+}

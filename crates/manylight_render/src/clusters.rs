@@ -43,6 +43,8 @@ pub struct ClusterReport {
     pub index_capacity: u64,
     /// Entries of the per-tile lists the build filters clusters from.
     pub tile_entries: u64,
+    /// Longest per-tile list.
+    pub max_per_tile: u32,
     /// Times the index list grew this frame (each re-renders the frame).
     pub regrows: u32,
     /// Bytes of GPU buffers the cluster build and clustered shading hold (grid bounds, light
@@ -406,6 +408,7 @@ impl ClusterResources {
             non_empty: c.non_empty,
             total_entries: total,
             max_per_cluster: c.max_count,
+            max_per_tile: c.max_tile_lights,
             mean_per_cluster: total as f64 / clusters.max(1) as f64,
             mean_per_non_empty: total as f64 / c.non_empty.max(1) as f64,
             dropped_pairs: c.dropped_pairs as u64,

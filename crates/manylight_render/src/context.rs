@@ -88,6 +88,19 @@ pub enum RenderError {
         /// `light–cluster` or `light–tile`.
         what: &'static str,
     },
+    /// A shader loop would run longer than the adapter lets one invocation loop (lavapipe
+    /// ends an invocation after 65 535 iterations, which would drop lights silently).
+    #[error(
+        "{what} needs {iterations} loop iterations in one shader invocation, more than this adapter's limit of {limit} (LAVAPIPE_LOOP_LIMIT: llvmpipe would end the invocation and drop lights); use fewer or smaller lights, a finer cluster grid, or a GPU"
+    )]
+    LoopLimit {
+        /// The loop: a tile's or cluster's light list, naive forward's light loop.
+        what: String,
+        /// Iterations it needs.
+        iterations: u64,
+        /// The adapter's limit.
+        limit: u32,
+    },
     /// A render target larger than the device's largest 2D texture.
     #[error(
         "a {width}x{height} render target exceeds this device's limit of {limit} pixels per side (max_texture_dimension_2d)"

@@ -24,6 +24,17 @@ pub const TILE_LIGHT_CHUNK: u32 = 4096;
 /// light–tile) pairs that reaches it did not fit in the u32 counters, and the frame is refused
 /// ([`crate::RenderError::TooManyPairs`]) instead of being built from a wrapped total.
 pub const PAIR_COUNT_SATURATED: u32 = u32::MAX;
+/// Loop iterations after which lavapipe (Mesa 22.3's llvmpipe) silently ends a shader
+/// invocation. A list that long would lose lights there, so frames that need it are refused on
+/// such an adapter ([`crate::RenderError::LoopLimit`]).
+pub const LAVAPIPE_LOOP_LIMIT: u32 = 65_535;
+
+/// True when `adapter` stops shader invocations after [`LAVAPIPE_LOOP_LIMIT`] loop
+/// iterations (Mesa's llvmpipe, which lavapipe runs on).
+pub fn has_loop_limit(adapter: &wgpu::AdapterInfo) -> bool {
+    adapter.device_type == wgpu::DeviceType::Cpu && adapter.name.contains("llvmpipe")
+}
+
 /// Workgroup size of the prefix-sum step of the cluster build (one workgroup scans all).
 pub const SCAN_WORKGROUP_SIZE: u32 = 256;
 /// `GpuClusterParams::cull_test` values.
@@ -230,6 +241,8 @@ pub struct GpuClusterCounters {
     pub non_empty: u32,
     /// Entries the per-tile lists needed.
     pub tile_entries: u32,
+    /// Longest per-tile list: the per-cluster loops of the build run this many iterations.
+    pub max_tile_lights: u32,
     /// Padding.
-    pub _pad: [u32; 2],
+    pub _pad: u32,
 }

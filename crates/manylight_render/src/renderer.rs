@@ -3,6 +3,7 @@
 
 use crate::clusters::ClusterResources;
 use crate::context::{GpuContext, RenderError};
+use crate::gpu_types::LAVAPIPE_LOOP_LIMIT;
 use crate::graph::{OUTPUT, PassContext, RenderGraph};
 use crate::pipelines::PipelineCache;
 use crate::pool::{TextureKey, TransientPool};
@@ -93,7 +94,18 @@ impl Renderer {
         output: &wgpu::TextureView,
         output_format: wgpu::TextureFormat,
     ) -> Result<FrameReport, RenderError> {
-        let builds_clusters = graph.pass_names()?.contains(&"cluster_build");
+        let names = graph.pass_names()?;
+        let builds_clusters = names.contains(&"cluster_build");
+        let loop_limited = crate::gpu_types::has_loop_limit(&self.gpu.info);
+        // Naive forward loops over every light, four per iteration.
+        let naive_iterations = u64::from(self.scene.light_count).div_ceil(4);
+        if loop_limited && names.contains(&"forward") && naive_iterations > u64::from(LAVAPIPE_LOOP_LIMIT) {
+            return Err(RenderError::LoopLimit {
+                what: format!("naive forward's loop over {} lights", self.scene.light_count),
+                iterations: naive_iterations,
+                limit: LAVAPIPE_LOOP_LIMIT,
+            });
+        }
         let mut regrows = 0;
         loop {
             let mut report = self.execute_once(graph, snapshot, output, output_format)?;
@@ -114,6 +126,15 @@ impl Renderer {
                     capacity: u64::from(
                         clusters.params.index_capacity.min(clusters.params.tile_index_capacity),
                     ),
+                });
+            }
+            if loop_limited && counters.max_tile_lights > LAVAPIPE_LOOP_LIMIT {
+                // The build's loops over that tile list (and shading over its clusters' lists)
+                // ended early: lights would be missing.
+                return Err(RenderError::LoopLimit {
+                    what: "a tile's light list".into(),
+                    iterations: u64::from(counters.max_tile_lights),
+                    limit: LAVAPIPE_LOOP_LIMIT,
                 });
             }
             report.clusters = Some(clusters.report(&counters, regrows));

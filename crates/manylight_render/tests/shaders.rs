@@ -1,7 +1,7 @@
 //! Every WGSL file parses and validates with naga, and the structs shared with Rust have the
 //! same size and field offsets on both sides. No GPU needed.
 
-use manylight_render::gpu_types::{GpuInstance, GpuMaterial, GpuPointLight, ViewUniform};
+use manylight_render::gpu_types::{GpuClusterCounters, GpuInstance, GpuMaterial, GpuPointLight, ViewUniform};
 use manylight_render::shaders::{SOURCES, compose};
 use std::mem::{offset_of, size_of};
 
@@ -121,6 +121,20 @@ fn shared_structs_match_rust() {
             ("specular", offset_of!(GpuMaterial, specular)),
             ("shading_model", offset_of!(GpuMaterial, shading_model)),
             ("has_texture", offset_of!(GpuMaterial, has_texture)),
+        ],
+    );
+    offsets(
+        &validate("cluster_build.wgsl"),
+        "ClusterCounters",
+        size_of::<GpuClusterCounters>(),
+        &[
+            ("total_entries", offset_of!(GpuClusterCounters, total_entries)),
+            ("dropped_pairs", offset_of!(GpuClusterCounters, dropped_pairs)),
+            ("clusters_overflowed", offset_of!(GpuClusterCounters, clusters_overflowed)),
+            ("max_count", offset_of!(GpuClusterCounters, max_count)),
+            ("non_empty", offset_of!(GpuClusterCounters, non_empty)),
+            ("tile_entries", offset_of!(GpuClusterCounters, tile_entries)),
+            ("max_tile_lights", offset_of!(GpuClusterCounters, max_tile_lights)),
         ],
     );
 }
