@@ -18,8 +18,7 @@ use manylight::app::render_world::DeviceLoss;
 use manylight::app::window::{WindowConfig, WindowRequests};
 use manylight::app::{HeadlessCapture, ViewportSize};
 use manylight::prelude::*;
-use std::path::PathBuf;
-use std::process::{Child, Command, Stdio};
+use std::process::Command;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -38,62 +37,6 @@ const ONE_PIXEL_FRAMES: u32 = 5;
 const COMPARED_FRAMES: u32 = 3;
 /// The size the 1×1 steps start from and come back to.
 const BACK: (u32, u32) = (320, 240);
-
-/// An Xvfb server this test started; killed on drop.
-struct Xvfb {
-    child: Child,
-    display: u32,
-}
-
-impl Drop for Xvfb {
-    fn drop(&mut self) {
-        // SIGTERM lets Xvfb remove its socket and lock file; SIGKILL only if it does not stop.
-        let _ = Command::new("kill").args(["-TERM", &self.child.id().to_string()]).status();
-        let deadline = Instant::now() + Duration::from_secs(3);
-        while Instant::now() < deadline && !matches!(self.child.try_wait(), Ok(Some(_))) {
-            std::thread::sleep(Duration::from_millis(20));
-        }
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-        let _ = std::fs::remove_file(format!("/tmp/.X11-unix/X{}", self.display));
-        let _ = std::fs::remove_file(format!("/tmp/.X{}-lock", self.display));
-    }
-}
-
-/// Starts `Xvfb :N` on the first free display number. `Err` when Xvfb cannot be run at all.
-fn start_xvfb() -> Result<Xvfb, String> {
-    for display in 90..140u32 {
-        let socket = PathBuf::from(format!("/tmp/.X11-unix/X{display}"));
-        let lock = PathBuf::from(format!("/tmp/.X{display}-lock"));
-        if socket.exists() || lock.exists() {
-            continue;
-        }
-        let child = Command::new("Xvfb")
-            .arg(format!(":{display}"))
-            .args(["-screen", "0", "1280x1024x24", "-nolisten", "tcp"])
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn();
-        let mut child = match child {
-            Ok(c) => c,
-            Err(e) => return Err(format!("cannot run Xvfb: {e}")),
-        };
-        let start = Instant::now();
-        while start.elapsed() < Duration::from_secs(10) {
-            if socket.exists() {
-                return Ok(Xvfb { child, display });
-            }
-            if let Ok(Some(_)) = child.try_wait() {
-                break; // lost a race for this display number: try the next one
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        }
-        let _ = child.kill();
-        let _ = child.wait();
-    }
-    Err("Xvfb did not start on any display from :90 to :139".into())
-}
 
 /// A unit cube with flat normals (24 vertices).
 fn cube() -> MeshData {
@@ -421,12 +364,11 @@ fn thread_names() -> Vec<String> {
 #[test]
 fn window_resize_minimise_close() {
     let ci = std::env::var("CI").is_ok_and(|v| v == "true" || v == "1");
-    let has_display = std::env::var_os("DISPLAY").is_some_and(|d| !d.is_empty())
-        || std::env::var_os("WAYLAND_DISPLAY").is_some_and(|d| !d.is_empty());
+    let has_display = manylight::app::window::xvfb::has_display();
     let _xvfb = if has_display {
         None
     } else {
-        match start_xvfb() {
+        match manylight::app::window::xvfb::Xvfb::start() {
             Ok(x) => {
                 // SAFETY: set before any other thread of this test binary reads the environment
                 // (the event loop and the renderer start below); this file has one test.
@@ -444,7 +386,7 @@ fn window_resize_minimise_close() {
     };
     // Stops a hung event loop from hanging the test run (the Xvfb child dies with the guard
     // only on a normal exit, so kill it here too).
-    let xvfb_pid = _xvfb.as_ref().map(|x| x.child.id());
+    let xvfb_pid = _xvfb.as_ref().map(|x| x.pid());
     std::thread::spawn(move || {
         std::thread::sleep(WATCHDOG);
         eprintln!("window test: still running after {WATCHDOG:?}, aborting");

@@ -19,6 +19,7 @@
 
 pub mod overlay;
 mod surface;
+pub mod xvfb;
 
 pub use overlay::{OVERLAY_PASS, Overlay};
 pub use surface::SurfaceSink;
