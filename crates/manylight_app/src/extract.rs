@@ -1,13 +1,11 @@
 //! Extract: copy what rendering needs out of the ECS world into a [`FrameSnapshot`] and hand
 //! it to the render side. Mesh and material data travel as `Arc`s (no copy of the data).
 
-use crate::backend::{RenderBackend, RenderFailed};
+use crate::backend::{RenderBackend, record_results};
 use crate::components::{
     Bloom, Camera3d, LightAnimation, Material, Mesh3d, MotionBlur, PointLight, Transform,
 };
-use crate::resources::{
-    DebugView, FrameClock, FrameStats, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize,
-};
+use crate::resources::{DebugView, FrameClock, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize};
 use bevy_app::AppExit;
 use bevy_ecs::prelude::*;
 use glam::Mat4;
@@ -87,7 +85,8 @@ pub fn build_snapshot(
     snapshot
 }
 
-/// The extract system (runs in `Last`, in [`crate::ManyLightSet::Extract`]).
+/// The extract system (runs in `Last`, in [`crate::ManyLightSet::Extract`]): takes the
+/// snapshot and hands it to the renderer; [`collect_results`] runs right after it.
 #[allow(clippy::too_many_arguments)]
 pub fn extract_and_render(
     mut state: Local<ExtractState>,
@@ -98,32 +97,25 @@ pub fn extract_and_render(
     meshes: Query<(&Transform, &Mesh3d, Option<&Material>)>,
     lights: Query<(&Transform, &PointLight)>,
     mut backend: ResMut<RenderBackend>,
-    mut stats: ResMut<FrameStats>,
-    mut capture: ResMut<HeadlessCapture>,
-    mut failure: ResMut<RenderFailure>,
-    mut failed: MessageWriter<RenderFailed>,
-    mut exit: MessageWriter<AppExit>,
+    capture: Res<HeadlessCapture>,
+    failure: Res<RenderFailure>,
 ) {
     if failure.0.is_some() {
         return;
     }
     let snapshot = build_snapshot(&mut state, viewport.0, &settings, &debug, &cameras, &meshes, &lights);
     backend.submit(snapshot, capture.enabled);
-    for result in backend.drain() {
-        match result {
-            Ok((report, image)) => {
-                stats.record(report);
-                if image.is_some() {
-                    capture.image = image;
-                }
-            }
-            Err(failure_message) => {
-                tracing::error!("rendering failed: {failure_message}");
-                failure.0 = Some(failure_message.to_string());
-                failed.write(failure_message);
-                exit.write(AppExit::error());
-            }
-        }
+}
+
+/// Stores the frames that finished since the last update ([`crate::backend::record_results`])
+/// and ends the app with `AppExit::error()` when one failed (runs after [`extract_and_render`]).
+pub fn collect_results(world: &mut World) {
+    if world.resource::<RenderFailure>().0.is_some() {
+        return;
+    }
+    let results = world.resource_mut::<RenderBackend>().drain();
+    if record_results(world, results) {
+        world.write_message(AppExit::error());
     }
 }
 

@@ -1,7 +1,7 @@
 //! `ManyLightPlugin`: adds the components' systems, the extract step and the renderer.
 
 use crate::backend::{RenderBackend, RenderThread};
-use crate::extract::{animate_lights, extract_and_render, tick_clock};
+use crate::extract::{animate_lights, collect_results, extract_and_render, tick_clock};
 use crate::render_world::HeadlessRenderer;
 use crate::resources::{
     DebugView, FrameClock, FrameStats, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize,
@@ -109,7 +109,7 @@ impl Plugin for ManyLightPlugin {
             .configure_sets(Last, ManyLightSet::Extract)
             .add_systems(First, tick_clock)
             .add_systems(Update, animate_lights.in_set(ManyLightSet::Animate))
-            .add_systems(Last, extract_and_render.in_set(ManyLightSet::Extract));
+            .add_systems(Last, (extract_and_render, collect_results).chain().in_set(ManyLightSet::Extract));
         match &self.mode {
             OutputMode::Window(config) => {
                 let config = config.clone();
