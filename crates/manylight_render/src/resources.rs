@@ -385,7 +385,7 @@ impl SceneResources {
             for (what, bytes) in [("vertex", vertex_bytes), ("index", index_bytes)] {
                 if bytes > limit {
                     return Err(RenderError::BufferTooLarge {
-                        label: format!("{} ({what} buffer of mesh `{}`)", what, mesh.label),
+                        label: format!("{}: {what} buffer", mesh.label),
                         bytes,
                         limit,
                         limit_name: "max_buffer_size",

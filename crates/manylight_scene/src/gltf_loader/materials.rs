@@ -211,7 +211,7 @@ impl<'a> Ctx<'a> {
                 image: index,
                 width,
                 height,
-                max,
+                max: decoded_max,
             });
         }
         if width == 0 || height == 0 {
