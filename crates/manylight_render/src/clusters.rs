@@ -378,7 +378,6 @@ impl ClusterResources {
         gpu: &GpuContext,
         counters: &GpuClusterCounters,
     ) -> Result<bool, RenderError> {
-        Self::check_saturation(counters)?;
         let tiles_short = counters.tile_entries > self.params.tile_index_capacity;
         let clusters_short = counters.total_entries > self.params.index_capacity;
         if !tiles_short && !clusters_short {

@@ -132,10 +132,16 @@ impl GpuInstance {
         GpuInstance { world_from_local, normal_from_local: Mat4::from_mat3(normal_matrix(world_from_local)) }
     }
 
-    /// True when `world_from_local` flattens every triangle to a line or a point (its 3×3 part
-    /// has rank 1 or 0, e.g. a zero scale on two axes): such an instance covers no pixel.
-    pub fn collapses(world_from_local: &Mat4) -> bool {
-        cofactor(glam::Mat3::from_mat4(*world_from_local)) == glam::Mat3::ZERO
+    /// The instance data, or `None` when `world_from_local` flattens every triangle to a line
+    /// or a point (its 3×3 part has rank 1 or 0, e.g. a zero scale on two axes): such an
+    /// instance covers no pixel.
+    pub fn drawable(world_from_local: Mat4) -> Option<GpuInstance> {
+        let m3 = glam::Mat3::from_mat4(world_from_local);
+        let c = cofactor(m3);
+        (c != glam::Mat3::ZERO).then(|| GpuInstance {
+            world_from_local,
+            normal_from_local: Mat4::from_mat3(normal_from_cofactor(m3, c)),
+        })
     }
 }
 
@@ -151,14 +157,19 @@ fn cofactor(m: glam::Mat3) -> glam::Mat3 {
 /// normal where the inverse transpose would be infinite. Shaders normalise the result.
 pub fn normal_matrix(world_from_local: Mat4) -> glam::Mat3 {
     let m3 = glam::Mat3::from_mat4(world_from_local);
-    let det = m3.determinant();
+    normal_from_cofactor(m3, cofactor(m3))
+}
+
+/// [`normal_matrix`] of `m` from its cofactor matrix `c`: `c / det(m)` (what
+/// `m.inverse().transpose()` computes) when that is finite, else `c` scaled.
+fn normal_from_cofactor(m: glam::Mat3, c: glam::Mat3) -> glam::Mat3 {
+    let det = m.x_axis.dot(c.x_axis);
     if det.is_finite() && det.abs() > f32::MIN_POSITIVE {
-        let n = m3.inverse().transpose();
+        let n = c * (1.0 / det);
         if n.is_finite() {
             return n;
         }
     }
-    let c = cofactor(m3);
     let largest = c.to_cols_array().iter().fold(0.0f32, |a, v| a.max(v.abs()));
     if largest > 0.0 && largest.is_finite() { c * (1.0 / largest) } else { c }
 }
@@ -245,4 +256,27 @@ pub struct GpuClusterCounters {
     pub max_tile_lights: u32,
     /// Padding.
     pub _pad: u32,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{GpuInstance, normal_matrix};
+    use glam::{Mat3, Mat4, Quat, Vec3};
+
+    #[test]
+    fn normal_matrix_is_the_inverse_transpose_and_finite_when_singular() {
+        let rotation = Quat::from_euler(glam::EulerRot::YXZ, 0.7, -0.3, 1.1);
+        for scale in [Vec3::ONE, Vec3::new(1.0, 2.0, 3.0), Vec3::new(-1.0, 0.5, 4.0), Vec3::splat(1e-3)] {
+            let m = Mat4::from_scale_rotation_translation(scale, rotation, Vec3::new(1.0, 2.0, 3.0));
+            // Bit for bit what the inverse transpose gives.
+            assert_eq!(normal_matrix(m), Mat3::from_mat4(m).inverse().transpose(), "{scale}");
+        }
+        // Flattened to the xz plane: normals along y stay along y.
+        let flat = Mat4::from_scale(Vec3::new(1.0, 0.0, 1.0));
+        let n = normal_matrix(flat) * Vec3::Y;
+        assert!(n.is_finite() && n.normalize().abs_diff_eq(Vec3::Y, 1e-6), "{n}");
+        assert!(GpuInstance::drawable(flat).is_some());
+        assert!(GpuInstance::drawable(Mat4::from_scale(Vec3::new(2.0, 0.0, 0.0))).is_none());
+        assert!(GpuInstance::drawable(Mat4::from_scale(Vec3::ZERO)).is_none());
+    }
 }

@@ -113,6 +113,7 @@ impl Renderer {
                 return Ok(report);
             };
             let counters = clusters.read_counters(&self.gpu)?;
+            ClusterResources::check_saturation(&counters)?;
             if regrows < 4 && clusters.grow_if_needed(&self.gpu, &counters)? {
                 regrows += 1;
                 tracing::debug!("light-index list grew to {} entries", clusters.params.index_capacity);

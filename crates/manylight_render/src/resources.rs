@@ -336,17 +336,17 @@ impl SceneResources {
                 self.invalid_instances += 1;
                 continue;
             }
-            if GpuInstance::collapses(&inst.world_from_local) {
+            let Some(gpu_instance) = GpuInstance::drawable(inst.world_from_local) else {
                 self.collapsed_instances += 1;
                 continue;
-            }
+            };
             if inst.mesh.indices.is_empty() {
                 continue;
             }
             let mesh = self.mesh_entry(device, &inst.mesh)?;
             let material = self.material_entry(gpu, &inst.material)?;
             self.draws.push(Draw { mesh, material, instance: instance_data.len() as u32 });
-            instance_data.push(GpuInstance::new(inst.world_from_local));
+            instance_data.push(gpu_instance);
         }
         self.draws.sort_by_key(|d| (d.material, d.mesh));
         if instance_data.is_empty() {
