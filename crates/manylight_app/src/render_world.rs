@@ -414,7 +414,7 @@ pub(crate) trait DeviceSink {
             self.recover(reason, frame)?;
             recoveries += 1;
         }
-        let lost_frame = empty_report(&snapshot);
+        let (viewport, pipeline) = (snapshot.viewport, snapshot.settings.pipeline);
         let result = self.render_on_device(snapshot, readback);
         match self.gpu().lost() {
             Some(reason) => {
@@ -422,6 +422,7 @@ pub(crate) trait DeviceSink {
                     tracing::warn!("frame {frame} failed on the lost device: {e}");
                 }
                 self.recover(reason, frame)?;
+                let lost_frame = report_without_passes(frame, viewport, pipeline);
                 Ok((FrameReport { device_recoveries: recoveries + 1, ..lost_frame }, None))
             }
             None => {
@@ -500,11 +501,16 @@ impl DeviceSink for HeadlessRenderer {
 
 /// The report of a frame that rendered nothing (zero-sized viewport).
 pub fn empty_report(snapshot: &FrameSnapshot) -> FrameReport {
+    report_without_passes(snapshot.frame_index, snapshot.viewport, snapshot.settings.pipeline)
+}
+
+/// The report of frame `frame_index` of `viewport` that ran no pass.
+fn report_without_passes(frame_index: u64, viewport: glam::UVec2, pipeline: PipelineKind) -> FrameReport {
     FrameReport {
-        frame_index: snapshot.frame_index,
-        width: snapshot.viewport.x,
-        height: snapshot.viewport.y,
-        pipeline: snapshot.settings.pipeline.name().to_string(),
+        frame_index,
+        width: viewport.x,
+        height: viewport.y,
+        pipeline: pipeline.name().to_string(),
         ..Default::default()
     }
 }
