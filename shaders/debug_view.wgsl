@@ -13,8 +13,10 @@ struct DebugParams {
     mode: u32,
     // light count shown as the hottest colour
     scale_max: u32,
+    // far end of the depth view's scale: the far plane, or without one the cluster grid's far
+    // (the farthest light's reach)
+    depth_far: f32,
     _pad0: u32,
-    _pad1: u32,
 };
 
 @group(0) @binding(0) var<uniform> view: ViewUniform;
@@ -46,8 +48,8 @@ fn index_color(i: u32) -> vec3<f32> {
 // (manylight_core::camera::linearize_depth_reverse_z).
 fn linearize_depth(z: f32) -> f32 {
     let near = view.params.x;
-    let far = view.params.y;
-    return near * far / (z * (far - near) + near);
+    let near_over_far = view.params.y;
+    return near / (z * (1.0 - near_over_far) + near_over_far);
 }
 
 @fragment
@@ -103,7 +105,7 @@ fn fs_depth(in: FullscreenOut) -> @location(0) vec4<f32> {
         return BACKGROUND;
     }
     let near = view.params.x;
-    let far = view.params.y;
+    let far = debug.depth_far;
     let d = linearize_depth(z);
     let t = clamp(log(d / near) / log(far / near), 0.0, 1.0);
     return vec4<f32>(vec3<f32>(1.0 - t), 1.0);

@@ -155,6 +155,42 @@ fn gpu_lists_equal_the_cpu_reference_on_hard_cases() {
     assert!(report.clusters.is_some());
 }
 
+/// Without a far plane the grid slices up to the farthest light's reach (a power of two), so
+/// lights a million units away still land in clusters: the GPU lists equal the CPU reference,
+/// and a light beyond any finite stand-in far plane (near × 10⁴ here is 1 000) is listed.
+#[test]
+fn an_infinite_projection_slices_to_the_farthest_light() {
+    let _gpu = gpu();
+    let mut r = HeadlessRenderer::new().expect("adapter");
+    let mut scene = default_scene();
+    let size = UVec2::new(160, 96);
+    let cam = scene.camera_or_fit(size.x as f32 / size.y as f32);
+    scene.cameras = vec![manylight::scene::SceneCamera {
+        transform: cam.transform,
+        projection: Projection::infinite(1.0, 0.1),
+    }];
+    let eye = cam.transform.w_axis.truncate();
+    let forward = -cam.transform.z_axis.truncate().normalize();
+    let right = cam.transform.x_axis.truncate().normalize();
+    let mut lights: Vec<_> = [0.5f32, 3.0, 40.0, 900.0, 5e3, 1e5, 1e6]
+        .iter()
+        .map(|&d| light(eye + forward * d + right * (0.05 * d), 0.2 * d))
+        .collect();
+    lights.extend(rig(&scene, 64, 3));
+    for slicing in [ZSlicing::Exponential, ZSlicing::Linear] {
+        let snap = scene_snapshot(&scene, size, lights.clone(), clustered(CullTest::Both, slicing, None));
+        let (report, gpu, cpu) = gpu_and_cpu(&mut r, snap);
+        assert_same_lists(&format!("infinite projection, {slicing:?}"), &gpu, &cpu);
+        assert_eq!(report.sanitized_cameras, 0, "an infinite projection is valid as it is");
+        let grid = r.render_world.renderer().clusters.as_ref().expect("clusters").grid;
+        let reach = 1e6 * 1.2;
+        assert!(grid.far >= reach && grid.far < 2.0 * reach, "grid far {} for reach {reach}", grid.far);
+        assert!(grid.far.log2().fract() == 0.0, "grid far {} is not a power of two", grid.far);
+        // The light at 10⁵ (index 5) lies past any finite stand-in and is still listed.
+        assert!((0..cpu.ranges.len() as u32).any(|c| cpu.lights_of(c).contains(&5)), "{slicing:?}");
+    }
+}
+
 #[test]
 fn a_cap_drops_deterministically_and_is_counted() {
     let _gpu = gpu();

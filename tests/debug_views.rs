@@ -204,3 +204,66 @@ fn count_views_show_the_cpu_reference_of_each_pixels_cluster() {
         }
     }
 }
+
+/// The depth view, rendered directly, shows `1 − ln(d / near) / ln(far / near)` of each pixel's
+/// view distance `d` from the read-back depth: `far` is the far plane, and without one the far
+/// a cluster grid would slice to (the farthest light's reach, rounded up to a power of two), so
+/// a projection without a far plane still gets a finite, meaningful scale.
+#[test]
+fn the_depth_view_scales_to_the_far_plane_or_to_the_lights_reach() {
+    let _gpu = gpu();
+    let mut scene = default_scene();
+    let rig = manylight::scene::light_rig(64, scene.bounds(), 1);
+    let lights: Vec<_> = rig.iter().map(|a| extracted_light(&a.at(0.0))).collect();
+    let camera = scene.camera_or_fit(SIZE.x as f32 / SIZE.y as f32);
+    let mut renderer = HeadlessRenderer::new().expect("adapter");
+    for far in [60.0, f32::INFINITY] {
+        let projection = manylight::core::Projection { far, ..camera.projection };
+        scene.cameras = vec![manylight::scene::SceneCamera { projection, ..camera }];
+        let settings = FrameSettings {
+            pipeline: PipelineKind::ClusteredForward,
+            debug_view: DebugViewMode::Depth,
+            ..FrameSettings::default()
+        };
+        let snapshot = scene_snapshot(&scene, lights.clone(), SIZE, settings, 0);
+        let (_, image) = renderer.render(snapshot, true).expect("renders");
+        let image = image.expect("image");
+        let r = renderer.render_world.renderer();
+        let view_from_world = camera.transform.inverse();
+        let reach = manylight::core::cluster::farthest_reach(lights.iter().map(|l| {
+            manylight::core::cluster::ViewSphere {
+                center: view_from_world.transform_point3(l.position),
+                radius: l.radius,
+            }
+        }));
+        let scale_far = projection.finite_for(reach).far;
+        assert!(scale_far.is_finite() && scale_far > projection.near, "far {far}: scale to {scale_far}");
+        let (w, h, depth) = r.read_depth().expect("depth readback").expect("a depth buffer");
+        let (mut covered, mut wrong) = (0usize, Vec::new());
+        for y in 0..h {
+            for x in 0..w {
+                let z = depth[(y * w + x) as usize];
+                if z <= 0.0 {
+                    continue;
+                }
+                covered += 1;
+                let d = linearize_depth_reverse_z(z, projection.near, far);
+                let t = ((d / projection.near).ln() / (scale_far / projection.near).ln()).clamp(0.0, 1.0);
+                let expected = srgb8(1.0 - t);
+                let actual = image.get_pixel(x, y).0;
+                if (0..3).any(|c| (expected - f32::from(actual[c])).abs() > 2.0) {
+                    wrong.push((x, y, expected, actual));
+                }
+            }
+        }
+        assert!(covered > (w * h / 2) as usize, "far {far}: {covered} covered pixels");
+        if !wrong.is_empty() {
+            let _ = image.save(support::output_dir().join(format!("depth_view_far_{far}.actual.png")));
+            panic!(
+                "far {far}: {} of {covered} pixels off, e.g. {:?}",
+                wrong.len(),
+                &wrong[..wrong.len().min(8)]
+            );
+        }
+    }
+}

@@ -352,6 +352,36 @@ fn huge_floor_matches_the_tessellated_reference_in_every_pipeline() {
     }
 }
 
+/// Without a far plane nothing is clipped however far the floor reaches (it runs to the
+/// horizon at 10⁷, where a finite stand-in of near × 10⁴ would have cut it at 1 000): the ring
+/// floor matches the analytic floor with `t ≤ ∞`, and every pipeline, layout and codec draws
+/// the one-quad floor like it. The lights reach 16 units, so the cluster grid ends there and
+/// the floor beyond lies in its last slice.
+#[test]
+fn an_infinite_projection_clips_nothing_in_every_pipeline() {
+    let _gpu = gpu();
+    let naive = RenderSettings { pipeline: PipelineKind::NaiveForward, ..RenderSettings::default() };
+    let reference = render(floor_scene(ring_floor(HUGE), f32::INFINITY), SIZE, 0, naive);
+    let analytic = analytic_floor(HUGE, f64::INFINITY, &naive);
+    // The frame shows floor beyond 1 000 units: a far plane there would change pixels.
+    let clipped = analytic_floor(HUGE, f64::from(NEAR) * 1e4, &naive);
+    assert!(worst_channel(&analytic, &clipped) > 2, "the view shows no floor beyond 1 000 units");
+    let worst = worst_channel(&analytic, &reference.image);
+    assert!(worst <= 2, "infinite ring floor vs analytic floor: worst channel {worst}/255");
+    for (name, settings) in configurations() {
+        let frame = render(floor_scene(quad_floor(HUGE), f32::INFINITY), SIZE, 0, settings);
+        let report = frame.stats.last.as_ref().expect("report");
+        assert_eq!(report.sanitized_cameras, 0, "{name}: an infinite projection is kept as it is");
+        let s = assert_similar(
+            &format!("infinite_floor_{name}"),
+            &reference.image,
+            &frame.image,
+            tolerance(&settings),
+        );
+        eprintln!("infinite floor {name}: FLIP mean {:.5}, p99 {:.5}", s.mean, s.p99);
+    }
+}
+
 /// Largest difference of one 8-bit colour channel between two images.
 fn worst_channel(a: &image::RgbaImage, b: &image::RgbaImage) -> u8 {
     a.pixels()

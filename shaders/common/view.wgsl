@@ -9,7 +9,7 @@ struct ViewUniform {
     camera_position: vec4<f32>,
     // x, y: viewport size in pixels, z, w: 1 / size
     viewport: vec4<f32>,
-    // x: near, y: far, z: exposure, w: ambient intensity
+    // x: near, y: near / far (0 without a far plane), z: exposure, w: ambient intensity
     params: vec4<f32>,
     light_count: u32,
     shading_model: u32,

@@ -96,7 +96,8 @@ pub struct Camera3d {
     pub fov_y: f32,
     /// Near plane distance.
     pub near: f32,
-    /// Far plane distance.
+    /// Far plane distance, or `f32::INFINITY` for none (nothing is clipped far away; the
+    /// cluster grid then slices up to the farthest light's reach).
     pub far: f32,
 }
 

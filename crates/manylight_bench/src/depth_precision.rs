@@ -82,7 +82,8 @@ impl DepthSetup {
             DepthConvention::Conventional => {
                 // Projection::matrix with depth = far (d - near) / ((far - near) d) instead.
                 let reverse = p.matrix(self.aspect());
-                let r = p.far / (p.near - p.far);
+                // far / (near - far), written so that an infinite far plane gives its limit -1.
+                let r = -1.0 / (1.0 - p.near / p.far);
                 Mat4::from_cols(
                     reverse.x_axis,
                     reverse.y_axis,
@@ -184,7 +185,8 @@ pub fn measure(
     let p = setup.projection.sanitized();
     // The decimal values the f32 parameters were written as (0.1, not 0.100000001490116).
     let decimal = |v: f32| v.to_string().parse::<f64>().unwrap_or(v as f64);
-    let (near, far) = (decimal(p.near), decimal(p.far));
+    // Without a far plane, six decades are measured.
+    let (near, far) = (decimal(p.near), if p.is_infinite() { decimal(p.near) * 1e6 } else { decimal(p.far) });
     let decades = (far / near).log10().ceil().max(1.0) as usize;
     let per = samples_per_decade.max(1);
     let mut out = Vec::with_capacity(decades);

@@ -261,8 +261,12 @@ impl ClusterResources {
         let device = &gpu.device;
         let queue = &gpu.queue;
         let settings = &snapshot.settings.clusters;
-        let projection = snapshot.camera.map(|c| c.projection).unwrap_or_default();
         let grid_config = settings.grid_for(snapshot.settings.pipeline);
+        self.view_spheres = view_spheres(view_from_world, lights.iter().copied());
+        // An infinite projection is sliced up to the farthest light's reach: nothing beyond it
+        // is lit, and every light lies inside the grid.
+        let reach = manylight_core::cluster::farthest_reach(self.view_spheres.iter().copied());
+        let projection = snapshot.camera.map(|c| c.projection).unwrap_or_default().finite_for(reach);
         self.grid = ClusterGrid::new(snapshot.viewport, &projection, &grid_config);
         self.cull = settings.cull;
         let count = self.grid.cluster_count();
@@ -306,7 +310,6 @@ impl ClusterResources {
             self.tile_bounds.write(device, queue, bytemuck::cast_slice(&tiles))?;
             self.bounds_of = Some(self.grid);
         }
-        self.view_spheres = view_spheres(view_from_world, lights.iter().copied());
         let spheres: Vec<[f32; 4]> =
             self.view_spheres.iter().map(|s| s.center.extend(s.radius).to_array()).collect();
         if spheres.is_empty() {
@@ -318,10 +321,10 @@ impl ClusterResources {
         let tiles = self.grid.dims.x as u64 * self.grid.dims.y as u64;
         let tile_chunks = (spheres.len() as u32).div_ceil(TILE_LIGHT_CHUNK).max(1);
         self.tile_ranges.reserve(device, tiles * tile_chunks as u64 * 8)?;
-        let p = projection.sanitized();
+        let (near, far) = (self.grid.near, self.grid.far);
         self.params = GpuClusterParams {
             dims: [self.grid.dims.x, self.grid.dims.y, self.grid.dims.z, count],
-            viewport: [snapshot.viewport.x.max(1) as f32, snapshot.viewport.y.max(1) as f32, p.near, p.far],
+            viewport: [snapshot.viewport.x.max(1) as f32, snapshot.viewport.y.max(1) as f32, near, far],
             light_count: spheres.len() as u32,
             cap: settings.cap.unwrap_or(CLUSTER_NO_CAP),
             cull_test: match settings.cull {
@@ -331,7 +334,7 @@ impl ClusterResources {
             },
             index_capacity: (self.indices.capacity() / 4).min(u32::MAX as u64) as u32,
             slicing: self.grid.slicing.gpu_id(),
-            log_far_over_near: (p.far / p.near).ln(),
+            log_far_over_near: (far / near).ln(),
             tile_index_capacity: (self.tile_indices.capacity() / 4).min(u32::MAX as u64) as u32,
             tile_chunks,
         };

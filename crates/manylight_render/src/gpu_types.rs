@@ -96,7 +96,7 @@ pub struct ViewUniform {
     pub camera_position: Vec4,
     /// Viewport width, height, 1/width, 1/height.
     pub viewport: Vec4,
-    /// near, far, exposure, ambient.
+    /// near, near / far (0 without a far plane), exposure, ambient.
     pub params: Vec4,
     /// Number of lights in the light buffer.
     pub light_count: u32,

@@ -289,6 +289,7 @@ impl SceneResources {
                 let view_from_world = cam.view_from_world();
                 let clip_from_world = clip_from_view * view_from_world;
                 let p = cam.projection.sanitized();
+                // near / far rather than far: 0 for an infinite projection, never infinite.
                 ViewUniform {
                     clip_from_world,
                     view_from_world,
@@ -297,7 +298,7 @@ impl SceneResources {
                     prev_clip_from_world: cam.prev_clip_from_world.unwrap_or(clip_from_world),
                     camera_position: cam.position().extend(1.0),
                     viewport: viewport_vec(size),
-                    params: Vec4::new(p.near, p.far, settings.exposure, settings.ambient),
+                    params: Vec4::new(p.near, p.near_over_far(), settings.exposure, settings.ambient),
                     light_count: 0,
                     shading_model: settings.shading.gpu_id(),
                     _pad: [0; 2],

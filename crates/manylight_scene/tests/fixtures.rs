@@ -70,11 +70,11 @@ fn hierarchy_lights_and_cameras_without_a_scene_list() {
     assert_eq!(l.intensity, 4.0);
     assert_eq!(l.color, Vec3::new(1.0, 0.5, 0.25));
     assert_eq!(l.radius, manylight_core::radius_for_intensity(4.0, 0.01));
-    // The camera: znear 0.05, infinite zfar -> 500, scale removed from the transform.
+    // The camera: znear 0.05, no zfar (infinite), scale removed from the transform.
     assert_eq!(s.cameras.len(), 1);
     let c = s.cameras[0];
     assert_eq!(c.projection.near, 0.05);
-    assert!((c.projection.far - 500.0).abs() < 1e-3);
+    assert!(c.projection.is_infinite(), "{:?}", c.projection);
     assert!((c.projection.fov_y - 0.8).abs() < 1e-6);
     let (scale, _, translation) = c.transform.to_scale_rotation_translation();
     assert!((scale - Vec3::ONE).length() < 1e-5);
@@ -91,4 +91,15 @@ fn extras_of_any_json_type_are_accepted() {
         .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(s.instances.len(), 1);
     s.validate().expect("valid");
+}
+
+#[test]
+fn an_infinite_camera_with_a_huge_znear_loads_with_a_finite_matrix() {
+    // znear 3.4e38 without zfar: once refused, because the old finite stand-in for the missing
+    // far plane (znear × 10⁴) overflowed; the infinite projection needs no far plane at all.
+    let s = load_gltf(&fixture("huge_znear.gltf"), &LoadOptions::default()).expect("loads");
+    let c = s.cameras[0];
+    assert_eq!(c.projection.near, 3.4e38);
+    assert!(c.projection.is_infinite(), "{:?}", c.projection);
+    assert!(c.projection.matrix(1.0).is_finite(), "{:?}", c.projection.matrix(1.0));
 }

@@ -902,7 +902,8 @@ fn check_scene(scene: &Scene, o: &LoadOptions) -> Result<(), String> {
     ];
     for (i, c) in scene.cameras.iter().enumerate() {
         let p = c.projection;
-        if !(p.fov_y.is_finite() && p.near.is_finite() && p.far.is_finite() && p.matrix(1.5).is_finite()) {
+        let far_ok = p.far.is_finite() || p.is_infinite();
+        if !(p.fov_y.is_finite() && p.near.is_finite() && far_ok && p.matrix(1.5).is_finite()) {
             return Err(format!("camera {i} has an unusable projection {p:?}"));
         }
     }

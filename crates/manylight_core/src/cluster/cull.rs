@@ -41,6 +41,12 @@ pub fn view_spheres(view_from_world: &Mat4, lights: impl Iterator<Item = (Vec3, 
         .collect()
 }
 
+/// The farthest view distance (along −Z) that any valid sphere reaches, 0 when none does:
+/// what [`crate::Projection::finite_for`] needs to slice a projection without a far plane.
+pub fn farthest_reach(spheres: impl IntoIterator<Item = ViewSphere>) -> f32 {
+    spheres.into_iter().filter(ViewSphere::is_valid).map(|s| -s.center.z + s.radius).fold(0.0, f32::max)
+}
+
 /// The radius the tests compare against: `r * RADIUS_INFLATION`.
 #[inline]
 pub fn inflated_radius(radius: f32) -> f32 {

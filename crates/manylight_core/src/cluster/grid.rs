@@ -91,6 +91,10 @@ pub struct ClusterGrid {
 impl ClusterGrid {
     /// Builds the grid for a viewport and projection; every input is sanitized, so the grid is
     /// always usable (dims ≥ 1, finite `0 < near < far`, fov in `(0, π)`).
+    ///
+    /// The grid needs a finite far plane. Pass an infinite projection through
+    /// [`Projection::finite_for`] with the lights' reach first (the renderer does); one passed
+    /// as it is gets `near × 10⁴`, and a light beyond that would reach no cluster.
     pub fn new(viewport: UVec2, projection: &Projection, config: &GridConfig) -> ClusterGrid {
         let viewport = viewport.max(UVec2::ONE);
         let p = projection.sanitized();

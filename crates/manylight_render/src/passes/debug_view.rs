@@ -70,6 +70,27 @@ impl DebugViewPipeline {
     }
 }
 
+/// Where the depth view's scale ends: at the far plane; without one, where a cluster grid
+/// would end (the farthest light's reach, [`manylight_core::Projection::finite_for`]), or at
+/// `near × 10⁴` when there is no light.
+fn depth_view_far(scene: &crate::resources::SceneResources) -> f32 {
+    let (near, near_over_far) = (scene.view.params.x, scene.view.params.y);
+    if near_over_far > 0.0 {
+        return near / near_over_far;
+    }
+    if scene.light_spheres.is_empty() {
+        return near * 1e4;
+    }
+    let view_from_world = scene.view.view_from_world;
+    let spheres = scene.light_spheres.iter().map(|&(position, radius)| manylight_core::cluster::ViewSphere {
+        center: view_from_world.transform_point3(position),
+        radius,
+    });
+    manylight_core::Projection::infinite(1.0, near)
+        .finite_for(manylight_core::cluster::farthest_reach(spheres))
+        .far
+}
+
 /// Writes a debug visualisation to [`OUTPUT`].
 pub struct DebugViewPass {
     /// What to show (not `DebugViewMode::None`).
@@ -99,9 +120,15 @@ impl Pass for DebugViewPass {
         let device = &ctx.gpu.device;
         let key = format_key(format).wrapping_add(family as u64);
         let pipeline = ctx.pipelines.get_or_create(key, || DebugViewPipeline::new(device, family, format))?;
+        let depth_far = depth_view_far(ctx.scene);
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("debug_view_params"),
-            contents: bytemuck::cast_slice(&[self.view.gpu_id(), self.heatmap_max.max(1), 0, 0]),
+            contents: bytemuck::cast_slice(&[
+                self.view.gpu_id(),
+                self.heatmap_max.max(1),
+                depth_far.to_bits(),
+                0,
+            ]),
             usage: wgpu::BufferUsages::UNIFORM,
         });
         let texture = |binding: u32, name: ResourceName| -> Result<wgpu::BindGroupEntry<'_>, RenderError> {

@@ -349,17 +349,14 @@ impl Ctx<'_> {
                 if !(p.znear.is_finite() && p.znear > 0.0) {
                     return Err(bad("znear must be finite and positive"));
                 }
+                // No zfar is glTF's infinite projection, and stays infinite (reverse-Z keeps
+                // it exact at any distance).
                 let far = match p.zfar {
-                    None => p.znear * 1e4,
+                    None => f32::INFINITY,
                     Some(f) if f.is_finite() && f > p.znear => f,
                     Some(_) => return Err(bad("zfar must be finite and greater than znear")),
                 };
-                // A huge znear overflows the default zfar (or the depth terms) to infinity,
-                // and the projection matrix to NaN.
                 let projection = Projection { fov_y: p.yfov, near: p.znear, far };
-                if !far.is_finite() || !projection.matrix(1.0).is_finite() {
-                    return Err(bad("znear and zfar give a projection with non-finite terms"));
-                }
                 let (_, rotation, translation) = world.to_scale_rotation_translation();
                 let transform = Mat4::from_rotation_translation(rotation.normalize(), translation);
                 if !transform.is_finite() {

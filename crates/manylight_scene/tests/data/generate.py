@@ -5,10 +5,11 @@
 - png16.gltf + png16.png: a textured triangle whose base-colour texture is a 16-bit RGBA PNG.
 - features.gltf: no `scenes` (root nodes are used), a TRS hierarchy, a non-indexed primitive,
   a POINTS primitive (skipped), a point light without range, a spot light (skipped), a camera
-  with infinite zfar and a primitive without material.
+  without zfar (infinite) and a primitive without material.
 - triangle.glb: a textured triangle in a GLB whose 8-bit PNG texture lives in a buffer view.
 - extras_any_type.gltf: a triangle whose `extras` are a string, an array, a number, `null`,
   `true` and a nested object (the spec allows any JSON value there).
+- huge_znear.gltf: a triangle and an infinite camera (no zfar) whose znear is 3.4e38.
 """
 import base64, json, struct, zlib
 from pathlib import Path
@@ -115,6 +116,13 @@ def main():
     doc["meshes"][0]["primitives"][0]["extras"] = 0.5
     doc["scenes"][0]["extras"] = None
     (HERE / "extras_any_type.gltf").write_text(json.dumps(doc, indent=1))
+
+    doc = triangle(POSITIONS + INDICES, [POS_ACC, IDX_ACC],
+                   [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 6}],
+                   {"POSITION": 0})
+    doc["cameras"] = [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 3.4e38}}]
+    doc["nodes"][0]["camera"] = 0
+    (HERE / "huge_znear.gltf").write_text(json.dumps(doc, indent=1))
 
     image = png8(2, 2, (0, 255, 0, 255))
     image += b"\0" * (-len(image) % 4)
