@@ -13,14 +13,18 @@ fn setup(mut commands: Commands) {
     // The embedded hall: meshes, materials, six warm lights and a camera.
     spawn_scene(&mut commands, &default_scene(), true, 16.0 / 9.0);
     for (x, z, color) in [(-13.0, -2.5, Vec3::new(1.0, 0.1, 0.05)), (-9.0, 2.5, Vec3::new(0.1, 0.3, 1.0))] {
-        commands.spawn((Transform::from_xyz(x, 1.0, z), PointLight { color, intensity: 60.0, radius: 6.0 }));
+        commands.spawn((
+            Transform::from_xyz(x, 1.0, z),
+            PointLight { color, intensity: 60.0, range: 6.0, ..PointLight::default() },
+        ));
     }
-    let green = PointLight { color: Vec3::new(0.2, 1.0, 0.3), intensity: 60.0, radius: 6.0 };
+    let green =
+        PointLight { color: Vec3::new(0.2, 1.0, 0.3), intensity: 60.0, range: 6.0, ..PointLight::default() };
     commands.spawn((Transform::from_xyz(-6.0, 1.5, 0.0), green, Orbiting));
 }
 
-fn orbit(clock: Res<FrameClock>, mut lights: Query<&mut Transform, With<Orbiting>>) {
-    let t = clock.elapsed * 0.5;
+fn orbit(time: Res<Time>, mut lights: Query<&mut Transform, With<Orbiting>>) {
+    let t = time.elapsed_secs() * 0.5;
     for mut transform in &mut lights {
         transform.translation = Vec3::new(-6.0 + 4.0 * t.cos(), 1.5, 3.0 * t.sin());
     }

@@ -103,7 +103,9 @@ fn run_headless(lights: usize, settings: RenderSettings, out_dir: PathBuf) -> an
     let mut app = App::new();
     app.add_plugins(ManyLightPlugin::headless(SIZE))
         .insert_resource(settings)
-        .insert_resource(FrameClock::fixed(HEADLESS_STEP))
+        .insert_resource(TimeUpdateStrategy::ManualDuration(std::time::Duration::from_secs_f32(
+            HEADLESS_STEP,
+        )))
         .add_systems(Startup, scene_setup(lights));
     for i in 0..HEADLESS_FRAMES {
         let started = Instant::now();
@@ -112,7 +114,7 @@ fn run_headless(lights: usize, settings: RenderSettings, out_dir: PathBuf) -> an
             anyhow::bail!("rendering failed: {message}");
         }
         let world = app.world_mut();
-        let t = world.resource::<FrameClock>().elapsed;
+        let t = world.resource::<Time>().elapsed_secs();
         let image = world.resource_mut::<HeadlessCapture>().image.take();
         let Some(image) = image else { anyhow::bail!("frame {i} was not captured") };
         let path = out_dir.join(format!("frame_{i}.png"));

@@ -122,15 +122,15 @@ pub struct FrameTimes {
 /// Moves each animated light along its orbit, bobs it, flickers its colour, and applies the
 /// radius multiplier: a plain system on `Transform` and `PointLight`.
 pub fn animate_lights(
-    clock: Res<FrameClock>,
+    time: Res<Time>,
     controls: Res<LightControls>,
     mut lights: Query<(&StressLight, &mut Transform, &mut PointLight)>,
 ) {
-    let t = clock.elapsed;
+    let t = time.elapsed_secs();
     for (light, mut transform, mut point) in &mut lights {
         transform.translation = light.0.position_at(t); // orbit in XZ + bob in Y
         point.color = light.0.color_at(t); // hue drift + flicker
-        point.radius = light.0.radius * controls.radius_scale;
+        point.range = light.0.radius * controls.radius_scale;
     }
 }
 
@@ -167,7 +167,7 @@ pub fn sync_light_count(
         commands.spawn_batch(lights.into_iter().map(move |l| {
             (
                 Transform::from_translation(l.position),
-                PointLight { color: l.color, intensity: l.intensity, radius: l.radius * scale },
+                PointLight { color: l.color, intensity: l.intensity, range: l.radius * scale, radius: 0.0 },
                 ShellLight { base_radius: l.radius },
             )
         }));
@@ -176,7 +176,12 @@ pub fn sync_light_count(
         commands.spawn_batch(rig.into_iter().map(move |a| {
             (
                 Transform::from_translation(a.position_at(0.0)),
-                PointLight { color: a.color_at(0.0), intensity: a.intensity, radius: a.radius * scale },
+                PointLight {
+                    color: a.color_at(0.0),
+                    intensity: a.intensity,
+                    range: a.radius * scale,
+                    radius: 0.0,
+                },
                 StressLight(a),
             )
         }));

@@ -108,7 +108,7 @@ fn invalid_lights_are_dropped_and_counted_and_the_image_stays_finite() {
             commands.spawn((Transform::from_xyz(f32::NAN, 1.0, 0.0), PointLight::default()));
             commands.spawn((
                 Transform::from_xyz(0.0, 1.0, 0.0),
-                PointLight { radius: f32::INFINITY, ..PointLight::default() },
+                PointLight { range: f32::INFINITY, ..PointLight::default() },
             ));
             commands.spawn((
                 Transform::from_xyz(0.0, 1.0, 0.0),
@@ -119,14 +119,14 @@ fn invalid_lights_are_dropped_and_counted_and_the_image_stays_finite() {
                 Transform::from_xyz(0.0, 1.0, 0.0),
                 PointLight { color: Vec3::splat(1e30), intensity: 1e30, ..PointLight::default() },
             ));
-            // Valid edge cases: radius 0 (lights nothing) and a huge radius.
+            // Valid edge cases: range 0 (lights nothing) and a huge range.
             commands.spawn((
                 Transform::from_xyz(0.0, 1.0, 0.0),
-                PointLight { radius: 0.0, ..PointLight::default() },
+                PointLight { range: 0.0, ..PointLight::default() },
             ));
             commands.spawn((
                 Transform::from_xyz(0.0, 1.0, 0.0),
-                PointLight { radius: 1e6, ..PointLight::default() },
+                PointLight { range: 1e6, ..PointLight::default() },
             ));
         });
     })
@@ -148,7 +148,7 @@ fn a_light_at_the_camera_position_is_finite() {
             spawn_scene(&mut commands, &scene, true, 1.5);
             commands.spawn((
                 Transform::from_translation(eye),
-                PointLight { radius: 30.0, ..PointLight::default() },
+                PointLight { range: 30.0, ..PointLight::default() },
             ));
         });
     })

@@ -91,8 +91,9 @@ fn a_system_toggles_the_debug_view_at_run_time() {
         .add_systems(Startup, |mut commands: Commands| {
             spawn_scene(&mut commands, &default_scene(), true, 64.0 / 48.0);
         })
-        .add_systems(Update, move |clock: Res<FrameClock>, mut debug: ResMut<DebugView>| {
-            debug.mode = modes[(clock.frame as usize - 1) % modes.len()];
+        .add_systems(Update, move |mut frame: Local<usize>, mut debug: ResMut<DebugView>| {
+            debug.mode = modes[*frame % modes.len()];
+            *frame += 1;
         });
     for mode in modes {
         app.update();

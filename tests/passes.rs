@@ -153,7 +153,7 @@ fn set_point(app: &mut App, p: Point) {
         for l in &default_scene().lights {
             world.spawn((
                 Transform::from_translation(l.position),
-                PointLight { color: l.color, intensity: l.intensity, radius: l.radius },
+                PointLight { color: l.color, intensity: l.intensity, range: l.radius, radius: 0.0 },
             ));
         }
     } else if !p.lights {

@@ -5,92 +5,77 @@ use glam::{Mat4, Quat, Vec3};
 use manylight_core::{MaterialData, MeshData, Projection};
 use std::sync::Arc;
 
-/// Position, rotation and scale of an entity in world space.
-#[derive(Component, Clone, Copy, Debug, PartialEq)]
-pub struct Transform {
-    /// Position.
-    pub translation: Vec3,
-    /// Orientation.
-    pub rotation: Quat,
-    /// Scale per axis.
-    pub scale: Vec3,
-}
+pub use bevy_transform::components::{GlobalTransform, Transform};
 
-impl Default for Transform {
-    fn default() -> Self {
-        Self::IDENTITY
+/// Decomposes a matrix (e.g. a glTF node's world matrix) into a [`Transform`]. Unlike
+/// `Transform::from_matrix`, a singular matrix (a zero scale on some axes, of the node or a
+/// parent) keeps its zero scales and a valid rotation, where a plain decomposition divides by
+/// zero and gives NaN; shear is lost.
+pub fn transform_from_matrix(m: Mat4) -> Transform {
+    let translation = m.w_axis.truncate();
+    let m3 = glam::Mat3::from_mat4(m);
+    let mut scale = Vec3::new(m3.x_axis.length(), m3.y_axis.length(), m3.z_axis.length());
+    if m3.determinant() < 0.0 {
+        scale.x = -scale.x;
     }
-}
-
-impl Transform {
-    /// No translation, rotation or scale.
-    pub const IDENTITY: Transform =
-        Transform { translation: Vec3::ZERO, rotation: Quat::IDENTITY, scale: Vec3::ONE };
-
-    /// A transform at `(x, y, z)`.
-    pub fn from_xyz(x: f32, y: f32, z: f32) -> Transform {
-        Transform { translation: Vec3::new(x, y, z), ..Self::IDENTITY }
-    }
-
-    /// A transform at `translation`.
-    pub fn from_translation(translation: Vec3) -> Transform {
-        Transform { translation, ..Self::IDENTITY }
-    }
-
-    /// Decomposes a matrix (e.g. from a glTF node) into translation, rotation and scale. A
-    /// singular matrix (a zero scale on some axes, of the node or a parent) keeps its zero
-    /// scales and a valid rotation, where a plain decomposition divides by zero and gives NaN;
-    /// shear is lost.
-    pub fn from_matrix(m: Mat4) -> Transform {
-        let translation = m.w_axis.truncate();
-        let m3 = glam::Mat3::from_mat4(m);
-        let mut scale = Vec3::new(m3.x_axis.length(), m3.y_axis.length(), m3.z_axis.length());
-        if m3.determinant() < 0.0 {
-            scale.x = -scale.x;
+    let axis = |col: Vec3, s: f32| (s != 0.0 && s.is_finite()).then(|| col / s);
+    let (x, y, z) = (axis(m3.x_axis, scale.x), axis(m3.y_axis, scale.y), axis(m3.z_axis, scale.z));
+    // Axes of zero length are completed to a right-handed orthonormal frame.
+    let (x, y, z) = match (x, y, z) {
+        (Some(x), Some(y), Some(z)) => (x, y, z),
+        (None, Some(y), Some(z)) => (y.cross(z), y, z),
+        (Some(x), None, Some(z)) => (x, z.cross(x), z),
+        (Some(x), Some(y), None) => (x, y, x.cross(y)),
+        (Some(x), None, None) => {
+            let y = x.any_orthonormal_vector();
+            (x, y, x.cross(y))
         }
-        let axis = |col: Vec3, s: f32| (s != 0.0 && s.is_finite()).then(|| col / s);
-        let (x, y, z) = (axis(m3.x_axis, scale.x), axis(m3.y_axis, scale.y), axis(m3.z_axis, scale.z));
-        // Axes of zero length are completed to a right-handed orthonormal frame.
-        let (x, y, z) = match (x, y, z) {
-            (Some(x), Some(y), Some(z)) => (x, y, z),
-            (None, Some(y), Some(z)) => (y.cross(z), y, z),
-            (Some(x), None, Some(z)) => (x, z.cross(x), z),
-            (Some(x), Some(y), None) => (x, y, x.cross(y)),
-            (Some(x), None, None) => {
-                let y = x.any_orthonormal_vector();
-                (x, y, x.cross(y))
-            }
-            (None, Some(y), None) => {
-                let z = y.any_orthonormal_vector();
-                (y.cross(z), y, z)
-            }
-            (None, None, Some(z)) => {
-                let x = z.any_orthonormal_vector();
-                (x, z.cross(x), z)
-            }
-            (None, None, None) => (Vec3::X, Vec3::Y, Vec3::Z),
-        };
-        let rotation = Quat::from_mat3(&glam::Mat3::from_cols(x, y, z)).normalize();
-        Transform { translation, rotation, scale }
-    }
+        (None, Some(y), None) => {
+            let z = y.any_orthonormal_vector();
+            (y.cross(z), y, z)
+        }
+        (None, None, Some(z)) => {
+            let x = z.any_orthonormal_vector();
+            (x, z.cross(x), z)
+        }
+        (None, None, None) => (Vec3::X, Vec3::Y, Vec3::Z),
+    };
+    let rotation = Quat::from_mat3(&glam::Mat3::from_cols(x, y, z)).normalize();
+    Transform { translation, rotation, scale }
+}
 
-    /// Turns the entity so its -Z axis points at `target`, with +Y as close to `up` as possible.
-    pub fn looking_at(mut self, target: Vec3, up: Vec3) -> Transform {
-        let forward = (target - self.translation).try_normalize().unwrap_or(Vec3::NEG_Z);
-        let right = forward.cross(up).try_normalize().unwrap_or_else(|| forward.any_orthonormal_vector());
-        let up = right.cross(forward);
-        self.rotation = Quat::from_mat3(&glam::Mat3::from_cols(right, up, -forward));
-        self
-    }
+/// Whether an entity is drawn or lights the scene, as Bevy's `Visibility`: `Inherited` (the
+/// default) follows the parent (`ChildOf`), `Hidden` hides the entity and its descendants,
+/// `Visible` shows it whatever its parent says. Hidden meshes and lights are not extracted and
+/// cost nothing on the render side. The plugin computes [`InheritedVisibility`] from it in
+/// `PostUpdate`.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[require(InheritedVisibility)]
+pub enum Visibility {
+    /// As the parent; visible for an entity without one.
+    #[default]
+    Inherited,
+    /// Hidden, with every descendant that inherits.
+    Hidden,
+    /// Visible, whatever the parent.
+    Visible,
+}
 
-    /// World-from-local matrix.
-    pub fn to_matrix(&self) -> Mat4 {
-        Mat4::from_scale_rotation_translation(self.scale, self.rotation, self.translation)
+/// Whether an entity is visible once its ancestors' [`Visibility`] is taken into account
+/// (written by the plugin in `PostUpdate`, after transform propagation; read by extract).
+#[derive(Component, Clone, Copy, Debug, PartialEq, Eq)]
+pub struct InheritedVisibility(pub bool);
+
+impl Default for InheritedVisibility {
+    fn default() -> Self {
+        InheritedVisibility(true)
     }
 }
 
-/// A perspective camera; the entity's [`Transform`] places it (looking down its -Z).
+/// A perspective camera; the entity's [`GlobalTransform`] places it (looking down its -Z; its
+/// scale is ignored).
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
+#[require(Transform)]
 pub struct Camera3d {
     /// Vertical field of view in radians.
     pub fov_y: f32,
@@ -115,32 +100,40 @@ impl Camera3d {
     }
 }
 
-/// A point light at the entity's [`Transform`] translation.
+/// A point light at the entity's [`GlobalTransform`] translation, in Bevy's words: `range` is
+/// the cut-off distance, `radius` the size of the emitter.
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
+#[require(Transform, Visibility)]
 pub struct PointLight {
     /// Linear RGB colour.
     pub color: Vec3,
     /// Multiplier of `color`.
     pub intensity: f32,
-    /// Distance at which the contribution reaches exactly zero.
+    /// Distance at which the contribution reaches exactly zero (the light's sphere of
+    /// influence, which the cluster build culls with).
+    pub range: f32,
+    /// Radius of the emitting sphere. Kept for Bevy's vocabulary; the shading treats every
+    /// light as a point, so it does not change the image.
     pub radius: f32,
 }
 
 impl Default for PointLight {
     fn default() -> Self {
-        Self { color: Vec3::ONE, intensity: 10.0, radius: 10.0 }
+        Self { color: Vec3::ONE, intensity: 10.0, range: 10.0, radius: 0.0 }
     }
 }
 
-/// The geometry drawn at the entity's [`Transform`] (shared; uploaded once per `Arc`).
+/// The geometry drawn at the entity's [`GlobalTransform`] (shared; uploaded once per `Arc`).
 #[derive(Component, Clone, Debug)]
+#[require(Transform, Visibility)]
 pub struct Mesh3d(pub Arc<MeshData>);
 
 /// The material of a [`Mesh3d`] entity (shared; one GPU binding per `Arc`).
 #[derive(Component, Clone, Debug)]
 pub struct Material(pub Arc<MaterialData>);
 
-/// Animates a light: the plugin moves its [`Transform`] and tints its [`PointLight`] each frame.
+/// Animates a light: the plugin moves its [`Transform`] (relative to its parent, if it has one)
+/// and tints its [`PointLight`] each frame, by [`bevy_time::Time`].
 #[derive(Component, Clone, Copy, Debug)]
 pub struct LightAnimation(pub manylight_scene::AnimatedLight);
 
@@ -248,7 +241,7 @@ mod tests {
             Vec3::ZERO,
         ] {
             let m = Mat4::from_scale_rotation_translation(scale, rotation, translation);
-            let t = Transform::from_matrix(m);
+            let t = transform_from_matrix(m);
             assert!(t.rotation.is_finite() && t.scale.is_finite(), "{scale}: {t:?}");
             assert!(t.to_matrix().abs_diff_eq(m, 1e-5), "{scale}: {:?} vs {m:?}", t.to_matrix());
         }

@@ -3,11 +3,13 @@
 
 use crate::backend::{RenderBackend, record_results};
 use crate::components::{
-    Bloom, Camera3d, LightAnimation, Material, Mesh3d, MotionBlur, PointLight, Transform,
+    Bloom, Camera3d, GlobalTransform, InheritedVisibility, LightAnimation, Material, Mesh3d, MotionBlur,
+    PointLight, Transform,
 };
-use crate::resources::{DebugView, FrameClock, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize};
+use crate::resources::{DebugView, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize};
 use bevy_app::AppExit;
 use bevy_ecs::prelude::*;
+use bevy_time::Time;
 use glam::Mat4;
 use manylight_core::MaterialData;
 use manylight_render::{ExtractedCamera, ExtractedInstance, ExtractedPointLight, FrameSnapshot};
@@ -25,7 +27,23 @@ pub struct ExtractState {
 
 /// What extract reads of a camera: placement, projection and its opt-in effects.
 pub type CameraItem =
-    (&'static Transform, &'static Camera3d, Option<&'static Bloom>, Option<&'static MotionBlur>);
+    (&'static GlobalTransform, &'static Camera3d, Option<&'static Bloom>, Option<&'static MotionBlur>);
+
+/// What extract reads of a mesh entity (hidden ones are skipped).
+pub type MeshItem = (
+    &'static GlobalTransform,
+    &'static Mesh3d,
+    Option<&'static Material>,
+    Option<&'static InheritedVisibility>,
+);
+
+/// What extract reads of a light entity (hidden ones are skipped).
+pub type LightItem = (&'static GlobalTransform, &'static PointLight, Option<&'static InheritedVisibility>);
+
+/// Whether an entity's computed visibility lets it render (none computed yet: visible).
+fn shown(visibility: Option<&InheritedVisibility>) -> bool {
+    visibility.is_none_or(|v| v.0)
+}
 
 /// Builds the frame's snapshot from the world.
 #[allow(clippy::too_many_arguments)]
@@ -35,15 +53,19 @@ pub fn build_snapshot(
     settings: &RenderSettings,
     debug: &DebugView,
     cameras: &Query<CameraItem>,
-    meshes: &Query<(&Transform, &Mesh3d, Option<&Material>)>,
-    lights: &Query<(&Transform, &PointLight)>,
+    meshes: &Query<MeshItem>,
+    lights: &Query<LightItem>,
 ) -> FrameSnapshot {
     let mut camera_iter = cameras.iter();
     // Last frame's camera at this frame's viewport: a resize alone moves no pixel, so motion
     // blur does not smear the first frame after one.
     let prev_clip_from_world = state.prev_camera.map(|c| c.clip_from_world(viewport));
     let camera = camera_iter.next().map(|(t, c, bloom, motion_blur)| ExtractedCamera {
-        world_from_view: Mat4::from_rotation_translation(t.rotation, t.translation),
+        // Placement only: a camera's scale (its own or a parent's) does not zoom the view.
+        world_from_view: {
+            let (_, rotation, translation) = t.to_scale_rotation_translation();
+            Mat4::from_rotation_translation(rotation, translation)
+        },
         projection: c.projection(),
         prev_clip_from_world,
         bloom: bloom.map(Bloom::settings),
@@ -58,7 +80,8 @@ pub fn build_snapshot(
         state.default_material.get_or_insert_with(|| Arc::new(MaterialData::default())).clone();
     let instances = meshes
         .iter()
-        .map(|(t, mesh, material)| ExtractedInstance {
+        .filter(|(.., visibility)| shown(*visibility))
+        .map(|(t, mesh, material, _)| ExtractedInstance {
             mesh: mesh.0.clone(),
             material: material.map_or_else(|| default_material.clone(), |m| m.0.clone()),
             world_from_local: t.to_matrix(),
@@ -66,11 +89,12 @@ pub fn build_snapshot(
         .collect();
     let lights = lights
         .iter()
-        .map(|(t, l)| ExtractedPointLight {
-            position: t.translation,
+        .filter(|(.., visibility)| shown(*visibility))
+        .map(|(t, l, _)| ExtractedPointLight {
+            position: t.translation(),
             color: l.color,
             intensity: l.intensity,
-            radius: l.radius,
+            radius: l.range,
         })
         .collect();
     let snapshot = FrameSnapshot {
@@ -94,8 +118,8 @@ pub fn extract_and_render(
     settings: Res<RenderSettings>,
     debug: Res<DebugView>,
     cameras: Query<CameraItem>,
-    meshes: Query<(&Transform, &Mesh3d, Option<&Material>)>,
-    lights: Query<(&Transform, &PointLight)>,
+    meshes: Query<MeshItem>,
+    lights: Query<LightItem>,
     mut backend: ResMut<RenderBackend>,
     capture: Res<HeadlessCapture>,
     failure: Res<RenderFailure>,
@@ -119,17 +143,13 @@ pub fn collect_results(world: &mut World) {
     }
 }
 
-/// Advances the clock (first system of `First`).
-pub fn tick_clock(mut clock: ResMut<FrameClock>) {
-    clock.tick();
-}
-
-/// Moves and tints lights that carry a [`LightAnimation`].
+/// Moves and tints lights that carry a [`LightAnimation`], at [`Time`]'s elapsed seconds (a
+/// fixed step headless, wall time in a window).
 pub fn animate_lights(
-    clock: Res<FrameClock>,
+    time: Res<Time>,
     mut lights: Query<(&LightAnimation, &mut Transform, &mut PointLight)>,
 ) {
-    let t = clock.elapsed;
+    let t = time.elapsed_secs();
     for (anim, mut transform, mut light) in &mut lights {
         transform.translation = anim.0.position_at(t);
         light.color = anim.0.color_at(t);

@@ -22,30 +22,33 @@ pub mod plugin;
 pub mod render_world;
 pub mod resources;
 pub mod scene;
+pub mod visibility;
 pub mod window;
 
 pub use backend::RenderFailed;
-pub use components::{Bloom, Camera3d, LightAnimation, Material, Mesh3d, MotionBlur, PointLight, Transform};
-pub use plugin::{HeadlessConfig, ManyLightPlugin, ManyLightSet, OutputMode};
+pub use components::{
+    Bloom, Camera3d, GlobalTransform, InheritedVisibility, LightAnimation, Material, Mesh3d, MotionBlur,
+    PointLight, Transform, Visibility,
+};
+pub use plugin::{HEADLESS_TIME_STEP, HeadlessConfig, ManyLightPlugin, ManyLightSet, OutputMode};
 pub use resources::{
-    DebugView, FrameClock, FrameStats, HeadlessCapture, LightControls, RenderFailure, RenderSettings,
-    ViewportSize,
+    DebugView, FrameStats, HeadlessCapture, LightControls, RenderFailure, RenderSettings, ViewportSize,
 };
 pub use window::{Overlay, PressedKeys, WindowConfig, WindowRequests};
 
 /// What an app needs in scope to use manylight.
 pub mod prelude {
     pub use crate::components::{
-        Bloom, Camera3d, LightAnimation, Material, Mesh3d, MotionBlur, PointLight, Transform,
+        Bloom, Camera3d, GlobalTransform, InheritedVisibility, LightAnimation, Material, Mesh3d, MotionBlur,
+        PointLight, Transform, Visibility,
     };
     pub use crate::plugin::{ManyLightPlugin, ManyLightSet};
-    pub use crate::resources::{
-        DebugView, FrameClock, FrameStats, HeadlessCapture, LightControls, RenderSettings,
-    };
+    pub use crate::resources::{DebugView, FrameStats, HeadlessCapture, LightControls, RenderSettings};
     pub use crate::scene::{spawn_light_rig, spawn_scene};
     pub use crate::window::{Overlay, PressedKeys, WindowConfig, WindowRequests};
     pub use bevy_app::prelude::*;
     pub use bevy_ecs::prelude::*;
+    pub use bevy_time::{Time, TimeUpdateStrategy};
     pub use glam::{Quat, UVec2, Vec3};
     pub use manylight_core::cluster::{CullTest, GridConfig, ZSlicing};
     pub use manylight_core::codec::NormalCodec;

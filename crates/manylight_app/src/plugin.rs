@@ -1,16 +1,22 @@
 //! `ManyLightPlugin`: adds the components' systems, the extract step and the renderer.
 
 use crate::backend::{RenderBackend, RenderThread};
-use crate::extract::{animate_lights, collect_results, extract_and_render, tick_clock};
+use crate::extract::{animate_lights, collect_results, extract_and_render};
 use crate::render_world::HeadlessRenderer;
-use crate::resources::{
-    DebugView, FrameClock, FrameStats, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize,
-};
+use crate::resources::{DebugView, FrameStats, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize};
 use crate::window::WindowConfig;
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
+use bevy_time::{TimePlugin, TimeUpdateStrategy};
+use bevy_transform::{TransformPlugin, TransformSystems};
 use glam::UVec2;
 use std::path::PathBuf;
+use std::time::Duration;
+
+/// How far [`bevy_time::Time`] advances per update in headless mode (1/60 s), so that
+/// animated frames are the same on every run and machine. Replace the plugin's
+/// `TimeUpdateStrategy` resource to change it.
+pub const HEADLESS_TIME_STEP: Duration = Duration::from_nanos(16_666_667);
 
 /// Public system sets, so user systems can be ordered around the plugin's.
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -98,6 +104,18 @@ impl ManyLightPlugin {
 
 impl Plugin for ManyLightPlugin {
     fn build(&self, app: &mut App) {
+        // Bevy's transform hierarchy (GlobalTransform from Transform and ChildOf, in
+        // PostUpdate) and clock, unless the app brought them already.
+        if !app.is_plugin_added::<TransformPlugin>() {
+            app.add_plugins(TransformPlugin);
+        }
+        if !app.is_plugin_added::<TimePlugin>() {
+            app.add_plugins(TimePlugin);
+        }
+        app.add_systems(
+            PostUpdate,
+            crate::visibility::propagate_visibility.after(TransformSystems::Propagate),
+        );
         app.init_resource::<RenderSettings>()
             .init_resource::<DebugView>()
             .init_resource::<FrameStats>()
@@ -107,15 +125,13 @@ impl Plugin for ManyLightPlugin {
             .init_resource::<crate::window::PressedKeys>()
             .configure_sets(Update, ManyLightSet::Animate)
             .configure_sets(Last, ManyLightSet::Extract)
-            .add_systems(First, tick_clock)
             .add_systems(Update, animate_lights.in_set(ManyLightSet::Animate))
             .add_systems(Last, (extract_and_render, collect_results).chain().in_set(ManyLightSet::Extract));
         match &self.mode {
             OutputMode::Window(config) => {
                 let config = config.clone();
                 let pipelined = self.pipelined;
-                app.insert_resource(FrameClock::real_time())
-                    .insert_resource(ViewportSize(UVec2::new(config.width, config.height)))
+                app.insert_resource(ViewportSize(UVec2::new(config.width, config.height)))
                     .insert_resource(HeadlessCapture::default())
                     .insert_resource(RenderBackend::Pending)
                     .set_runner(move |app| crate::window::run_window(app, config, pipelined));
@@ -130,7 +146,7 @@ impl Plugin for ManyLightPlugin {
                     Err(e) => RenderBackend::Failed(e.to_string()),
                 };
                 let config = config.clone();
-                app.insert_resource(FrameClock::fixed(1.0 / 60.0))
+                app.insert_resource(TimeUpdateStrategy::ManualDuration(HEADLESS_TIME_STEP))
                     .insert_resource(ViewportSize(config.size))
                     .insert_resource(HeadlessCapture { enabled: true, image: None })
                     .insert_resource(backend)

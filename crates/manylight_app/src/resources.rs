@@ -139,47 +139,6 @@ impl FrameStats {
     }
 }
 
-/// The frame clock: elapsed time advanced once per update, either by wall time or by a fixed
-/// step (headless renders use a fixed step so they are reproducible).
-#[derive(Resource, Clone, Copy, Debug)]
-pub struct FrameClock {
-    /// Seconds since start.
-    pub elapsed: f32,
-    /// Seconds of the last step.
-    pub delta: f32,
-    /// Updates so far.
-    pub frame: u64,
-    /// `Some(step)` advances by a fixed step instead of wall time.
-    pub fixed_step: Option<f32>,
-    last_instant: Option<std::time::Instant>,
-}
-
-impl FrameClock {
-    /// A clock driven by wall time.
-    pub fn real_time() -> Self {
-        FrameClock { elapsed: 0.0, delta: 0.0, frame: 0, fixed_step: None, last_instant: None }
-    }
-
-    /// A clock that advances `step` seconds per update.
-    pub fn fixed(step: f32) -> Self {
-        FrameClock { fixed_step: Some(step), ..Self::real_time() }
-    }
-
-    pub(crate) fn tick(&mut self) {
-        let now = std::time::Instant::now();
-        self.delta = match (self.fixed_step, self.last_instant) {
-            (Some(step), _) => step,
-            (None, Some(last)) => (now - last).as_secs_f32().min(0.25),
-            (None, None) => 0.0,
-        };
-        self.last_instant = Some(now);
-        if self.frame > 0 {
-            self.elapsed += self.delta;
-        }
-        self.frame += 1;
-    }
-}
-
 /// Size of the render target in pixels (the window's inner size, or the headless size).
 #[derive(Resource, Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ViewportSize(pub UVec2);

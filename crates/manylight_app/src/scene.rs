@@ -1,6 +1,8 @@
 //! Turning a [`Scene`] (loaded glTF or the embedded default) into entities.
 
-use crate::components::{Camera3d, LightAnimation, Material, Mesh3d, PointLight, Transform};
+use crate::components::{
+    Camera3d, LightAnimation, Material, Mesh3d, PointLight, Transform, Visibility, transform_from_matrix,
+};
 use bevy_ecs::prelude::*;
 use manylight_core::Aabb;
 use manylight_render::{
@@ -9,9 +11,14 @@ use manylight_render::{
 use manylight_scene::light_rig;
 use manylight_scene::{Scene, SceneLight};
 
-/// Spawns the scene's instances and lights, and its camera (or one framing it) when
-/// `spawn_camera` is set. `aspect` is the viewport's width / height.
-pub fn spawn_scene(commands: &mut Commands, scene: &Scene, spawn_camera: bool, aspect: f32) {
+/// Spawns the scene under one root entity (returned; `Transform::IDENTITY`, named by the
+/// scene): its instances and lights are the root's children (`ChildOf`), so moving, hiding
+/// or despawning the root moves, hides or despawns the whole scene. With `spawn_camera`, the
+/// scene's camera is spawned as a child of the root too, or, when the scene has none, a camera
+/// framing it at the top level. `aspect` is the viewport's width / height.
+pub fn spawn_scene(commands: &mut Commands, scene: &Scene, spawn_camera: bool, aspect: f32) -> Entity {
+    let root =
+        commands.spawn((Transform::IDENTITY, Visibility::default(), SceneRoot(scene.name.clone()))).id();
     for inst in &scene.instances {
         let (Some(mesh), Some(material)) = (scene.meshes.get(inst.mesh), scene.materials.get(inst.material))
         else {
@@ -19,33 +26,50 @@ pub fn spawn_scene(commands: &mut Commands, scene: &Scene, spawn_camera: bool, a
             continue;
         };
         commands.spawn((
-            Transform::from_matrix(inst.transform),
+            transform_from_matrix(inst.transform),
             Mesh3d(mesh.clone()),
             Material(material.clone()),
+            ChildOf(root),
         ));
     }
     for light in &scene.lights {
         commands.spawn((
             Transform::from_translation(light.position),
-            PointLight { color: light.color, intensity: light.intensity, radius: light.radius },
+            PointLight { color: light.color, intensity: light.intensity, range: light.radius, radius: 0.0 },
+            ChildOf(root),
         ));
     }
     if spawn_camera {
         let cam = scene.camera_or_fit(aspect);
         let p = cam.projection;
-        commands.spawn((
-            Transform::from_matrix(cam.transform),
-            Camera3d { fov_y: p.fov_y, near: p.near, far: p.far },
-        ));
+        let camera = commands
+            .spawn((
+                transform_from_matrix(cam.transform),
+                Camera3d { fov_y: p.fov_y, near: p.near, far: p.far },
+            ))
+            .id();
+        if !scene.cameras.is_empty() {
+            commands.entity(camera).insert(ChildOf(root));
+        }
     }
+    root
 }
+
+/// Marks the root entity of a spawned [`Scene`]; holds the scene's name.
+#[derive(Component, Clone, Debug, PartialEq, Eq)]
+pub struct SceneRoot(pub String);
 
 /// Spawns `count` animated lights inside `bounds` (deterministic for a `seed`).
 pub fn spawn_light_rig(commands: &mut Commands, count: usize, bounds: Aabb, seed: u64) {
     for anim in light_rig(count, bounds, seed) {
         commands.spawn((
             Transform::from_translation(anim.position_at(0.0)),
-            PointLight { color: anim.color_at(0.0), intensity: anim.intensity, radius: anim.radius },
+            PointLight {
+                color: anim.color_at(0.0),
+                intensity: anim.intensity,
+                range: anim.radius,
+                radius: 0.0,
+            },
             LightAnimation(anim),
         ));
     }

@@ -316,7 +316,9 @@ pub fn run(args: SoakArgs) -> Result<()> {
         .add_plugins(ManyLightPlugin::window(config))
         .insert_resource(soak)
         .init_resource::<FrameCount>()
-        .add_systems(Startup, move |mut commands: Commands| spawn_scene(&mut commands, &scene, true, aspect))
+        .add_systems(Startup, move |mut commands: Commands| {
+            spawn_scene(&mut commands, &scene, true, aspect);
+        })
         .add_systems(Update, (drive, measure).chain())
         .run();
     let seconds = started.elapsed().as_secs_f64();
