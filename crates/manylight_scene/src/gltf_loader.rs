@@ -38,13 +38,13 @@
 mod data;
 mod materials;
 mod nodes;
+mod normalize;
 mod uri;
 
 pub use materials::blinn_phong_from_pbr;
 
 use crate::{Scene, SceneError};
 use manylight_core::TextureData;
-use std::borrow::Cow;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -154,11 +154,13 @@ impl Default for LoadOptions {
 const UNSUPPORTED_REQUIRED: &[&str] = &[
     "KHR_draco_mesh_compression",
     "EXT_meshopt_compression",
-    "KHR_mesh_quantization",
     "KHR_texture_basisu",
     "EXT_texture_webp",
     "EXT_texture_avif",
 ];
+
+/// Extensions the loader implements, so requiring them needs no warning.
+const SUPPORTED_REQUIRED: &[&str] = &["KHR_lights_punctual", "KHR_mesh_quantization"];
 
 /// Loads a `.gltf` or `.glb` file into a [`Scene`].
 ///
@@ -362,13 +364,12 @@ fn load_inner(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
     }
     // A UTF-8 byte-order mark is not valid JSON but harmless; accept it.
     let json_bytes = json_bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(json_bytes);
-    let root: gltf::json::Root = gltf::json::deserialize::from_slice(json_bytes)
-        .map_err(|e| SceneError::Json { path: path.to_owned(), message: e.to_string() })?;
+    let root = normalize::parse_root(path, json_bytes)?;
     for ext in &root.extensions_required {
         if UNSUPPORTED_REQUIRED.contains(&ext.as_str()) {
             return Err(SceneError::UnsupportedExtension { path: path.to_owned(), extension: ext.clone() });
         }
-        if ext != "KHR_lights_punctual" {
+        if !SUPPORTED_REQUIRED.contains(&ext.as_str()) {
             tracing::warn!(file = %path.display(), extension = %ext, "required extension is ignored");
         }
     }
@@ -415,8 +416,8 @@ struct Ctx<'a> {
     base_dir: PathBuf,
     /// The parsed, unvalidated JSON.
     root: &'a gltf::json::Root,
-    /// Buffer contents, each cut to its `byteLength`.
-    buffers: Vec<Cow<'a, [u8]>>,
+    /// Buffer contents, each cut to its `byteLength` (or why a buffer has none).
+    buffers: Vec<data::BufferData<'a>>,
     /// Limits chosen by the caller.
     options: &'a LoadOptions,
     /// Decoded images by image index.
