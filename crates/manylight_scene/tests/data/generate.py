@@ -22,10 +22,10 @@ Files the specification allows that strict parsers refuse (one per family):
   whose target has no `node` (ignored, as the specification says).
 - data_uri_percent.gltf: the buffer is a `data:application/octet-stream,...` URI without
   `;base64` (RFC 2397: percent-encoded bytes), the image a `data:image/png,...` one.
-- unused_buffer_without_uri.gltf: a second buffer without `uri` that nothing reads.
+- unused_buffer_without_uri.gltf / .glb: a second buffer without `uri` that nothing reads (in
+  the GLB, besides buffer 0, the binary chunk).
 - several_buffers.glb + several_buffers.bin: a GLB whose buffer 0 is the binary chunk, buffer 1
-  an external file (the indices), buffer 2 a `data:` URI (TEXCOORD_0) and buffer 3 has no uri
-  and is unused.
+  an external file (the indices) and buffer 2 a `data:` URI (TEXCOORD_0).
 - quantized.gltf: KHR_mesh_quantization: four triangles whose positions, normals and texture
   coordinates are (normalized or not) BYTE, UNSIGNED_BYTE, SHORT and UNSIGNED_SHORT, each on a
   node whose transform carries the dequantisation scale and offset.
@@ -173,6 +173,13 @@ def percent_data_uri(data, mime="application/octet-stream"):
     return f"data:{mime}," + urllib.parse.quote_from_bytes(data, safe="")
 
 
+def glb(doc, bin_chunk):
+    j = pad4(json.dumps(doc).encode()).replace(b"\0", b" ")
+    body = (struct.pack("<I4s", len(j), b"JSON") + j
+            + struct.pack("<I4s", len(pad4(bin_chunk)), b"BIN\0") + pad4(bin_chunk))
+    return struct.pack("<4sII", b"glTF", 2, 12 + len(body)) + body
+
+
 def floats_for_integers(value):
     """The same document with every int written as a float (`3` becomes `3.0`)."""
     if isinstance(value, bool):
@@ -277,10 +284,12 @@ def spec_allowed():
                     {"buffer": 2, "byteLength": 24}],
                    {"POSITION": 0, "TEXCOORD_0": 2})
     doc["buffers"] = [{"byteLength": 36}, {"byteLength": 6, "uri": "several_buffers.bin"},
-                      {"byteLength": 24, "uri": data_uri(UVS)}, {"byteLength": 4096}]
-    j = pad4(json.dumps(doc).encode()).replace(b"\0", b" ")
-    body = struct.pack("<I4s", len(j), b"JSON") + j + struct.pack("<I4s", 36, b"BIN\0") + POSITIONS
-    (HERE / "several_buffers.glb").write_bytes(struct.pack("<4sII", b"glTF", 2, 12 + len(body)) + body)
+                      {"byteLength": 24, "uri": data_uri(UVS)}]
+    (HERE / "several_buffers.glb").write_bytes(glb(doc, POSITIONS))
+
+    doc = triangle(b"", [POS_ACC, IDX_ACC], views, {"POSITION": 0})
+    doc["buffers"] = [{"byteLength": 44}, {"byteLength": 4096}]
+    (HERE / "unused_buffer_without_uri.glb").write_bytes(glb(doc, POSITIONS + INDICES))
 
     # KHR_mesh_quantization: (positions, normals, texcoords, node transform) per triangle, each
     # attribute as (accessor fields, struct format, values); byteStride keeps elements 4-aligned.
