@@ -338,8 +338,12 @@ fn load_inner(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
     if bytes.iter().all(|b| b.is_ascii_whitespace()) {
         return Err(SceneError::Empty { path: path.to_owned() });
     }
-    let (json_bytes, glb_bin) =
-        if bytes.starts_with(b"glTF") { split_glb(path, &bytes)? } else { (&bytes[..], None) };
+    let (json_bytes, glb) = if bytes.starts_with(b"glTF") {
+        let (json, bin) = split_glb(path, &bytes)?;
+        (json, Some(bin))
+    } else {
+        (&bytes[..], None)
+    };
     if json_bytes.len() as u64 > options.max_json_bytes {
         let what = "the GLB JSON chunk";
         return Err(over_budget(
@@ -374,7 +378,7 @@ fn load_inner(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
         }
     }
     let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let buffers = data::load_buffers(path, &base_dir, &root, glb_bin, options)?;
+    let buffers = data::load_buffers(path, &base_dir, &root, glb, options)?;
     let mut ctx = Ctx {
         path,
         base_dir,

@@ -14,7 +14,8 @@ use std::path::Path;
 /// view does.
 pub(super) type BufferData<'a> = Result<Cow<'a, [u8]>, &'static str>;
 
-/// Loads every buffer of the file; each is cut to its declared `byteLength` (of a file, only
+/// Loads every buffer of the file (`glb`: the binary chunk of a GLB file, `None` for a
+/// `.gltf` file); each is cut to its declared `byteLength` (of a file, only
 /// that many bytes are read: the file may be longer, not shorter). The declared lengths count
 /// against `LoadOptions::max_buffer_bytes` before each buffer is read; a buffer without data
 /// (see [`BufferData`]) counts nothing.
@@ -22,9 +23,10 @@ pub(super) fn load_buffers<'a>(
     path: &Path,
     base_dir: &Path,
     root: &gltf::json::Root,
-    glb_bin: Option<&'a [u8]>,
+    glb: Option<Option<&'a [u8]>>,
     options: &LoadOptions,
 ) -> Result<Vec<BufferData<'a>>, SceneError> {
+    let glb_bin = glb.flatten();
     let mut out = Vec::with_capacity(root.buffers.len());
     let mut total = 0u64;
     for (i, buffer) in root.buffers.iter().enumerate() {
@@ -33,8 +35,10 @@ pub(super) fn load_buffers<'a>(
         let absent = match (&buffer.uri, glb_bin) {
             (Some(_), _) => None,
             (None, Some(_)) if i == 0 => None,
-            (None, None) if i == 0 => Some("has no uri and the file has no GLB binary chunk"),
-            (None, _) => Some("has no uri (only buffer 0 may use the GLB binary chunk)"),
+            (None, _) if i > 0 && glb.is_some() => {
+                Some("has no uri (only buffer 0 may use the GLB binary chunk)")
+            }
+            (None, _) => Some("has no uri and the file has no GLB binary chunk"),
         };
         if let Some(problem) = absent {
             out.push(Err(problem));
