@@ -7,14 +7,18 @@
 //!    hand (GLB header and chunk lengths are checked against the file size), the JSON's
 //!    values are counted by a scan before it is parsed (`max_json_values`: parsing turns a
 //!    few bytes of text into a struct of hundreds), and it is parsed without `gltf`'s
-//!    validation; every index is looked up with a bounds check that turns into a
-//!    [`SceneError::MissingReference`].
+//!    validation (normalised first where the crate's types refuse what the specification
+//!    allows, see `normalize.rs`); every index is looked up with a bounds check that turns
+//!    into a [`SceneError::MissingReference`].
 //! 2. Buffers are loaded from the GLB chunk, `data:` URIs or local files (never the network);
 //!    their declared lengths count against `max_buffer_bytes` before each is read, and of a
-//!    file only `byteLength` bytes are read. Views and accessors are range-checked before
-//!    reading.
+//!    file only `byteLength` bytes are read. A buffer without `uri` that is not the GLB chunk
+//!    is refused only when a buffer view reads it. Views and accessors are range-checked
+//!    before reading; `KHR_mesh_quantization` attributes (8- and 16-bit integers) are
+//!    dequantised to `f32`.
 //!
-//!    A buffer or image `uri` is either a base64 `data:` URI or a relative path that stays
+//!    A buffer or image `uri` is either a `data:` URI (RFC 2397: base64, or percent-encoded
+//!    bytes) or a relative path that stays
 //!    inside the glTF file's folder: after percent-decoding it may not be absolute, contain a
 //!    `..` component, a Windows drive letter or a backslash (UNC paths), or use any other
 //!    scheme (`http:`, `file:`, ...); its canonical path must lie under the folder's, so a

@@ -429,3 +429,30 @@ fn read_uint(c: ComponentType, b: &[u8]) -> u32 {
         _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn components_dequantise_as_gltf_specifies() {
+        use ComponentType::{F32, I8, I16, U8, U16};
+        let cases: &[(ComponentType, bool, &[u8], f32)] = &[
+            (F32, false, &1.5f32.to_le_bytes(), 1.5),
+            (I8, false, &[0x80], -128.0),
+            (I8, true, &[0x80], -1.0), // -128 / 127 clamps to -1
+            (I8, true, &[0x81], -1.0),
+            (I8, true, &[127], 1.0),
+            (U8, false, &[255], 255.0),
+            (U8, true, &[255], 1.0),
+            (I16, false, &(-300i16).to_le_bytes(), -300.0),
+            (I16, true, &i16::MIN.to_le_bytes(), -1.0),
+            (I16, true, &16384i16.to_le_bytes(), 16384.0 / 32767.0),
+            (U16, false, &65535u16.to_le_bytes(), 65535.0),
+            (U16, true, &32768u16.to_le_bytes(), 32768.0 / 65535.0),
+        ];
+        for &(c, normalized, bytes, expected) in cases {
+            assert_eq!(component_f32(c, normalized, bytes), expected, "{c:?} {normalized} {bytes:?}");
+        }
+    }
+}
