@@ -32,13 +32,11 @@ pub(super) fn load_buffers<'a>(
     for (i, buffer) in root.buffers.iter().enumerate() {
         let what = format!("buffer {i}");
         let declared = buffer.byte_length.0;
-        let absent = match (&buffer.uri, glb_bin) {
-            (Some(_), _) => None,
-            (None, Some(_)) if i == 0 => None,
-            (None, _) if i > 0 && glb.is_some() => {
-                Some("has no uri (only buffer 0 may use the GLB binary chunk)")
-            }
-            (None, _) => Some("has no uri and the file has no GLB binary chunk"),
+        let absent = match &buffer.uri {
+            Some(_) => None,
+            None if i == 0 && glb_bin.is_some() => None,
+            None if i > 0 && glb.is_some() => Some("has no uri (only buffer 0 may use the GLB binary chunk)"),
+            None => Some("has no uri and the file has no GLB binary chunk"),
         };
         if let Some(problem) = absent {
             out.push(Err(problem));
@@ -50,8 +48,8 @@ pub(super) fn load_buffers<'a>(
             let limit = options.max_buffer_bytes;
             return Err(over_budget(path, what, total, "bytes of buffers", limit, "max_buffer_bytes"));
         }
-        let data: Cow<'a, [u8]> = match (&buffer.uri, glb_bin) {
-            (Some(uri), _) => match resolve_uri(path, base_dir, &what, uri)? {
+        let data: Cow<'a, [u8]> = match &buffer.uri {
+            Some(uri) => match resolve_uri(path, base_dir, &what, uri)? {
                 UriSource::Data { bytes, .. } => Cow::Owned(bytes),
                 UriSource::File(file) => {
                     if file.size < declared {
@@ -68,8 +66,8 @@ pub(super) fn load_buffers<'a>(
                     Cow::Owned(file.read_prefix(path, &what, declared)?)
                 }
             },
-            // `absent` is `None` here: buffer 0 of a file with a GLB binary chunk.
-            (None, bin) => Cow::Borrowed(bin.unwrap_or_default()),
+            // Not `absent`: buffer 0 of a file with a GLB binary chunk.
+            None => Cow::Borrowed(glb_bin.unwrap_or_default()),
         };
         if (data.len() as u64) < declared {
             return Err(SceneError::BadBuffer {
