@@ -7,14 +7,18 @@
 //!    hand (GLB header and chunk lengths are checked against the file size), the JSON's
 //!    values are counted by a scan before it is parsed (`max_json_values`: parsing turns a
 //!    few bytes of text into a struct of hundreds), and it is parsed without `gltf`'s
-//!    validation; every index is looked up with a bounds check that turns into a
-//!    [`SceneError::MissingReference`].
+//!    validation (normalised first where the crate's types refuse what the specification
+//!    allows, see `normalize.rs`); every index is looked up with a bounds check that turns
+//!    into a [`SceneError::MissingReference`].
 //! 2. Buffers are loaded from the GLB chunk, `data:` URIs or local files (never the network);
 //!    their declared lengths count against `max_buffer_bytes` before each is read, and of a
-//!    file only `byteLength` bytes are read. Views and accessors are range-checked before
-//!    reading.
+//!    file only `byteLength` bytes are read. A buffer without `uri` that is not the GLB chunk
+//!    is refused only when a buffer view reads it. Views and accessors are range-checked
+//!    before reading; `KHR_mesh_quantization` attributes (8- and 16-bit integers) are
+//!    dequantised to `f32`.
 //!
-//!    A buffer or image `uri` is either a base64 `data:` URI or a relative path that stays
+//!    A buffer or image `uri` is either a `data:` URI (RFC 2397: base64, or percent-encoded
+//!    bytes) or a relative path that stays
 //!    inside the glTF file's folder: after percent-decoding it may not be absolute, contain a
 //!    `..` component, a Windows drive letter or a backslash (UNC paths), or use any other
 //!    scheme (`http:`, `file:`, ...); its canonical path must lie under the folder's, so a
@@ -38,13 +42,13 @@
 mod data;
 mod materials;
 mod nodes;
+mod normalize;
 mod uri;
 
 pub use materials::blinn_phong_from_pbr;
 
 use crate::{Scene, SceneError};
 use manylight_core::TextureData;
-use std::borrow::Cow;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -154,11 +158,13 @@ impl Default for LoadOptions {
 const UNSUPPORTED_REQUIRED: &[&str] = &[
     "KHR_draco_mesh_compression",
     "EXT_meshopt_compression",
-    "KHR_mesh_quantization",
     "KHR_texture_basisu",
     "EXT_texture_webp",
     "EXT_texture_avif",
 ];
+
+/// Extensions the loader implements, so requiring them needs no warning.
+const SUPPORTED_REQUIRED: &[&str] = &["KHR_lights_punctual", "KHR_mesh_quantization"];
 
 /// Loads a `.gltf` or `.glb` file into a [`Scene`].
 ///
@@ -336,8 +342,12 @@ fn load_inner(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
     if bytes.iter().all(|b| b.is_ascii_whitespace()) {
         return Err(SceneError::Empty { path: path.to_owned() });
     }
-    let (json_bytes, glb_bin) =
-        if bytes.starts_with(b"glTF") { split_glb(path, &bytes)? } else { (&bytes[..], None) };
+    let (json_bytes, glb) = if bytes.starts_with(b"glTF") {
+        let (json, bin) = split_glb(path, &bytes)?;
+        (json, Some(bin))
+    } else {
+        (&bytes[..], None)
+    };
     if json_bytes.len() as u64 > options.max_json_bytes {
         let what = "the GLB JSON chunk";
         return Err(over_budget(
@@ -362,18 +372,17 @@ fn load_inner(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
     }
     // A UTF-8 byte-order mark is not valid JSON but harmless; accept it.
     let json_bytes = json_bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(json_bytes);
-    let root: gltf::json::Root = gltf::json::deserialize::from_slice(json_bytes)
-        .map_err(|e| SceneError::Json { path: path.to_owned(), message: e.to_string() })?;
+    let root = normalize::parse_root(path, json_bytes)?;
     for ext in &root.extensions_required {
         if UNSUPPORTED_REQUIRED.contains(&ext.as_str()) {
             return Err(SceneError::UnsupportedExtension { path: path.to_owned(), extension: ext.clone() });
         }
-        if ext != "KHR_lights_punctual" {
+        if !SUPPORTED_REQUIRED.contains(&ext.as_str()) {
             tracing::warn!(file = %path.display(), extension = %ext, "required extension is ignored");
         }
     }
     let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let buffers = data::load_buffers(path, &base_dir, &root, glb_bin, options)?;
+    let buffers = data::load_buffers(path, &base_dir, &root, glb, options)?;
     let mut ctx = Ctx {
         path,
         base_dir,
@@ -415,8 +424,8 @@ struct Ctx<'a> {
     base_dir: PathBuf,
     /// The parsed, unvalidated JSON.
     root: &'a gltf::json::Root,
-    /// Buffer contents, each cut to its `byteLength`.
-    buffers: Vec<Cow<'a, [u8]>>,
+    /// Buffer contents, each cut to its `byteLength` (or why a buffer has none).
+    buffers: Vec<data::BufferData<'a>>,
     /// Limits chosen by the caller.
     options: &'a LoadOptions,
     /// Decoded images by image index.

@@ -85,6 +85,13 @@ const EXPECTED: &[(&str, &str, &str)] = &[
     ("zero_filled_accessor.gltf", "OverBudget", "needs 22369620 vertices, over the limit of 16000000"),
     ("deep_node_chain.gltf", "OverBudget", "node 1024 needs 1025 levels of node nesting"),
     ("huge_buffer.gltf", "OverBudget", "buffer 0 needs 1099511627776 bytes of buffers"),
+    ("fractional_count.gltf", "Json", "1.5"),
+    ("bad_percent_data_uri.gltf", "BadUri", "invalid percent escape"),
+    ("uriless_buffer_read.gltf", "BadBuffer", "buffer 1: has no uri and the file has no GLB binary chunk"),
+    ("glb_second_buffer_without_uri.glb", "BadBuffer", "buffer view 1 reads it"),
+    ("animation_without_target.gltf", "Json", "target"),
+    ("missing_default_scene.gltf", "MissingReference", "scene 1"),
+    ("quantized_unsigned_normal.gltf", "AccessorType", "normalized UNSIGNED_BYTE"),
 ];
 
 #[test]

@@ -103,3 +103,127 @@ fn an_infinite_camera_with_a_huge_znear_loads_with_a_finite_matrix() {
     assert!(c.projection.is_infinite(), "{:?}", c.projection);
     assert!(c.projection.matrix(1.0).is_finite(), "{:?}", c.projection.matrix(1.0));
 }
+
+// Files the glTF 2.0 specification (and the Khronos validator) allow, one family per test.
+
+/// Loads fixture `name`, panicking with the error's message.
+fn load_ok(name: &str) -> manylight_scene::Scene {
+    let s = load_gltf(&fixture(name), &LoadOptions::default()).unwrap_or_else(|e| panic!("{name}: {e}"));
+    s.validate().unwrap_or_else(|e| panic!("{name}: {e}"));
+    s
+}
+
+/// The world-space positions of instance `i`'s vertices.
+fn world_positions(s: &manylight_scene::Scene, i: usize) -> Vec<Vec3> {
+    let instance = &s.instances[i];
+    let mesh = &s.meshes[instance.mesh];
+    mesh.vertices.iter().map(|v| instance.transform.transform_point3(Vec3::from(v.position))).collect()
+}
+
+fn assert_near<const N: usize>(found: &[[f32; N]], expected: &[[f32; N]], what: &str) {
+    assert_eq!(found.len(), expected.len(), "{what}");
+    for (f, e) in found.iter().zip(expected) {
+        assert!(f.iter().zip(e).all(|(a, b)| (a - b).abs() < 1e-5), "{what}: {found:?} != {expected:?}");
+    }
+}
+
+const TRIANGLE: [[f32; 3]; 3] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+
+#[test]
+fn integers_written_with_a_zero_fraction_are_integers() {
+    let s = load_ok("integers_as_floats.gltf");
+    assert_eq!(s.instances.len(), 1);
+    assert_eq!(s.meshes[0].indices, vec![0, 1, 2]);
+    let found: Vec<[f32; 3]> = world_positions(&s, 0).iter().map(|p| p.to_array()).collect();
+    assert_near(&found, &TRIANGLE.map(|p| [p[0], p[1], p[2] + 2.0]), "positions");
+}
+
+#[test]
+fn extras_of_any_type_are_accepted_on_every_object() {
+    let s = load_ok("extras_everywhere.gltf");
+    assert_eq!((s.instances.len(), s.lights.len(), s.cameras.len()), (1, 1, 1));
+    assert_eq!(s.lights[0].intensity, 2.0);
+    assert_eq!(s.cameras[0].projection.far, 50.0);
+    let t = s.materials[0].base_color_texture.as_ref().expect("texture");
+    assert_eq!(&t.rgba8[..4], &[0, 0, 255, 255]);
+}
+
+#[test]
+fn a_scene_without_nodes_is_empty() {
+    let s = load_ok("scene_without_nodes.gltf");
+    assert!(s.instances.is_empty() && s.meshes.is_empty() && s.lights.is_empty());
+}
+
+#[test]
+fn animation_channels_without_a_target_node_are_ignored() {
+    let s = load_ok("animation_channel_without_node.gltf");
+    assert_eq!(s.instances.len(), 1);
+    assert_eq!(s.instances[0].transform, Mat4::IDENTITY);
+}
+
+#[test]
+fn data_uris_without_base64_are_percent_decoded() {
+    let s = load_ok("data_uri_percent.gltf");
+    assert_eq!(s.meshes[0].indices, vec![0, 1, 2]);
+    let found: Vec<[f32; 3]> = s.meshes[0].vertices.iter().map(|v| v.position).collect();
+    assert_near(&found, &TRIANGLE, "positions");
+    let t = s.materials[0].base_color_texture.as_ref().expect("texture");
+    assert_eq!((t.width, t.height, &t.rgba8[..]), (1, 1, &[255, 0, 0, 255][..]));
+}
+
+#[test]
+fn a_buffer_without_uri_that_nothing_reads_is_accepted() {
+    let s = load_ok("unused_buffer_without_uri.gltf");
+    assert_eq!(s.instances.len(), 1);
+    // In a GLB too, besides buffer 0 (the binary chunk).
+    let s = load_ok("unused_buffer_without_uri.glb");
+    assert_eq!((s.instances.len(), s.meshes[0].indices.len()), (1, 3));
+}
+
+#[test]
+fn a_glb_may_have_buffers_besides_its_binary_chunk() {
+    let s = load_ok("several_buffers.glb");
+    let mesh = &s.meshes[0];
+    assert_eq!(mesh.indices, vec![0, 1, 2]); // buffer 1: an external file
+    let found: Vec<[f32; 3]> = mesh.vertices.iter().map(|v| v.position).collect();
+    assert_near(&found, &TRIANGLE, "positions (buffer 0, the binary chunk)");
+    let uvs: Vec<[f32; 2]> = mesh.vertices.iter().map(|v| v.uv).collect();
+    assert_near(&uvs, &[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], "uvs (buffer 2, a data URI)");
+}
+
+#[test]
+fn quantized_attributes_are_dequantised() {
+    let s = load_ok("quantized.gltf");
+    assert_eq!(s.instances.len(), 4);
+    let positions: [[[f32; 3]; 3]; 4] = [
+        // SHORT, node scale 0.001.
+        [[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        // Normalized UNSIGNED_BYTE (255 is 1), node scale 2 and translation (5, 0, 0).
+        [[5.0, 0.0, 0.0], [7.0, 0.0, 0.0], [5.0, 2.0, 0.0]],
+        // BYTE, node translation (0, 5, 0).
+        [[-2.0, 5.0, 0.0], [2.0, 5.0, 0.0], [0.0, 8.0, 0.0]],
+        // Normalized SHORT (-32768 clamps to -1), node translation (0, 0, 5).
+        [[-1.0, 0.0, 5.0], [1.0, 0.0, 5.0], [0.0, 1.0, 5.0]],
+    ];
+    let normals: [[[f32; 3]; 3]; 4] = [
+        [[0.0, 0.0, 1.0]; 3],                                 // normalized BYTE
+        [[0.0, 0.0, 1.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]], // normalized SHORT, -32768 is -1
+        [[0.0, 0.0, 1.0]; 3],                                 // none: generated
+        [[0.0, 0.0, 1.0]; 3],
+    ];
+    let uvs: [[[f32; 2]; 3]; 4] = [
+        [[0.0, 0.0], [1.0, 0.0], [0.0, 32768.0 / 65535.0]], // normalized UNSIGNED_SHORT
+        [[0.0, 0.0], [1.0, 0.0], [0.0, -1.0]],              // normalized BYTE, -128 is -1
+        [[0.0, 0.0], [1.0, 0.0], [0.0, 2.0]],               // UNSIGNED_BYTE
+        [[0.0, 0.0], [1.0, 0.0], [-1.0, 1.0]],              // SHORT
+    ];
+    for i in 0..4 {
+        let found: Vec<[f32; 3]> = world_positions(&s, i).iter().map(|p| p.to_array()).collect();
+        assert_near(&found, &positions[i], &format!("triangle {i} positions"));
+        let mesh = &s.meshes[s.instances[i].mesh];
+        let found: Vec<[f32; 3]> = mesh.vertices.iter().map(|v| v.normal).collect();
+        assert_near(&found, &normals[i], &format!("triangle {i} normals"));
+        let found: Vec<[f32; 2]> = mesh.vertices.iter().map(|v| v.uv).collect();
+        assert_near(&found, &uvs[i], &format!("triangle {i} uvs"));
+    }
+}

@@ -181,6 +181,12 @@ fn seeds(root: &Path) -> Vec<Seed> {
     add("png16", read_json(data.join("png16.gltf")), None, Some(data.clone()));
     let (json, bin) = split_glb(&std::fs::read(data.join("triangle.glb")).expect("triangle.glb"));
     add("triangle_glb", json, Some(bin), None);
+    // Files the specification allows that strict parsers refuse: quantized attributes, and a
+    // GLB whose other buffers are a file and a `data:` URI.
+    add("quantized", read_json(data.join("quantized.gltf")), None, None);
+    let (json, bin) =
+        split_glb(&std::fs::read(data.join("several_buffers.glb")).expect("several_buffers.glb"));
+    add("several_buffers_glb", json, Some(bin), Some(data.clone()));
     let (json, bin) = damaged_helmet();
     add("DamagedHelmet", json, Some(bin), None);
     out

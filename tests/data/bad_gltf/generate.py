@@ -172,6 +172,39 @@ def main():
     d = base_doc(); d["buffers"][0]["byteLength"] = 1 << 40
     write_json("huge_buffer.gltf", d)
 
+    # Neighbours of files the specification allows: each is refused.
+    # A count of 1.5 (a zero fraction, `3.0`, is an integer; 1.5 is not).
+    d = base_doc(); d["accessors"][0]["count"] = 1.5
+    write_json("fractional_count.gltf", d)
+    # A data URI without `;base64` whose percent escape is not two hex digits.
+    d = base_doc(); d["buffers"][0]["uri"] = "data:application/octet-stream,%zz" + "%00" * 43
+    write_json("bad_percent_data_uri.gltf", d)
+    # Buffer 1 has no uri (fine while unused), and the index view reads it.
+    d = base_doc(POSITIONS)
+    d["buffers"].append({"byteLength": 6})
+    d["bufferViews"][1] = {"buffer": 1, "byteLength": 6}
+    write_json("uriless_buffer_read.gltf", d)
+    # The same in a GLB: only buffer 0 may be the binary chunk.
+    d = base_doc()
+    d["buffers"] = [{"byteLength": 36}, {"byteLength": 6}]
+    d["bufferViews"][1] = {"buffer": 1, "byteLength": 6}
+    (HERE / "glb_second_buffer_without_uri.glb").write_bytes(glb(d, POSITIONS))
+    # An animation channel without a target (a target without `node` is allowed).
+    d = base_doc()
+    d["animations"] = [{"samplers": [{"input": 1, "output": 0}], "channels": [{"sampler": 0}]}]
+    write_json("animation_without_target.gltf", d)
+    # `"scenes": [{}]` is allowed, but the default scene must exist.
+    d = base_doc(); d["scenes"] = [{}]; d["scene"] = 1
+    write_json("missing_default_scene.gltf", d)
+    # KHR_mesh_quantization allows normalized BYTE or SHORT normals, never unsigned ones.
+    d = base_doc(POSITIONS + INDICES + bytes([0, 0, 255, 0] * 3))
+    d["extensionsUsed"] = d["extensionsRequired"] = ["KHR_mesh_quantization"]
+    d["bufferViews"].append({"buffer": 0, "byteOffset": 44, "byteLength": 12, "byteStride": 4})
+    d["accessors"].append({"bufferView": 2, "componentType": 5121, "normalized": True, "count": 3,
+                           "type": "VEC3"})
+    d["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = 2
+    write_json("quantized_unsigned_normal.gltf", d)
+
 
 if __name__ == "__main__":
     main()

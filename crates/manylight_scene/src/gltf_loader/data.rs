@@ -9,21 +9,39 @@ use gltf::json::validation::Checked;
 use std::borrow::Cow;
 use std::path::Path;
 
-/// Loads every buffer of the file; each is cut to its declared `byteLength` (of a file, only
+/// One buffer's bytes, or why it has none: a buffer without `uri` that is not the GLB binary
+/// chunk is valid as long as nothing reads it, so the problem is reported only when a buffer
+/// view does.
+pub(super) type BufferData<'a> = Result<Cow<'a, [u8]>, &'static str>;
+
+/// Loads every buffer of the file (`glb`: the binary chunk of a GLB file, `None` for a
+/// `.gltf` file); each is cut to its declared `byteLength` (of a file, only
 /// that many bytes are read: the file may be longer, not shorter). The declared lengths count
-/// against `LoadOptions::max_buffer_bytes` before each buffer is read.
+/// against `LoadOptions::max_buffer_bytes` before each buffer is read; a buffer without data
+/// (see [`BufferData`]) counts nothing.
 pub(super) fn load_buffers<'a>(
     path: &Path,
     base_dir: &Path,
     root: &gltf::json::Root,
-    glb_bin: Option<&'a [u8]>,
+    glb: Option<Option<&'a [u8]>>,
     options: &LoadOptions,
-) -> Result<Vec<Cow<'a, [u8]>>, SceneError> {
+) -> Result<Vec<BufferData<'a>>, SceneError> {
+    let glb_bin = glb.flatten();
     let mut out = Vec::with_capacity(root.buffers.len());
     let mut total = 0u64;
     for (i, buffer) in root.buffers.iter().enumerate() {
         let what = format!("buffer {i}");
         let declared = buffer.byte_length.0;
+        let absent = match &buffer.uri {
+            Some(_) => None,
+            None if i == 0 && glb_bin.is_some() => None,
+            None if i > 0 && glb.is_some() => Some("has no uri (only buffer 0 may use the GLB binary chunk)"),
+            None => Some("has no uri and the file has no GLB binary chunk"),
+        };
+        if let Some(problem) = absent {
+            out.push(Err(problem));
+            continue;
+        }
         total = total.saturating_add(declared);
         if total > options.max_buffer_bytes {
             let what = if i == 0 { what } else { format!("{what} (with the buffers before it)") };
@@ -48,18 +66,8 @@ pub(super) fn load_buffers<'a>(
                     Cow::Owned(file.read_prefix(path, &what, declared)?)
                 }
             },
-            None if i == 0 => Cow::Borrowed(glb_bin.ok_or_else(|| SceneError::BadBuffer {
-                path: path.to_owned(),
-                buffer: i,
-                problem: "has no uri and the file has no GLB binary chunk".into(),
-            })?),
-            None => {
-                return Err(SceneError::BadBuffer {
-                    path: path.to_owned(),
-                    buffer: i,
-                    problem: "has no uri (only buffer 0 may use the GLB binary chunk)".into(),
-                });
-            }
+            // Not `absent`: buffer 0 of a file with a GLB binary chunk.
+            None => Cow::Borrowed(glb_bin.unwrap_or_default()),
         };
         if (data.len() as u64) < declared {
             return Err(SceneError::BadBuffer {
@@ -76,7 +84,7 @@ pub(super) fn load_buffers<'a>(
                 Cow::Owned(v)
             }
         };
-        out.push(data);
+        out.push(Ok(data));
     }
     Ok(out)
 }
@@ -128,6 +136,11 @@ impl Ctx<'_> {
         let v = self.lookup(&self.root.buffer_views, view, what, "buffer view")?;
         let buffer = v.buffer.value();
         let data = self.lookup(&self.buffers, buffer, &format!("buffer view {view}"), "buffer")?;
+        let data = data.as_ref().map_err(|problem| SceneError::BadBuffer {
+            path: self.path.to_owned(),
+            buffer,
+            problem: format!("{problem}, and buffer view {view} reads it"),
+        })?;
         let offset = v.byte_offset.map_or(0, |o| o.0);
         let length = v.byte_length.0;
         match offset.checked_add(length) {
@@ -292,52 +305,73 @@ impl Ctx<'_> {
         Ok(())
     }
 
-    /// Checks that accessor `index` is a `VEC3` of `FLOAT` (positions, normals).
+    /// Whether the file uses `KHR_mesh_quantization`, which allows integer vertex attributes.
+    fn quantized(&self) -> bool {
+        let root = self.root;
+        (root.extensions_used.iter().chain(&root.extensions_required)).any(|e| e == QUANTIZATION)
+    }
+
+    /// Checks that accessor `index` is a `VEC3` that `usage` (`POSITION` or `NORMAL`) may use:
+    /// `FLOAT`, or with `KHR_mesh_quantization` any 8- or 16-bit integer for positions and a
+    /// normalized `BYTE` or `SHORT` for normals.
     pub(super) fn vec3_layout(&self, index: usize, what: &str, usage: &str) -> Result<Layout, SceneError> {
-        self.layout(
-            index,
-            what,
-            usage,
-            &|t, c, _| t == Type::Vec3 && c == ComponentType::F32,
-            "VEC3 of FLOAT",
-        )
+        use ComponentType::{F32, I8, I16, U8, U16};
+        let normal = usage == "NORMAL";
+        let (accept, expected): (&dyn Fn(Type, ComponentType, bool) -> bool, _) = match (
+            self.quantized(),
+            normal,
+        ) {
+            (false, _) => (&|t, c, _| t == Type::Vec3 && c == F32, "VEC3 of FLOAT"),
+            (true, false) => (
+                &|t, c, _| t == Type::Vec3 && matches!(c, F32 | I8 | U8 | I16 | U16),
+                "VEC3 of FLOAT, or of (normalized) BYTE, UNSIGNED_BYTE, SHORT or UNSIGNED_SHORT (KHR_mesh_quantization)",
+            ),
+            (true, true) => (
+                &|t, c, n| t == Type::Vec3 && (c == F32 || (n && matches!(c, I8 | I16))),
+                "VEC3 of FLOAT, or of normalized BYTE or SHORT (KHR_mesh_quantization)",
+            ),
+        };
+        self.layout(index, what, usage, accept, expected)
     }
 
-    /// Reads a `VEC3` `FLOAT` accessor checked by [`Ctx::vec3_layout`].
+    /// Reads a `VEC3` accessor checked by [`Ctx::vec3_layout`], dequantised to `f32`.
     pub(super) fn read_vec3(&self, index: usize, layout: Layout) -> Result<Vec<glam::Vec3>, SceneError> {
-        let bytes = self.packed(index, layout)?;
-        Ok(bytes
-            .chunks_exact(12)
-            .map(|c| glam::Vec3::new(f32_at(c, 0), f32_at(c, 4), f32_at(c, 8)))
-            .collect())
+        Ok(self.read_floats::<3>(index, layout)?.into_iter().map(glam::Vec3::from_array).collect())
     }
 
-    /// Checks that accessor `index` is a texture-coordinate accessor (`VEC2` of `FLOAT` or
-    /// normalized unsigned ints).
+    /// Checks that accessor `index` is a texture-coordinate accessor: `VEC2` of `FLOAT` or
+    /// normalized unsigned bytes or shorts, or with `KHR_mesh_quantization` any 8- or 16-bit
+    /// integer.
     pub(super) fn uv_layout(&self, index: usize, what: &str) -> Result<Layout, SceneError> {
-        self.layout(
-            index,
-            what,
-            "TEXCOORD_0",
-            &|t, c, n| {
-                t == Type::Vec2
-                    && (c == ComponentType::F32 || (n && matches!(c, ComponentType::U8 | ComponentType::U16)))
-            },
-            "VEC2 of FLOAT, normalized UNSIGNED_BYTE or normalized UNSIGNED_SHORT",
-        )
+        use ComponentType::{F32, I8, I16, U8, U16};
+        let (accept, expected): (&dyn Fn(Type, ComponentType, bool) -> bool, _) = if self.quantized() {
+            (
+                &|t, c, _| t == Type::Vec2 && matches!(c, F32 | I8 | U8 | I16 | U16),
+                "VEC2 of FLOAT, or of (normalized) BYTE, UNSIGNED_BYTE, SHORT or UNSIGNED_SHORT (KHR_mesh_quantization)",
+            )
+        } else {
+            (
+                &|t, c, n| t == Type::Vec2 && (c == F32 || (n && matches!(c, U8 | U16))),
+                "VEC2 of FLOAT, normalized UNSIGNED_BYTE or normalized UNSIGNED_SHORT",
+            )
+        };
+        self.layout(index, what, "TEXCOORD_0", accept, expected)
     }
 
-    /// Reads a texture-coordinate accessor checked by [`Ctx::uv_layout`].
+    /// Reads a texture-coordinate accessor checked by [`Ctx::uv_layout`], dequantised to `f32`.
     pub(super) fn read_uv(&self, index: usize, layout: Layout) -> Result<Vec<glam::Vec2>, SceneError> {
+        Ok(self.read_floats::<2>(index, layout)?.into_iter().map(glam::Vec2::from_array).collect())
+    }
+
+    /// Reads an accessor of `N` components per element as `f32` ([`component_f32`]).
+    fn read_floats<const N: usize>(&self, index: usize, layout: Layout) -> Result<Vec<[f32; N]>, SceneError> {
+        debug_assert_eq!(layout.components, N);
         let bytes = self.packed(index, layout)?;
         let cs = layout.component.size();
-        let read = |b: &[u8]| match layout.component {
-            ComponentType::F32 => f32_at(b, 0),
-            ComponentType::U8 => b[0] as f32 / 255.0,
-            _ => u16::from_le_bytes([b[0], b[1]]) as f32 / 65535.0,
+        let element = |e: &[u8]| {
+            std::array::from_fn(|i| component_f32(layout.component, layout.normalized, &e[i * cs..]))
         };
-        debug_assert!(layout.normalized || layout.component == ComponentType::F32);
-        Ok(bytes.chunks_exact(2 * cs).map(|c| glam::Vec2::new(read(c), read(&c[cs..]))).collect())
+        Ok(bytes.chunks_exact(N * cs).map(element).collect())
     }
 
     /// Checks that accessor `index` is an index accessor (`SCALAR` of unsigned ints).
@@ -361,6 +395,25 @@ impl Ctx<'_> {
     }
 }
 
+/// The extension that allows 8- and 16-bit integer vertex attributes.
+const QUANTIZATION: &str = "KHR_mesh_quantization";
+
+/// Component of type `c` at the start of `b` as `f32`. Normalized integers map to `[0, 1]`
+/// (unsigned: `c / 255`, `c / 65535`) or `[-1, 1]` (signed: `max(c / 127, -1)`,
+/// `max(c / 32767, -1)`), as glTF specifies; other integers keep their value (the
+/// dequantisation scale and offset of `KHR_mesh_quantization` are in the node transform).
+fn component_f32(c: ComponentType, normalized: bool, b: &[u8]) -> f32 {
+    let (value, max) = match c {
+        ComponentType::F32 => return f32_at(b, 0),
+        ComponentType::I8 => (f32::from(b[0] as i8), 127.0),
+        ComponentType::U8 => (f32::from(b[0]), 255.0),
+        ComponentType::I16 => (f32::from(i16::from_le_bytes([b[0], b[1]])), 32767.0),
+        ComponentType::U16 => (f32::from(u16::from_le_bytes([b[0], b[1]])), 65535.0),
+        ComponentType::U32 => (u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f32, u32::MAX as f32),
+    };
+    if normalized { (value / max).max(-1.0) } else { value }
+}
+
 /// Little-endian f32 at `at`; callers pass slices of at least `at + 4` bytes.
 fn f32_at(b: &[u8], at: usize) -> f32 {
     f32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]])
@@ -372,5 +425,32 @@ fn read_uint(c: ComponentType, b: &[u8]) -> u32 {
         ComponentType::U8 | ComponentType::I8 => b[0] as u32,
         ComponentType::U16 | ComponentType::I16 => u16::from_le_bytes([b[0], b[1]]) as u32,
         _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn components_dequantise_as_gltf_specifies() {
+        use ComponentType::{F32, I8, I16, U8, U16};
+        let cases: &[(ComponentType, bool, &[u8], f32)] = &[
+            (F32, false, &1.5f32.to_le_bytes(), 1.5),
+            (I8, false, &[0x80], -128.0),
+            (I8, true, &[0x80], -1.0), // -128 / 127 clamps to -1
+            (I8, true, &[0x81], -1.0),
+            (I8, true, &[127], 1.0),
+            (U8, false, &[255], 255.0),
+            (U8, true, &[255], 1.0),
+            (I16, false, &(-300i16).to_le_bytes(), -300.0),
+            (I16, true, &i16::MIN.to_le_bytes(), -1.0),
+            (I16, true, &16384i16.to_le_bytes(), 16384.0 / 32767.0),
+            (U16, false, &65535u16.to_le_bytes(), 65535.0),
+            (U16, true, &32768u16.to_le_bytes(), 32768.0 / 65535.0),
+        ];
+        for &(c, normalized, bytes, expected) in cases {
+            assert_eq!(component_f32(c, normalized, bytes), expected, "{c:?} {normalized} {bytes:?}");
+        }
     }
 }

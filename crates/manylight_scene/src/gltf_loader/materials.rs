@@ -36,10 +36,11 @@ fn is_data_uri(uri: &str) -> bool {
     uri.get(..5).is_some_and(|s| s.eq_ignore_ascii_case("data:"))
 }
 
-/// The lower-cased media type of a `data:` URI (empty when it has none).
+/// The lower-cased media type of a `data:` URI, without parameters or `;base64` (empty when
+/// it has none).
 fn data_media_type(uri: &str) -> String {
     let header = uri.get(5..).and_then(|r| r.split_once(',')).map_or("", |(h, _)| h);
-    header.strip_suffix(";base64").unwrap_or(header).to_ascii_lowercase()
+    header.split(';').next().unwrap_or_default().trim().to_ascii_lowercase()
 }
 
 /// Blinn-Phong exponent and specular strength for a metallic-roughness material.

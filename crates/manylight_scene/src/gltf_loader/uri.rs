@@ -68,22 +68,34 @@ fn short_uri(uri: &str) -> String {
     format!("{}...", &uri[..cut])
 }
 
-/// Decodes `%XX` escapes of a relative URI reference.
+/// Decodes the `%XX` escapes of URI text, refusing a `%` that is not followed by two hex
+/// digits (the `percent-encoding` crate passes such a `%` through unchanged).
+fn percent_decode_strict(text: &str) -> Option<std::borrow::Cow<'_, [u8]>> {
+    let bytes = text.as_bytes();
+    let escapes_ok = (0..bytes.len())
+        .filter(|&i| bytes[i] == b'%')
+        .all(|i| bytes.get(i + 1..i + 3).is_some_and(|hex| hex.iter().all(u8::is_ascii_hexdigit)));
+    escapes_ok.then(|| percent_encoding::percent_decode(bytes).into())
+}
+
+/// Decodes `%XX` escapes of a relative URI reference (the result must be UTF-8).
 fn percent_decode(uri: &str) -> Option<String> {
-    let bytes = uri.as_bytes();
-    let mut out = Vec::with_capacity(bytes.len());
-    let mut i = 0;
-    while i < bytes.len() {
-        if bytes[i] == b'%' {
-            let hex = std::str::from_utf8(bytes.get(i + 1..i + 3)?).ok()?;
-            out.push(u8::from_str_radix(hex, 16).ok()?);
-            i += 3;
-        } else {
-            out.push(bytes[i]);
-            i += 1;
-        }
+    String::from_utf8(percent_decode_strict(uri)?.into_owned()).ok()
+}
+
+/// The bytes of `data:` URI `uri` (RFC 2397): `data:[<mediatype>][;base64],<data>`, where
+/// `<data>` is percent-encoded URI text, decoded as base64 when the header ends in `;base64`.
+fn decode_data_uri(uri: &str) -> Result<Vec<u8>, String> {
+    let rest = uri.get(5..).unwrap_or_default();
+    let (header, payload) = rest.split_once(',').ok_or("data URI without ','")?;
+    let base64 = header.rsplit_once(';').is_some_and(|(_, last)| last.eq_ignore_ascii_case("base64"));
+    let payload = percent_decode_strict(payload)
+        .ok_or("invalid percent escape in the data (`%` must be followed by two hex digits)")?;
+    if !base64 {
+        return Ok(payload.into_owned());
     }
-    String::from_utf8(out).ok()
+    let payload = payload.trim_ascii_end();
+    base64::engine::general_purpose::STANDARD.decode(payload).map_err(|e| format!("invalid base64: {e}"))
 }
 
 /// Whether `s` starts with a Windows drive letter (`C:`).
@@ -219,14 +231,7 @@ pub(super) fn resolve_uri(
         });
     }
     if lower.starts_with("data:") {
-        let rest = &uri[5..];
-        let (header, payload) = rest.split_once(',').ok_or_else(|| bad("data URI without ','"))?;
-        if !header.ends_with(";base64") {
-            return Err(bad("only base64 data URIs are supported"));
-        }
-        let bytes = base64::engine::general_purpose::STANDARD
-            .decode(payload.trim_end())
-            .map_err(|e| bad(&format!("invalid base64: {e}")))?;
+        let bytes = decode_data_uri(uri).map_err(|reason| bad(&reason))?;
         return Ok(UriSource::Data { bytes });
     }
     // A scheme is letters/digits/+/-/. before the first ':' that comes before any '/'; a
@@ -369,6 +374,19 @@ mod tests {
         let ty = opened.expect("open").expect("metadata");
         assert_eq!(file_kind(ty), "FIFO (named pipe)");
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn data_uris_follow_rfc_2397() {
+        assert_eq!(decode_data_uri("data:,a%20b%00"), Ok(b"a b\0".to_vec()));
+        assert_eq!(decode_data_uri("data:application/octet-stream,%FF%fe"), Ok(vec![0xFF, 0xFE]));
+        assert_eq!(decode_data_uri("data:;base64,QUI%3D"), Ok(b"AB".to_vec()));
+        assert_eq!(decode_data_uri("data:text/plain;charset=US-ASCII;BASE64,QUI="), Ok(b"AB".to_vec()));
+        // `base64` as the media type is not the `;base64` flag.
+        assert_eq!(decode_data_uri("data:base64,QUI="), Ok(b"QUI=".to_vec()));
+        for bad in ["data:,%zz", "data:,%4", "data:,100%", "data:;base64,@@@@", "data:abc"] {
+            assert!(decode_data_uri(bad).is_err(), "{bad}");
+        }
     }
 
     #[test]
