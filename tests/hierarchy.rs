@@ -171,3 +171,82 @@ fn time_advances_by_the_headless_step() {
     assert_eq!(elapsed, manylight::app::HEADLESS_TIME_STEP * 2);
     assert!(app.world().resource::<FrameStats>().last.is_some());
 }
+
+/// A glTF scene spawns its node tree: one entity per node with the file's parentage (under the
+/// scene root), its meshes and lights as children of their node, each at the world transform
+/// the loader computed by composing the nodes (CesiumMan: 22 nested nodes; NegativeScaleTest:
+/// mirrored parents; LightsPunctualLamp: lights on nodes).
+#[test]
+fn a_gltf_node_tree_spawns_as_entities_with_its_parentage() {
+    let _gpu = gpu();
+    let (mut nested, mut lit) = (false, false);
+    for asset in [
+        "CesiumMan/CesiumMan.gltf",
+        "NegativeScaleTest/NegativeScaleTest.gltf",
+        "LightsPunctualLamp/LightsPunctualLamp.gltf",
+    ] {
+        let (nodes, lights) = check_spawned_tree(asset);
+        nested |= nodes;
+        lit |= lights > 0;
+    }
+    assert!(nested && lit, "the assets have nested nodes and lights");
+}
+
+/// Spawns `asset` and checks its entity tree against the loaded scene; returns whether the
+/// tree has nested nodes and how many lights it spawned.
+fn check_spawned_tree(asset: &str) -> (bool, usize) {
+    let path = support::asset(asset);
+    let scene = manylight::scene::load_gltf(&path, &Default::default()).expect("loads");
+    let expected = scene.clone();
+    let mut app = App::new();
+    app.add_plugins(ManyLightPlugin::headless(UVec2::new(32, 32))).add_systems(
+        Startup,
+        move |mut commands: Commands| {
+            spawn_scene(&mut commands, &scene, true, 1.0);
+        },
+    );
+    app.update();
+    let world = app.world_mut();
+    let root = world
+        .query_filtered::<Entity, With<manylight::app::scene::SceneRoot>>()
+        .single(world)
+        .expect("a root");
+    let nodes: std::collections::HashMap<Entity, usize> = world
+        .query::<(Entity, &manylight::app::scene::SceneNodeIndex)>()
+        .iter(world)
+        .map(|(e, i)| (e, i.0))
+        .collect();
+    assert_eq!(nodes.len(), expected.nodes.len(), "{asset}: one entity per node");
+    let mut index_to_entity = vec![Entity::PLACEHOLDER; nodes.len()];
+    for (&e, &i) in &nodes {
+        index_to_entity[i] = e;
+    }
+    for (i, node) in expected.nodes.iter().enumerate() {
+        let parent = world.get::<ChildOf>(index_to_entity[i]).expect("every node has a parent").parent();
+        let want = node.parent.map_or(root, |p| index_to_entity[p]);
+        assert_eq!(parent, want, "{asset}: node {i} ({:?})", node.name);
+    }
+    // Meshes and lights hang from their nodes, at the loader's world transforms.
+    let mut meshes = 0;
+    for (child_of, global, _) in world.query::<(&ChildOf, &GlobalTransform, &Mesh3d)>().iter(world) {
+        let node = nodes[&child_of.parent()];
+        let matches = expected.nodes[node]
+            .instances
+            .iter()
+            .any(|&k| global.to_matrix().abs_diff_eq(expected.instances[k].transform, 1e-4));
+        assert!(matches, "{asset}: a mesh of node {node} is not at any of its instances' transforms");
+        meshes += 1;
+    }
+    assert_eq!(meshes, expected.instances.len(), "{asset}");
+    let mut lights = 0;
+    for (child_of, global, _) in world.query::<(&ChildOf, &GlobalTransform, &PointLight)>().iter(world) {
+        let node = nodes[&child_of.parent()];
+        let at = global.translation();
+        let matches =
+            expected.nodes[node].lights.iter().any(|&k| (expected.lights[k].position - at).length() < 1e-4);
+        assert!(matches, "{asset}: a light of node {node} at {at} is not where the loader put it");
+        lights += 1;
+    }
+    assert_eq!(lights, expected.lights.len(), "{asset}");
+    (expected.nodes.iter().any(|n| n.parent.is_some()), lights)
+}

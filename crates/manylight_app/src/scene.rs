@@ -3,6 +3,7 @@
 use crate::components::{
     Camera3d, LightAnimation, Material, Mesh3d, PointLight, Transform, Visibility, transform_from_matrix,
 };
+use bevy_ecs::name::Name;
 use bevy_ecs::prelude::*;
 use manylight_core::Aabb;
 use manylight_render::{
@@ -11,35 +12,68 @@ use manylight_render::{
 use manylight_scene::light_rig;
 use manylight_scene::{Scene, SceneLight};
 
-/// Spawns the scene under one root entity (returned; `Transform::IDENTITY`, named by the
-/// scene): its instances and lights are the root's children (`ChildOf`), so moving, hiding
-/// or despawning the root moves, hides or despawns the whole scene. With `spawn_camera`, the
-/// scene's camera is spawned as a child of the root too, or, when the scene has none, a camera
-/// framing it at the top level. `aspect` is the viewport's width / height.
+/// Spawns the scene under one root entity (returned; `Transform::IDENTITY`, a [`SceneRoot`]
+/// named by the scene), so moving, hiding or despawning the root moves, hides or despawns the
+/// whole scene:
+/// - a scene with a node tree (glTF) spawns one entity per node (`Name` from the file, its
+///   local `Transform`, `ChildOf` its parent or the root), and each node's meshes, lights and
+///   camera as children of its entity at the node's origin, so moving a node moves what hangs
+///   from it;
+/// - instances and lights outside any node (generated scenes) are children of the root at
+///   their world transforms.
+///
+/// With `spawn_camera`, the scene's first camera is spawned where it hangs, or, when the scene
+/// has none, a camera framing it at the top level. `aspect` is the viewport's width / height.
 pub fn spawn_scene(commands: &mut Commands, scene: &Scene, spawn_camera: bool, aspect: f32) -> Entity {
     let root =
         commands.spawn((Transform::IDENTITY, Visibility::default(), SceneRoot(scene.name.clone()))).id();
-    for inst in &scene.instances {
-        let (Some(mesh), Some(material)) = (scene.meshes.get(inst.mesh), scene.materials.get(inst.material))
-        else {
-            tracing::warn!("scene `{}`: instance refers to a missing mesh or material", scene.name);
-            continue;
-        };
-        commands.spawn((
-            transform_from_matrix(inst.transform),
-            Mesh3d(mesh.clone()),
-            Material(material.clone()),
-            ChildOf(root),
+    let mut placed_instances = vec![false; scene.instances.len()];
+    let mut placed_lights = vec![false; scene.lights.len()];
+    let mut camera_placed = false;
+    let mut node_entities: Vec<Entity> = Vec::with_capacity(scene.nodes.len());
+    for node in &scene.nodes {
+        let parent = node.parent.and_then(|p| node_entities.get(p).copied()).unwrap_or(root);
+        let mut entity = commands.spawn((
+            transform_from_matrix(node.local),
+            Visibility::default(),
+            SceneNodeIndex(node_entities.len()),
+            ChildOf(parent),
         ));
+        if let Some(name) = &node.name {
+            entity.insert(Name::new(name.clone()));
+        }
+        let entity = entity.id();
+        node_entities.push(entity);
+        for &i in &node.instances {
+            if spawn_instance(commands, scene, i, Transform::IDENTITY, entity) {
+                placed_instances[i] = true;
+            }
+        }
+        for &l in &node.lights {
+            if let Some(light) = scene.lights.get(l) {
+                commands.spawn((Transform::IDENTITY, point_light(light), ChildOf(entity)));
+                placed_lights[l] = true;
+            }
+        }
+        if spawn_camera && node.cameras.contains(&0) {
+            let p = scene.cameras[0].projection;
+            commands.spawn((
+                Transform::IDENTITY,
+                Camera3d { fov_y: p.fov_y, near: p.near, far: p.far },
+                ChildOf(entity),
+            ));
+            camera_placed = true;
+        }
     }
-    for light in &scene.lights {
-        commands.spawn((
-            Transform::from_translation(light.position),
-            PointLight { color: light.color, intensity: light.intensity, range: light.radius, radius: 0.0 },
-            ChildOf(root),
-        ));
+    for (i, inst) in scene.instances.iter().enumerate() {
+        if !placed_instances[i] {
+            spawn_instance(commands, scene, i, transform_from_matrix(inst.transform), root);
+        }
     }
-    if spawn_camera {
+    for (light, _) in scene.lights.iter().zip(&placed_lights).filter(|(_, placed)| !**placed) {
+        commands.spawn((Transform::from_translation(light.position), point_light(light), ChildOf(root)));
+    }
+    if spawn_camera && !camera_placed {
         let cam = scene.camera_or_fit(aspect);
         let p = cam.projection;
         let camera = commands
@@ -54,6 +88,34 @@ pub fn spawn_scene(commands: &mut Commands, scene: &Scene, spawn_camera: bool, a
     }
     root
 }
+
+/// Spawns instance `index` of `scene` at `transform` under `parent`; false (with a warning)
+/// when it refers to a missing mesh or material.
+fn spawn_instance(
+    commands: &mut Commands,
+    scene: &Scene,
+    index: usize,
+    transform: Transform,
+    parent: Entity,
+) -> bool {
+    let Some(inst) = scene.instances.get(index) else { return false };
+    let (Some(mesh), Some(material)) = (scene.meshes.get(inst.mesh), scene.materials.get(inst.material))
+    else {
+        tracing::warn!("scene `{}`: instance {index} refers to a missing mesh or material", scene.name);
+        return false;
+    };
+    commands.spawn((transform, Mesh3d(mesh.clone()), Material(material.clone()), ChildOf(parent)));
+    true
+}
+
+/// The component of a scene light (its range is the scene light's radius).
+fn point_light(light: &SceneLight) -> PointLight {
+    PointLight { color: light.color, intensity: light.intensity, range: light.radius, radius: 0.0 }
+}
+
+/// Marks the entity of node `.0` of `Scene::nodes` (spawned by [`spawn_scene`]).
+#[derive(Component, Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SceneNodeIndex(pub usize);
 
 /// Marks the root entity of a spawned [`Scene`]; holds the scene's name.
 #[derive(Component, Clone, Debug, PartialEq, Eq)]

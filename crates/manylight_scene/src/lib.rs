@@ -42,6 +42,28 @@ pub struct Scene {
     pub lights: Vec<SceneLight>,
     /// Cameras that come with the scene (glTF cameras); may be empty.
     pub cameras: Vec<SceneCamera>,
+    /// The node tree the instances, lights and cameras hang from (glTF nodes), parents before
+    /// children; empty for generated scenes. The world transforms above stay authoritative:
+    /// composing the nodes' `local` transforms from the root gives them.
+    pub nodes: Vec<SceneNode>,
+}
+
+/// A node of a scene's tree: a local transform under its parent, and what hangs from it.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SceneNode {
+    /// The node's name in the file, if it has one.
+    pub name: Option<String>,
+    /// Index of the parent in `Scene::nodes` (always lower than the node's own), or `None` for
+    /// a root of the scene.
+    pub parent: Option<usize>,
+    /// Parent-from-node transform (TRS or the node's matrix).
+    pub local: Mat4,
+    /// Indices into `Scene::instances` drawn at this node (one per triangle primitive).
+    pub instances: Vec<usize>,
+    /// Indices into `Scene::lights` placed at this node.
+    pub lights: Vec<usize>,
+    /// Indices into `Scene::cameras` placed at this node.
+    pub cameras: Vec<usize>,
 }
 
 /// One drawn object: a mesh with a material at a world transform.

@@ -249,6 +249,7 @@ pub fn sphere_shell_scene() -> Scene {
             transform: Mat4::IDENTITY,
             projection: Projection { fov_y: 45f32.to_radians(), near: 0.1, far: 1000.0 },
         }],
+        nodes: Vec::new(),
     }
 }
 

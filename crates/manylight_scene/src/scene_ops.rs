@@ -129,6 +129,35 @@ impl Scene {
                 return Err(invalid(format!("camera {i} has an unusable transform or projection")));
             }
         }
+        self.validate_nodes().map_err(invalid)
+    }
+
+    /// The node tree: parents first, finite local transforms, and every instance, light and
+    /// camera hanging from at most one node.
+    fn validate_nodes(&self) -> Result<(), String> {
+        let mut owned = [
+            vec![false; self.instances.len()],
+            vec![false; self.lights.len()],
+            vec![false; self.cameras.len()],
+        ];
+        for (i, n) in self.nodes.iter().enumerate() {
+            if n.parent.is_some_and(|p| p >= i) {
+                return Err(format!("node {i} comes before its parent"));
+            }
+            if !n.local.is_finite() {
+                return Err(format!("node {i} has a non-finite transform"));
+            }
+            let lists = [("instance", &n.instances), ("light", &n.lights), ("camera", &n.cameras)];
+            for ((kind, list), flags) in lists.into_iter().zip(&mut owned) {
+                for &k in list {
+                    match flags.get_mut(k) {
+                        Some(flag) if !*flag => *flag = true,
+                        Some(_) => return Err(format!("{kind} {k} hangs from two nodes")),
+                        None => return Err(format!("node {i} refers to a missing {kind} {k}")),
+                    }
+                }
+            }
+        }
         Ok(())
     }
 }

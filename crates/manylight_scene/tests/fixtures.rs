@@ -61,6 +61,16 @@ fn hierarchy_lights_and_cameras_without_a_scene_list() {
     );
     let expected = parent * Mat4::from_translation(Vec3::Y);
     assert!(s.instances[0].transform.abs_diff_eq(expected, 1e-6));
+    // The node tree is kept: composing the local transforms from the root gives the
+    // instance's world transform.
+    let node = s.nodes.iter().position(|n| n.instances == [0]).expect("the instance's node");
+    let (mut world, mut at) = (Mat4::IDENTITY, Some(node));
+    while let Some(i) = at {
+        world = s.nodes[i].local * world;
+        at = s.nodes[i].parent;
+    }
+    assert!(s.nodes[node].parent.is_some(), "{:?}", s.nodes);
+    assert!(world.abs_diff_eq(expected, 1e-6), "{world:?}");
     // The non-indexed triangle got sequential indices.
     assert_eq!(s.meshes[s.instances[0].mesh].indices, vec![0, 1, 2]);
     // The point light sits at node 2's world position; the spot light is skipped.

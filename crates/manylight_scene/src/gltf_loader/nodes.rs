@@ -1,7 +1,7 @@
 //! The node tree of a glTF scene: transforms, mesh instances, point lights and cameras.
 
 use super::{Ctx, over_budget};
-use crate::{SceneCamera, SceneError, SceneInstance, SceneLight};
+use crate::{SceneCamera, SceneError, SceneInstance, SceneLight, SceneNode};
 use glam::{Mat4, Quat, Vec3};
 use gltf::json::camera::Type as CameraType;
 use gltf::json::extensions::scene::khr_lights_punctual::Type as LightType;
@@ -36,17 +36,21 @@ impl Ctx<'_> {
         };
         self.check_node_tree(&roots)?;
         let mut visited = vec![false; root.nodes.len()];
-        let mut stack: Vec<(usize, Mat4, String)> =
-            roots.into_iter().rev().map(|n| (n, Mat4::IDENTITY, "the scene".to_owned())).collect();
-        while let Some((index, parent, referrer)) = stack.pop() {
+        // (glTF node, its parent's world transform, its parent in `Scene::nodes`, referrer)
+        let mut stack: Vec<(usize, Mat4, Option<usize>, String)> =
+            roots.into_iter().rev().map(|n| (n, Mat4::IDENTITY, None, "the scene".to_owned())).collect();
+        while let Some((index, parent_world, parent, referrer)) = stack.pop() {
             let node = self.lookup(&root.nodes, index, &referrer, "node")?;
             if std::mem::replace(&mut visited[index], true) {
                 return Err(SceneError::NodeHierarchy { path: self.path.to_owned(), node: index });
             }
-            let world = parent * self.local_transform(index)?;
+            let local = self.local_transform(index)?;
+            let world = parent_world * local;
             if !world.is_finite() {
                 return Err(SceneError::NonFiniteTransform { path: self.path.to_owned(), node: index });
             }
+            let counts = |s: &crate::Scene| (s.instances.len(), s.lights.len(), s.cameras.len());
+            let before = counts(&self.scene);
             if let Some(mesh) = node.mesh {
                 self.add_mesh_instances(index, mesh.value(), world)?;
             }
@@ -56,8 +60,18 @@ impl Ctx<'_> {
             if let Some(camera) = node.camera {
                 self.add_camera(index, camera.value(), world)?;
             }
+            let after = counts(&self.scene);
+            let own = self.scene.nodes.len();
+            self.scene.nodes.push(SceneNode {
+                name: node.name.clone(),
+                parent,
+                local,
+                instances: (before.0..after.0).collect(),
+                lights: (before.1..after.1).collect(),
+                cameras: (before.2..after.2).collect(),
+            });
             for child in node.children.iter().flatten().rev() {
-                stack.push((child.value(), world, format!("node {index}")));
+                stack.push((child.value(), world, Some(own), format!("node {index}")));
             }
         }
         Ok(())
