@@ -230,13 +230,11 @@ fn the_depth_view_scales_to_the_far_plane_or_to_the_lights_reach() {
         let (_, image) = renderer.render(snapshot, true).expect("renders");
         let image = image.expect("image");
         let r = renderer.render_world.renderer();
-        let view_from_world = camera.transform.inverse();
-        let reach = manylight::core::cluster::farthest_reach(lights.iter().map(|l| {
-            manylight::core::cluster::ViewSphere {
-                center: view_from_world.transform_point3(l.position),
-                radius: l.radius,
-            }
-        }));
+        let spheres = manylight::core::cluster::to_view_space(
+            camera.transform.inverse(),
+            lights.iter().map(|l| (l.position, l.radius)),
+        );
+        let reach = manylight::core::cluster::farthest_reach(spheres);
         let scale_far = projection.finite_for(reach).far;
         assert!(scale_far.is_finite() && scale_far > projection.near, "far {far}: scale to {scale_far}");
         let (w, h, depth) = r.read_depth().expect("depth readback").expect("a depth buffer");

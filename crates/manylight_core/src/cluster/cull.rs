@@ -33,12 +33,22 @@ impl ViewSphere {
     }
 }
 
+/// Transforms world-space light positions to view space (`view_from_world`) keeping radii,
+/// one at a time (no allocation); [`view_spheres`] collects them.
+pub fn to_view_space(
+    view_from_world: Mat4,
+    lights: impl Iterator<Item = (Vec3, f32)>,
+) -> impl Iterator<Item = ViewSphere> {
+    lights.map(move |(position, radius)| ViewSphere {
+        center: view_from_world.transform_point3(position),
+        radius,
+    })
+}
+
 /// Transforms world-space light positions to view space (`view_from_world`) keeping radii; used
 /// by both the CPU and GPU paths.
 pub fn view_spheres(view_from_world: &Mat4, lights: impl Iterator<Item = (Vec3, f32)>) -> Vec<ViewSphere> {
-    lights
-        .map(|(position, radius)| ViewSphere { center: view_from_world.transform_point3(position), radius })
-        .collect()
+    to_view_space(*view_from_world, lights).collect()
 }
 
 /// The farthest view distance (along −Z) that any valid sphere reaches, 0 when none does:

@@ -81,14 +81,9 @@ fn depth_view_far(scene: &crate::resources::SceneResources) -> f32 {
     if scene.light_spheres.is_empty() {
         return near * 1e4;
     }
-    let view_from_world = scene.view.view_from_world;
-    let spheres = scene.light_spheres.iter().map(|&(position, radius)| manylight_core::cluster::ViewSphere {
-        center: view_from_world.transform_point3(position),
-        radius,
-    });
-    manylight_core::Projection::infinite(1.0, near)
-        .finite_for(manylight_core::cluster::farthest_reach(spheres))
-        .far
+    use manylight_core::cluster::{farthest_reach, to_view_space};
+    let spheres = to_view_space(scene.view.view_from_world, scene.light_spheres.iter().copied());
+    manylight_core::Projection::infinite(1.0, near).finite_for(farthest_reach(spheres)).far
 }
 
 /// Writes a debug visualisation to [`OUTPUT`].
