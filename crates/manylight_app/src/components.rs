@@ -88,8 +88,13 @@ pub struct Camera3d {
 
 impl Default for Camera3d {
     fn default() -> Self {
-        let p = Projection::default();
-        Self { fov_y: p.fov_y, near: p.near, far: p.far }
+        Camera3d::from(Projection::default())
+    }
+}
+
+impl From<Projection> for Camera3d {
+    fn from(p: Projection) -> Self {
+        Camera3d { fov_y: p.fov_y, near: p.near, far: p.far }
     }
 }
 

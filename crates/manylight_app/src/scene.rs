@@ -56,10 +56,9 @@ pub fn spawn_scene(commands: &mut Commands, scene: &Scene, spawn_camera: bool, a
             }
         }
         if spawn_camera && node.cameras.contains(&0) {
-            let p = scene.cameras[0].projection;
             commands.spawn((
                 Transform::IDENTITY,
-                Camera3d { fov_y: p.fov_y, near: p.near, far: p.far },
+                Camera3d::from(scene.cameras[0].projection),
                 ChildOf(entity),
             ));
             camera_placed = true;
@@ -75,13 +74,8 @@ pub fn spawn_scene(commands: &mut Commands, scene: &Scene, spawn_camera: bool, a
     }
     if spawn_camera && !camera_placed {
         let cam = scene.camera_or_fit(aspect);
-        let p = cam.projection;
-        let camera = commands
-            .spawn((
-                transform_from_matrix(cam.transform),
-                Camera3d { fov_y: p.fov_y, near: p.near, far: p.far },
-            ))
-            .id();
+        let camera =
+            commands.spawn((transform_from_matrix(cam.transform), Camera3d::from(cam.projection))).id();
         if !scene.cameras.is_empty() {
             commands.entity(camera).insert(ChildOf(root));
         }
