@@ -6,7 +6,7 @@
 //! the `LoadOptions::max_image_bytes` budget before any pixel is decoded, so a tiny file that
 //! declares a huge image, or names one image many times, costs nothing.
 
-use super::uri::{UriSource, resolve_uri};
+use super::uri::{UriSource, is_data_uri, resolve_uri, split_data_uri};
 use super::{Ctx, MAX_DOWNSCALED_SOURCE, OversizedTextures, over_budget};
 use crate::SceneError;
 use glam::Vec4;
@@ -31,15 +31,10 @@ pub(super) enum ImageSource<'a> {
     View(usize),
 }
 
-/// Whether `uri` is a `data:` URI (the scheme is case-insensitive).
-fn is_data_uri(uri: &str) -> bool {
-    uri.get(..5).is_some_and(|s| s.eq_ignore_ascii_case("data:"))
-}
-
 /// The lower-cased media type of a `data:` URI, without parameters or `;base64` (empty when
 /// it has none).
 fn data_media_type(uri: &str) -> String {
-    let header = uri.get(5..).and_then(|r| r.split_once(',')).map_or("", |(h, _)| h);
+    let header = split_data_uri(uri).map_or("", |(h, _)| h);
     header.split(';').next().unwrap_or_default().trim().to_ascii_lowercase()
 }
 

@@ -83,11 +83,24 @@ fn percent_decode(uri: &str) -> Option<String> {
     String::from_utf8(percent_decode_strict(uri)?.into_owned()).ok()
 }
 
+/// Whether `uri` is a `data:` URI (the scheme is case-insensitive).
+pub(super) fn is_data_uri(uri: &str) -> bool {
+    uri.get(..5).is_some_and(|s| s.eq_ignore_ascii_case("data:"))
+}
+
+/// `(header, data)` of `data:` URI `uri`: the text before and after the first `,`; `None` for
+/// another URI or one without a `,`.
+pub(super) fn split_data_uri(uri: &str) -> Option<(&str, &str)> {
+    if !is_data_uri(uri) {
+        return None;
+    }
+    uri[5..].split_once(',')
+}
+
 /// The bytes of `data:` URI `uri` (RFC 2397): `data:[<mediatype>][;base64],<data>`, where
 /// `<data>` is percent-encoded URI text, decoded as base64 when the header ends in `;base64`.
 fn decode_data_uri(uri: &str) -> Result<Vec<u8>, String> {
-    let rest = uri.get(5..).unwrap_or_default();
-    let (header, payload) = rest.split_once(',').ok_or("data URI without ','")?;
+    let (header, payload) = split_data_uri(uri).ok_or("data URI without ','")?;
     let base64 = header.rsplit_once(';').is_some_and(|(_, last)| last.eq_ignore_ascii_case("base64"));
     let payload = percent_decode_strict(payload)
         .ok_or("invalid percent escape in the data (`%` must be followed by two hex digits)")?;
@@ -230,7 +243,7 @@ pub(super) fn resolve_uri(
             uri: short_uri(uri),
         });
     }
-    if lower.starts_with("data:") {
+    if is_data_uri(uri) {
         let bytes = decode_data_uri(uri).map_err(|reason| bad(&reason))?;
         return Ok(UriSource::Data { bytes });
     }
