@@ -15,6 +15,12 @@ fn changed_pixels(a: &image::RgbaImage, b: &image::RgbaImage) -> usize {
     a.pixels().zip(b.pixels()).filter(|(p, q)| (0..3).any(|c| p.0[c].abs_diff(q.0[c]) > 8)).count()
 }
 
+/// Runs one update of a headless app and returns the frame it rendered.
+fn next_frame(app: &mut App) -> image::RgbaImage {
+    app.update();
+    app.world_mut().resource_mut::<HeadlessCapture>().image.take().expect("a frame")
+}
+
 /// A bright light that makes a visible spot on the default scene's floor.
 fn spot_light() -> PointLight {
     PointLight { color: Vec3::new(1.0, 0.3, 0.1), intensity: 80.0, range: 5.0, radius: 0.0 }
@@ -73,17 +79,13 @@ fn moving_a_parent_moves_its_child_lights_in_the_image() {
             commands.spawn((Transform::from_xyz(x, 0.0, 0.0), spot_light(), ChildOf(arm)));
         }
     });
-    let frame = |app: &mut App| {
-        app.update();
-        app.world_mut().resource_mut::<HeadlessCapture>().image.take().expect("a frame")
-    };
-    let before = frame(&mut app);
+    let before = next_frame(&mut app);
     let mut arms = app.world_mut().query_filtered::<&mut Transform, With<Arm>>();
     for mut t in arms.iter_mut(app.world_mut()) {
         t.translation.z += 4.0;
     }
-    let after = frame(&mut app);
-    let again = frame(&mut app);
+    let after = next_frame(&mut app);
+    let again = next_frame(&mut app);
     let changed = changed_pixels(&before, &after);
     assert!(changed > 100, "moving the parent changed {changed} pixels");
     assert_similar("hierarchy_moved_parent_still", &after, &again, STRICT);
@@ -99,13 +101,11 @@ fn moving_a_scene_root_moves_the_whole_scene() {
         scene.cameras.clear(); // a framing camera at the top level, outside the scene root
         spawn_scene(&mut commands, &scene, true, SIZE.x as f32 / SIZE.y as f32);
     });
-    app.update();
-    let before = app.world_mut().resource_mut::<HeadlessCapture>().image.take().expect("a frame");
+    let before = next_frame(&mut app);
     let mut roots = app.world_mut().query::<(&manylight::app::scene::SceneRoot, &mut Transform)>();
     let (_, mut root) = roots.single_mut(app.world_mut()).expect("one scene root");
     root.translation.y -= 1.0;
-    app.update();
-    let after = app.world_mut().resource_mut::<HeadlessCapture>().image.take().expect("a frame");
+    let after = next_frame(&mut app);
     let changed = changed_pixels(&before, &after);
     assert!(changed > 100, "moving the scene root changed {changed} pixels");
     let children = app.world_mut().query::<(&ChildOf, &Mesh3d)>().iter(app.world()).count();
