@@ -53,7 +53,7 @@ fn gpu_and_cpu(
     let settings = snapshot.settings;
     let (report, _) = r.render(snapshot, false).expect("renders");
     let renderer = r.render_world.renderer();
-    let clusters = renderer.clusters.as_ref().expect("the frame built clusters");
+    let clusters = renderer.view_clusters(0).expect("the frame built clusters");
     let gpu = clusters.read_assignment(&renderer.gpu).expect("readback");
     let cpu =
         assign_lights(&clusters.grid, &clusters.view_spheres, settings.clusters.cull, settings.clusters.cap);
@@ -182,7 +182,7 @@ fn an_infinite_projection_slices_to_the_farthest_light() {
         let (report, gpu, cpu) = gpu_and_cpu(&mut r, snap);
         assert_same_lists(&format!("infinite projection, {slicing:?}"), &gpu, &cpu);
         assert_eq!(report.sanitized_cameras, 0, "an infinite projection is valid as it is");
-        let grid = r.render_world.renderer().clusters.as_ref().expect("clusters").grid;
+        let grid = r.render_world.renderer().view_clusters(0).expect("clusters").grid;
         let reach = 1e6 * 1.2;
         assert!(grid.far >= reach && grid.far < 2.0 * reach, "grid far {} for reach {reach}", grid.far);
         assert!(grid.far.log2().fract() == 0.0, "grid far {} is not a power of two", grid.far);
@@ -242,10 +242,10 @@ fn culling_efficiency_finds_no_missing_light_and_clusters_beat_tiles() {
         let mut settings = clustered(CullTest::Both, ZSlicing::Exponential, None);
         settings.pipeline = pipeline;
         let snap = scene_snapshot(&scene, size, rig(&scene, 256, 9), settings);
-        let projection = snap.camera.expect("camera").projection;
+        let projection = snap.camera().expect("camera").projection;
         r.render(snap, false).expect("renders");
         let renderer = r.render_world.renderer();
-        let clusters = renderer.clusters.as_ref().expect("clusters");
+        let clusters = renderer.view_clusters(0).expect("clusters");
         let assignment = clusters.read_assignment(&renderer.gpu).expect("lists");
         let (w, h, depth) = renderer.read_depth().expect("readback").expect("depth");
         assert_eq!((w, h), (size.x, size.y));

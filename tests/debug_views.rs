@@ -146,11 +146,11 @@ fn count_views_show_the_cpu_reference_of_each_pixels_cluster() {
         };
         let heatmap_max = settings.debug_heatmap_max.max(1);
         let snapshot = scene_snapshot(&scene, lights.clone(), SIZE, settings, 0);
-        let projection = snapshot.camera.expect("camera").projection;
+        let projection = snapshot.camera().expect("camera").projection;
         let (_, image) = renderer.render(snapshot, true).expect("renders");
         let image = image.expect("image");
         let r = renderer.render_world.renderer();
-        let clusters = r.clusters.as_ref().expect("the frame built clusters");
+        let clusters = r.view_clusters(0).expect("the frame built clusters");
         // Uncapped counts: the overflow view shows a capped cluster red when its list hit the cap.
         let reference = assign_lights(&clusters.grid, &clusters.view_spheres, settings.clusters.cull, None);
         let (w, h, depth) = r.read_depth().expect("depth readback").expect("a depth buffer");

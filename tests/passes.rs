@@ -98,7 +98,7 @@ fn snapshot(p: Point) -> manylight::render::FrameSnapshot {
         ..FrameSettings::default()
     };
     let mut s = scene_snapshot(&scene, lights, SIZE, settings, 0);
-    if let Some(camera) = &mut s.camera {
+    if let Some(camera) = s.camera_mut() {
         camera.bloom = p.bloom.then(BloomSettings::default);
         camera.motion_blur = p.motion_blur.then(MotionBlurSettings::default);
     }
@@ -136,7 +136,7 @@ fn other_debug_views_need_only_their_data() {
     // The seed's bloom: 5 iterations at full resolution.
     let p = Point { lights: true, bloom: true, motion_blur: false, deferred: false, debug: false };
     let mut s = snapshot(p);
-    if let Some(c) = &mut s.camera {
+    if let Some(c) = s.camera_mut() {
         c.bloom = Some(BloomSettings::full_resolution());
     }
     let names = plan_passes(s).expect("plan");

@@ -4,15 +4,27 @@
 //! more than one frame ahead).
 
 use crate::render_world::DeviceLoss;
-use crate::resources::{FrameStats, HeadlessCapture, RenderFailure};
+use crate::resources::{FrameStats, HeadlessCapture, RenderFailure, RenderedImages};
 use bevy_ecs::prelude::*;
 use crossbeam_channel::{Receiver, Sender, bounded, unbounded};
-use manylight_render::{FrameReport, FrameSnapshot, RenderError};
+use manylight_render::{FrameReport, FrameSnapshot, RenderError, RenderTextureId};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::thread::JoinHandle;
 
-/// What a rendered frame gives back: its report and, if asked, its image.
-pub type FrameResult = Result<(FrameReport, Option<image::RgbaImage>), RenderFailed>;
+/// What a rendered frame gives back: its report, its image if asked, and the images of its
+/// render-to-texture cameras.
+#[derive(Debug)]
+pub struct RenderedFrame {
+    /// The frame's report.
+    pub report: FrameReport,
+    /// The main target's image, when read back.
+    pub image: Option<image::RgbaImage>,
+    /// The render-to-texture images, by id.
+    pub textures: Vec<(RenderTextureId, image::RgbaImage)>,
+}
+
+/// A rendered frame, or why rendering stopped.
+pub type FrameResult = Result<RenderedFrame, RenderFailed>;
 
 /// Why rendering stopped: sent as a message (`MessageReader<RenderFailed>`) in the update that
 /// learns of it, before the app exits with `AppExit::error()`; its text is also kept in
@@ -46,6 +58,11 @@ pub trait FrameSink: Send + Sync + 'static {
     fn lose_device(&mut self, when: DeviceLoss) {
         let _ = when;
     }
+
+    /// The images the last frame's render-to-texture cameras drew (none by default).
+    fn take_textures(&mut self) -> Vec<(RenderTextureId, image::RgbaImage)> {
+        Vec::new()
+    }
 }
 
 impl FrameSink for crate::render_world::HeadlessRenderer {
@@ -59,6 +76,10 @@ impl FrameSink for crate::render_world::HeadlessRenderer {
 
     fn lose_device(&mut self, when: DeviceLoss) {
         self.render_world.lose_device(when);
+    }
+
+    fn take_textures(&mut self) -> Vec<(RenderTextureId, image::RgbaImage)> {
+        self.render_world.take_textures()
     }
 }
 
@@ -75,7 +96,9 @@ fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
 /// frame (the app ends on it; the render thread stops).
 fn render_caught(sink: &mut dyn FrameSink, snapshot: FrameSnapshot, readback: bool) -> FrameResult {
     match catch_unwind(AssertUnwindSafe(|| sink.render_frame(snapshot, readback))) {
-        Ok(result) => result.map_err(RenderFailed::Render),
+        Ok(result) => result
+            .map(|(report, image)| RenderedFrame { report, image, textures: sink.take_textures() })
+            .map_err(RenderFailed::Render),
         Err(payload) => Err(RenderFailed::Panic(panic_message(payload.as_ref()))),
     }
 }
@@ -241,7 +264,14 @@ pub fn record_results(world: &mut World, results: Vec<FrameResult>) -> bool {
     let mut failed = false;
     for result in results {
         match result {
-            Ok((report, image)) => {
+            Ok(RenderedFrame { report, image, textures }) => {
+                if !textures.is_empty()
+                    && let Some(mut images) = world.get_resource_mut::<RenderedImages>()
+                {
+                    for (id, texture) in textures {
+                        images.insert(id, report.frame_index, texture);
+                    }
+                }
                 if let Some(mut stats) = world.get_resource_mut::<FrameStats>() {
                     stats.record(report);
                 }

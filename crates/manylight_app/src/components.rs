@@ -72,10 +72,80 @@ impl Default for InheritedVisibility {
     }
 }
 
-/// A perspective camera; the entity's [`GlobalTransform`] places it (looking down its -Z; its
-/// scale is ignored).
+/// Where, into which part and in what order a camera renders, as Bevy's `Camera`. Every
+/// [`Camera3d`] has one (the default: the whole main target, order 0). Each active camera
+/// renders its own view, with its own clusters and light lists, its own post-processing
+/// components ([`Bloom`], [`MotionBlur`]) and debug view ([`CameraDebugView`]); the frame's
+/// lights are uploaded once and shared by all views.
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
-#[require(Transform)]
+pub struct Camera {
+    /// Render order: lower first; a later camera draws over an earlier one where their
+    /// viewports overlap. Equal orders render in query order.
+    pub order: isize,
+    /// The part of the target it draws into; `None` for the whole target.
+    pub viewport: Option<Viewport>,
+    /// The window (or headless image), or an offscreen image the app reads.
+    pub target: RenderTarget,
+    /// An inactive camera renders nothing and costs nothing.
+    pub is_active: bool,
+}
+
+impl Default for Camera {
+    fn default() -> Self {
+        Camera { order: 0, viewport: None, target: RenderTarget::Window, is_active: true }
+    }
+}
+
+/// A rectangle of a camera's target in physical pixels, as Bevy's `Viewport`. The parts of
+/// the target no camera covers show the clear colour. A viewport reaching past the target is
+/// clipped to it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Viewport {
+    /// Top-left corner, from the target's top-left.
+    pub physical_position: glam::UVec2,
+    /// Width and height.
+    pub physical_size: glam::UVec2,
+}
+
+/// What a camera renders into, as Bevy's `RenderTarget`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RenderTarget {
+    /// The window, or the headless image.
+    #[default]
+    Window,
+    /// An offscreen image: after each frame it is read back and put into
+    /// [`RenderedImages`](crate::RenderedImages) for the app (render to texture).
+    Image(RenderImage),
+}
+
+/// An offscreen image a camera renders into; copy it into as many cameras as should draw into
+/// the same image. Its pixels arrive in [`RenderedImages`](crate::RenderedImages).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct RenderImage {
+    /// Its id on the render side.
+    pub id: manylight_render::RenderTextureId,
+    /// Its size in pixels (1 to the GPU's largest texture size on each axis).
+    pub size: glam::UVec2,
+}
+
+impl RenderImage {
+    /// A new image of `width × height` pixels, with an id no other image of this process has.
+    pub fn new(width: u32, height: u32) -> RenderImage {
+        static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+        let id = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        RenderImage { id: manylight_render::RenderTextureId(id), size: glam::UVec2::new(width, height) }
+    }
+}
+
+/// A debug view for this camera only, instead of the [`DebugView`](crate::DebugView)
+/// resource's (e.g. one split-screen half showing light counts).
+#[derive(Component, Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CameraDebugView(pub manylight_render::DebugViewMode);
+
+/// A perspective camera; the entity's [`GlobalTransform`] places it (looking down its -Z; its
+/// scale is ignored). Its [`Camera`] says where it renders.
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+#[require(Transform, Camera)]
 pub struct Camera3d {
     /// Vertical field of view in radians.
     pub fov_y: f32,

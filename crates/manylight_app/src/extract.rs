@@ -3,8 +3,8 @@
 
 use crate::backend::{RenderBackend, record_results};
 use crate::components::{
-    Bloom, Camera3d, GlobalTransform, InheritedVisibility, LightAnimation, Material, Mesh3d, MotionBlur,
-    PointLight, Transform,
+    Bloom, Camera, Camera3d, CameraDebugView, GlobalTransform, InheritedVisibility, LightAnimation, Material,
+    Mesh3d, MotionBlur, PointLight, RenderTarget, Transform,
 };
 use crate::resources::{DebugView, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize};
 use bevy_app::AppExit;
@@ -12,22 +12,33 @@ use bevy_ecs::prelude::*;
 use bevy_time::Time;
 use glam::Mat4;
 use manylight_core::MaterialData;
-use manylight_render::{ExtractedCamera, ExtractedInstance, ExtractedPointLight, FrameSnapshot};
+use manylight_render::{
+    ExtractedCamera, ExtractedInstance, ExtractedPointLight, ExtractedView, FrameSnapshot, ViewRect,
+    ViewTarget,
+};
+use std::collections::HashMap;
 use std::sync::Arc;
 
 /// State the extract system keeps between frames.
 #[derive(Default)]
 pub struct ExtractState {
-    /// Last frame's camera: motion blur projects with its placement and projection.
-    prev_camera: Option<ExtractedCamera>,
+    /// Each camera's last frame: motion blur projects with its placement and projection.
+    prev_cameras: HashMap<Entity, ExtractedCamera>,
     frame_index: u64,
     default_material: Option<Arc<MaterialData>>,
-    warned_cameras: bool,
 }
 
-/// What extract reads of a camera: placement, projection and its opt-in effects.
-pub type CameraItem =
-    (&'static GlobalTransform, &'static Camera3d, Option<&'static Bloom>, Option<&'static MotionBlur>);
+/// What extract reads of a camera: which one, placement, projection, target and order, and
+/// its opt-in effects.
+pub type CameraItem = (
+    Entity,
+    &'static GlobalTransform,
+    &'static Camera3d,
+    Option<&'static Camera>,
+    Option<&'static Bloom>,
+    Option<&'static MotionBlur>,
+    Option<&'static CameraDebugView>,
+);
 
 /// What extract reads of a mesh entity (hidden ones are skipped).
 pub type MeshItem = (
@@ -56,26 +67,48 @@ pub fn build_snapshot(
     meshes: &Query<MeshItem>,
     lights: &Query<LightItem>,
 ) -> FrameSnapshot {
-    let mut camera_iter = cameras.iter();
-    // Last frame's camera at this frame's viewport: a resize alone moves no pixel, so motion
-    // blur does not smear the first frame after one.
-    let prev_clip_from_world = state.prev_camera.map(|c| c.clip_from_world(viewport));
-    let camera = camera_iter.next().map(|(t, c, bloom, motion_blur)| ExtractedCamera {
-        // Placement only: a camera's scale (its own or a parent's) does not zoom the view.
-        world_from_view: {
-            let (_, rotation, translation) = t.to_scale_rotation_translation();
-            Mat4::from_rotation_translation(rotation, translation)
-        },
-        projection: c.projection(),
-        prev_clip_from_world,
-        bloom: bloom.map(Bloom::settings),
-        motion_blur: motion_blur.map(MotionBlur::settings),
-    });
-    if camera_iter.next().is_some() && !state.warned_cameras {
-        tracing::warn!("more than one Camera3d: rendering the first one only");
-        state.warned_cameras = true;
+    let mut views: Vec<ExtractedView> = Vec::with_capacity(cameras.iter().len());
+    let mut seen = Vec::with_capacity(views.capacity());
+    for (entity, t, c, camera, bloom, motion_blur, debug) in cameras.iter() {
+        let camera = camera.copied().unwrap_or_default();
+        if !camera.is_active {
+            continue;
+        }
+        let (target, target_size) = match camera.target {
+            RenderTarget::Window => (ViewTarget::Main, viewport),
+            RenderTarget::Image(image) => {
+                (ViewTarget::Texture { id: image.id, size: image.size }, image.size)
+            }
+        };
+        let rect = camera.viewport.map(|v| ViewRect { origin: v.physical_position, size: v.physical_size });
+        let mut view = ExtractedView {
+            camera: ExtractedCamera {
+                // Placement only: a camera's scale (its own or a parent's) does not zoom the view.
+                world_from_view: {
+                    let (_, rotation, translation) = t.to_scale_rotation_translation();
+                    Mat4::from_rotation_translation(rotation, translation)
+                },
+                projection: c.projection(),
+                prev_clip_from_world: None,
+                bloom: bloom.map(Bloom::settings),
+                motion_blur: motion_blur.map(MotionBlur::settings),
+            },
+            target,
+            rect,
+            debug_view: debug.map(|d| d.0),
+            order: camera.order,
+        };
+        // Last frame's camera at this frame's size: a resize alone moves no pixel, so motion
+        // blur does not smear the first frame after one.
+        let size = view.rect_in(target_size).size;
+        view.camera.prev_clip_from_world = state.prev_cameras.get(&entity).map(|p| p.clip_from_world(size));
+        state.prev_cameras.insert(entity, view.camera);
+        seen.push(entity);
+        views.push(view);
     }
-    state.prev_camera = camera;
+    // Lower order first; equal orders keep query order.
+    views.sort_by_key(|v| v.order);
+    state.prev_cameras.retain(|e, _| seen.contains(e));
     let default_material =
         state.default_material.get_or_insert_with(|| Arc::new(MaterialData::default())).clone();
     let instances = meshes
@@ -100,7 +133,7 @@ pub fn build_snapshot(
     let snapshot = FrameSnapshot {
         frame_index: state.frame_index,
         viewport,
-        camera,
+        views,
         instances,
         lights,
         settings: settings.frame_settings(debug),

@@ -27,29 +27,37 @@ pub mod window;
 
 pub use backend::RenderFailed;
 pub use components::{
-    Bloom, Camera3d, GlobalTransform, InheritedVisibility, LightAnimation, Material, Mesh3d, MotionBlur,
-    PointLight, Transform, Visibility,
+    Bloom, Camera, Camera3d, CameraDebugView, GlobalTransform, InheritedVisibility, LightAnimation, Material,
+    Mesh3d, MotionBlur, PointLight, RenderImage, RenderTarget, Transform, Viewport, Visibility,
 };
 pub use plugin::{HEADLESS_TIME_STEP, HeadlessConfig, ManyLightPlugin, ManyLightSet, OutputMode};
 pub use resources::{
-    DebugView, FrameStats, HeadlessCapture, LightControls, RenderFailure, RenderSettings, ViewportSize,
+    DebugView, FrameStats, HeadlessCapture, LightControls, RenderFailure, RenderSettings, RenderedImages,
+    ViewportSize,
 };
 pub use window::{Overlay, PressedKeys, WindowConfig, WindowRequests};
 
 /// What an app needs in scope to use manylight.
 pub mod prelude {
+    /// `T::default()`, as Bevy's prelude has it: `Camera { order: 1, ..default() }`.
+    pub fn default<T: Default>() -> T {
+        T::default()
+    }
+
     pub use crate::components::{
-        Bloom, Camera3d, GlobalTransform, InheritedVisibility, LightAnimation, Material, Mesh3d, MotionBlur,
-        PointLight, Transform, Visibility,
+        Bloom, Camera, Camera3d, CameraDebugView, GlobalTransform, InheritedVisibility, LightAnimation,
+        Material, Mesh3d, MotionBlur, PointLight, RenderImage, RenderTarget, Transform, Viewport, Visibility,
     };
     pub use crate::plugin::{ManyLightPlugin, ManyLightSet};
-    pub use crate::resources::{DebugView, FrameStats, HeadlessCapture, LightControls, RenderSettings};
+    pub use crate::resources::{
+        DebugView, FrameStats, HeadlessCapture, LightControls, RenderSettings, RenderedImages,
+    };
     pub use crate::scene::{spawn_light_rig, spawn_scene};
     pub use crate::window::{Overlay, PressedKeys, WindowConfig, WindowRequests};
     pub use bevy_app::prelude::*;
     pub use bevy_ecs::prelude::*;
     pub use bevy_time::{Time, TimeUpdateStrategy};
-    pub use glam::{Quat, UVec2, Vec3};
+    pub use glam::{Quat, UVec2, Vec2, Vec3};
     pub use manylight_core::cluster::{CullTest, GridConfig, ZSlicing};
     pub use manylight_core::codec::NormalCodec;
     pub use manylight_core::{MaterialData, MeshData, ShadingModel};

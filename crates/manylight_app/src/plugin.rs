@@ -119,6 +119,7 @@ impl Plugin for ManyLightPlugin {
         app.init_resource::<RenderSettings>()
             .init_resource::<DebugView>()
             .init_resource::<FrameStats>()
+            .init_resource::<crate::resources::RenderedImages>()
             .init_resource::<RenderFailure>()
             .add_message::<crate::backend::RenderFailed>()
             .init_resource::<crate::window::WindowRequests>()

@@ -1,7 +1,11 @@
-//! The render side of the app: a small render `World` and `Schedule` that, for each
-//! [`FrameSnapshot`], run `Prepare` (upload), `Graph` (one system per stage adds its pass only
-//! if the snapshot calls for it) and `Execute`. It runs on the render thread (pipelined mode)
-//! or on the caller's thread (synchronous mode).
+//! The render side of the app: a small render `World` and `Schedule`. For each
+//! [`FrameSnapshot`] the data its views share (lights, instances, meshes) is uploaded once;
+//! then, for each view in order, the schedule runs `Prepare` (the view's constants and
+//! clusters), `Graph` (one system per stage adds its pass only if the view calls for it) and
+//! `Execute`. A view with a viewport rectangle renders into a texture of its size that is
+//! copied into its rectangle; render-to-texture views are read back for the app after the
+//! frame. It runs on the render thread (pipelined mode) or on the caller's thread (synchronous
+//! mode).
 
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::ScheduleLabel;
@@ -11,15 +15,17 @@ use manylight_render::passes::{
 };
 use manylight_render::{
     DebugViewMode, FrameReport, FrameSnapshot, GBufferLayout, GpuContext, HeadlessTarget, PipelineKind,
-    RenderError, RenderGraph, Renderer,
+    RenderError, RenderGraph, RenderTextureId, RenderView, Renderer, ViewReport, ViewTarget,
 };
+use std::collections::HashMap;
 
 /// The ordered steps of one rendered frame.
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum RenderSet {
-    /// Upload changed meshes/textures, write light and instance buffers.
+    /// Write the view's constants and cluster inputs (the frame's shared data is uploaded
+    /// once, before the first view).
     Prepare,
-    /// Add the passes the frame needs to the graph.
+    /// Add the passes the view needs to the graph.
     Graph,
     /// Record and submit the graph.
     Execute,
@@ -32,6 +38,26 @@ pub struct RenderSchedule;
 /// The snapshot being rendered.
 #[derive(Resource, Default)]
 pub struct CurrentSnapshot(pub FrameSnapshot);
+
+/// The view being rendered (its camera, image size and settings), and whether the frame has
+/// lights to shade it with.
+#[derive(Resource, Clone, Copy, Debug)]
+pub struct CurrentView(pub RenderView, pub bool);
+
+impl CurrentView {
+    /// View `index` of `snapshot`.
+    pub fn of(snapshot: &FrameSnapshot, index: usize) -> CurrentView {
+        CurrentView(snapshot.render_view(index), snapshot.has_lights())
+    }
+
+    fn settings(&self) -> &manylight_render::FrameSettings {
+        &self.0.settings
+    }
+
+    fn has_lights(&self) -> bool {
+        self.1
+    }
+}
 
 /// The graph being built for this frame.
 #[derive(Resource, Default)]
@@ -112,6 +138,13 @@ pub struct RenderWorld {
     schedule: Schedule,
     losses: LossHistory,
     lose_in_frame: bool,
+    /// Render-to-texture targets, by id (dropped when no view draws into them).
+    textures: HashMap<RenderTextureId, HeadlessTarget>,
+    /// Images of the view rectangles, copied into their targets, by size and format.
+    view_images: HashMap<(u32, u32, wgpu::TextureFormat), wgpu::Texture>,
+    /// The render-to-texture images of the last frame, until taken.
+    texture_images: Vec<(RenderTextureId, image::RgbaImage)>,
+    last_passes: Vec<&'static str>,
 }
 
 impl RenderWorld {
@@ -127,7 +160,16 @@ impl RenderWorld {
         schedule.add_systems(prepare.in_set(RenderSet::Prepare));
         add_graph_systems(&mut schedule);
         schedule.add_systems(execute.in_set(RenderSet::Execute));
-        RenderWorld { world, schedule, losses: LossHistory::default(), lose_in_frame: false }
+        RenderWorld {
+            world,
+            schedule,
+            losses: LossHistory::default(),
+            lose_in_frame: false,
+            textures: HashMap::new(),
+            view_images: HashMap::new(),
+            texture_images: Vec::new(),
+            last_passes: Vec::new(),
+        }
     }
 
     /// Destroys the device as a driver reset would, now or during the next frame.
@@ -171,36 +213,306 @@ impl RenderWorld {
         &self.world.resource::<RendererResource>().0
     }
 
-    /// Renders `snapshot` into `output`.
+    /// Renders `snapshot` into `output`: each view in order, into its rectangle of `output`
+    /// or into its render-to-texture target (read back afterwards: [`RenderWorld::take_textures`]).
+    /// A frame without views draws the clear colour.
     pub fn render(
         &mut self,
         snapshot: FrameSnapshot,
         output: &wgpu::TextureView,
         format: wgpu::TextureFormat,
     ) -> Result<FrameReport, RenderError> {
+        let start = std::time::Instant::now();
         let mut snapshot = snapshot;
         let invalid_cameras = snapshot.reject_invalid_camera();
         let sanitized_cameras = snapshot.sanitized_cameras();
+        self.last_passes.clear();
+        self.texture_images.clear();
+        self.world.resource_mut::<RendererResource>().0.prepare(&snapshot)?;
+        let light_upload_bytes = self.world.resource::<RendererResource>().0.scene.light_upload_bytes;
         self.world.insert_resource(CurrentSnapshot(snapshot));
+        let result = self.render_views(output, format);
+        if std::mem::take(&mut self.lose_in_frame) {
+            self.gpu().device.destroy();
+        }
+        let views = result?;
+        let mut report = merge_view_reports(views, &self.world.resource::<CurrentSnapshot>().0);
+        report.invalid_cameras = invalid_cameras;
+        report.sanitized_cameras = sanitized_cameras;
+        report.light_uploads = 1;
+        report.light_upload_bytes = light_upload_bytes;
+        report.frame_cpu_ms = start.elapsed().as_secs_f64() * 1e3;
+        self.read_textures()?;
+        Ok(report)
+    }
+
+    /// Renders every view of the current snapshot; returns each view's report.
+    fn render_views(
+        &mut self,
+        output: &wgpu::TextureView,
+        format: wgpu::TextureFormat,
+    ) -> Result<Vec<(ViewReport, FrameReport)>, RenderError> {
+        let gpu = self.gpu().clone();
+        let snapshot = &self.world.resource::<CurrentSnapshot>().0;
+        let (main_size, clear_color) = (snapshot.viewport, snapshot.settings.clear_color);
+        // What each view draws into (a few words per view; the snapshot stays in the world).
+        let plans: Vec<ViewPlan> = (0..snapshot.views.len().max(1))
+            .map(|index| {
+                let extracted = snapshot.views.get(index);
+                let target = extracted.map_or(ViewTarget::Main, |v| v.target);
+                let target_size = extracted.map_or(main_size, |v| v.target_size(main_size));
+                let rect = extracted.map(|v| v.rect_in(target_size));
+                ViewPlan {
+                    view: CurrentView::of(snapshot, index),
+                    target,
+                    rect,
+                    whole: rect.is_none_or(|r| r.origin == glam::UVec2::ZERO && r.size == target_size),
+                    order: extracted.map_or(0, |v| v.order),
+                }
+            })
+            .collect();
+        // Render-to-texture targets of this frame (others are dropped).
+        self.textures.retain(|id, _| plans.iter().any(|p| p.texture_id() == Some(*id)));
+        let limit = gpu.device.limits().max_texture_dimension_2d;
+        for plan in &plans {
+            if let ViewTarget::Texture { id, size } = plan.target {
+                if size.x > limit || size.y > limit {
+                    return Err(RenderError::TargetTooLarge { width: size.x, height: size.y, limit });
+                }
+                if size.x == 0 || size.y == 0 {
+                    return Err(RenderError::UnsupportedSettings(format!(
+                        "a render image of {}×{} pixels (each side must be at least 1)",
+                        size.x, size.y
+                    )));
+                }
+                if self.textures.get(&id).map(|t| t.size()) != Some((size.x, size.y)) {
+                    self.textures.insert(id, HeadlessTarget::new(&gpu, size.x, size.y));
+                }
+            }
+        }
+        let mut cleared: Vec<ViewTarget> = Vec::with_capacity(plans.len());
+        let mut reports = Vec::with_capacity(plans.len());
+        for plan in plans {
+            let (target_view, target_format) = match plan.target {
+                ViewTarget::Main => (output.clone(), format),
+                ViewTarget::Texture { id, .. } => {
+                    (self.textures[&id].view().clone(), manylight_render::HEADLESS_FORMAT)
+                }
+            };
+            if !cleared.contains(&plan.target) {
+                // What no view covers shows the clear colour.
+                if !plan.whole {
+                    clear_target(&gpu, &target_view, clear_color);
+                }
+                cleared.push(plan.target);
+            }
+            let size = plan.view.0.size;
+            if size.x == 0 || size.y == 0 {
+                continue;
+            }
+            let image = (!plan.whole).then(|| self.view_image(&gpu, size, target_format));
+            let draw_into =
+                image.as_ref().map_or_else(|| target_view.clone(), |t| t.create_view(&Default::default()));
+            let report = self.render_view(plan.view, &draw_into, target_format)?;
+            if let (Some(image), Some(rect)) = (&image, plan.rect) {
+                copy_into(&gpu, image, target_view.texture(), rect)?;
+            }
+            let view_report = ViewReport {
+                index: plan.view.0.index,
+                order: plan.order,
+                target: target_name(plan.target),
+                width: size.x,
+                height: size.y,
+                passes: report.passes.iter().map(|p| p.name.clone()).collect(),
+                clusters: report.clusters.clone(),
+                cpu_ms: report.frame_cpu_ms,
+                gpu_ms: report.frame_gpu_ms,
+            };
+            reports.push((view_report, report));
+        }
+        Ok(reports)
+    }
+
+    /// Renders one view into `output` through the schedule.
+    fn render_view(
+        &mut self,
+        view: CurrentView,
+        output: &wgpu::TextureView,
+        format: wgpu::TextureFormat,
+    ) -> Result<FrameReport, RenderError> {
+        self.world.insert_resource(view);
         self.world.insert_resource(OutputTarget { view: output.clone(), format });
         self.world.resource_mut::<FrameGraph>().0.clear();
         *self.world.resource_mut::<FrameOutcome>() = FrameOutcome::default();
         self.schedule.run(&mut self.world);
-        if std::mem::take(&mut self.lose_in_frame) {
-            self.gpu().device.destroy();
-        }
+        self.last_passes.extend(self.world.resource::<FrameGraph>().0.pass_names().unwrap_or_default());
         let outcome = std::mem::take(&mut *self.world.resource_mut::<FrameOutcome>());
         match (outcome.error, outcome.report) {
             (Some(e), _) => Err(e),
-            (None, Some(r)) => Ok(FrameReport { invalid_cameras, sanitized_cameras, ..r }),
-            (None, None) => Err(RenderError::Graph("the frame produced no report".into())),
+            (None, Some(r)) => Ok(r),
+            (None, None) => Err(RenderError::Graph("the view produced no report".into())),
         }
     }
 
-    /// Names of the passes the last frame's graph ran, in order.
-    pub fn last_pass_names(&self) -> Vec<&'static str> {
-        self.world.resource::<FrameGraph>().0.pass_names().unwrap_or_default()
+    /// The image a view rectangle of `size` renders into before it is copied.
+    fn view_image(
+        &mut self,
+        gpu: &GpuContext,
+        size: glam::UVec2,
+        format: wgpu::TextureFormat,
+    ) -> wgpu::Texture {
+        self.view_images
+            .entry((size.x, size.y, format))
+            .or_insert_with(|| {
+                gpu.device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some("view_rect"),
+                    size: wgpu::Extent3d { width: size.x, height: size.y, depth_or_array_layers: 1 },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format,
+                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                    view_formats: &[],
+                })
+            })
+            .clone()
     }
+
+    /// Reads the render-to-texture targets back (the app asked for their pixels).
+    fn read_textures(&mut self) -> Result<(), RenderError> {
+        let gpu = self.gpu().clone();
+        let mut ids: Vec<_> = self.textures.keys().copied().collect();
+        ids.sort();
+        for id in ids {
+            let image = self.textures[&id].read(&gpu)?;
+            self.texture_images.push((id, image));
+        }
+        Ok(())
+    }
+
+    /// The render-to-texture images of the last frame, by id (empty once taken).
+    pub fn take_textures(&mut self) -> Vec<(RenderTextureId, image::RgbaImage)> {
+        std::mem::take(&mut self.texture_images)
+    }
+
+    /// Names of the passes the last frame ran, in order (view after view).
+    pub fn last_pass_names(&self) -> Vec<&'static str> {
+        self.last_passes.clone()
+    }
+}
+
+/// What one view draws into.
+struct ViewPlan {
+    view: CurrentView,
+    target: ViewTarget,
+    /// Its rectangle of the target (`None`: a frame without views, drawing the whole target).
+    rect: Option<manylight_render::ViewRect>,
+    /// True when it covers the whole target (it draws straight into it).
+    whole: bool,
+    order: isize,
+}
+
+impl ViewPlan {
+    fn texture_id(&self) -> Option<RenderTextureId> {
+        match self.target {
+            ViewTarget::Texture { id, .. } => Some(id),
+            ViewTarget::Main => None,
+        }
+    }
+}
+
+/// `main`, or `texture N`.
+fn target_name(target: ViewTarget) -> String {
+    match target {
+        ViewTarget::Main => "main".to_string(),
+        ViewTarget::Texture { id, .. } => format!("texture {}", id.0),
+    }
+}
+
+/// Clears `target` to `color` (linear).
+fn clear_target(gpu: &GpuContext, target: &wgpu::TextureView, color: [f32; 3]) {
+    let mut encoder =
+        gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("clear") });
+    let [r, g, b] = color.map(f64::from);
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("clear_target"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: target,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a: 1.0 }),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    gpu.queue.submit([encoder.finish()]);
+}
+
+/// Copies a view's image into its rectangle of `target`.
+fn copy_into(
+    gpu: &GpuContext,
+    image: &wgpu::Texture,
+    target: &wgpu::Texture,
+    rect: manylight_render::ViewRect,
+) -> Result<(), RenderError> {
+    if !target.usage().contains(wgpu::TextureUsages::COPY_DST) {
+        return Err(RenderError::UnsupportedSettings(
+            "a camera viewport needs a target that can be copied into (COPY_DST), which this surface is not"
+                .into(),
+        ));
+    }
+    let mut encoder =
+        gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("view_rect_copy") });
+    encoder.copy_texture_to_texture(
+        image.as_image_copy(),
+        wgpu::TexelCopyTextureInfo {
+            texture: target,
+            mip_level: 0,
+            origin: wgpu::Origin3d { x: rect.origin.x, y: rect.origin.y, z: 0 },
+            aspect: wgpu::TextureAspect::All,
+        },
+        wgpu::Extent3d { width: rect.size.x, height: rect.size.y, depth_or_array_layers: 1 },
+    );
+    gpu.queue.submit([encoder.finish()]);
+    Ok(())
+}
+
+/// One frame's report from its views' reports: their passes one view after the other, the
+/// first view's cluster statistics, the sums of their GPU times and non-finite pixels.
+fn merge_view_reports(views: Vec<(ViewReport, FrameReport)>, snapshot: &FrameSnapshot) -> FrameReport {
+    let mut merged = FrameReport { ..empty_report(snapshot) };
+    let mut gpu_ms: Option<f64> = None;
+    for (i, (view, report)) in views.into_iter().enumerate() {
+        if i == 0 {
+            merged = FrameReport {
+                passes: Vec::new(),
+                views: Vec::new(),
+                nonfinite_pixels: None,
+                ..report.clone()
+            };
+            merged.width = snapshot.viewport.x;
+            merged.height = snapshot.viewport.y;
+        }
+        merged.passes.extend(report.passes);
+        merged.clusters = merged.clusters.or(report.clusters);
+        if let Some(n) = report.nonfinite_pixels {
+            merged.nonfinite_pixels = Some(merged.nonfinite_pixels.unwrap_or(0) + n);
+        }
+        if let Some(ms) = report.frame_gpu_ms {
+            gpu_ms = Some(gpu_ms.unwrap_or(0.0) + ms);
+        }
+        merged.transient_textures = report.transient_textures;
+        merged.transient_bytes = report.transient_bytes;
+        merged.transient_allocations = report.transient_allocations;
+        merged.views.push(view);
+    }
+    merged.frame_gpu_ms = gpu_ms;
+    merged
 }
 
 /// Adds the `Graph` systems, in order: each adds its pass only if the snapshot calls for it.
@@ -226,8 +538,13 @@ fn add_graph_systems(schedule: &mut Schedule) {
 /// The passes the `Graph` systems would run for `snapshot`, in order, without a GPU (tests and
 /// tools use it to see what a scene calls for).
 pub fn plan_passes(snapshot: FrameSnapshot) -> Result<Vec<&'static str>, RenderError> {
+    plan_view_passes(&snapshot, 0)
+}
+
+/// The passes the `Graph` systems would run for view `index` of `snapshot`, in order.
+pub fn plan_view_passes(snapshot: &FrameSnapshot, index: usize) -> Result<Vec<&'static str>, RenderError> {
     let mut world = World::new();
-    world.insert_resource(CurrentSnapshot(snapshot));
+    world.insert_resource(CurrentView::of(snapshot, index));
     world.init_resource::<FrameGraph>();
     let mut schedule = Schedule::new(RenderSchedule);
     add_graph_systems(&mut schedule);
@@ -237,88 +554,88 @@ pub fn plan_passes(snapshot: FrameSnapshot) -> Result<Vec<&'static str>, RenderE
 
 fn prepare(
     mut renderer: ResMut<RendererResource>,
-    snapshot: Res<CurrentSnapshot>,
+    view: Res<CurrentView>,
     mut outcome: ResMut<FrameOutcome>,
 ) {
-    if let Err(e) = renderer.0.prepare(&snapshot.0) {
+    if let Err(e) = renderer.0.prepare_view(&view.0, view.has_lights()) {
         outcome.error.get_or_insert(e);
     }
 }
 
-/// True when the frame shades with cluster lists (a tiled/clustered pipeline with lights).
-fn shades_with_clusters(snapshot: &FrameSnapshot) -> bool {
-    snapshot.settings.pipeline.uses_clusters() && snapshot.has_lights() && !replaces_shading(snapshot)
+/// True when the view shades with cluster lists (a tiled/clustered pipeline with lights).
+fn shades_with_clusters(view: &CurrentView) -> bool {
+    view.settings().pipeline.uses_clusters() && view.has_lights() && !replaces_shading(view)
 }
 
-/// True when the frame is shaded deferred: a G-buffer, then a full-screen lighting pass
+/// True when the view is shaded deferred: a G-buffer, then a full-screen lighting pass
 /// (clustered deferred) or light volumes. Without lights the forward pass draws the ambient.
-fn shades_deferred(snapshot: &FrameSnapshot) -> bool {
-    snapshot.settings.pipeline.is_deferred() && snapshot.has_lights() && !replaces_shading(snapshot)
+fn shades_deferred(view: &CurrentView) -> bool {
+    view.settings().pipeline.is_deferred() && view.has_lights() && !replaces_shading(view)
 }
 
-/// True when the frame runs a depth pre-pass (forward pipelines only).
-fn runs_depth_prepass(snapshot: &FrameSnapshot) -> bool {
-    let s = &snapshot.settings;
-    shades_with_clusters(snapshot)
-        && !shades_deferred(snapshot)
+/// True when the view runs a depth pre-pass (forward pipelines only).
+fn runs_depth_prepass(view: &CurrentView) -> bool {
+    let s = view.settings();
+    shades_with_clusters(view)
+        && !shades_deferred(view)
         && (s.pipeline == PipelineKind::ForwardPlus || s.clusters.depth_prepass)
 }
 
-/// True when a debug view shows surface attributes (albedo, normal): the frame then draws the
+/// True when a debug view shows surface attributes (albedo, normal): the view then draws the
 /// Full G-buffer instead of shading (the debug view replaces the image), in every pipeline.
-fn shows_surfaces(snapshot: &FrameSnapshot) -> bool {
-    snapshot.settings.debug_view.uses_surfaces()
+fn shows_surfaces(view: &CurrentView) -> bool {
+    view.settings().debug_view.uses_surfaces()
 }
 
 /// True when a debug view that needs neither lighting nor clusters replaces the image: albedo
 /// and normal draw the Full G-buffer, depth only the depth pre-pass, in every pipeline.
-fn replaces_shading(snapshot: &FrameSnapshot) -> bool {
-    shows_surfaces(snapshot) || snapshot.settings.debug_view == DebugViewMode::Depth
+fn replaces_shading(view: &CurrentView) -> bool {
+    shows_surfaces(view) || view.settings().debug_view == DebugViewMode::Depth
 }
 
-fn add_depth_prepass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
-    if runs_depth_prepass(&snapshot.0) || snapshot.0.settings.debug_view == DebugViewMode::Depth {
+fn add_depth_prepass(view: Res<CurrentView>, mut graph: ResMut<FrameGraph>) {
+    if runs_depth_prepass(&view) || view.settings().debug_view == DebugViewMode::Depth {
         graph.0.add(DepthPrepass);
     }
 }
 
-fn add_cluster_build(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
-    if snapshot.0.needs_clusters() {
-        graph.0.add(ClusterBuildPass { workgroup_size: snapshot.0.settings.clusters.workgroup_size });
+fn add_cluster_build(view: Res<CurrentView>, mut graph: ResMut<FrameGraph>) {
+    if view.0.needs_clusters(view.has_lights()) {
+        graph.0.add(ClusterBuildPass { workgroup_size: view.settings().clusters.workgroup_size });
     }
 }
 
-fn add_forward_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
+fn add_forward_pass(view: Res<CurrentView>, mut graph: ResMut<FrameGraph>) {
     // Naive forward, and the other pipelines when there are no lights to assign.
-    if !shades_with_clusters(&snapshot.0) && !shades_deferred(&snapshot.0) && !replaces_shading(&snapshot.0) {
-        graph.0.add(ForwardPass { clear_color: snapshot.0.settings.clear_color });
+    if !shades_with_clusters(&view) && !shades_deferred(&view) && !replaces_shading(&view) {
+        graph.0.add(ForwardPass { clear_color: view.settings().clear_color });
     }
 }
 
-fn add_gbuffer_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
-    let s = &snapshot.0.settings;
-    if shows_surfaces(&snapshot.0) {
+fn add_gbuffer_pass(view: Res<CurrentView>, mut graph: ResMut<FrameGraph>) {
+    let s = view.settings();
+    if shows_surfaces(&view) {
         graph.0.add(GBufferPass { layout: GBufferLayout::Full, codec: s.normal_codec });
-    } else if shades_deferred(&snapshot.0) {
+    } else if shades_deferred(&view) {
         graph.0.add(GBufferPass { layout: s.gbuffer, codec: s.normal_codec });
     }
 }
 
-fn add_deferred_lighting_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
-    let s = &snapshot.0.settings;
-    if shades_deferred(&snapshot.0) && s.pipeline == PipelineKind::ClusteredDeferred {
+fn add_deferred_lighting_pass(view: Res<CurrentView>, mut graph: ResMut<FrameGraph>) {
+    let s = view.settings();
+    if shades_deferred(&view) && s.pipeline == PipelineKind::ClusteredDeferred {
         let (layout, codec, clear_color) = (s.gbuffer, s.normal_codec, s.clear_color);
         graph.0.add(DeferredLightingPass { layout, codec, clear_color });
     }
 }
 
 fn add_light_volumes_pass(
-    snapshot: Res<CurrentSnapshot>,
+    view: Res<CurrentView>,
     renderer: Option<Res<RendererResource>>,
     mut graph: ResMut<FrameGraph>,
 ) {
-    let s = &snapshot.0.settings;
-    if shades_deferred(&snapshot.0) && s.pipeline == PipelineKind::LightVolumes {
+    let s = view.settings();
+    if shades_deferred(&view) && s.pipeline == PipelineKind::LightVolumes {
         let (layout, codec, clear_color) = (s.gbuffer, s.normal_codec, s.clear_color);
         // Planning without a GPU (`plan_passes`) lists the same passes with either format.
         let accumulation = renderer.map_or(manylight_render::resources::HDR_FORMAT, |r| {
@@ -328,20 +645,20 @@ fn add_light_volumes_pass(
     }
 }
 
-fn add_clustered_forward_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
-    if shades_with_clusters(&snapshot.0) && !shades_deferred(&snapshot.0) {
+fn add_clustered_forward_pass(view: Res<CurrentView>, mut graph: ResMut<FrameGraph>) {
+    if shades_with_clusters(&view) && !shades_deferred(&view) {
         graph.0.add(ClusteredForwardPass {
-            clear_color: snapshot.0.settings.clear_color,
-            after_prepass: runs_depth_prepass(&snapshot.0),
+            clear_color: view.settings().clear_color,
+            after_prepass: runs_depth_prepass(&view),
         });
     }
 }
 
 /// Camera-motion blur, when the camera has it (and no debug view replaces the image).
-fn add_motion_blur_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
-    let s = &snapshot.0;
-    if let Some(pass) = s.camera.and_then(|c| MotionBlurPass::for_camera(&c, s.viewport))
-        && s.settings.debug_view == DebugViewMode::None
+fn add_motion_blur_pass(view: Res<CurrentView>, mut graph: ResMut<FrameGraph>) {
+    let v = &view.0;
+    if let Some(pass) = v.camera.and_then(|c| MotionBlurPass::for_camera(&c, v.size))
+        && v.settings.debug_view == DebugViewMode::None
     {
         graph.0.add(pass);
     }
@@ -349,10 +666,10 @@ fn add_motion_blur_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameG
 
 /// Bloom's bright pass, blur chain and composite, when the camera has bloom (and no debug view
 /// replaces the image).
-fn add_bloom_passes(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
-    let s = &snapshot.0;
-    if let Some(bloom) = s.camera.and_then(|c| c.bloom)
-        && s.settings.debug_view == DebugViewMode::None
+fn add_bloom_passes(view: Res<CurrentView>, mut graph: ResMut<FrameGraph>) {
+    let v = &view.0;
+    if let Some(bloom) = v.camera.and_then(|c| c.bloom)
+        && v.settings.debug_view == DebugViewMode::None
     {
         for pass in bloom.passes() {
             graph.0.add_boxed(pass);
@@ -361,8 +678,8 @@ fn add_bloom_passes(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph
 }
 
 /// Tone mapping, or the debug view that replaces it.
-fn add_output_pass(snapshot: Res<CurrentSnapshot>, mut graph: ResMut<FrameGraph>) {
-    let s = &snapshot.0.settings;
+fn add_output_pass(view: Res<CurrentView>, mut graph: ResMut<FrameGraph>) {
+    let s = view.settings();
     if s.debug_view == DebugViewMode::None {
         graph.0.add(TonemapPass);
     } else {
@@ -374,13 +691,14 @@ fn execute(
     mut renderer: ResMut<RendererResource>,
     graph: Res<FrameGraph>,
     snapshot: Res<CurrentSnapshot>,
+    view: Res<CurrentView>,
     target: Res<OutputTarget>,
     mut outcome: ResMut<FrameOutcome>,
 ) {
     if outcome.error.is_some() {
         return;
     }
-    match renderer.0.execute(&graph.0, &snapshot.0, &target.view, target.format) {
+    match renderer.0.execute(&graph.0, &snapshot.0, &view.0, &target.view, target.format) {
         Ok(report) => outcome.report = Some(report),
         Err(e) => outcome.error = Some(e),
     }
@@ -477,7 +795,7 @@ impl DeviceSink for HeadlessRenderer {
         let mut snapshot = snapshot;
         let invalid_cameras = snapshot.reject_invalid_camera();
         let size = snapshot.viewport;
-        if size.x == 0 || size.y == 0 || snapshot.camera.is_none() {
+        if size.x == 0 || size.y == 0 || snapshot.views.is_empty() {
             // Nothing to look through or at.
             return Ok((FrameReport { invalid_cameras, ..empty_report(&snapshot) }, None));
         }

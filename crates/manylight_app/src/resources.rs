@@ -154,6 +154,33 @@ pub struct HeadlessCapture {
     pub image: Option<image::RgbaImage>,
 }
 
+/// The images of the cameras that render to an offscreen image ([`RenderTarget::Image`]), from
+/// the latest frame that finished (in pipelined mode, a frame after the one extracted). Each
+/// such image is read back every frame it is rendered.
+///
+/// [`RenderTarget::Image`]: crate::components::RenderTarget::Image
+#[derive(Resource, Clone, Debug, Default)]
+pub struct RenderedImages {
+    images: std::collections::HashMap<manylight_render::RenderTextureId, (u64, image::RgbaImage)>,
+}
+
+impl RenderedImages {
+    /// The latest pixels of `image`, if it was rendered.
+    pub fn get(&self, image: &crate::components::RenderImage) -> Option<&image::RgbaImage> {
+        self.images.get(&image.id).map(|(_, i)| i)
+    }
+
+    /// The frame the latest pixels of `image` belong to.
+    pub fn frame_of(&self, image: &crate::components::RenderImage) -> Option<u64> {
+        self.images.get(&image.id).map(|(f, _)| *f)
+    }
+
+    /// Stores frame `frame`'s pixels of texture `id`.
+    pub fn insert(&mut self, id: manylight_render::RenderTextureId, frame: u64, image: image::RgbaImage) {
+        self.images.insert(id, (frame, image));
+    }
+}
+
 /// The error that stopped rendering, if any (the app also receives `AppExit::error()`).
 #[derive(Resource, Clone, Debug, Default)]
 pub struct RenderFailure(pub Option<String>);

@@ -7,7 +7,7 @@ use bevy_ecs::name::Name;
 use bevy_ecs::prelude::*;
 use manylight_core::Aabb;
 use manylight_render::{
-    ExtractedCamera, ExtractedInstance, ExtractedPointLight, FrameSettings, FrameSnapshot,
+    ExtractedCamera, ExtractedInstance, ExtractedPointLight, ExtractedView, FrameSettings, FrameSnapshot,
 };
 use manylight_scene::light_rig;
 use manylight_scene::{Scene, SceneLight};
@@ -149,13 +149,13 @@ pub fn scene_snapshot(
     FrameSnapshot {
         frame_index,
         viewport: size,
-        camera: Some(ExtractedCamera {
+        views: vec![ExtractedView::main(ExtractedCamera {
             world_from_view: cam.transform,
             projection: cam.projection,
             prev_clip_from_world: None,
             bloom: None,
             motion_blur: None,
-        }),
+        })],
         instances: scene
             .instances
             .iter()

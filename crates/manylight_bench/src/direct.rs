@@ -31,11 +31,11 @@ pub fn measure_culling(
     renderer: &mut HeadlessRenderer,
     snapshot: FrameSnapshot,
 ) -> Result<(FrameReport, CullingEfficiency)> {
-    let projection = snapshot.camera.map(|c| c.projection).unwrap_or_default();
+    let projection = snapshot.camera().map(|c| c.projection).unwrap_or_default();
     let (report, _) = renderer.render(snapshot, false)?;
     let r = renderer.render_world.renderer();
     let clusters =
-        r.clusters.as_ref().context("the frame built no clusters (naive pipeline, or no lights)")?;
+        r.view_clusters(0).context("the frame built no clusters (naive pipeline, or no lights)")?;
     let assignment = clusters.read_assignment(&r.gpu)?;
     let (_, _, depth) = r.read_depth()?.context("the frame has no depth buffer")?;
     let eff =

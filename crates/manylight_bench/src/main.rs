@@ -33,6 +33,7 @@ mod post;
 mod progress;
 mod report;
 mod soak;
+mod views;
 
 #[derive(Parser)]
 #[command(name = "manylight", version, about = "Many-light rendering with wgpu: render, check, bench")]
@@ -58,6 +59,9 @@ enum Command {
     /// What bloom and motion blur cost per frame: the same frame without post stages, with
     /// each bloom chain, with motion blur and with both, in one run, as a markdown table.
     Post(ReportArgs),
+    /// What several cameras cost: the same pixels as 1, 2 and 4 views (each with its own
+    /// clusters; lights uploaded once per frame), in one run, as a markdown table.
+    Views(ViewsArgs),
     /// Thousands of frames in a window while sizes, post stages, debug views and the light
     /// count keep changing; exit 1 if memory or the transient pool grows, a frame fails or a
     /// pixel is NaN.
@@ -115,6 +119,24 @@ struct ReportArgs {
     /// Also write the results as CSV and PNG figures into this folder.
     #[arg(long)]
     plot: Option<PathBuf>,
+}
+
+#[derive(clap::Args)]
+struct ViewsArgs {
+    /// `default`, `sphere-shell` or a .gltf/.glb path.
+    #[arg(long, default_value = "default")]
+    scene: String,
+    /// Rig lights.
+    #[arg(long, default_value_t = 1024)]
+    lights: usize,
+    /// Size of the whole target, WxH (the views split it).
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    size: UVec2,
+    /// Timed frames per view count (after one warm-up).
+    #[arg(long, default_value_t = 5)]
+    frames: u32,
+    #[command(flatten)]
+    clusters: ClusterArgs,
 }
 
 #[derive(clap::Args)]
@@ -524,6 +546,14 @@ fn post_cmd(args: ReportArgs) -> Result<()> {
     Ok(())
 }
 
+fn views_cmd(args: ViewsArgs) -> Result<()> {
+    let scene = load_scene(&args.scene, &LoadOptions::default())?;
+    let base = manylight_render::FrameSettings { clusters: args.clusters.settings(), ..Default::default() };
+    let name = scene_name(&args.scene);
+    print!("{}", views::run(&scene, &name, args.lights, args.size, args.frames.max(1), base)?);
+    Ok(())
+}
+
 fn plot_cmd(csv: PathBuf, out: PathBuf) -> Result<()> {
     let text = std::fs::read_to_string(&csv).with_context(|| format!("cannot read {}", csv.display()))?;
     for figure in plot::figures(&text, &out).with_context(|| format!("{}", csv.display()))? {
@@ -589,6 +619,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => bench_cmd(args),
         Command::Report(args) => report_cmd(args),
         Command::Post(args) => post_cmd(args),
+        Command::Views(args) => views_cmd(args),
         Command::Plot { csv, out } => plot_cmd(csv, out),
         Command::Soak(args) => soak::run(args),
         Command::DepthPrecision { samples } => {

@@ -49,7 +49,7 @@ fn configurations() -> Vec<Config> {
 /// turned by [`TURN`] when it moves.
 fn apply(mut snap: FrameSnapshot, config: &Config) -> FrameSnapshot {
     let size = snap.viewport;
-    if let Some(camera) = &mut snap.camera {
+    if let Some(camera) = snap.camera_mut() {
         camera.bloom = config.bloom;
         camera.motion_blur = config.motion_blur;
         let mut previous = *camera;

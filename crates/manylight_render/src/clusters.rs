@@ -13,7 +13,7 @@ use crate::gpu_types::{
 use crate::passes::common::{storage_entry, uniform_entry};
 use crate::pool::GrowableBuffer;
 use crate::readback::read_buffer;
-use crate::snapshot::FrameSnapshot;
+use crate::snapshot::RenderView;
 use glam::Mat4;
 use manylight_core::cluster::{ClusterAssignment, ClusterGrid, CullTest, ViewSphere, view_spheres};
 use serde::Serialize;
@@ -254,20 +254,20 @@ impl ClusterResources {
     pub fn prepare(
         &mut self,
         gpu: &GpuContext,
-        snapshot: &FrameSnapshot,
+        view: &RenderView,
         view_from_world: &Mat4,
         lights: &[(glam::Vec3, f32)],
     ) -> Result<(), RenderError> {
         let device = &gpu.device;
         let queue = &gpu.queue;
-        let settings = &snapshot.settings.clusters;
-        let grid_config = settings.grid_for(snapshot.settings.pipeline);
+        let settings = &view.settings.clusters;
+        let grid_config = settings.grid_for(view.settings.pipeline);
         self.view_spheres = view_spheres(view_from_world, lights.iter().copied());
         // An infinite projection is sliced up to the farthest light's reach: nothing beyond it
         // is lit, and every light lies inside the grid.
         let reach = manylight_core::cluster::farthest_reach(self.view_spheres.iter().copied());
-        let projection = snapshot.camera.map(|c| c.projection).unwrap_or_default().finite_for(reach);
-        self.grid = ClusterGrid::new(snapshot.viewport, &projection, &grid_config);
+        let projection = view.camera.map(|c| c.projection).unwrap_or_default().finite_for(reach);
+        self.grid = ClusterGrid::new(view.size, &projection, &grid_config);
         self.cull = settings.cull;
         let count = self.grid.cluster_count();
         if self.bounds_of != Some(self.grid) {
@@ -289,7 +289,7 @@ impl ClusterResources {
             self.bounds.write(device, queue, bytemuck::cast_slice(&bounds))?;
             // Level 1 of the build: the same tiles with one slice from near to far.
             let tile_grid = ClusterGrid::new(
-                snapshot.viewport,
+                view.size,
                 &projection,
                 &manylight_core::cluster::GridConfig {
                     dims: Some(glam::UVec3::new(dims.x, dims.y, 1)),
@@ -324,7 +324,7 @@ impl ClusterResources {
         let (near, far) = (self.grid.near, self.grid.far);
         self.params = GpuClusterParams {
             dims: [self.grid.dims.x, self.grid.dims.y, self.grid.dims.z, count],
-            viewport: [snapshot.viewport.x.max(1) as f32, snapshot.viewport.y.max(1) as f32, near, far],
+            viewport: [view.size.x.max(1) as f32, view.size.y.max(1) as f32, near, far],
             light_count: spheres.len() as u32,
             cap: settings.cap.unwrap_or(CLUSTER_NO_CAP),
             cull_test: match settings.cull {

@@ -25,6 +25,7 @@ pub use readback::{HEADLESS_FORMAT, HeadlessTarget};
 pub use renderer::Renderer;
 pub use snapshot::{
     BloomChain, BloomSettings, ClusterSettings, DebugViewMode, ExtractedCamera, ExtractedInstance,
-    ExtractedPointLight, FrameSettings, FrameSnapshot, GBufferLayout, MotionBlurSettings, PipelineKind,
+    ExtractedPointLight, ExtractedView, FrameSettings, FrameSnapshot, GBufferLayout, MotionBlurSettings,
+    PipelineKind, RenderTextureId, RenderView, ViewRect, ViewTarget,
 };
-pub use stats::{FrameReport, PassTiming};
+pub use stats::{FrameReport, PassTiming, ViewReport};

@@ -52,6 +52,14 @@ impl TransientPool {
         }
     }
 
+    /// Makes every texture available again within the frame (the next view of the frame runs
+    /// after the last one finished).
+    pub fn release_all(&mut self) {
+        for e in &mut self.entries {
+            e.in_use = false;
+        }
+    }
+
     /// A texture for `key` not yet handed out this frame, created if needed.
     pub fn acquire(&mut self, device: &wgpu::Device, key: TextureKey, label: &str) -> wgpu::TextureView {
         let frame = self.frame;

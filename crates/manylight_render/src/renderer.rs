@@ -8,7 +8,7 @@ use crate::graph::{OUTPUT, PassContext, RenderGraph};
 use crate::pipelines::PipelineCache;
 use crate::pool::{TextureKey, TransientPool};
 use crate::resources::SceneResources;
-use crate::snapshot::FrameSnapshot;
+use crate::snapshot::{FrameSnapshot, RenderView};
 use crate::stats::{FrameReport, PassTiming};
 use crate::timing::{GpuTimer, MAX_TIMED_PASSES};
 use std::collections::HashMap;
@@ -22,8 +22,9 @@ pub struct Renderer {
     pub scene: SceneResources,
     /// Pipelines created so far.
     pub pipelines: PipelineCache,
-    /// Cluster buffers, created the first time a frame needs them.
-    pub clusters: Option<ClusterResources>,
+    /// Cluster buffers of each view (by its position in the frame's views), created the first
+    /// time the view needs them: views keep their own grids, lists and statistics.
+    pub clusters: Vec<Option<ClusterResources>>,
     pool: TransientPool,
     timer: Option<GpuTimer>,
     cpu_adapter: bool,
@@ -38,7 +39,7 @@ impl Renderer {
         Renderer {
             scene: SceneResources::new(&gpu),
             pipelines: PipelineCache::default(),
-            clusters: None,
+            clusters: Vec::new(),
             pool: TransientPool::default(),
             timer,
             cpu_adapter,
@@ -47,7 +48,8 @@ impl Renderer {
         }
     }
 
-    /// Uploads the snapshot's data (the `Prepare` step).
+    /// Uploads the data the frame's views share (the `Prepare` step): lights, instances,
+    /// meshes and materials, once per frame; starts the frame's transient textures.
     pub fn prepare(&mut self, snapshot: &FrameSnapshot) -> Result<(), RenderError> {
         let settings = &snapshot.settings;
         if settings.pipeline.is_deferred() && !settings.gbuffer.supports(settings.normal_codec) {
@@ -57,14 +59,33 @@ impl Renderer {
                 settings.normal_codec.name()
             )));
         }
+        self.pool.begin_frame();
         self.scene.prepare(&self.gpu, snapshot)?;
-        if snapshot.needs_clusters() {
+        // Views that went away free their cluster buffers.
+        self.clusters.truncate(snapshot.views.len().max(1));
+        Ok(())
+    }
+
+    /// Writes one view's constants and, when it needs them, its cluster grid and light
+    /// spheres (before the view is executed; views run one after the other).
+    /// `has_lights`: the frame has a valid light ([`FrameSnapshot::has_lights`]).
+    pub fn prepare_view(&mut self, view: &RenderView, has_lights: bool) -> Result<(), RenderError> {
+        self.scene.prepare_view(&self.gpu, view);
+        if view.needs_clusters(has_lights) {
+            if self.clusters.len() <= view.index {
+                self.clusters.resize_with(view.index + 1, || None);
+            }
             let gpu = &self.gpu;
-            let clusters = self.clusters.get_or_insert_with(|| ClusterResources::new(gpu));
-            let view_from_world = snapshot.camera.map(|c| c.view_from_world()).unwrap_or_default();
-            clusters.prepare(gpu, snapshot, &view_from_world, &self.scene.light_spheres)?;
+            let clusters = self.clusters[view.index].get_or_insert_with(|| ClusterResources::new(gpu));
+            let view_from_world = view.camera.map(|c| c.view_from_world()).unwrap_or_default();
+            clusters.prepare(gpu, view, &view_from_world, &self.scene.light_spheres)?;
         }
         Ok(())
+    }
+
+    /// The cluster buffers of view `index`, if it built clusters.
+    pub fn view_clusters(&self, index: usize) -> Option<&ClusterResources> {
+        self.clusters.get(index).and_then(Option::as_ref)
     }
 
     /// The last frame's depth buffer (reverse-Z, row-major), if the frame had one.
@@ -84,13 +105,15 @@ impl Renderer {
         &self.pool
     }
 
-    /// Runs `graph` into `output` (the `Execute` step) and waits for the GPU to finish. When the
+    /// Runs `graph` for `view` into `output` (the `Execute` step) and waits for the GPU to
+    /// finish. When the
     /// cluster build finds its light-index list too small, the list grows and the frame is
     /// rendered again, so no light is ever lost to a buffer size.
     pub fn execute(
         &mut self,
         graph: &RenderGraph,
         snapshot: &FrameSnapshot,
+        view: &RenderView,
         output: &wgpu::TextureView,
         output_format: wgpu::TextureFormat,
     ) -> Result<FrameReport, RenderError> {
@@ -108,8 +131,10 @@ impl Renderer {
         }
         let mut regrows = 0;
         loop {
-            let mut report = self.execute_once(graph, snapshot, output, output_format)?;
-            let Some(clusters) = self.clusters.as_mut().filter(|_| builds_clusters) else {
+            let mut report = self.execute_once(graph, snapshot, view, output, output_format)?;
+            let Some(clusters) =
+                self.clusters.get_mut(view.index).and_then(Option::as_mut).filter(|_| builds_clusters)
+            else {
                 return Ok(report);
             };
             let counters = clusters.read_counters(&self.gpu)?;
@@ -147,13 +172,15 @@ impl Renderer {
         &mut self,
         graph: &RenderGraph,
         snapshot: &FrameSnapshot,
+        view: &RenderView,
         output: &wgpu::TextureView,
         output_format: wgpu::TextureFormat,
     ) -> Result<FrameReport, RenderError> {
         let frame_start = Instant::now();
         let order = graph.compile()?;
-        self.pool.begin_frame();
-        let size = snapshot.viewport;
+        // Views of one frame run one after the other: they may share transient textures.
+        self.pool.release_all();
+        let size = view.size;
         let mut textures = HashMap::new();
         textures.insert(OUTPUT, output.clone());
         for &i in &order {
@@ -180,7 +207,7 @@ impl Renderer {
                 gpu: &self.gpu,
                 scene: &self.scene,
                 pipelines: &self.pipelines,
-                clusters: self.clusters.as_ref(),
+                clusters: self.clusters.get(view.index).and_then(Option::as_ref),
                 encoder: &mut encoder,
                 output_format,
                 textures: &textures,
@@ -226,7 +253,7 @@ impl Renderer {
             frame_index: snapshot.frame_index,
             width: size.x,
             height: size.y,
-            pipeline: snapshot.settings.pipeline.name().to_string(),
+            pipeline: view.settings.pipeline.name().to_string(),
             frame_gpu_ms: (!gpu_times.is_empty()).then(|| gpu_times.iter().sum()),
             passes,
             frame_cpu_ms: frame_start.elapsed().as_secs_f64() * 1e3,
@@ -242,6 +269,9 @@ impl Renderer {
             transient_bytes: self.pool.frame_bytes(),
             transient_allocations: self.pool.allocations(),
             clusters: None,
+            views: Vec::new(),
+            light_uploads: 0,
+            light_upload_bytes: 0,
             device_recoveries: 0,
         })
     }

@@ -7,7 +7,7 @@
 use crate::context::{GpuContext, RenderError};
 use crate::gpu_types::{GpuInstance, GpuMaterial, GpuPointLight, SHADING_GLOBAL, ViewUniform};
 use crate::pool::GrowableBuffer;
-use crate::snapshot::{FrameSnapshot, aspect};
+use crate::snapshot::{FrameSnapshot, RenderView, aspect};
 use glam::{Mat4, Vec4};
 use manylight_core::{MaterialData, MeshData, TextureData, Vertex};
 use std::collections::HashMap;
@@ -79,6 +79,8 @@ pub struct SceneResources {
     pub view: ViewUniform,
     /// Lights uploaded this frame.
     pub light_count: u32,
+    /// Bytes written to the light buffer this frame (once per frame, whatever the views).
+    pub light_upload_bytes: u64,
     /// Lights dropped for invalid parameters this frame.
     pub invalid_lights: u32,
     /// Instances not drawn this frame because their transform is not finite.
@@ -240,6 +242,7 @@ impl SceneResources {
             draws: Vec::new(),
             view: ViewUniform::zeroed_default(),
             light_count: 0,
+            light_upload_bytes: 0,
             invalid_lights: 0,
             invalid_instances: 0,
             collapsed_instances: 0,
@@ -274,16 +277,12 @@ impl SceneResources {
         })
     }
 
-    /// Uploads the frame's view, lights, instances and any new meshes/materials/textures.
-    pub fn prepare(&mut self, gpu: &GpuContext, snapshot: &FrameSnapshot) -> Result<(), RenderError> {
-        self.frame += 1;
-        let device = &gpu.device;
-        let queue = &gpu.queue;
-
-        // View constants.
-        let size = snapshot.viewport;
-        let settings = &snapshot.settings;
-        self.view = match &snapshot.camera {
+    /// Writes the view constants of `view` (before each view's submission: the views of a
+    /// frame share the lights and instances that [`SceneResources::prepare`] uploaded once).
+    pub fn prepare_view(&mut self, gpu: &GpuContext, view: &RenderView) {
+        let size = view.size;
+        let settings = &view.settings;
+        self.view = match &view.camera {
             Some(cam) => {
                 let clip_from_view = cam.projection.matrix(aspect(size));
                 let view_from_world = cam.view_from_world();
@@ -299,13 +298,26 @@ impl SceneResources {
                     camera_position: cam.position().extend(1.0),
                     viewport: viewport_vec(size),
                     params: Vec4::new(p.near, p.near_over_far(), settings.exposure, settings.ambient),
-                    light_count: 0,
+                    light_count: self.light_count,
                     shading_model: settings.shading.gpu_id(),
                     _pad: [0; 2],
                 }
             }
-            None => ViewUniform { viewport: viewport_vec(size), ..ViewUniform::zeroed_default() },
+            None => ViewUniform {
+                viewport: viewport_vec(size),
+                light_count: self.light_count,
+                ..ViewUniform::zeroed_default()
+            },
         };
+        gpu.queue.write_buffer(&self.view_buffer, 0, bytemuck::bytes_of(&self.view));
+    }
+
+    /// Uploads the frame's lights, instances and any new meshes/materials/textures, once per
+    /// frame whatever the number of views.
+    pub fn prepare(&mut self, gpu: &GpuContext, snapshot: &FrameSnapshot) -> Result<(), RenderError> {
+        self.frame += 1;
+        let device = &gpu.device;
+        let queue = &gpu.queue;
 
         // Lights: invalid ones (NaN, inf, negative) are dropped and counted, never uploaded.
         let gpu_lights: Vec<GpuPointLight> = snapshot
@@ -321,11 +333,10 @@ impl SceneResources {
         self.light_spheres =
             snapshot.lights.iter().filter(|l| l.is_valid()).map(|l| (l.position, l.radius)).collect();
         self.light_count = gpu_lights.len() as u32;
-        self.view.light_count = self.light_count;
         let light_bytes: &[u8] =
             if gpu_lights.is_empty() { &[0u8; 32] } else { bytemuck::cast_slice(&gpu_lights) };
         self.lights.write(device, queue, light_bytes)?;
-        queue.write_buffer(&self.view_buffer, 0, bytemuck::bytes_of(&self.view));
+        self.light_upload_bytes = light_bytes.len() as u64;
 
         // Meshes, materials, instances.
         let mut instance_data = Vec::with_capacity(snapshot.instances.len());

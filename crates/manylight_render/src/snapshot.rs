@@ -382,15 +382,113 @@ impl ExtractedPointLight {
     }
 }
 
+/// A texture a view renders into instead of the main target; the app reads its image back
+/// after the frame (render to texture). Ids are chosen by the app and only compared.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Default, serde::Serialize)]
+pub struct RenderTextureId(pub u64);
+
+/// Where a view's image goes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ViewTarget {
+    /// The frame's main target: the window, or the headless image.
+    #[default]
+    Main,
+    /// An offscreen texture of `size` pixels, read back for the app after the frame.
+    Texture {
+        /// Which texture (views with the same id draw into one texture).
+        id: RenderTextureId,
+        /// Its size in pixels.
+        size: UVec2,
+    },
+}
+
+/// A rectangle of a target, in pixels from its top-left corner.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ViewRect {
+    /// Top-left corner.
+    pub origin: UVec2,
+    /// Width and height.
+    pub size: UVec2,
+}
+
+/// One camera's view of the frame: where it looks from, where its image goes and what it
+/// shows. Views share the frame's lights and instances, which are uploaded once.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ExtractedView {
+    /// The camera, with its post-processing components.
+    pub camera: ExtractedCamera,
+    /// The target the view draws into.
+    pub target: ViewTarget,
+    /// The part of the target it covers; `None` for the whole target. Clipped to the target.
+    pub rect: Option<ViewRect>,
+    /// The view's own debug view, instead of the frame's [`FrameSettings::debug_view`].
+    pub debug_view: Option<DebugViewMode>,
+    /// Render order (lower first, as Bevy's `Camera::order`); views with equal order keep
+    /// their order in [`FrameSnapshot::views`]. Reported in [`crate::stats::ViewReport`].
+    pub order: isize,
+}
+
+impl ExtractedView {
+    /// A view of the whole main target through `camera`.
+    pub fn main(camera: ExtractedCamera) -> ExtractedView {
+        ExtractedView { camera, target: ViewTarget::Main, rect: None, debug_view: None, order: 0 }
+    }
+
+    /// The size of the view's target, given the main target's.
+    pub fn target_size(&self, main: UVec2) -> UVec2 {
+        match self.target {
+            ViewTarget::Main => main,
+            ViewTarget::Texture { size, .. } => size,
+        }
+    }
+
+    /// The rectangle it covers, clipped to a target of `target_size` (zero-sized when it
+    /// lies outside).
+    pub fn rect_in(&self, target_size: UVec2) -> ViewRect {
+        let rect = self.rect.unwrap_or(ViewRect { origin: UVec2::ZERO, size: target_size });
+        let origin = rect.origin.min(target_size);
+        let end = rect.origin.saturating_add(rect.size).min(target_size);
+        ViewRect { origin, size: end - origin }
+    }
+}
+
+/// One view as the render side draws it: the camera, the size of its image and the settings
+/// with its debug view.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderView {
+    /// Position in [`FrameSnapshot::views`] (the view's cluster buffers are kept by it).
+    pub index: usize,
+    /// The camera; `None` for a frame without views (only the clear colour).
+    pub camera: Option<ExtractedCamera>,
+    /// Image size in pixels.
+    pub size: UVec2,
+    /// The frame's settings, with the view's debug view.
+    pub settings: FrameSettings,
+}
+
+impl RenderView {
+    /// True when the view needs the cluster build: a tiled/clustered pipeline with lights
+    /// (`has_lights`) and no debug view, or a debug view that shows cluster data.
+    pub fn needs_clusters(&self, has_lights: bool) -> bool {
+        // A debug view replaces the image: then only a view of cluster data needs them.
+        self.camera.is_some()
+            && match self.settings.debug_view {
+                DebugViewMode::None => self.settings.pipeline.uses_clusters() && has_lights,
+                view => view.uses_clusters(),
+            }
+    }
+}
+
 /// Everything one frame is rendered from.
 #[derive(Clone, Debug, Default)]
 pub struct FrameSnapshot {
     /// Frame counter, from 0.
     pub frame_index: u64,
-    /// Target size in pixels (0 in either axis: nothing is rendered).
+    /// Main target size in pixels (0 in either axis: nothing is drawn into it).
     pub viewport: UVec2,
-    /// The camera; `None` renders nothing but the clear colour.
-    pub camera: Option<ExtractedCamera>,
+    /// The views, rendered in this order (extract sorts them by [`ExtractedView::order`]);
+    /// none renders nothing but the clear colour.
+    pub views: Vec<ExtractedView>,
     /// Drawn objects.
     pub instances: Vec<ExtractedInstance>,
     /// Point lights.
@@ -400,34 +498,67 @@ pub struct FrameSnapshot {
 }
 
 impl FrameSnapshot {
-    /// Removes a camera that [`ExtractedCamera::is_valid`] refuses (the frame then renders
-    /// nothing) and returns how many were removed, for [`crate::FrameReport::invalid_cameras`].
-    pub fn reject_invalid_camera(&mut self) -> u32 {
-        if self.camera.as_ref().is_some_and(|c| !c.is_valid()) {
-            tracing::warn!(
-                "the camera's transform is not finite or not invertible: nothing is rendered this frame"
-            );
-            self.camera = None;
-            1
-        } else {
-            0
+    /// The first view's camera.
+    pub fn camera(&self) -> Option<&ExtractedCamera> {
+        self.views.first().map(|v| &v.camera)
+    }
+
+    /// The first view's camera, to change it.
+    pub fn camera_mut(&mut self) -> Option<&mut ExtractedCamera> {
+        self.views.first_mut().map(|v| &mut v.camera)
+    }
+
+    /// Makes `camera` the frame's only view, of the whole main target (`None`: no view).
+    pub fn set_camera(&mut self, camera: Option<ExtractedCamera>) {
+        self.views.clear();
+        self.views.extend(camera.map(ExtractedView::main));
+    }
+
+    /// View `index` as the render side draws it (its image size, its debug view).
+    pub fn render_view(&self, index: usize) -> RenderView {
+        let mut settings = self.settings;
+        match self.views.get(index) {
+            Some(view) => {
+                settings.debug_view = view.debug_view.unwrap_or(settings.debug_view);
+                let size = view.rect_in(view.target_size(self.viewport)).size;
+                RenderView { index, camera: Some(view.camera), size, settings }
+            }
+            None => RenderView { index, camera: None, size: self.viewport, settings },
         }
     }
 
-    /// Cameras whose projection [`Projection::sanitized`](manylight_core::Projection::sanitized)
-    /// changes (0 or 1), for [`crate::FrameReport::sanitized_cameras`].
-    pub fn sanitized_cameras(&self) -> u32 {
-        let changed = self.camera.as_ref().is_some_and(|c| {
-            let p = c.projection;
-            let s = p.sanitized();
-            // Compared bit for bit, so a NaN parameter counts as changed.
-            (p.fov_y.to_bits(), p.near.to_bits(), p.far.to_bits())
-                != (s.fov_y.to_bits(), s.near.to_bits(), s.far.to_bits())
-        });
-        if changed {
-            tracing::debug!("the camera's projection was sanitised to render");
+    /// Removes the views whose camera [`ExtractedCamera::is_valid`] refuses and returns how
+    /// many were removed, for [`crate::FrameReport::invalid_cameras`].
+    pub fn reject_invalid_camera(&mut self) -> u32 {
+        let before = self.views.len();
+        self.views.retain(|v| v.camera.is_valid());
+        let removed = (before - self.views.len()) as u32;
+        if removed > 0 {
+            tracing::warn!(
+                "{removed} camera(s) with a transform that is not finite or not invertible: not rendered this frame"
+            );
         }
-        u32::from(changed)
+        removed
+    }
+
+    /// Cameras whose projection [`Projection::sanitized`](manylight_core::Projection::sanitized)
+    /// changes, for [`crate::FrameReport::sanitized_cameras`].
+    pub fn sanitized_cameras(&self) -> u32 {
+        let changed = self
+            .views
+            .iter()
+            .filter(|v| {
+                let p = v.camera.projection;
+                let s = p.sanitized();
+                // Compared bit for bit, so a NaN parameter counts as changed.
+                (p.fov_y.to_bits(), p.near.to_bits(), p.far.to_bits())
+                    != (s.fov_y.to_bits(), s.near.to_bits(), s.far.to_bits())
+            })
+            .count() as u32;
+        if changed > 0 {
+            tracing::debug!("{changed} camera projection(s) were sanitised to render");
+        }
+        changed
     }
 
     /// True when at least one light has valid parameters.
@@ -435,14 +566,9 @@ impl FrameSnapshot {
         self.lights.iter().any(|l| l.is_valid())
     }
 
-    /// True when the frame needs the cluster build: a tiled/clustered pipeline with lights and
-    /// no debug view, or a debug view that shows cluster data.
+    /// True when some view needs the cluster build (see [`RenderView::needs_clusters`]).
     pub fn needs_clusters(&self) -> bool {
-        // A debug view replaces the image: then only a view of cluster data needs them.
-        self.camera.is_some()
-            && match self.settings.debug_view {
-                DebugViewMode::None => self.settings.pipeline.uses_clusters() && self.has_lights(),
-                view => view.uses_clusters(),
-            }
+        let has_lights = self.has_lights();
+        (0..self.views.len()).any(|i| self.render_view(i).needs_clusters(has_lights))
     }
 }

@@ -62,10 +62,41 @@ pub struct FrameReport {
     pub transient_allocations: u64,
     /// Cluster statistics, when the frame built clusters.
     pub clusters: Option<crate::clusters::ClusterReport>,
+    /// The views the frame rendered, in order (the passes of each are in [`FrameReport::passes`],
+    /// one view after the other).
+    pub views: Vec<ViewReport>,
+    /// Times the light buffer was written this frame: 1 when the frame has lights, whatever the
+    /// number of views (they share it).
+    pub light_uploads: u32,
+    /// Bytes written to the light buffer this frame.
+    pub light_upload_bytes: u64,
     /// Times the GPU device was found lost and recreated while this frame was rendered (0
     /// normally). A frame in which the loss was found reports no passes: its work went to the
     /// lost device, and the next frame renders on the new one.
     pub device_recoveries: u32,
+}
+
+/// What one view of a frame did.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct ViewReport {
+    /// Position in the frame's views.
+    pub index: usize,
+    /// Its render order (`Camera::order`).
+    pub order: isize,
+    /// `main`, or `texture N` for a render-to-texture view.
+    pub target: String,
+    /// Image size.
+    pub width: u32,
+    /// Image size.
+    pub height: u32,
+    /// Names of its passes, in order.
+    pub passes: Vec<String>,
+    /// Its cluster statistics, when it built clusters.
+    pub clusters: Option<crate::clusters::ClusterReport>,
+    /// CPU time of the view on the render side (view constants, clusters, record, submit, wait).
+    pub cpu_ms: f64,
+    /// Sum of its passes' GPU times, when known.
+    pub gpu_ms: Option<f64>,
 }
 
 impl FrameReport {

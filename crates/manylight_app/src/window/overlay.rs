@@ -280,10 +280,13 @@ fn lights_ui(ui: &mut egui::Ui, world: &mut World, pending: &mut Option<u32>) {
     }
 }
 
-/// The first camera: the one extract renders.
+/// The camera the effect controls act on: the active one rendered first (lowest order).
 fn first_camera(world: &mut World) -> Option<Entity> {
-    let mut q = world.query_filtered::<Entity, With<Camera3d>>();
-    q.iter(world).next()
+    let mut q = world.query_filtered::<(Entity, Option<&crate::Camera>), With<Camera3d>>();
+    q.iter(world)
+        .filter(|(_, c)| c.is_none_or(|c| c.is_active))
+        .min_by_key(|(_, c)| c.map_or(0, |c| c.order))
+        .map(|(e, _)| e)
 }
 
 fn effects_ui(ui: &mut egui::Ui, world: &mut World) {
@@ -353,19 +356,29 @@ fn clusters_ui(ui: &mut egui::Ui, world: &mut World) {
     if s != old {
         *world.resource_mut::<RenderSettings>() = s;
     }
-    let report = world.get_resource::<FrameStats>().and_then(|st| st.last.as_ref()?.clusters.clone());
-    match report {
-        Some(c) => {
-            ui.label(format!(
-                "last frame: {}×{}×{} clusters, max {} / mean {:.1} lights per non-empty cluster",
-                c.dims[0], c.dims[1], c.dims[2], c.max_per_cluster, c.mean_per_non_empty
-            ));
-            if c.dropped_pairs > 0 {
-                ui.colored_label(Color32::LIGHT_RED, format!("{} pairs dropped by the cap", c.dropped_pairs));
+    let views = world.get_resource::<FrameStats>().and_then(|st| Some(st.last.as_ref()?.views.clone()));
+    let views = views.unwrap_or_default();
+    if views.is_empty() {
+        ui.label("last frame rendered no view");
+    }
+    for v in &views {
+        let name = format!("view {} ({}, order {}, {}×{})", v.index, v.target, v.order, v.width, v.height);
+        match &v.clusters {
+            Some(c) => {
+                ui.label(format!(
+                    "{name}: {}×{}×{} clusters, max {} / mean {:.1} lights per non-empty cluster",
+                    c.dims[0], c.dims[1], c.dims[2], c.max_per_cluster, c.mean_per_non_empty
+                ));
+                if c.dropped_pairs > 0 {
+                    ui.colored_label(
+                        Color32::LIGHT_RED,
+                        format!("{} pairs dropped by the cap", c.dropped_pairs),
+                    );
+                }
             }
-        }
-        None => {
-            ui.label("last frame built no clusters");
+            None => {
+                ui.label(format!("{name}: built no clusters"));
+            }
         }
     }
 }
@@ -411,11 +424,26 @@ fn timings_ui(ui: &mut egui::Ui, world: &mut World, history: &VecDeque<Sample>, 
             ui.monospace(format!("{:7.2}", p.cpu_ms));
             ui.end_row();
         }
+        // One row per view when the frame has several (each camera renders its own).
+        if report.views.len() > 1 {
+            for v in &report.views {
+                ui.monospace(format!("view {} ({}, {}×{})", v.index, v.target, v.width, v.height));
+                ui.monospace(v.gpu_ms.map_or("       –".into(), |ms| format!("{ms:8.2}")));
+                ui.monospace(format!("{:7.2}", v.cpu_ms));
+                ui.end_row();
+            }
+        }
         ui.strong("frame");
         ui.monospace(report.frame_gpu_ms.map_or("       –".into(), |ms| format!("{ms:8.2}")));
         ui.monospace(format!("{:7.2}", report.frame_cpu_ms));
         ui.end_row();
     });
+    ui.small(format!(
+        "{} view(s); lights uploaded {}× this frame ({:.1} KiB), shared by every view",
+        report.views.len(),
+        report.light_uploads,
+        report.light_upload_bytes as f64 / 1024.0
+    ));
     ui.small("? = timestamps not trusted on this adapter (compute on lavapipe)");
     plot(ui, history);
 }

@@ -62,7 +62,9 @@ impl SurfaceSink {
         let present_mode =
             if self.vsync { wgpu::PresentMode::AutoVsync } else { wgpu::PresentMode::AutoNoVsync };
         // Copies out of the swapchain serve read-back, where the surface allows them.
-        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | (caps.usages & wgpu::TextureUsages::COPY_SRC);
+        // Copied from (read-back) and into (camera viewports) where the surface allows it.
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT
+            | (caps.usages & (wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::COPY_DST));
         let config = wgpu::SurfaceConfiguration {
             usage,
             format,
@@ -157,6 +159,10 @@ impl SurfaceSink {
 impl FrameSink for SurfaceSink {
     fn lose_device(&mut self, when: crate::render_world::DeviceLoss) {
         self.render_world.lose_device(when);
+    }
+
+    fn take_textures(&mut self) -> Vec<(manylight_render::RenderTextureId, image::RgbaImage)> {
+        self.render_world.take_textures()
     }
 
     fn render_frame(
