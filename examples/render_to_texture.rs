@@ -35,7 +35,7 @@ fn setup(mut commands: Commands) {
     // Rendered before the main camera, into its image.
     commands.spawn((
         Transform::from_xyz(18.5, 6.0, 6.5).looking_at(Vec3::new(-6.0, 0.5, -1.0), Vec3::Y),
-        Camera3d::default(),
+        Camera3d,
         Camera { order: -1, target: RenderTarget::Image(feed), ..default() },
         Bloom::default(),
     ));
@@ -62,7 +62,7 @@ fn setup(mut commands: Commands) {
     // A lamp that lights the screen.
     commands.spawn((
         Transform::from_xyz(-13.5, 2.0, 0.0),
-        PointLight { color: Vec3::ONE, intensity: 25.0, range: 6.0, ..default() },
+        PointLight { color: Vec3::ONE, intensity: 10.0, range: 6.0, ..default() },
     ));
 }
 

@@ -29,24 +29,18 @@ fn setup(mut commands: Commands) {
     spawn_light_rig(&mut commands, 512, scene.bounds(), 7);
     let entrance = Transform::from_xyz(-18.0, 1.7, 0.0).looking_at(Vec3::new(0.0, 1.2, 0.0), Vec3::Y);
     let above = Transform::from_xyz(0.0, 14.0, 0.1).looking_at(Vec3::ZERO, Vec3::Y);
-    commands.spawn((entrance, Camera3d::default(), Camera { order: 0, ..default() }, Quarter(0, 0)));
-    commands.spawn((
-        above,
-        Camera3d::default(),
-        Camera { order: 1, ..default() },
-        Bloom::default(),
-        Quarter(1, 0),
-    ));
+    commands.spawn((entrance, Camera3d, Camera { order: 0, ..default() }, Quarter(0, 0)));
+    commands.spawn((above, Camera3d, Camera { order: 1, ..default() }, Bloom::default(), Quarter(1, 0)));
     commands.spawn((
         entrance,
-        Camera3d::default(),
+        Camera3d,
         Camera { order: 2, ..default() },
         CameraDebugView(DebugViewMode::LightCount),
         Quarter(0, 1),
     ));
     commands.spawn((
         Transform::default(),
-        Camera3d::default(),
+        Camera3d,
         Camera { order: 3, ..default() },
         MotionBlur::default(),
         Circling,

@@ -285,7 +285,7 @@ pub fn setup(app: &mut App, args: &Args, exit_when_done: bool) -> Result<()> {
             spawn_scene(&mut commands, &scene, !shell, aspect);
             if shell {
                 let p = scene.cameras.first().map(|c| c.projection).unwrap_or_default();
-                commands.spawn((Transform::IDENTITY, Camera3d::from(p), Turning));
+                commands.spawn((Transform::IDENTITY, Camera3d, Projection::from(p), Turning));
             }
         })
         .add_systems(

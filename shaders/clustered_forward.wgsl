@@ -13,7 +13,7 @@ fn fs_main(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> @
     let p = surface_point(view, in.clip_position.xy, in.camera_offset);
     let albedo = surface_albedo(material, base_color_texture, base_color_sampler, in.uv);
     let s = surface_params(material, view.shading_model, albedo.rgb, in.world_normal, front_facing);
-    let view_dir = normalize(view.camera_position.xyz - p.world_position);
+    let view_dir = direction_to_eye(view, p.world_position);
     let cluster = cluster_index(cluster_params, in.clip_position.xy, p.view_depth);
     let range = cluster_ranges[cluster];
     var color = albedo.rgb * view.params.w;

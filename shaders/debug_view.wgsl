@@ -44,13 +44,6 @@ fn index_color(i: u32) -> vec3<f32> {
     return clamp(abs(fract(vec3<f32>(h) + k) * 6.0 - 3.0) - 1.0, vec3<f32>(0.0), vec3<f32>(1.0)) * select(0.55, 0.95, i % 2u == 0u);
 }
 
-// View distance (positive) of a reverse-Z depth value
-// (manylight_core::camera::linearize_depth_reverse_z).
-fn linearize_depth(z: f32) -> f32 {
-    let near = view.params.x;
-    let near_over_far = view.params.y;
-    return near / (z * (1.0 - near_over_far) + near_over_far);
-}
 
 @fragment
 fn fs_clusters(in: FullscreenOut) -> @location(0) vec4<f32> {
@@ -106,8 +99,12 @@ fn fs_depth(in: FullscreenOut) -> @location(0) vec4<f32> {
     }
     let near = view.params.x;
     let far = debug.depth_far;
-    let d = linearize_depth(z);
-    let t = clamp(log(d / near) / log(far / near), 0.0, 1.0);
+    let d = view_distance_of_depth(view, z);
+    // Log scale in perspective; orthographic depth is linear, and so is its scale.
+    var t = clamp(log(d / near) / log(far / near), 0.0, 1.0);
+    if is_orthographic(view) {
+        t = clamp((d - near) / (far - near), 0.0, 1.0);
+    }
     return vec4<f32>(vec3<f32>(1.0 - t), 1.0);
 }
 

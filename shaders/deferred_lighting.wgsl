@@ -17,7 +17,7 @@
 @group(2) @binding(2) var<storage, read> cluster_indices: array<u32>;
 
 fn shade(g: GSurface, frag: vec2<f32>) -> vec4<f32> {
-    let view_dir = normalize(view.camera_position.xyz - g.world_position);
+    let view_dir = direction_to_eye(view, g.world_position);
     let view_distance = -(view.view_from_world * vec4<f32>(g.world_position, 1.0)).z;
     let range = cluster_ranges[cluster_index(cluster_params, frag, view_distance)];
     var color = g.params.albedo * view.params.w;

@@ -49,7 +49,7 @@ fn ambient(g: GSurface) -> vec4<f32> {
 }
 
 fn one_light(g: GSurface, light_index: u32) -> vec4<f32> {
-    let view_dir = normalize(view.camera_position.xyz - g.world_position);
+    let view_dir = direction_to_eye(view, g.world_position);
     return vec4<f32>(shade_point_light(g.params, g.world_position, view_dir, lights[light_index]), 0.0);
 }
 

@@ -295,7 +295,7 @@ fn an_invalid_camera_renders_nothing_and_is_counted() {
                 let scene = default_scene();
                 spawn_scene(&mut commands, &scene, false, 1.5);
                 spawn_light_rig(&mut commands, 8, scene.bounds(), 1);
-                commands.spawn((camera, Camera3d::default()));
+                commands.spawn((camera, Camera3d));
             },
         );
         app.update();
@@ -329,7 +329,8 @@ fn extreme_projections_render_finite_images() {
                 spawn_light_rig(&mut commands, 8, scene.bounds(), 1);
                 commands.spawn((
                     Transform::from_xyz(0.0, 2.0, 8.0).looking_at(Vec3::ZERO, Vec3::Y),
-                    Camera3d { fov_y, near, far },
+                    Camera3d,
+                    Projection::Perspective(PerspectiveProjection { fov: fov_y, near, far }),
                 ));
             });
         })

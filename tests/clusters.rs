@@ -142,7 +142,7 @@ fn gpu_lists_equal_the_cpu_reference_on_hard_cases() {
     let mut scene = default_scene();
     scene.cameras = vec![manylight::scene::SceneCamera {
         transform: cam.transform,
-        projection: Projection { fov_y: 1.0, near: 1e-4, far: 1e6 },
+        projection: Projection::perspective(1.0, 1e-4, 1e6),
     }];
     let mut lights = Vec::new();
     for k in 0..24 {

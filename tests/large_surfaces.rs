@@ -24,7 +24,7 @@ const NEAR: f32 = 0.1;
 fn camera(far: f32) -> SceneCamera {
     SceneCamera {
         transform: camera_looking_at(EYE, TARGET),
-        projection: Projection { fov_y: 60f32.to_radians(), near: NEAR, far },
+        projection: Projection::perspective(60f32.to_radians(), NEAR, far),
     }
 }
 

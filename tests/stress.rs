@@ -76,10 +76,11 @@ fn sphere_shell_preset_has_its_lattice_and_turns_the_camera() {
     assert_eq!(report.light_count, 2048);
     assert_eq!(report.instance_count, 2);
     let world = app.world_mut();
-    let mut cameras = world.query_filtered::<(&Transform, &Camera3d), With<Turning>>();
+    let mut cameras = world.query_filtered::<(&Transform, &Projection), (With<Camera3d>, With<Turning>)>();
     let (t, cam) = cameras.single(world).expect("one turning camera");
     assert_eq!(t.translation, Vec3::ZERO);
-    assert!((cam.fov_y - 45f32.to_radians()).abs() < 1e-6 && cam.near == 0.1 && cam.far == 1000.0);
+    let Projection::Perspective(cam) = *cam else { panic!("a perspective camera: {cam:?}") };
+    assert!((cam.fov - 45f32.to_radians()).abs() < 1e-6 && cam.near == 0.1 && cam.far == 1000.0);
     let step = Quat::from_rotation_x(stress::SHELL_TURN_PER_FRAME)
         * Quat::from_rotation_z(stress::SHELL_TURN_PER_FRAME);
     let expected = step * step * step;

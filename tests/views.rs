@@ -70,19 +70,19 @@ fn viewport(x: u32) -> Option<Viewport> {
 fn split_screen_cameras_render_their_own_views() {
     let _gpu = gpu();
     let (split, stats) = render(SIZE, |commands| {
-        commands.spawn((near_camera(), Camera3d::default(), Camera { viewport: viewport(0), ..default() }));
+        commands.spawn((near_camera(), Camera3d, Camera { viewport: viewport(0), ..default() }));
         commands.spawn((
             far_camera(),
-            Camera3d::default(),
+            Camera3d,
             Camera { viewport: viewport(HALF.x), order: 1, ..default() },
             Bloom::default(),
         ));
     });
     let (left, _) = render(HALF, |commands| {
-        commands.spawn((near_camera(), Camera3d::default()));
+        commands.spawn((near_camera(), Camera3d));
     });
     let (right, _) = render(HALF, |commands| {
-        commands.spawn((far_camera(), Camera3d::default(), Bloom::default()));
+        commands.spawn((far_camera(), Camera3d, Bloom::default()));
     });
     assert_similar("split_screen_left", &left, &half(&split, false), STRICT);
     assert_similar("split_screen_right", &right, &half(&split, true), STRICT);
@@ -115,20 +115,12 @@ fn order_activity_and_a_per_camera_debug_view() {
     let (_, stats) = render(SIZE, |commands| {
         commands.spawn((
             far_camera(),
-            Camera3d::default(),
+            Camera3d,
             Camera { viewport: viewport(HALF.x), order: 2, ..default() },
             CameraDebugView(DebugViewMode::LightCount),
         ));
-        commands.spawn((
-            near_camera(),
-            Camera3d::default(),
-            Camera { viewport: viewport(0), order: -1, ..default() },
-        ));
-        commands.spawn((
-            near_camera(),
-            Camera3d::default(),
-            Camera { order: 5, is_active: false, ..default() },
-        ));
+        commands.spawn((near_camera(), Camera3d, Camera { viewport: viewport(0), order: -1, ..default() }));
+        commands.spawn((near_camera(), Camera3d, Camera { order: 5, is_active: false, ..default() }));
     });
     let report = last(&stats);
     let orders: Vec<isize> = report.views.iter().map(|v| v.order).collect();
@@ -146,10 +138,10 @@ fn a_camera_renders_into_an_image_the_app_reads() {
     let mut app = App::new();
     app.add_plugins(ManyLightPlugin::headless(SIZE)).add_systems(Startup, move |mut commands: Commands| {
         scene(&mut commands);
-        commands.spawn((near_camera(), Camera3d::default()));
+        commands.spawn((near_camera(), Camera3d));
         commands.spawn((
             far_camera(),
-            Camera3d::default(),
+            Camera3d,
             Camera { target: RenderTarget::Image(target), order: -1, ..default() },
         ));
     });
@@ -163,11 +155,11 @@ fn a_camera_renders_into_an_image_the_app_reads() {
     assert_eq!(targets, [format!("texture {}", target.id.0).as_str(), "main"]);
 
     let (alone, _) = render(HALF, |commands| {
-        commands.spawn((far_camera(), Camera3d::default()));
+        commands.spawn((far_camera(), Camera3d));
     });
     assert_similar("render_to_texture", &alone, &texture, STRICT);
     let (main, _) = render(SIZE, |commands| {
-        commands.spawn((near_camera(), Camera3d::default()));
+        commands.spawn((near_camera(), Camera3d));
     });
     let shown =
         app.world_mut().resource_mut::<manylight::app::HeadlessCapture>().image.take().expect("a frame");
@@ -182,11 +174,7 @@ fn uncovered_pixels_show_the_clear_colour() {
     let (image, stats) = render(SIZE, |commands| {
         let oversized =
             Viewport { physical_position: UVec2::new(HALF.x, 0), physical_size: UVec2::new(500, 500) };
-        commands.spawn((
-            far_camera(),
-            Camera3d::default(),
-            Camera { viewport: Some(oversized), ..default() },
-        ));
+        commands.spawn((far_camera(), Camera3d, Camera { viewport: Some(oversized), ..default() }));
     });
     let report = last(&stats);
     assert_eq!((report.views[0].width, report.views[0].height), (HALF.x, HALF.y), "clipped to the target");

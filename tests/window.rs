@@ -63,7 +63,8 @@ fn cube() -> MeshData {
     }
 }
 
-/// A floor, four boxes, eight coloured lights and a camera.
+/// A floor, four boxes, eight coloured lights, a camera and a second one drawn over its top-left
+/// corner (a viewport copied into the swapchain image).
 fn spawn_small_scene(mut commands: Commands) {
     let mesh = Arc::new(cube());
     let material = Arc::new(MaterialData::default());
@@ -81,7 +82,13 @@ fn spawn_small_scene(mut commands: Commands) {
             PointLight { color, intensity: 4.0, range: 6.0, radius: 0.0 },
         ));
     }
-    commands.spawn((Transform::from_xyz(0.0, 4.0, 7.0).looking_at(Vec3::ZERO, Vec3::Y), Camera3d::default()));
+    commands.spawn((Transform::from_xyz(0.0, 4.0, 7.0).looking_at(Vec3::ZERO, Vec3::Y), Camera3d));
+    let corner = Viewport { physical_position: UVec2::new(8, 8), physical_size: UVec2::new(64, 48) };
+    commands.spawn((
+        Transform::from_xyz(0.0, 9.0, 0.1).looking_at(Vec3::ZERO, Vec3::Y),
+        Camera3d,
+        Camera { order: 1, viewport: Some(corner), ..default() },
+    ));
 }
 
 /// One step of the script.
@@ -175,6 +182,8 @@ struct Log {
     close_requested: Option<Instant>,
     /// Frames whose report counted non-finite pixels.
     nonfinite_frames: u32,
+    /// The most views one rendered frame had.
+    max_views: usize,
     /// Passes of the last frame rendered at 1×1.
     one_pixel_passes: Vec<String>,
     /// Frames read back at [`BACK`] after the 1×1 ones and compared with the reference.
@@ -239,6 +248,7 @@ fn run_script(
         if report.nonfinite_pixels.is_some_and(|n| n > 0) {
             log.nonfinite_frames += 1;
         }
+        log.max_views = log.max_views.max(report.views.len());
         if let Some(Step::RenderedFrames(w, h, _)) = SCRIPT.get(state.step)
             && (report.width, report.height) == (*w, *h)
             && report.pass_names().contains(&"bloom_composite")
@@ -512,6 +522,7 @@ fn drive_window(pipelined: bool) {
     assert!(log.minimised_updates >= 3 * MINIMISED_UPDATES, "too few minimised updates");
     assert!(log.zero_sized_frames > 0, "no 0×0 frame reached the renderer while minimised");
     assert_eq!(log.nonfinite_frames, 0, "frames with non-finite pixels");
+    assert_eq!(log.max_views, 2, "both cameras rendered, the second into its viewport");
     for pass in ["cluster_build", "clustered_forward", "bloom_composite", "tonemap"] {
         assert!(
             log.one_pixel_passes.iter().any(|p| p == pass),

@@ -67,13 +67,14 @@ const SURFACE_POINT_MIN_COSINE: f32 = 1e-3;
 fn surface_point(v: ViewUniform, frag: vec2<f32>, offset: vec3<f32>) -> SurfacePoint {
     let g = cross(dpdx(offset), dpdy(offset));
     let ray = view_ray(v, frag);
+    let origin = view_ray_origin(v, frag);
     let denom = dot(ray, g);
-    let t = dot(offset, g) / denom;
+    let t = dot(offset - origin, g) / denom;
     let camera = v.camera_position.xyz;
     var p: SurfacePoint;
     // NaN (a degenerate derivative) fails every comparison and falls back.
     if abs(denom) > SURFACE_POINT_MIN_COSINE * length(ray) * length(g) && t > 0.0 && t < 3.4e38 {
-        p.world_position = camera + ray * t;
+        p.world_position = camera + origin + ray * t;
         p.view_depth = t;
     } else {
         p.world_position = camera + offset;

@@ -17,19 +17,70 @@ struct ViewUniform {
     _pad1: u32,
 };
 
-// Direction of the ray through the framebuffer position `frag` (pixel centres at .5), in world
-// axes but relative to the camera, scaled so that its view-space z is -1: the point
-// `camera + t * ray` lies at view depth t. Built from the projection's scale terms and the
-// inverse of the view's 3x3 part (cofactors, so a scaled camera works too); no world
-// coordinate enters it, so it is as exact far from the world origin as near it.
-fn view_ray(v: ViewUniform, frag: vec2<f32>) -> vec3<f32> {
-    let ndc = vec2<f32>(frag.x * v.viewport.z * 2.0 - 1.0, 1.0 - frag.y * v.viewport.w * 2.0);
-    let dir_view = vec3<f32>(ndc.x / v.clip_from_view[0][0], ndc.y / v.clip_from_view[1][1], -1.0);
+// True for an orthographic projection: its matrix has w = 1 for every point (a perspective
+// one has w = -z).
+fn is_orthographic(v: ViewUniform) -> bool {
+    return v.clip_from_view[3][3] == 1.0;
+}
+
+// A view-space vector in world axes, through the inverse of the view's 3x3 part (cofactors,
+// so a scaled camera works too); no world coordinate enters it, so it is as exact far from the
+// world origin as near it.
+fn view_to_world_vector(v: ViewUniform, d: vec3<f32>) -> vec3<f32> {
     let c0 = v.view_from_world[0].xyz;
     let c1 = v.view_from_world[1].xyz;
     let c2 = v.view_from_world[2].xyz;
     let r0 = cross(c1, c2);
     let r1 = cross(c2, c0);
     let r2 = cross(c0, c1);
-    return vec3<f32>(dot(r0, dir_view), dot(r1, dir_view), dot(r2, dir_view)) / dot(c0, r0);
+    return vec3<f32>(dot(r0, d), dot(r1, d), dot(r2, d)) / dot(c0, r0);
+}
+
+// NDC of the framebuffer position `frag` (pixel centres at .5).
+fn frag_ndc(v: ViewUniform, frag: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(frag.x * v.viewport.z * 2.0 - 1.0, 1.0 - frag.y * v.viewport.w * 2.0);
+}
+
+// Direction of the ray through the framebuffer position `frag`, in world axes, scaled so that
+// its view-space z is -1: the point `camera + view_ray_origin + t * ray` lies at view depth t.
+// Perspective rays leave the camera; orthographic rays are parallel.
+fn view_ray(v: ViewUniform, frag: vec2<f32>) -> vec3<f32> {
+    if is_orthographic(v) {
+        return view_to_world_vector(v, vec3<f32>(0.0, 0.0, -1.0));
+    }
+    let ndc = frag_ndc(v, frag);
+    return view_to_world_vector(v, vec3<f32>(ndc.x / v.clip_from_view[0][0], ndc.y / v.clip_from_view[1][1], -1.0));
+}
+
+// Where the ray through `frag` starts, relative to the camera position: 0 in perspective; on
+// the camera's plane, beside it, in orthographic.
+fn view_ray_origin(v: ViewUniform, frag: vec2<f32>) -> vec3<f32> {
+    if !is_orthographic(v) {
+        return vec3<f32>(0.0);
+    }
+    let ndc = frag_ndc(v, frag);
+    return view_to_world_vector(v, vec3<f32>(ndc.x / v.clip_from_view[0][0], ndc.y / v.clip_from_view[1][1], 0.0));
+}
+
+// Unit direction from the surface point `p` (world) towards the eye: to the camera position in
+// perspective, against the view direction in orthographic.
+fn direction_to_eye(v: ViewUniform, p: vec3<f32>) -> vec3<f32> {
+    if is_orthographic(v) {
+        return normalize(view_to_world_vector(v, vec3<f32>(0.0, 0.0, 1.0)));
+    }
+    return normalize(v.camera_position.xyz - p);
+}
+
+// View distance (positive) of a reverse-Z depth value, through the projection's depth terms
+// (depth = (A z + B) / w): perspective `B / (depth + A)` with w = -z, orthographic
+// `(B - depth) / A` with w = 1 (manylight_core::Projection::linearize_depth).
+fn view_distance_of_depth(v: ViewUniform, depth: f32) -> f32 {
+    let a = v.clip_from_view[2][2];
+    let b = v.clip_from_view[3][2];
+    if is_orthographic(v) {
+        return (b - depth) / a;
+    }
+    let near = v.params.x;
+    let near_over_far = v.params.y;
+    return near / (depth * (1.0 - near_over_far) + near_over_far);
 }

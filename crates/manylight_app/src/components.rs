@@ -2,7 +2,7 @@
 
 use bevy_ecs::prelude::*;
 use glam::{Mat4, Quat, Vec3};
-use manylight_core::{MaterialData, MeshData, Projection};
+use manylight_core::{MaterialData, MeshData};
 use std::sync::Arc;
 
 pub use bevy_transform::components::{GlobalTransform, Transform};
@@ -142,13 +142,35 @@ impl RenderImage {
 #[derive(Component, Clone, Copy, Debug, PartialEq, Eq)]
 pub struct CameraDebugView(pub manylight_render::DebugViewMode);
 
-/// A perspective camera; the entity's [`GlobalTransform`] places it (looking down its -Z; its
-/// scale is ignored). Its [`Camera`] says where it renders.
+/// A 3D camera, as Bevy's: the entity's [`GlobalTransform`] places it (looking down its -Z; its
+/// scale is ignored), its [`Projection`] says how it sees (perspective by default), its
+/// [`Camera`] where it renders.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[require(Transform, Camera, Projection)]
+pub struct Camera3d;
+
+/// How a [`Camera3d`] projects the scene, as Bevy's `Projection`: perspective (the default) or
+/// orthographic. Both keep reverse-Z depth; clusters of an orthographic view are boxes sliced
+/// linearly in depth.
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
-#[require(Transform, Camera)]
-pub struct Camera3d {
+pub enum Projection {
+    /// Rays from the camera through the pixels.
+    Perspective(PerspectiveProjection),
+    /// Parallel rays.
+    Orthographic(OrthographicProjection),
+}
+
+impl Default for Projection {
+    fn default() -> Self {
+        Projection::Perspective(PerspectiveProjection::default())
+    }
+}
+
+/// A perspective projection.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PerspectiveProjection {
     /// Vertical field of view in radians.
-    pub fov_y: f32,
+    pub fov: f32,
     /// Near plane distance.
     pub near: f32,
     /// Far plane distance, or `f32::INFINITY` for none (nothing is clipped far away; the
@@ -156,22 +178,57 @@ pub struct Camera3d {
     pub far: f32,
 }
 
-impl Default for Camera3d {
+impl Default for PerspectiveProjection {
     fn default() -> Self {
-        Camera3d::from(Projection::default())
+        let p = manylight_core::Projection::default();
+        PerspectiveProjection { fov: p.fov_y, near: p.near, far: p.far }
     }
 }
 
-impl From<Projection> for Camera3d {
-    fn from(p: Projection) -> Self {
-        Camera3d { fov_y: p.fov_y, near: p.near, far: p.far }
+/// An orthographic projection: `viewport_height` world units fill the view vertically (Bevy's
+/// `ScalingMode::FixedVertical`), the width follows the view's aspect ratio.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OrthographicProjection {
+    /// Near plane distance (> 0).
+    pub near: f32,
+    /// Far plane distance (finite, > near: orthographic depth is linear).
+    pub far: f32,
+    /// Visible height in world units.
+    pub viewport_height: f32,
+}
+
+impl Default for OrthographicProjection {
+    fn default() -> Self {
+        OrthographicProjection { near: 0.1, far: 1000.0, viewport_height: 10.0 }
     }
 }
 
-impl Camera3d {
-    /// The projection parameters.
-    pub fn projection(&self) -> Projection {
-        Projection { fov_y: self.fov_y, near: self.near, far: self.far }
+impl From<manylight_core::Projection> for Projection {
+    fn from(p: manylight_core::Projection) -> Self {
+        match p.kind {
+            manylight_core::ProjectionKind::Perspective => {
+                Projection::Perspective(PerspectiveProjection { fov: p.fov_y, near: p.near, far: p.far })
+            }
+            manylight_core::ProjectionKind::Orthographic { height } => {
+                Projection::Orthographic(OrthographicProjection {
+                    near: p.near,
+                    far: p.far,
+                    viewport_height: height,
+                })
+            }
+        }
+    }
+}
+
+impl Projection {
+    /// The render side's parameters.
+    pub fn params(&self) -> manylight_core::Projection {
+        match *self {
+            Projection::Perspective(p) => manylight_core::Projection::perspective(p.fov, p.near, p.far),
+            Projection::Orthographic(o) => {
+                manylight_core::Projection::orthographic(o.viewport_height, o.near, o.far)
+            }
+        }
     }
 }
 

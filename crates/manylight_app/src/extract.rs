@@ -4,7 +4,7 @@
 use crate::backend::{RenderBackend, record_results};
 use crate::components::{
     Bloom, Camera, Camera3d, CameraDebugView, GlobalTransform, InheritedVisibility, LightAnimation, Material,
-    Mesh3d, MotionBlur, PointLight, RenderTarget, Transform,
+    Mesh3d, MotionBlur, PointLight, Projection, RenderTarget, Transform,
 };
 use crate::resources::{DebugView, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize};
 use bevy_app::AppExit;
@@ -33,7 +33,7 @@ pub struct ExtractState {
 pub type CameraItem = (
     Entity,
     &'static GlobalTransform,
-    &'static Camera3d,
+    &'static Projection,
     Option<&'static Camera>,
     Option<&'static Bloom>,
     Option<&'static MotionBlur>,
@@ -63,13 +63,13 @@ pub fn build_snapshot(
     viewport: glam::UVec2,
     settings: &RenderSettings,
     debug: &DebugView,
-    cameras: &Query<CameraItem>,
+    cameras: &Query<CameraItem, With<Camera3d>>,
     meshes: &Query<MeshItem>,
     lights: &Query<LightItem>,
 ) -> FrameSnapshot {
     let mut views: Vec<ExtractedView> = Vec::with_capacity(cameras.iter().len());
     let mut seen = Vec::with_capacity(views.capacity());
-    for (entity, t, c, camera, bloom, motion_blur, debug) in cameras.iter() {
+    for (entity, t, projection, camera, bloom, motion_blur, debug) in cameras.iter() {
         let camera = camera.copied().unwrap_or_default();
         if !camera.is_active {
             continue;
@@ -88,7 +88,7 @@ pub fn build_snapshot(
                     let (_, rotation, translation) = t.to_scale_rotation_translation();
                     Mat4::from_rotation_translation(rotation, translation)
                 },
-                projection: c.projection(),
+                projection: projection.params(),
                 prev_clip_from_world: None,
                 bloom: bloom.map(Bloom::settings),
                 motion_blur: motion_blur.map(MotionBlur::settings),
@@ -150,7 +150,7 @@ pub fn extract_and_render(
     viewport: Res<ViewportSize>,
     settings: Res<RenderSettings>,
     debug: Res<DebugView>,
-    cameras: Query<CameraItem>,
+    cameras: Query<CameraItem, With<Camera3d>>,
     meshes: Query<MeshItem>,
     lights: Query<LightItem>,
     mut backend: ResMut<RenderBackend>,

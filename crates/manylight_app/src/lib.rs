@@ -6,7 +6,7 @@
 //! App::new()
 //!     .add_plugins(ManyLightPlugin::headless(UVec2::new(256, 256)))
 //!     .add_systems(Startup, |mut commands: Commands| {
-//!         commands.spawn((Transform::from_xyz(0.0, 1.0, 5.0), Camera3d::default()));
+//!         commands.spawn((Transform::from_xyz(0.0, 1.0, 5.0), Camera3d));
 //!         commands.spawn((Transform::from_xyz(0.0, 2.0, 0.0), PointLight::default()));
 //!     })
 //!     .run();
@@ -28,7 +28,8 @@ pub mod window;
 pub use backend::RenderFailed;
 pub use components::{
     Bloom, Camera, Camera3d, CameraDebugView, GlobalTransform, InheritedVisibility, LightAnimation, Material,
-    Mesh3d, MotionBlur, PointLight, RenderImage, RenderTarget, Transform, Viewport, Visibility,
+    Mesh3d, MotionBlur, OrthographicProjection, PerspectiveProjection, PointLight, Projection, RenderImage,
+    RenderTarget, Transform, Viewport, Visibility,
 };
 pub use plugin::{HEADLESS_TIME_STEP, HeadlessConfig, ManyLightPlugin, ManyLightSet, OutputMode};
 pub use resources::{
@@ -46,7 +47,8 @@ pub mod prelude {
 
     pub use crate::components::{
         Bloom, Camera, Camera3d, CameraDebugView, GlobalTransform, InheritedVisibility, LightAnimation,
-        Material, Mesh3d, MotionBlur, PointLight, RenderImage, RenderTarget, Transform, Viewport, Visibility,
+        Material, Mesh3d, MotionBlur, OrthographicProjection, PerspectiveProjection, PointLight, Projection,
+        RenderImage, RenderTarget, Transform, Viewport, Visibility,
     };
     pub use crate::plugin::{ManyLightPlugin, ManyLightSet};
     pub use crate::resources::{

@@ -1,7 +1,8 @@
 //! Turning a [`Scene`] (loaded glTF or the embedded default) into entities.
 
 use crate::components::{
-    Camera3d, LightAnimation, Material, Mesh3d, PointLight, Transform, Visibility, transform_from_matrix,
+    Camera3d, LightAnimation, Material, Mesh3d, PointLight, Projection, Transform, Visibility,
+    transform_from_matrix,
 };
 use bevy_ecs::name::Name;
 use bevy_ecs::prelude::*;
@@ -58,7 +59,8 @@ pub fn spawn_scene(commands: &mut Commands, scene: &Scene, spawn_camera: bool, a
         if spawn_camera && node.cameras.contains(&0) {
             commands.spawn((
                 Transform::IDENTITY,
-                Camera3d::from(scene.cameras[0].projection),
+                Camera3d,
+                Projection::from(scene.cameras[0].projection),
                 ChildOf(entity),
             ));
             camera_placed = true;
@@ -74,8 +76,9 @@ pub fn spawn_scene(commands: &mut Commands, scene: &Scene, spawn_camera: bool, a
     }
     if spawn_camera && !camera_placed {
         let cam = scene.camera_or_fit(aspect);
-        let camera =
-            commands.spawn((transform_from_matrix(cam.transform), Camera3d::from(cam.projection))).id();
+        let camera = commands
+            .spawn((transform_from_matrix(cam.transform), Camera3d, Projection::from(cam.projection)))
+            .id();
         if !scene.cameras.is_empty() {
             commands.entity(camera).insert(ChildOf(root));
         }

@@ -26,7 +26,7 @@ pub fn scene(grid: &ClusterGrid, lights: usize, seed: u64) -> Vec<ViewSphere> {
 pub fn grid() -> ClusterGrid {
     ClusterGrid::new(
         UVec2::new(1280, 720),
-        &Projection { fov_y: 60f32.to_radians(), near: 0.1, far: 100.0 },
+        &Projection::perspective(60f32.to_radians(), 0.1, 100.0),
         &GridConfig::default(),
     )
 }

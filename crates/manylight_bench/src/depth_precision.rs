@@ -53,7 +53,7 @@ impl DepthSetup {
     /// looking down -Z (world = view space, so only the depth path is measured).
     pub fn at_origin(fov_y_deg: f32) -> DepthSetup {
         DepthSetup {
-            projection: Projection { fov_y: fov_y_deg.to_radians(), near: 0.1, far: 1000.0 },
+            projection: Projection::perspective(fov_y_deg.to_radians(), 0.1, 1000.0),
             width: 1280,
             height: 720,
             world_from_view: Mat4::IDENTITY,

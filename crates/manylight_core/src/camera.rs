@@ -1,7 +1,8 @@
 //! Camera projection with reverse-Z (depth 1 at the near plane, 0 at the far plane), which
-//! spreads float depth precision evenly in log space and keeps far geometry stable.
+//! spreads float depth precision evenly in log space and keeps far geometry stable;
+//! perspective or orthographic.
 
-use glam::Mat4;
+use glam::{Mat4, Vec2, Vec3};
 
 /// Smallest field of view a projection keeps (radians); smaller ones are raised to it.
 pub const MIN_FOV_Y: f32 = 1e-6;
@@ -10,28 +11,76 @@ pub const MIN_FOV_Y: f32 = 1e-6;
 /// π/2 (`std::f32::consts::PI` rounds above π, and half of it would flip the image).
 pub const MAX_FOV_Y: f32 = 3.141_592_5;
 
-/// A perspective projection.
+/// Depth range an orthographic projection gets when its far plane is missing, not finite or
+/// not beyond the near plane (an orthographic projection needs a finite far plane: its depth
+/// is linear).
+pub const ORTHOGRAPHIC_FALLBACK_DEPTH: f32 = 1000.0;
+
+/// Perspective or orthographic.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum ProjectionKind {
+    /// Rays from the camera position through the pixels, with [`Projection::fov_y`].
+    #[default]
+    Perspective,
+    /// Parallel rays: `height` world units fill the view vertically, the width follows the
+    /// aspect ratio; [`Projection::fov_y`] is ignored. Depth is linear in view distance.
+    Orthographic {
+        /// Visible height in world units (> 0).
+        height: f32,
+    },
+}
+
+/// A perspective or orthographic projection.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Projection {
-    /// Vertical field of view in radians, in (0, π).
+    /// Vertical field of view in radians, in (0, π) (perspective only).
     pub fov_y: f32,
     /// Near plane distance (> 0).
     pub near: f32,
     /// Far plane distance (> near), or `f32::INFINITY` for no far plane: reverse-Z keeps an
     /// infinite projection exact (depth = near / distance), as glTF's infinite cameras are.
+    /// An orthographic projection needs a finite one ([`ORTHOGRAPHIC_FALLBACK_DEPTH`]).
     pub far: f32,
+    /// Perspective (the default) or orthographic.
+    pub kind: ProjectionKind,
 }
 
 impl Default for Projection {
     fn default() -> Self {
-        Self { fov_y: 60f32.to_radians(), near: 0.1, far: 1000.0 }
+        Self { fov_y: 60f32.to_radians(), near: 0.1, far: 1000.0, kind: ProjectionKind::Perspective }
     }
 }
 
 impl Projection {
-    /// A projection without a far plane ([`Projection::far`] is `f32::INFINITY`).
+    /// A perspective projection.
+    pub fn perspective(fov_y: f32, near: f32, far: f32) -> Projection {
+        Projection { fov_y, near, far, kind: ProjectionKind::Perspective }
+    }
+
+    /// A perspective projection without a far plane ([`Projection::far`] is `f32::INFINITY`).
     pub fn infinite(fov_y: f32, near: f32) -> Projection {
-        Projection { fov_y, near, far: f32::INFINITY }
+        Projection::perspective(fov_y, near, f32::INFINITY)
+    }
+
+    /// An orthographic projection `height` world units tall, from `near` to `far`.
+    pub fn orthographic(height: f32, near: f32, far: f32) -> Projection {
+        Projection { fov_y: 60f32.to_radians(), near, far, kind: ProjectionKind::Orthographic { height } }
+    }
+
+    /// Half the visible width and height in world units for an orthographic projection at
+    /// `aspect` (sanitised), `None` for a perspective one.
+    pub fn orthographic_half_extent(&self, aspect: f32) -> Option<Vec2> {
+        match self.sanitized().kind {
+            ProjectionKind::Orthographic { height } => {
+                Some(Vec2::new(0.5 * height * aspect_or_one(aspect), 0.5 * height))
+            }
+            ProjectionKind::Perspective => None,
+        }
+    }
+
+    /// Whether the projection is orthographic.
+    pub fn is_orthographic(&self) -> bool {
+        matches!(self.kind, ProjectionKind::Orthographic { .. })
     }
 
     /// Whether the projection has no far plane.
@@ -44,24 +93,56 @@ impl Projection {
     /// infinite or non-positive near plane becomes 0.1. A far plane that is NaN, not beyond the
     /// near plane, or so close to a huge near plane that the depth terms overflow is dropped:
     /// the projection becomes infinite. `+∞` stays infinite.
+    ///
+    /// Orthographic: a height that is not finite and positive becomes 1 (and one whose
+    /// half-extent overflows or underflows is clamped into `[1e-30, 1e30]`), and a far plane
+    /// that is missing, infinite, not beyond the near plane or too close to it for the linear
+    /// depth scale to be finite becomes `near + ORTHOGRAPHIC_FALLBACK_DEPTH` (or the near
+    /// plane is moved back from a far plane at `f32::MAX`).
     pub fn sanitized(self) -> Projection {
         let fov_y = if self.fov_y.is_finite() { self.fov_y.clamp(MIN_FOV_Y, MAX_FOV_Y) } else { 1.0 };
         let near = if self.near.is_finite() && self.near > 0.0 { self.near } else { 0.1 };
+        if let ProjectionKind::Orthographic { height } = self.kind {
+            let height = if height.is_finite() && height > 0.0 { height.clamp(1e-30, 1e30) } else { 1.0 };
+            let fits =
+                |near: f32, far: f32| far.is_finite() && far > near && (1.0 / (far - near)).is_finite();
+            let (near, far) = if fits(near, self.far) {
+                (near, self.far)
+            } else if fits(near, near + ORTHOGRAPHIC_FALLBACK_DEPTH) {
+                (near, near + ORTHOGRAPHIC_FALLBACK_DEPTH)
+            } else {
+                // A near plane so large that adding the fallback depth does not change it.
+                (near * 0.5, near)
+            };
+            return Projection { fov_y, near, far, kind: ProjectionKind::Orthographic { height } };
+        }
         // `far > near` is false for NaN.
         let far = if self.far > near && depth_terms(near, self.far).1.is_finite() {
             self.far
         } else {
             f32::INFINITY
         };
-        Projection { fov_y, near, far }
+        Projection { fov_y, near, far, kind: ProjectionKind::Perspective }
     }
 
     /// Right-handed, reverse-Z clip-from-view matrix (view looks down -Z; depth in [0, 1],
     /// 1 at `near`, 0 at `far`; for an infinite projection depth is `near / distance`, 0 only
     /// at infinity).
+    ///
+    /// Orthographic: `x / half_width`, `y / half_height`, depth `(far − distance) / (far − near)`
+    /// (linear; `w = 1`).
     pub fn matrix(&self, aspect: f32) -> Mat4 {
         let p = self.sanitized();
-        let aspect = if aspect.is_finite() && aspect > 0.0 { aspect } else { 1.0 };
+        let aspect = aspect_or_one(aspect);
+        if let Some(half) = p.orthographic_half_extent(aspect) {
+            let range = p.far - p.near;
+            return Mat4::from_cols(
+                glam::Vec4::new(1.0 / half.x, 0.0, 0.0, 0.0),
+                glam::Vec4::new(0.0, 1.0 / half.y, 0.0, 0.0),
+                glam::Vec4::new(0.0, 0.0, 1.0 / range, 0.0),
+                glam::Vec4::new(0.0, 0.0, p.far / range, 1.0),
+            );
+        }
         let f = 1.0 / (0.5 * p.fov_y).tan();
         let (depth_scale, depth_offset) = depth_terms(p.near, p.far);
         Mat4::from_cols(
@@ -84,6 +165,8 @@ impl Projection {
     /// rounded up to a power of two so that the grid changes only when the lights move a lot,
     /// and at least twice the near plane. Geometry beyond it lies in the last slice, where no
     /// light reaches, so no light is lost.
+    ///
+    /// An orthographic projection is always finite (it is returned sanitised).
     pub fn finite_for(&self, reach: f32) -> Projection {
         let p = self.sanitized();
         if !p.is_infinite() {
@@ -96,6 +179,35 @@ impl Projection {
         let far = if rounded.is_finite() && rounded >= reach { rounded } else { reach };
         Projection { far, ..p }
     }
+
+    /// View distance (positive, along −Z) of a reverse-Z depth-buffer value: for a perspective
+    /// projection [`linearize_depth_reverse_z`], for an orthographic one the linear map back.
+    pub fn linearize_depth(&self, depth: f32) -> f32 {
+        let p = self.sanitized();
+        match p.kind {
+            ProjectionKind::Orthographic { .. } => p.far - depth * (p.far - p.near),
+            ProjectionKind::Perspective => linearize_depth_reverse_z(depth, p.near, p.far),
+        }
+    }
+
+    /// The view-space point at normalised device coordinates `ndc` and reverse-Z `depth`, for a
+    /// target of `aspect`.
+    pub fn view_position(&self, ndc: Vec2, depth: f32, aspect: f32) -> Vec3 {
+        let d = self.linearize_depth(depth);
+        let half = match self.orthographic_half_extent(aspect) {
+            Some(half) => half,
+            None => {
+                let tan_y = (0.5 * self.sanitized().fov_y).tan();
+                Vec2::new(tan_y * aspect_or_one(aspect), tan_y) * d
+            }
+        };
+        (ndc * half).extend(-d)
+    }
+}
+
+/// `aspect`, or 1 when it is not finite and positive.
+fn aspect_or_one(aspect: f32) -> f32 {
+    if aspect.is_finite() && aspect > 0.0 { aspect } else { 1.0 }
 }
 
 /// `(depth_scale, depth_offset)` of the reverse-Z matrix: depth = (scale · z + offset) / −z.
@@ -148,7 +260,7 @@ mod tests {
             for &far in &values {
                 for &fov_y in &fovs {
                     for aspect in [0.0, 1e-6, 16.0 / 9.0, f32::NAN] {
-                        let p = Projection { fov_y, near, far };
+                        let p = Projection::perspective(fov_y, near, far);
                         let s = p.sanitized();
                         assert!(s.near.is_finite() && s.near > 0.0 && s.far > s.near, "{p:?} -> {s:?}");
                         assert!(s.far.is_finite() || s.is_infinite(), "{p:?} -> {s:?}");
@@ -165,7 +277,7 @@ mod tests {
 
     #[test]
     fn reverse_z_maps_near_to_one_and_far_to_zero() {
-        let p = Projection { fov_y: 1.0, near: 0.5, far: 100.0 };
+        let p = Projection::perspective(1.0, 0.5, 100.0);
         let m = p.matrix(1.5);
         let n = m * Vec4::new(0.0, 0.0, -0.5, 1.0);
         let f = m * Vec4::new(0.0, 0.0, -100.0, 1.0);
@@ -203,10 +315,10 @@ mod tests {
             assert_eq!(linearize_depth_reverse_z(0.0, near, f32::INFINITY), f32::INFINITY);
         }
         for far in [f32::NAN, f32::NEG_INFINITY, 0.0, 0.5, 1.0] {
-            assert!(Projection { fov_y: 1.0, near: 1.0, far }.sanitized().is_infinite(), "far {far}");
+            assert!(Projection::perspective(1.0, 1.0, far).sanitized().is_infinite(), "far {far}");
         }
         // A huge near plane just before the far plane: the depth offset would overflow.
-        let tight = Projection { fov_y: 1.0, near: 1e38, far: 1.000_001e38 }.sanitized();
+        let tight = Projection::perspective(1.0, 1e38, 1.000_001e38).sanitized();
         assert!(tight.is_infinite() && tight.matrix(1.0).is_finite(), "{tight:?}");
         // A finite far plane is kept.
         assert_eq!(Projection::default().sanitized().far, 1000.0);
@@ -235,9 +347,43 @@ mod tests {
         assert!(Projection::infinite(1.0, f32::MAX).finite_for(0.0).far.is_finite());
     }
 
+    /// Orthographic: near maps to 1 and far to 0 linearly, x and y by the half-extents at every
+    /// distance, and depth linearises back; bad parameters give a finite projection with a
+    /// finite far plane.
+    #[test]
+    fn orthographic_depth_is_linear_and_exact() {
+        let p = Projection::orthographic(6.0, 0.5, 40.5);
+        assert!(p.is_orthographic() && p.sanitized() == p);
+        let aspect = 1.5;
+        let m = p.matrix(aspect);
+        assert_eq!(p.orthographic_half_extent(aspect), Some(Vec2::new(4.5, 3.0)));
+        for (d, depth) in [(0.5f32, 1.0f32), (20.5, 0.5), (40.5, 0.0)] {
+            let c = m * Vec4::new(4.5, -3.0, -d, 1.0);
+            assert_eq!(c.w, 1.0);
+            assert!((c.x - 1.0).abs() < 1e-6 && (c.y + 1.0).abs() < 1e-6, "{c:?}");
+            assert!((c.z - depth).abs() < 1e-6, "{d}: {}", c.z);
+            assert!((p.linearize_depth(c.z) - d).abs() < 1e-4, "{d}");
+            let q = p.view_position(Vec2::new(0.5, -0.25), c.z, aspect);
+            assert!(q.abs_diff_eq(Vec3::new(2.25, -0.75, -d), 1e-4), "{q}");
+        }
+        for (height, near, far) in [
+            (f32::NAN, 0.1, 10.0),
+            (0.0, 0.1, 10.0),
+            (1.0, 0.1, f32::INFINITY),
+            (1.0, 5.0, 1.0),
+            (1.0, f32::MAX, f32::MAX),
+        ] {
+            let s = Projection::orthographic(height, near, far).sanitized();
+            let ProjectionKind::Orthographic { height: h } = s.kind else { panic!("{s:?}") };
+            assert!(h.is_finite() && h > 0.0 && s.far.is_finite() && s.far > s.near && s.near > 0.0, "{s:?}");
+            assert!(s.matrix(1.0).is_finite(), "{s:?}");
+            assert_eq!(s.finite_for(1e9), s);
+        }
+    }
+
     #[test]
     fn bad_parameters_still_give_a_finite_matrix() {
-        let p = Projection { fov_y: f32::NAN, near: 0.0, far: -1.0 };
+        let p = Projection::perspective(f32::NAN, 0.0, -1.0);
         assert!(p.matrix(0.0).to_cols_array().iter().all(|x| x.is_finite()));
     }
 }

@@ -10,7 +10,6 @@
 //!    the list (must be zero for a conservative assignment).
 
 use crate::Projection;
-use crate::camera::linearize_depth_reverse_z;
 use crate::cluster::{ClusterAssignment, ClusterGrid, ViewSphere};
 use glam::{Vec2, Vec3};
 
@@ -50,8 +49,7 @@ pub fn culling_efficiency(
 ) -> CullingEfficiency {
     let p = projection.sanitized();
     let (w, h) = (grid.viewport.x.max(1), grid.viewport.y.max(1));
-    let tan_y = (0.5 * p.fov_y).tan();
-    let tan_x = tan_y * w as f32 / h as f32;
+    let aspect = w as f32 / h as f32;
     let inside = |s: &ViewSphere, q: Vec3| s.is_valid() && s.center.distance_squared(q) < s.radius * s.radius;
     let mut out = CullingEfficiency::default();
     for y in 0..h {
@@ -60,10 +58,10 @@ pub fn culling_efficiency(
             if z <= 0.0 || !z.is_finite() {
                 continue;
             }
-            let d = linearize_depth_reverse_z(z, p.near, p.far);
             let px = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
             let ndc = Vec2::new(px.x / w as f32 * 2.0 - 1.0, 1.0 - px.y / h as f32 * 2.0);
-            let q = Vec3::new(ndc.x * tan_x * d, ndc.y * tan_y * d, -d);
+            let q = p.view_position(ndc, z, aspect);
+            let d = -q.z;
             let list = assignment.lights_of(grid.cluster_of(px, d));
             out.pixels += 1;
             out.evaluated_pairs += list.len() as u64;

@@ -15,6 +15,6 @@ pub mod material;
 pub mod mesh;
 
 pub use attenuation::{attenuation, radius_for_intensity};
-pub use camera::{Projection, linearize_depth_reverse_z};
+pub use camera::{Projection, ProjectionKind, linearize_depth_reverse_z};
 pub use material::{MaterialData, ShadingModel, TextureData};
 pub use mesh::{Aabb, MeshData, MeshError, Vertex};

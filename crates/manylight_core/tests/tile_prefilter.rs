@@ -20,10 +20,10 @@ fn a_column_accepts_every_light_its_clusters_accept() {
         (seed >> 40) as f32 / (1u64 << 24) as f32
     };
     let cases = [
-        (UVec2::new(200, 120), Projection { fov_y: 1.0, near: 0.1, far: 200.0 }, ZSlicing::Exponential),
-        (UVec2::new(96, 64), Projection { fov_y: 1.0, near: 0.1, far: 200.0 }, ZSlicing::Linear),
-        (UVec2::new(1, 1), Projection { fov_y: 3.1, near: 1e-4, far: 1e6 }, ZSlicing::Exponential),
-        (UVec2::new(640, 17), Projection { fov_y: 0.01, near: 0.5, far: 50.0 }, ZSlicing::Exponential),
+        (UVec2::new(200, 120), Projection::perspective(1.0, 0.1, 200.0), ZSlicing::Exponential),
+        (UVec2::new(96, 64), Projection::perspective(1.0, 0.1, 200.0), ZSlicing::Linear),
+        (UVec2::new(1, 1), Projection::perspective(3.1, 1e-4, 1e6), ZSlicing::Exponential),
+        (UVec2::new(640, 17), Projection::perspective(0.01, 0.5, 50.0), ZSlicing::Exponential),
     ];
     for (viewport, projection, slicing) in cases {
         let config = GridConfig { slicing, ..GridConfig::default() };

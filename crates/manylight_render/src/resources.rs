@@ -31,6 +31,8 @@ pub struct GpuMesh {
     pub indices: wgpu::Buffer,
     /// Number of indices.
     pub index_count: u32,
+    /// Upload order (draws sort by it: the same scene draws in the same order on every run).
+    pub order: u64,
     last_used: u64,
 }
 
@@ -45,6 +47,8 @@ pub struct GpuMaterialBinding {
     _source: Arc<MaterialData>,
     /// The bind group.
     pub bind_group: wgpu::BindGroup,
+    /// Upload order (see [`GpuMesh::order`]).
+    pub order: u64,
     last_used: u64,
 }
 
@@ -57,6 +61,10 @@ pub struct Draw {
     pub material: usize,
     /// Index into the instance buffer (the draw's `first_instance`).
     pub instance: u32,
+    /// Draw order: (material, mesh) upload order. Draws are batched by material and mesh in an
+    /// order that does not depend on where their data lies in memory, so coplanar surfaces
+    /// resolve the same way on every run.
+    pub order: (u64, u64),
 }
 
 /// Scene data on the GPU for the current frame.
@@ -100,6 +108,7 @@ pub struct SceneResources {
     frame: u64,
     bound_generations: (u64, u64),
     max_texture_size: u32,
+    uploads: u64,
 }
 
 /// A GPU counter of pixels whose HDR colour is NaN or infinite, written by the tone map and
@@ -256,6 +265,7 @@ impl SceneResources {
             frame: 0,
             bound_generations: (0, 0),
             max_texture_size: gpu.max_texture_size(),
+            uploads: 0,
         }
     }
 
@@ -357,10 +367,11 @@ impl SceneResources {
             }
             let mesh = self.mesh_entry(device, &inst.mesh)?;
             let material = self.material_entry(gpu, &inst.material)?;
-            self.draws.push(Draw { mesh, material, instance: instance_data.len() as u32 });
+            let order = (self.materials[&material].order, self.meshes[&mesh].order);
+            self.draws.push(Draw { mesh, material, instance: instance_data.len() as u32, order });
             instance_data.push(gpu_instance);
         }
-        self.draws.sort_by_key(|d| (d.material, d.mesh));
+        self.draws.sort_by_key(|d| d.order);
         if instance_data.is_empty() {
             instance_data.push(GpuInstance::new(Mat4::IDENTITY));
         }
@@ -405,8 +416,12 @@ impl SceneResources {
                 }
             }
         }
-        self.meshes
-            .entry(k)
+        let order = self.uploads;
+        let entry = self.meshes.entry(k);
+        if matches!(entry, std::collections::hash_map::Entry::Vacant(_)) {
+            self.uploads += 1;
+        }
+        entry
             .or_insert_with(|| GpuMesh {
                 _source: mesh.clone(),
                 vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -420,6 +435,7 @@ impl SceneResources {
                     usage: wgpu::BufferUsages::INDEX,
                 }),
                 index_count: mesh.indices.len() as u32,
+                order,
                 last_used: frame,
             })
             .last_used = frame;
@@ -482,8 +498,10 @@ impl SceneResources {
                 wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.sampler) },
             ],
         });
+        let order = self.uploads;
+        self.uploads += 1;
         self.materials
-            .insert(k, GpuMaterialBinding { _source: material.clone(), bind_group, last_used: frame });
+            .insert(k, GpuMaterialBinding { _source: material.clone(), bind_group, order, last_used: frame });
         Ok(k)
     }
 

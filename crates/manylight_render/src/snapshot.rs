@@ -548,11 +548,17 @@ impl FrameSnapshot {
             .views
             .iter()
             .filter(|v| {
-                let p = v.camera.projection;
-                let s = p.sanitized();
-                // Compared bit for bit, so a NaN parameter counts as changed.
-                (p.fov_y.to_bits(), p.near.to_bits(), p.far.to_bits())
-                    != (s.fov_y.to_bits(), s.near.to_bits(), s.far.to_bits())
+                // Compared bit for bit, so a NaN parameter counts as changed; an orthographic
+                // projection ignores its field of view.
+                let bits = |p: manylight_core::Projection| match p.kind {
+                    manylight_core::ProjectionKind::Perspective => {
+                        (0, p.fov_y.to_bits(), p.near.to_bits(), p.far.to_bits())
+                    }
+                    manylight_core::ProjectionKind::Orthographic { height } => {
+                        (1, height.to_bits(), p.near.to_bits(), p.far.to_bits())
+                    }
+                };
+                bits(v.camera.projection) != bits(v.camera.projection.sanitized())
             })
             .count() as u32;
         if changed > 0 {

@@ -184,7 +184,7 @@ pub fn default_scene() -> Scene {
     let eye = Vec3::new(-HALF_LENGTH + 2.0, 1.7, 0.0);
     a.scene.cameras.push(SceneCamera {
         transform: camera_looking_at(eye, eye + Vec3::X),
-        projection: Projection { fov_y: 60f32.to_radians(), near: 0.1, far: 200.0 },
+        projection: Projection::perspective(60f32.to_radians(), 0.1, 200.0),
     });
     a.scene
 }

@@ -95,6 +95,6 @@ pub struct SceneLight {
 pub struct SceneCamera {
     /// World-from-camera transform; the camera looks down its local -Z with +Y up.
     pub transform: Mat4,
-    /// Perspective parameters.
+    /// Perspective or orthographic parameters.
     pub projection: Projection,
 }

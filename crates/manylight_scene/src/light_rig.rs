@@ -247,7 +247,7 @@ pub fn sphere_shell_scene() -> Scene {
         lights: Vec::new(),
         cameras: vec![SceneCamera {
             transform: Mat4::IDENTITY,
-            projection: Projection { fov_y: 45f32.to_radians(), near: 0.1, far: 1000.0 },
+            projection: Projection::perspective(45f32.to_radians(), 0.1, 1000.0),
         }],
         nodes: Vec::new(),
     }

@@ -71,11 +71,11 @@ impl Scene {
         let transform = camera_looking_at(eye, center);
         SceneCamera {
             transform,
-            projection: Projection {
+            projection: Projection::perspective(
                 fov_y,
-                near: (distance - radius).max(distance * 1e-3).max(1e-4) * 0.5,
-                far: (distance + radius) * 2.0,
-            },
+                (distance - radius).max(distance * 1e-3).max(1e-4) * 0.5,
+                (distance + radius) * 2.0,
+            ),
         }
     }
 

@@ -114,6 +114,18 @@ fn an_infinite_camera_with_a_huge_znear_loads_with_a_finite_matrix() {
     assert!(c.projection.matrix(1.0).is_finite(), "{:?}", c.projection.matrix(1.0));
 }
 
+#[test]
+fn an_orthographic_camera_loads_as_one() {
+    // ymag is half the height; znear 0 (allowed) moves to zfar × 10⁻⁶, as the renderer needs a
+    // positive near plane.
+    let s = load_gltf(&fixture("orthographic_camera.gltf"), &LoadOptions::default()).expect("loads");
+    let c = s.cameras[0];
+    assert_eq!(c.projection.kind, manylight_core::ProjectionKind::Orthographic { height: 4.0 });
+    assert_eq!((c.projection.near, c.projection.far), (50.0 * 1e-6, 50.0));
+    assert_eq!(c.transform.w_axis.truncate(), Vec3::new(0.0, 0.0, 5.0));
+    assert!(c.projection.matrix(1.5).is_finite());
+}
+
 // Files the glTF 2.0 specification (and the Khronos validator) allow, one family per test.
 
 /// Loads fixture `name`, panicking with the error's message.

@@ -43,8 +43,8 @@ pub(crate) struct ClusterTables {
     x_ext: Vec<(f32, f32)>,
     y_ext: Vec<(f32, f32)>,
     z_ext: Vec<(f32, f32)>,
-    x_normals: Vec<(Vec3, Vec3)>,
-    y_normals: Vec<(Vec3, Vec3)>,
+    x_planes: Vec<(Vec4, Vec4)>,
+    y_planes: Vec<(Vec4, Vec4)>,
     /// Suffix minimum of `b(z) - 2m(z)`.
     lo_eff: Vec<f64>,
     /// Prefix maximum of `b(z+1) + 2m(z)`.
@@ -77,8 +77,8 @@ impl ClusterTables {
         ClusterTables {
             grid: *grid,
             z_ext: (0..nz).map(|z| grid.z_extent(z)).collect(),
-            x_normals: (0..nx).map(|x| grid.x_plane_normals(x)).collect(),
-            y_normals: (0..ny).map(|y| grid.y_plane_normals(y)).collect(),
+            x_planes: (0..nx).map(|x| grid.x_planes(x)).collect(),
+            y_planes: (0..ny).map(|y| grid.y_planes(y)).collect(),
             boundary,
             margin,
             x_ext,
@@ -113,13 +113,14 @@ impl ClusterTables {
     fn touches_planes(&self, light: &ViewSphere, x: u32, y: u32, z: u32) -> bool {
         let zu = z as usize;
         let m = self.margin[zu];
-        let (left, right) = self.x_normals[x as usize];
-        let (bottom, top) = self.y_normals[y as usize];
+        let (left, right) = self.x_planes[x as usize];
+        let (bottom, top) = self.y_planes[y as usize];
+        let margin = Vec4::new(0.0, 0.0, 0.0, m);
         let planes = [
-            left.extend(m),
-            right.extend(m),
-            bottom.extend(m),
-            top.extend(m),
+            left + margin,
+            right + margin,
+            bottom + margin,
+            top + margin,
             Vec4::new(0.0, 0.0, -1.0, m - self.boundary[zu]),
             Vec4::new(0.0, 0.0, 1.0, m + self.boundary[zu + 1]),
         ];
@@ -146,7 +147,6 @@ impl ClusterTables {
         if !light.is_valid() {
             return None;
         }
-        let [nx, ny, _] = self.grid.dims.to_array();
         let c: DVec3 = light.center.as_dvec3();
         let r = f64::from(inflated_radius(light.radius));
         let slack = SLACK * (c.x.abs() + c.y.abs() + c.z.abs() + r);
@@ -162,25 +162,39 @@ impl ClusterTables {
 
         // Step 3: tiles.
         let big_r = r + 2.0 * f64::from(self.margin[z_hi]) + slack;
-        let (x, y) = match test {
-            // Both: the AABB test must accept, so its (tighter) search range suffices.
-            CullTest::Aabb | CullTest::Both => {
-                let (d0, d1) = (f64::from(self.boundary[z_lo]), f64::from(self.boundary[z_hi + 1]));
-                (box_ndc(c.x, big_r, d0, d1), box_ndc(c.y, big_r, d0, d1))
+        let (x, y) = match (self.grid.ortho_half, test) {
+            // Orthographic: the clusters are boxes whose side planes are their box faces, so
+            // every test needs the sphere's box to overlap the tile's x and y ranges.
+            (Some(h), _) => {
+                let (hx, hy) = (f64::from(h.x), f64::from(h.y));
+                let x = [(c.x - big_r) / hx, (c.x + big_r) / hx];
+                let y = [(c.y - big_r) / hy, (c.y + big_r) / hy];
+                return self.tile_candidates(x, y, [z_lo as u32, z_hi as u32]);
             }
-            CullTest::Planes if d > big_r * (1.0 + 1e-6) => {
-                (tangent_ndc(c.x, d, big_r), tangent_ndc(c.y, d, big_r))
-            }
-            CullTest::Planes => ([f64::NEG_INFINITY, f64::INFINITY], [f64::NEG_INFINITY, f64::INFINITY]),
+            (None, test) => match test {
+                // Both: the AABB test must accept, so its (tighter) search range suffices.
+                CullTest::Aabb | CullTest::Both => {
+                    let (d0, d1) = (f64::from(self.boundary[z_lo]), f64::from(self.boundary[z_hi + 1]));
+                    (box_ndc(c.x, big_r, d0, d1), box_ndc(c.y, big_r, d0, d1))
+                }
+                CullTest::Planes if d > big_r * (1.0 + 1e-6) => {
+                    (tangent_ndc(c.x, d, big_r), tangent_ndc(c.y, d, big_r))
+                }
+                CullTest::Planes => ([f64::NEG_INFINITY, f64::INFINITY], [f64::NEG_INFINITY, f64::INFINITY]),
+            },
         };
         let x = x.map(|s| s / self.tan[0]);
         let y = y.map(|s| s / self.tan[1]);
+        self.tile_candidates(x, y, [z_lo as u32, z_hi as u32])
+    }
 
-        // Step 4: NDC → tiles. Column k spans NDC [-1 + 2k/X, -1 + 2(k+1)/X]; row k spans
-        // [1 - 2(k+1)/Y, 1 - 2k/Y].
+    /// Step 4: NDC ranges → tiles. Column k spans NDC [-1 + 2k/X, -1 + 2(k+1)/X]; row k spans
+    /// [1 - 2(k+1)/Y, 1 - 2k/Y].
+    fn tile_candidates(&self, x: [f64; 2], y: [f64; 2], z: [u32; 2]) -> Option<Candidates> {
+        let [nx, ny, _] = self.grid.dims.to_array();
         let x_range = tile_range((x[0] + 1.0) * 0.5 * f64::from(nx), (x[1] + 1.0) * 0.5 * f64::from(nx), nx)?;
         let y_range = tile_range((1.0 - y[1]) * 0.5 * f64::from(ny), (1.0 - y[0]) * 0.5 * f64::from(ny), ny)?;
-        Some(Candidates { x: x_range, y: y_range, z: [z_lo as u32, z_hi as u32] })
+        Some(Candidates { x: x_range, y: y_range, z })
     }
 }
 

@@ -26,13 +26,31 @@ struct Piece {
 
 impl Piece {
     fn new(grid: &ClusterGrid, x: u32, y: u32, z: u32) -> Piece {
+        let [nx, ny, _] = grid.dims.to_array().map(f64::from);
+        let ndc_x = [2.0 * f64::from(x) / nx - 1.0, 2.0 * f64::from(x + 1) / nx - 1.0];
+        // Bottom edge first (row y + 1), then top (row y).
+        let ndc_y = [1.0 - 2.0 * f64::from(y + 1) / ny, 1.0 - 2.0 * f64::from(y) / ny];
+        let d = [f64::from(grid.slice_boundary(z)), f64::from(grid.slice_boundary(z + 1))];
+        let depth_planes = [(DVec3::new(0.0, 0.0, -1.0), -d[0]), (DVec3::new(0.0, 0.0, 1.0), d[1])];
+        if let Some(h) = grid.ortho_half {
+            // A box: edges at ndc × half-extent, at any depth.
+            let ax = ndc_x.map(|a| a * f64::from(h.x));
+            let ay = ndc_y.map(|a| a * f64::from(h.y));
+            let corners = std::array::from_fn(|i| DVec3::new(ax[i & 1], ay[(i >> 1) & 1], -d[i >> 2]));
+            let planes = [
+                (DVec3::X, -ax[0]),
+                (DVec3::NEG_X, ax[1]),
+                (DVec3::Y, -ay[0]),
+                (DVec3::NEG_Y, ay[1]),
+                depth_planes[0],
+                depth_planes[1],
+            ];
+            return Piece { corners, planes };
+        }
         let tan_y = (0.5 * f64::from(grid.fov_y)).tan();
         let tan_x = tan_y * f64::from(grid.aspect);
-        let [nx, ny, _] = grid.dims.to_array().map(f64::from);
-        let ax = [2.0 * f64::from(x) / nx - 1.0, 2.0 * f64::from(x + 1) / nx - 1.0].map(|a| a * tan_x);
-        // Bottom edge first (row y + 1), then top (row y).
-        let ay = [1.0 - 2.0 * f64::from(y + 1) / ny, 1.0 - 2.0 * f64::from(y) / ny].map(|a| a * tan_y);
-        let d = [f64::from(grid.slice_boundary(z)), f64::from(grid.slice_boundary(z + 1))];
+        let ax = ndc_x.map(|a| a * tan_x);
+        let ay = ndc_y.map(|a| a * tan_y);
         let corners = std::array::from_fn(|i| {
             DVec3::new(ax[i & 1] * d[i >> 2], ay[(i >> 1) & 1] * d[i >> 2], -d[i >> 2])
         });
@@ -41,8 +59,8 @@ impl Piece {
             (DVec3::new(-1.0, 0.0, -ax[1]).normalize(), 0.0),
             (DVec3::new(0.0, 1.0, ay[0]).normalize(), 0.0),
             (DVec3::new(0.0, -1.0, -ay[1]).normalize(), 0.0),
-            (DVec3::new(0.0, 0.0, -1.0), -d[0]),
-            (DVec3::new(0.0, 0.0, 1.0), d[1]),
+            depth_planes[0],
+            depth_planes[1],
         ];
         Piece { corners, planes }
     }

@@ -16,6 +16,10 @@
 //! 5. **Bounds**: the AABB is the box of the 8 corners of the frustum piece, then ± margin; the
 //!    planes are the tile's four edge planes through the origin plus `z = -boundary`, with unit
 //!    inward normals and the margin added to `w`.
+//! 6. **Orthographic** views: a point with NDC `(nx, ny)` is `(nx * half_x, ny * half_y, -d)` at
+//!    any distance, so a cluster is a box; its side planes are axis-aligned with offsets
+//!    (`x >= a0` is `(1, 0, 0) · p - a0 >= 0`), the margin is `CLUSTER_MARGIN * max(boundary,
+//!    half_x, half_y)`, and the slices are always linear in depth.
 
 use glam::{UVec2, UVec3, Vec2, Vec3, Vec4};
 
@@ -84,8 +88,10 @@ pub struct ClusterGrid {
     pub fov_y: f32,
     /// `viewport.x / viewport.y`.
     pub aspect: f32,
-    /// How slice boundaries are spaced.
+    /// How slice boundaries are spaced (always linear for an orthographic view).
     pub slicing: ZSlicing,
+    /// Half the visible width and height of an orthographic view; `None` for perspective.
+    pub ortho_half: Option<Vec2>,
 }
 
 impl ClusterGrid {
@@ -101,14 +107,18 @@ impl ClusterGrid {
         // `sanitized` can overflow `far` for an absurd near plane; keep both finite.
         let near = p.near.min(1e30);
         let far = if p.far.is_finite() && p.far > near { p.far } else { near * 1e4 };
+        let aspect = viewport.x as f32 / viewport.y as f32;
+        let ortho_half = p.orthographic_half_extent(aspect);
         ClusterGrid {
             dims: config.dims_for(viewport),
             viewport,
             near,
             far,
             fov_y: p.fov_y,
-            aspect: viewport.x as f32 / viewport.y as f32,
-            slicing: config.slicing,
+            aspect,
+            // Depth is linear in an orthographic view, and so are its slices.
+            slicing: if ortho_half.is_some() { ZSlicing::Linear } else { config.slicing },
+            ortho_half,
         }
     }
 
@@ -128,7 +138,13 @@ impl ClusterGrid {
         UVec3::new(index % self.dims.x, (index % layer) / self.dims.x, index / layer)
     }
 
-    /// `(tan_x, tan_y)`: half-extent of the frustum per unit of view distance.
+    /// Half-extent `(x, y)` of the view at view distance `d`: `tan_half_fov() * d`, or the
+    /// orthographic half-extent at any distance.
+    pub fn half_extent_at(&self, d: f32) -> Vec2 {
+        self.ortho_half.unwrap_or_else(|| self.tan_half_fov() * d)
+    }
+
+    /// `(tan_x, tan_y)`: half-extent of the frustum per unit of view distance (perspective).
     pub fn tan_half_fov(&self) -> Vec2 {
         let tan_y = (0.5 * self.fov_y).tan();
         Vec2::new(tan_y * self.aspect, tan_y)
@@ -202,8 +218,12 @@ impl ClusterGrid {
 
     /// Outward widening of every bound of the clusters in slice `z` (module docs, step 4).
     pub fn cluster_margin(&self, z: u32) -> f32 {
+        let b = self.slice_boundary(z.min(self.dims.z - 1) + 1);
+        if let Some(h) = self.ortho_half {
+            return CLUSTER_MARGIN * b.max(h.x).max(h.y);
+        }
         let tan = self.tan_half_fov();
-        CLUSTER_MARGIN * self.slice_boundary(z.min(self.dims.z - 1) + 1) * tan.x.max(tan.y).max(1.0)
+        CLUSTER_MARGIN * b * tan.x.max(tan.y).max(1.0)
     }
 
     /// NDC x of the left edge of tile column `k ∈ 0..=X` (`k = X` is the right screen edge).
@@ -218,6 +238,10 @@ impl ClusterGrid {
 
     /// View-space x range of column `x` over slice `z`, widened by the margin.
     pub(crate) fn x_extent(&self, x: u32, z: u32) -> (f32, f32) {
+        if let Some(h) = self.ortho_half {
+            let m = self.cluster_margin(z);
+            return (self.ndc_x_edge(x) * h.x - m, self.ndc_x_edge(x + 1) * h.x + m);
+        }
         let tan_x = self.tan_half_fov().x;
         let (a0, a1) = (self.ndc_x_edge(x) * tan_x, self.ndc_x_edge(x + 1) * tan_x);
         extent(a0, a1, self.slice_boundary(z), self.slice_boundary(z + 1), self.cluster_margin(z))
@@ -225,6 +249,10 @@ impl ClusterGrid {
 
     /// View-space y range of row `y` over slice `z`, widened by the margin.
     pub(crate) fn y_extent(&self, y: u32, z: u32) -> (f32, f32) {
+        if let Some(h) = self.ortho_half {
+            let m = self.cluster_margin(z);
+            return (self.ndc_y_edge(y + 1) * h.y - m, self.ndc_y_edge(y) * h.y + m);
+        }
         let tan_y = self.tan_half_fov().y;
         let (a0, a1) = (self.ndc_y_edge(y + 1) * tan_y, self.ndc_y_edge(y) * tan_y);
         extent(a0, a1, self.slice_boundary(z), self.slice_boundary(z + 1), self.cluster_margin(z))
@@ -236,19 +264,29 @@ impl ClusterGrid {
         (-self.slice_boundary(z + 1) - m, -self.slice_boundary(z) + m)
     }
 
-    /// Inward unit normals of column `x`'s left and right planes (through the origin).
-    pub(crate) fn x_plane_normals(&self, x: u32) -> (Vec3, Vec3) {
+    /// Column `x`'s left and right planes `(n, w)` without the margin: unit inward normals,
+    /// through the origin (`w = 0`) in perspective, axis-aligned with offsets in orthographic.
+    pub(crate) fn x_planes(&self, x: u32) -> (Vec4, Vec4) {
+        if let Some(h) = self.ortho_half {
+            let (a0, a1) = (self.ndc_x_edge(x) * h.x, self.ndc_x_edge(x + 1) * h.x);
+            // Left: x - a0 >= 0.  Right: a1 - x >= 0.
+            return (Vec4::new(1.0, 0.0, 0.0, -a0), Vec4::new(-1.0, 0.0, 0.0, a1));
+        }
         let tan_x = self.tan_half_fov().x;
         let (a0, a1) = (self.ndc_x_edge(x) * tan_x, self.ndc_x_edge(x + 1) * tan_x);
         // Left: x >= a0 * d = -a0 * z  <=>  x + a0 z >= 0.  Right: -x - a1 z >= 0.
-        (Vec3::new(1.0, 0.0, a0).normalize(), Vec3::new(-1.0, 0.0, -a1).normalize())
+        (Vec3::new(1.0, 0.0, a0).normalize().extend(0.0), Vec3::new(-1.0, 0.0, -a1).normalize().extend(0.0))
     }
 
-    /// Inward unit normals of row `y`'s bottom and top planes (through the origin).
-    pub(crate) fn y_plane_normals(&self, y: u32) -> (Vec3, Vec3) {
+    /// Row `y`'s bottom and top planes `(n, w)` without the margin (see [`Self::x_planes`]).
+    pub(crate) fn y_planes(&self, y: u32) -> (Vec4, Vec4) {
+        if let Some(h) = self.ortho_half {
+            let (b0, b1) = (self.ndc_y_edge(y + 1) * h.y, self.ndc_y_edge(y) * h.y);
+            return (Vec4::new(0.0, 1.0, 0.0, -b0), Vec4::new(0.0, -1.0, 0.0, b1));
+        }
         let tan_y = self.tan_half_fov().y;
         let (b0, b1) = (self.ndc_y_edge(y + 1) * tan_y, self.ndc_y_edge(y) * tan_y);
-        (Vec3::new(0.0, 1.0, b0).normalize(), Vec3::new(0.0, -1.0, -b1).normalize())
+        (Vec3::new(0.0, 1.0, b0).normalize().extend(0.0), Vec3::new(0.0, -1.0, -b1).normalize().extend(0.0))
     }
 
     /// Clamps cluster coordinates into the grid.
@@ -273,13 +311,14 @@ impl ClusterGrid {
     pub fn cluster_planes(&self, x: u32, y: u32, z: u32) -> [Vec4; 6] {
         let (x, y, z) = self.clamp_coords(x, y, z);
         let m = self.cluster_margin(z);
-        let (left, right) = self.x_plane_normals(x);
-        let (bottom, top) = self.y_plane_normals(y);
+        let (left, right) = self.x_planes(x);
+        let (bottom, top) = self.y_planes(y);
+        let margin = Vec4::new(0.0, 0.0, 0.0, m);
         [
-            left.extend(m),
-            right.extend(m),
-            bottom.extend(m),
-            top.extend(m),
+            left + margin,
+            right + margin,
+            bottom + margin,
+            top + margin,
             // Near: d >= b(z)  <=>  -z - b(z) >= 0.  Far: z + b(z+1) >= 0.
             Vec4::new(0.0, 0.0, -1.0, m - self.slice_boundary(z)),
             Vec4::new(0.0, 0.0, 1.0, m + self.slice_boundary(z + 1)),

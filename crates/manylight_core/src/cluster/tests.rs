@@ -63,13 +63,19 @@ pub(super) fn random_grid(rng: &mut Rng) -> ClusterGrid {
     let dims = UVec3::new(1 + rng.below(10), 1 + rng.below(8), 1 + rng.below(12));
     let slicing = if rng.chance(0.5) { ZSlicing::Linear } else { ZSlicing::Exponential };
     let config = GridConfig { dims: Some(dims), slicing, ..Default::default() };
-    ClusterGrid::new(viewport, &Projection { fov_y, near, far }, &config)
+    // One grid in four is orthographic (boxes, linear slices).
+    let projection = if rng.chance(0.25) {
+        Projection::orthographic(rng.log_range(1e-3, 1e4), near, far)
+    } else {
+        Projection::perspective(fov_y, near, far)
+    };
+    ClusterGrid::new(viewport, &projection, &config)
 }
 
 /// View-space point at NDC `(nx, ny)` and view distance `d`.
 pub(super) fn view_point(grid: &ClusterGrid, nx: f32, ny: f32, d: f32) -> Vec3 {
-    let tan = grid.tan_half_fov();
-    Vec3::new(nx * tan.x * d, ny * tan.y * d, -d)
+    let half = grid.half_extent_at(d);
+    Vec3::new(nx * half.x, ny * half.y, -d)
 }
 
 /// A random light; about half are ordinary, the rest adversarial.
@@ -86,7 +92,7 @@ pub(super) fn random_light(rng: &mut Rng, grid: &ClusterGrid) -> ViewSphere {
                 grid.slice_boundary(rng.below(nz + 1)),
             );
             match rng.below(4) {
-                0 => p.x = rng.range(-1.0, 1.0) * p.z.abs() * grid.tan_half_fov().x,
+                0 => p.x = rng.range(-1.0, 1.0) * grid.half_extent_at(p.z.abs()).x,
                 1 => p.z = -depth(rng),
                 _ => {}
             }

@@ -11,7 +11,7 @@ use crate::Projection;
 
 fn grid(viewport: UVec2, fov_deg: f32, near: f32, far: f32, dims: UVec3, slicing: ZSlicing) -> ClusterGrid {
     let config = GridConfig { dims: Some(dims), slicing, ..Default::default() };
-    ClusterGrid::new(viewport, &Projection { fov_y: fov_deg.to_radians(), near, far }, &config)
+    ClusterGrid::new(viewport, &Projection::perspective(fov_deg.to_radians(), near, far), &config)
 }
 
 fn default_grid() -> ClusterGrid {
@@ -179,7 +179,7 @@ fn extreme_viewports_and_fields_of_view() {
         for fov in [0.01, 60.0, 179.0] {
             for slicing in ZSlicing::ALL {
                 let config = GridConfig { slicing, ..Default::default() };
-                let projection = Projection { fov_y: f32::to_radians(fov), near: 0.05, far: 500.0 };
+                let projection = Projection::perspective(f32::to_radians(fov), 0.05, 500.0);
                 let g = ClusterGrid::new(viewport, &projection, &config);
                 let lights = random_lights(&mut rng, &g, 40);
                 for test in CullTest::ALL {
@@ -235,7 +235,7 @@ fn fp_scene(rng: &mut Rng, g: &ClusterGrid, n: usize) -> Vec<ViewSphere> {
 fn false_positive_rates_are_ordered() {
     let g = ClusterGrid::new(
         UVec2::new(1280, 720),
-        &Projection { fov_y: 60f32.to_radians(), near: 0.1, far: 100.0 },
+        &Projection::perspective(60f32.to_radians(), 0.1, 100.0),
         &GridConfig::default(),
     );
     let lights = fp_scene(&mut Rng::new(1), &g, 1024);
@@ -260,7 +260,7 @@ fn false_positive_rates_are_ordered() {
 fn default_grid_matches_brute_force() {
     let mut rng = Rng::new(11);
     for (near, far) in [(0.1, 1000.0), (1e-4, 1e6)] {
-        let projection = Projection { fov_y: 60f32.to_radians(), near, far };
+        let projection = Projection::perspective(60f32.to_radians(), near, far);
         for slicing in ZSlicing::ALL {
             let g = ClusterGrid::new(
                 UVec2::new(1280, 720),

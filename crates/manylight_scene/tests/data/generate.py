@@ -10,6 +10,8 @@
 - extras_any_type.gltf: a triangle whose `extras` are a string, an array, a number, `null`,
   `true` and a nested object (the spec allows any JSON value there).
 - huge_znear.gltf: a triangle and an infinite camera (no zfar) whose znear is 3.4e38.
+- orthographic_camera.gltf: a triangle and an orthographic camera (xmag 3, ymag 2, znear 0,
+  zfar 50) on a node moved to (0, 0, 5).
 
 Files the specification allows that strict parsers refuse (one per family):
 - integers_as_floats.gltf: every integer (indices, counts, lengths, offsets, component types,
@@ -142,6 +144,15 @@ def main():
     doc["cameras"] = [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 3.4e38}}]
     doc["nodes"][0]["camera"] = 0
     (HERE / "huge_znear.gltf").write_text(json.dumps(doc, indent=1))
+
+    doc = triangle(POSITIONS + INDICES, [POS_ACC, IDX_ACC],
+                   [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 6}],
+                   {"POSITION": 0})
+    doc["cameras"] = [{"type": "orthographic",
+                       "orthographic": {"xmag": 3.0, "ymag": 2.0, "znear": 0.0, "zfar": 50.0}}]
+    doc["nodes"].append({"camera": 0, "translation": [0.0, 0.0, 5.0]})
+    doc["scenes"][0]["nodes"].append(1)
+    (HERE / "orthographic_camera.gltf").write_text(json.dumps(doc, indent=1))
 
     image = png8(2, 2, (0, 255, 0, 255))
     image += b"\0" * (-len(image) % 4)
