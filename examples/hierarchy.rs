@@ -52,16 +52,6 @@ fn spin(time: Res<Time>, mut hubs: Query<&mut Transform, With<Hub>>) {
 
 fn main() -> AppExit {
     tracing_subscriber::fmt().with_env_filter("warn,winit=error,manylight_app=info").init();
-    let args: Vec<String> = std::env::args().collect();
-    let value = |flag: &str| args.iter().position(|a| a == flag).and_then(|i| args.get(i + 1));
-    let plugin = match args.iter().position(|a| a == "--headless") {
-        Some(_) => {
-            let frames = value("--frames").and_then(|s| s.parse().ok()).unwrap_or(30);
-            ManyLightPlugin::headless(UVec2::new(1280, 720))
-                .with_frames(frames)
-                .with_output(value("--headless").map_or("hierarchy.png", |s| s.as_str()))
-        }
-        None => ManyLightPlugin::default(),
-    };
+    let plugin = manylight::app::cli::ExampleArgs::from_env("hierarchy.png").plugin();
     App::new().add_plugins(plugin).add_systems(Startup, setup).add_systems(Update, (slide, spin)).run()
 }

@@ -95,10 +95,10 @@ fn show_on_screen(
 }
 
 /// Headless: writes the security camera's last image beside the main output.
-fn save_feed(path: String) -> impl FnMut(Res<SecurityFeed>, Res<RenderedImages>) {
+fn save_feed(path: std::path::PathBuf) -> impl FnMut(Res<SecurityFeed>, Res<RenderedImages>) {
     move |feed, images| {
         if let Some(image) = images.get(&feed.0) {
-            let out = std::path::Path::new(&path).with_extension("camera.png");
+            let out = path.with_extension("camera.png");
             if let Err(e) = manylight::app::headless::save_png(image, &out) {
                 eprintln!("{e}");
             }
@@ -108,20 +108,10 @@ fn save_feed(path: String) -> impl FnMut(Res<SecurityFeed>, Res<RenderedImages>)
 
 fn main() -> AppExit {
     tracing_subscriber::fmt().with_env_filter("warn,winit=error,manylight_app=info").init();
-    let args: Vec<String> = std::env::args().collect();
-    let value = |flag: &str| args.iter().position(|a| a == flag).and_then(|i| args.get(i + 1));
-    let headless = args.iter().any(|a| a == "--headless");
-    let output = value("--headless").map_or("render_to_texture.png", |s| s.as_str()).to_string();
-    let plugin = match headless {
-        true => {
-            let frames = value("--frames").and_then(|s| s.parse().ok()).unwrap_or(30);
-            ManyLightPlugin::headless(UVec2::new(1280, 720)).with_frames(frames).with_output(output.clone())
-        }
-        false => ManyLightPlugin::default(),
-    };
+    let args = manylight::app::cli::ExampleArgs::from_env("render_to_texture.png");
     let mut app = App::new();
-    app.add_plugins(plugin).add_systems(Startup, setup).add_systems(Update, show_on_screen);
-    if headless {
+    app.add_plugins(args.plugin()).add_systems(Startup, setup).add_systems(Update, show_on_screen);
+    if let Some(output) = args.headless {
         app.add_systems(Last, save_feed(output));
     }
     app.run()

@@ -72,16 +72,6 @@ fn circle(time: Res<Time>, mut cameras: Query<&mut Transform, With<Circling>>) {
 
 fn main() -> AppExit {
     tracing_subscriber::fmt().with_env_filter("warn,winit=error,manylight_app=info").init();
-    let args: Vec<String> = std::env::args().collect();
-    let value = |flag: &str| args.iter().position(|a| a == flag).and_then(|i| args.get(i + 1));
-    let plugin = match args.iter().position(|a| a == "--headless") {
-        Some(_) => {
-            let frames = value("--frames").and_then(|s| s.parse().ok()).unwrap_or(30);
-            ManyLightPlugin::headless(UVec2::new(1280, 720))
-                .with_frames(frames)
-                .with_output(value("--headless").map_or("split_screen.png", |s| s.as_str()))
-        }
-        None => ManyLightPlugin::default(),
-    };
+    let plugin = manylight::app::cli::ExampleArgs::from_env("split_screen.png").plugin();
     App::new().add_plugins(plugin).add_systems(Startup, setup).add_systems(Update, (layout, circle)).run()
 }

@@ -21,7 +21,8 @@ pub struct Row {
     culling: Option<f64>,
 }
 
-fn median(v: &[f64]) -> f64 {
+/// The median of `v` (the upper one of an even count; NaN when empty).
+pub(crate) fn median(v: &[f64]) -> f64 {
     let mut s = v.to_vec();
     s.sort_by(f64::total_cmp);
     if s.is_empty() { f64::NAN } else { s[s.len() / 2] }

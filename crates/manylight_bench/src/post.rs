@@ -3,6 +3,7 @@
 //! with both, in one run, and prints a markdown table of median frame time, the difference to
 //! the frame without post stages, and the post passes' GPU time.
 
+use crate::bench::median;
 use crate::direct::snapshot;
 use crate::progress::Progress;
 use crate::report::Report;
@@ -59,11 +60,6 @@ fn apply(mut snap: FrameSnapshot, config: &Config) -> FrameSnapshot {
         camera.prev_clip_from_world = Some(previous.clip_from_world(size));
     }
     snap
-}
-
-fn median(mut values: Vec<f64>) -> f64 {
-    values.sort_by(f64::total_cmp);
-    values.get(values.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
 /// GPU milliseconds of the post passes (bloom, motion blur): their total, and per pass name
@@ -137,8 +133,9 @@ pub fn run(
         .zip(passes)
         .zip(texture_bytes)
         .map(|(((config, times), passes), transient_bytes)| {
-            let post_gpu_ms =
-                median(passes.iter().map(|frame| frame.iter().fold(0.0, |sum, p| sum + p.1)).collect());
+            let post_gpu_ms = median(
+                &passes.iter().map(|frame| frame.iter().fold(0.0, |sum, p| sum + p.1)).collect::<Vec<_>>(),
+            );
             let per_pass = passes
                 .first()
                 .map(|first| {
@@ -146,10 +143,10 @@ pub fn run(
                         .iter()
                         .map(|(name, _, count)| {
                             let v = median(
-                                passes
+                                &passes
                                     .iter()
                                     .filter_map(|frame| frame.iter().find(|p| p.0 == *name).map(|p| p.1))
-                                    .collect(),
+                                    .collect::<Vec<_>>(),
                             );
                             (name.clone(), v, *count)
                         })
@@ -158,7 +155,7 @@ pub fn run(
                 .unwrap_or_default();
             PostRow {
                 name: config.name,
-                frame_ms: median(times),
+                frame_ms: median(&times),
                 post_gpu_ms,
                 passes: per_pass,
                 transient_bytes,

@@ -3,6 +3,7 @@
 //! that look in different directions), in one run; each view builds its own clusters, and the
 //! lights are uploaded once per frame whatever the number of views.
 
+use crate::bench::median;
 use crate::direct::snapshot;
 use crate::progress::Progress;
 use anyhow::Result;
@@ -42,11 +43,6 @@ pub fn split(mut snap: FrameSnapshot, count: u32) -> FrameSnapshot {
         })
         .collect();
     snap
-}
-
-fn median(mut values: Vec<f64>) -> f64 {
-    values.sort_by(f64::total_cmp);
-    values.get(values.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
 /// One view count's figures.
@@ -90,7 +86,7 @@ pub fn run(
         .iter()
         .zip(times)
         .zip(last)
-        .map(|((&views, times), last)| Row { views, frame_ms: median(times), last })
+        .map(|((&views, times), last)| Row { views, frame_ms: median(&times), last })
         .collect();
     let context = format!(
         "{}×{} in all, {scene_name}, {} rig lights + {} scene lights, {}, median of {frames} frames after 1 warm-up \
