@@ -45,9 +45,9 @@ struct ClusterCounters {
 @group(0) @binding(7) var<storage, read_write> tile_ranges: array<vec2<u32>>;
 @group(0) @binding(8) var<storage, read_write> tile_indices: array<u32>;
 
-// Extra inflation of the tile prefilter, so float rounding can never make it reject a light a
-// cluster of the column would accept.
-const TILE_PREFILTER_INFLATION: f32 = 1.001;
+// TILE_PREFILTER_INFLATION (from Rust, manylight_core::cluster::TILE_PREFILTER_INFLATION): extra
+// inflation of the tile prefilter, so float rounding can never make it reject a light a cluster
+// of the column would accept; the CPU bound of the tile list (cluster::list_bounds) uses it too.
 
 override WORKGROUP_SIZE: u32 = 64u;
 

@@ -210,24 +210,44 @@ fn a_cap_drops_deterministically_and_is_counted() {
     assert_eq!(c.dropped_pairs, cpu.dropped_pairs);
 }
 
+/// Lights that grow and move from frame to frame, so the lists must grow between frames: the
+/// CPU bounds size them before each frame is submitted, so no frame is rendered twice, and the
+/// GPU lists equal the CPU reference in every frame (no contributing light is missing).
 #[test]
-fn the_index_list_grows_instead_of_truncating() {
+fn lists_sized_before_submission_never_overflow_or_rerender() {
     let _gpu = gpu();
     let mut r = HeadlessRenderer::new().expect("adapter");
     let scene = default_scene();
     let size = UVec2::new(640, 384);
-    // Large lights: tens of thousands of light-cluster pairs, beyond the initial capacity.
-    let lights: Vec<_> =
-        rig(&scene, 600, 6).into_iter().map(|l| ExtractedPointLight { radius: 12.0, ..l }).collect();
-    let snap = scene_snapshot(&scene, size, lights, clustered(CullTest::Aabb, ZSlicing::Exponential, None));
-    let (report, gpu, cpu) = gpu_and_cpu(&mut r, snap);
-    let c = report.clusters.expect("cluster report");
-    assert!(c.total_entries > 1 << 16, "the scene must outgrow the initial list: {c:?}");
-    let initial_tiles = manylight::render::clusters::INITIAL_TILE_INDEX_CAPACITY;
-    assert!(c.tile_entries > initial_tiles, "the scene must outgrow the initial tile list: {c:?}");
-    assert!(c.regrows >= 1, "{c:?}");
-    assert_eq!(c.dropped_pairs, 0);
-    assert_same_lists("grown", &gpu, &cpu);
+    let base = rig(&scene, 600, 6);
+    let mut grew = 0;
+    let mut last_capacity = 0;
+    for frame in 0..6u32 {
+        // From small lights to large ones (tens of thousands of pairs, beyond the initial
+        // capacities), drifting along the hall.
+        let radius = 0.5 * 2f32.powi(frame as i32).min(24.0);
+        let shift = Vec3::new(frame as f32 * 1.5, 0.0, 0.0);
+        let lights: Vec<_> =
+            base.iter().map(|l| ExtractedPointLight { radius, position: l.position + shift, ..*l }).collect();
+        let snap =
+            scene_snapshot(&scene, size, lights, clustered(CullTest::Aabb, ZSlicing::Exponential, None));
+        let (report, gpu, cpu) = gpu_and_cpu(&mut r, snap);
+        let c = report.clusters.expect("cluster report");
+        let what = format!("frame {frame}, radius {radius}");
+        assert_eq!(c.regrows, 0, "{what}: the lists were sized before the frame: {c:?}");
+        assert!(c.pair_bound >= c.total_entries && c.index_capacity >= c.pair_bound, "{what}: {c:?}");
+        assert!(c.tile_entry_bound >= c.tile_entries, "{what}: {c:?}");
+        assert_eq!(c.dropped_pairs, 0, "{what}");
+        assert_same_lists(&what, &gpu, &cpu);
+        grew += u32::from(c.index_capacity > last_capacity && frame > 0);
+        last_capacity = c.index_capacity;
+        if frame == 5 {
+            assert!(c.total_entries > 1 << 16, "the last frame outgrows the initial list: {c:?}");
+            let initial_tiles = manylight::render::clusters::INITIAL_TILE_INDEX_CAPACITY;
+            assert!(c.tile_entries > initial_tiles, "and the initial tile list: {c:?}");
+        }
+    }
+    assert!(grew > 0, "the lists grew between frames");
 }
 
 #[test]

@@ -159,7 +159,8 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
         "adapter,scene,pipeline,gbuffer,gbuffer_bytes_per_pixel,lights,width,height,frames,frame_ms_median,\
          frame_ms_mean,depth_prepass_gpu_ms,cluster_build_gpu_ms,cluster_build_gpu_trusted,\
          forward_gpu_ms,clustered_forward_gpu_ms,gbuffer_gpu_ms,deferred_lighting_gpu_ms,light_volumes_gpu_ms,tonemap_gpu_ms,clusters,non_empty_clusters,list_entries,\
-         max_per_cluster,mean_per_non_empty,dropped_pairs,culling_ratio,transient_mib,cluster_buffer_mib\n",
+         max_per_cluster,mean_per_non_empty,dropped_pairs,culling_ratio,transient_mib,cluster_buffer_mib,\
+         list_entry_bound,tile_entries,tile_entry_bound,list_bound_cpu_ms\n",
     );
     for r in rows {
         let c = r.last.clusters.as_ref();
@@ -172,7 +173,7 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
         let mean = r.frame_ms.iter().sum::<f64>() / r.frame_ms.len().max(1) as f64;
         let _ = writeln!(
             out,
-            "\"{adapter}\",\"{scene}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{}",
+            "\"{adapter}\",\"{scene}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{},{},{},{},{}",
             r.pipeline.name(),
             r.gbuffer.map_or("", |g| g.name()),
             r.gbuffer.map_or(String::new(), |g| g.bytes_per_pixel().to_string()),
@@ -200,6 +201,10 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
             r.culling.map_or(String::new(), |x| format!("{x:.3}")),
             mib(r.last.transient_bytes),
             c.map_or(String::new(), |c| format!("{:.2}", mib(c.buffer_bytes))),
+            c.map_or(String::new(), |c| c.pair_bound.to_string()),
+            c.map_or(String::new(), |c| c.tile_entries.to_string()),
+            c.map_or(String::new(), |c| c.tile_entry_bound.to_string()),
+            c.map_or(String::new(), |c| format!("{:.3}", c.bound_cpu_ms)),
         );
     }
     out

@@ -9,8 +9,8 @@ use manylight_core::cluster::{
     ClusterGrid, GridConfig, ViewSphere, ZSlicing, sphere_intersects_aabb, sphere_intersects_planes,
 };
 
-/// `TILE_PREFILTER_INFLATION` in shaders/cluster_build.wgsl.
-const INFLATION: f32 = 1.001;
+/// The GPU build's tile-level inflation (emitted into shaders/cluster_build.wgsl).
+const INFLATION: f32 = manylight_core::cluster::TILE_PREFILTER_INFLATION;
 
 #[test]
 fn a_column_accepts_every_light_its_clusters_accept() {
@@ -24,6 +24,7 @@ fn a_column_accepts_every_light_its_clusters_accept() {
         (UVec2::new(96, 64), Projection::perspective(1.0, 0.1, 200.0), ZSlicing::Linear),
         (UVec2::new(1, 1), Projection::perspective(3.1, 1e-4, 1e6), ZSlicing::Exponential),
         (UVec2::new(640, 17), Projection::perspective(0.01, 0.5, 50.0), ZSlicing::Exponential),
+        (UVec2::new(200, 120), Projection::orthographic(30.0, 0.5, 100.0), ZSlicing::Linear),
     ];
     for (viewport, projection, slicing) in cases {
         let config = GridConfig { slicing, ..GridConfig::default() };

@@ -15,7 +15,9 @@ use crate::pool::GrowableBuffer;
 use crate::readback::read_buffer;
 use crate::snapshot::RenderView;
 use glam::Mat4;
-use manylight_core::cluster::{ClusterAssignment, ClusterGrid, CullTest, ViewSphere, view_spheres};
+use manylight_core::cluster::{
+    ClusterAssignment, ClusterGrid, CullTest, ListBounds, ViewSphere, list_bounds, view_spheres,
+};
 use serde::Serialize;
 
 /// What the cluster build reported for a frame (in `FrameReport::clusters`).
@@ -45,8 +47,15 @@ pub struct ClusterReport {
     pub tile_entries: u64,
     /// Longest per-tile list.
     pub max_per_tile: u32,
-    /// Times the index list grew this frame (each re-renders the frame).
+    /// Times the lists had to grow after the frame was rendered (each renders it again): 0, since
+    /// the CPU bounds size them before submission, unless a bound exceeds what the device binds.
     pub regrows: u32,
+    /// The CPU bound the light-index list was sized to (at least `total_entries`).
+    pub pair_bound: u64,
+    /// The CPU bound the per-tile lists were sized to (at least `tile_entries`).
+    pub tile_entry_bound: u64,
+    /// CPU milliseconds the two bounds took (before the frame was submitted).
+    pub bound_cpu_ms: f64,
     /// Bytes of GPU buffers the cluster build and clustered shading hold (grid bounds, light
     /// spheres, per-tile and per-cluster ranges and index lists, parameters, counters).
     pub buffer_bytes: u64,
@@ -87,6 +96,10 @@ pub struct ClusterResources {
     generations: [u64; 7],
     /// The view-space spheres uploaded this frame (for the CPU reference in tests and stats).
     pub view_spheres: Vec<ViewSphere>,
+    /// This frame's CPU bounds of the list sizes, which the lists were sized to before it was
+    /// submitted.
+    pub bounds_estimate: ListBounds,
+    bound_cpu_ms: f64,
     cull: CullTest,
 }
 
@@ -177,6 +190,8 @@ impl ClusterResources {
             bounds_of: None,
             generations: [0; 7],
             view_spheres: Vec::new(),
+            bounds_estimate: ListBounds::default(),
+            bound_cpu_ms: 0.0,
             cull: CullTest::default(),
         }
     }
@@ -318,6 +333,17 @@ impl ClusterResources {
             self.spheres.write(device, queue, bytemuck::cast_slice(&spheres))?;
         }
         self.ranges.reserve(device, count as u64 * 8)?;
+        // Lists sized before the frame is submitted, from a CPU bound of what the build can
+        // write (`list_bounds`): the GPU lists cannot overflow, so the frame is never rendered
+        // twice. A bound beyond what the device can bind reserves what it can; then the build's
+        // counters decide, after the frame, whether the real lists fit.
+        let started = std::time::Instant::now();
+        self.bounds_estimate = list_bounds(&self.grid, &self.view_spheres, settings.cull);
+        self.bound_cpu_ms = started.elapsed().as_secs_f64() * 1e3;
+        let bytes =
+            |entries: u64, buffer: &crate::pool::GrowableBuffer| (entries.max(1) * 4).min(buffer.max_bytes());
+        self.indices.reserve(device, bytes(self.bounds_estimate.cluster_pairs, &self.indices))?;
+        self.tile_indices.reserve(device, bytes(self.bounds_estimate.tile_entries, &self.tile_indices))?;
         let tiles = self.grid.dims.x as u64 * self.grid.dims.y as u64;
         let tile_chunks = (spheres.len() as u32).div_ceil(TILE_LIGHT_CHUNK).max(1);
         self.tile_ranges.reserve(device, tiles * tile_chunks as u64 * 8)?;
@@ -418,6 +444,9 @@ impl ClusterResources {
             index_capacity: self.params.index_capacity as u64,
             tile_entries: c.tile_entries as u64,
             regrows,
+            pair_bound: self.bounds_estimate.cluster_pairs,
+            tile_entry_bound: self.bounds_estimate.tile_entries,
+            bound_cpu_ms: self.bound_cpu_ms,
             buffer_bytes: self.buffer_bytes(),
             cull_test: self.cull.name().to_string(),
             z_slicing: self.grid.slicing.name().to_string(),

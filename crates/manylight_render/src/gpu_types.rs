@@ -194,6 +194,7 @@ pub struct GpuMaterial {
 pub fn shared_f32_constants() -> Vec<(&'static str, f32)> {
     vec![
         ("RADIUS_INFLATION", manylight_core::cluster::RADIUS_INFLATION),
+        ("TILE_PREFILTER_INFLATION", manylight_core::cluster::TILE_PREFILTER_INFLATION),
         ("TOON_RIM_STRENGTH", manylight_core::material::TOON_RIM_STRENGTH),
     ]
 }

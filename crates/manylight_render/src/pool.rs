@@ -200,6 +200,11 @@ impl GrowableBuffer {
         Ok(true)
     }
 
+    /// The most bytes the device can bind.
+    pub fn max_bytes(&self) -> u64 {
+        self.max_bytes
+    }
+
     /// The buffer.
     pub fn buffer(&self) -> &wgpu::Buffer {
         &self.buffer

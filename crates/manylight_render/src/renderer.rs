@@ -106,9 +106,11 @@ impl Renderer {
     }
 
     /// Runs `graph` for `view` into `output` (the `Execute` step) and waits for the GPU to
-    /// finish. When the
-    /// cluster build finds its light-index list too small, the list grows and the frame is
-    /// rendered again, so no light is ever lost to a buffer size.
+    /// finish. The light lists were sized by their CPU bounds in [`Renderer::prepare_view`], so
+    /// the build cannot overflow them; only when a bound exceeded what the device can bind (and
+    /// the lists were sized to the limit) can the counters show a list short, and then it grows
+    /// and the frame is rendered again (`ClusterReport::regrows`), so no light is ever lost to
+    /// a buffer size.
     pub fn execute(
         &mut self,
         graph: &RenderGraph,

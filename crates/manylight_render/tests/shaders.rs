@@ -145,6 +145,12 @@ fn constants_come_from_rust() {
     for (name, value) in manylight_render::gpu_types::shared_u32_constants() {
         assert!(code.contains(&format!("const {name}: u32 = {value}u;")), "{name}");
     }
+    let build = compose("cluster_build.wgsl").unwrap();
+    for (name, value) in manylight_render::gpu_types::shared_f32_constants() {
+        assert!(build.contains(&format!("const {name}: f32 = {value:?};")), "{name}");
+        // Defined once: from Rust, never again in a shader.
+        assert_eq!(build.matches(&format!("const {name}:")).count(), 1, "{name}");
+    }
 }
 
 /// Every entry point of every shader also goes through naga's SPIR-V backend (what wgpu runs

@@ -167,6 +167,29 @@ proptest! {
         }
     }
 
+    /// The CPU bounds hold: at least the pairs the assignment keeps, and at least the entries
+    /// of the tile level (each light against each one-slice column, radius inflated), both
+    /// counted by brute force.
+    #[test]
+    fn list_bounds_hold(seed in any::<u64>()) {
+        let mut rng = Rng::new(seed);
+        let grid = random_grid(&mut rng);
+        let count = rng.below(24) as usize;
+        let lights = random_lights(&mut rng, &grid, count);
+        let columns = ClusterGrid { dims: UVec3::new(grid.dims.x, grid.dims.y, 1), ..grid };
+        let inflated: Vec<ViewSphere> = lights
+            .iter()
+            .map(|l| ViewSphere { radius: l.radius * TILE_PREFILTER_INFLATION, ..*l })
+            .collect();
+        for test in CullTest::ALL {
+            let bounds = list_bounds(&grid, &lights, test);
+            let pairs = assign_lights_brute_force(&grid, &lights, test, None).indices.len() as u64;
+            let tiles = assign_lights_brute_force(&columns, &inflated, test, None).indices.len() as u64;
+            prop_assert!(bounds.cluster_pairs >= pairs, "{test:?}: {bounds:?} < {pairs} pairs, {grid:?}");
+            prop_assert!(bounds.tile_entries >= tiles, "{test:?}: {bounds:?} < {tiles} tile entries, {grid:?}");
+        }
+    }
+
     #[test]
     fn cap_keeps_the_lowest_lights_and_counts_the_rest(seed in any::<u64>(), cap in 0u32..6) {
         let mut rng = Rng::new(seed);
