@@ -17,6 +17,8 @@
 //!      pass exactly when its edges straddle the sphere's tangent slopes `x/d` (a contiguous
 //!      range). Otherwise the offset planes can pass in disjoint tiles (e.g. a sphere beside the
 //!      camera passes the far-left and far-right columns), so the whole screen is a candidate.
+//!    - both tests: the intersection of the two ranges (the box range alone is loose for deep
+//!      slices, such as the one-slice columns of the GPU build's first level).
 //! 4. NDC ranges become tile ranges with a small pad for the rounding of the tile edges.
 
 use glam::{DVec3, Vec3, Vec4};
@@ -180,10 +182,16 @@ impl ClusterTables {
                 return self.tile_candidates(x, y, [z_lo as u32, z_hi as u32]);
             }
             (None, test) => match test {
-                // Both: the AABB test must accept, so its (tighter) search range suffices.
+                // Both: both tests must accept, so a cluster lies in both search ranges.
                 CullTest::Aabb | CullTest::Both => {
                     let (d0, d1) = (f64::from(self.boundary[z_lo]), f64::from(self.boundary[z_hi + 1]));
-                    (box_ndc(c.x, big_r, d0, d1), box_ndc(c.y, big_r, d0, d1))
+                    let boxed = (box_ndc(c.x, big_r, d0, d1), box_ndc(c.y, big_r, d0, d1));
+                    if test == CullTest::Both && d > big_r * (1.0 + 1e-6) {
+                        let meet = |a: [f64; 2], b: [f64; 2]| [a[0].max(b[0]), a[1].min(b[1])];
+                        (meet(boxed.0, tangent_ndc(c.x, d, big_r)), meet(boxed.1, tangent_ndc(c.y, d, big_r)))
+                    } else {
+                        boxed
+                    }
                 }
                 CullTest::Planes if d > big_r * (1.0 + 1e-6) => {
                     (tangent_ndc(c.x, d, big_r), tangent_ndc(c.y, d, big_r))
