@@ -185,3 +185,24 @@ fn uncovered_pixels_show_the_clear_colour() {
     let right = half(&image, true);
     assert!(right.pixels().any(|p| *p != first), "the covered half shows the scene");
 }
+
+/// A viewport that changes size every frame (a split-screen window being resized) leaves no
+/// image behind: only the sizes of the last frame are kept.
+#[test]
+fn viewport_images_of_old_sizes_are_freed() {
+    let _gpu = gpu();
+    let mut renderer = manylight::app::render_world::HeadlessRenderer::new().expect("adapter");
+    let scene = default_scene();
+    for (frame, width) in [40u32, 48, 56, 64, 72].into_iter().enumerate() {
+        let mut snap =
+            manylight::app::scene::scene_snapshot(&scene, Vec::new(), SIZE, Default::default(), frame as u64);
+        let camera = *snap.camera().expect("a camera");
+        snap.views = vec![manylight::render::ExtractedView {
+            rect: Some(manylight::render::ViewRect { origin: UVec2::new(8, 8), size: UVec2::new(width, 40) }),
+            ..manylight::render::ExtractedView::main(camera)
+        }];
+        let (report, _) = renderer.render(snap, false).expect("renders");
+        assert_eq!((report.views[0].width, report.views[0].height), (width, 40));
+        assert_eq!(renderer.render_world.view_image_count(), 1, "frame {frame}");
+    }
+}

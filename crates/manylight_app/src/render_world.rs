@@ -140,7 +140,8 @@ pub struct RenderWorld {
     lose_in_frame: bool,
     /// Render-to-texture targets, by id (dropped when no view draws into them).
     textures: HashMap<RenderTextureId, HeadlessTarget>,
-    /// Images of the view rectangles, copied into their targets, by size and format.
+    /// Images of the view rectangles, copied into their targets, by size and format (only the
+    /// sizes the last frame used are kept).
     view_images: HashMap<(u32, u32, wgpu::TextureFormat), wgpu::Texture>,
     /// The render-to-texture images of the last frame, until taken.
     texture_images: Vec<(RenderTextureId, image::RgbaImage)>,
@@ -290,6 +291,17 @@ impl RenderWorld {
                 }
             }
         }
+        // View-rectangle images of sizes no view has this frame are freed (a window being
+        // resized would otherwise leave one behind per size).
+        let format_of = |t: ViewTarget| match t {
+            ViewTarget::Main => format,
+            ViewTarget::Texture { .. } => manylight_render::HEADLESS_FORMAT,
+        };
+        self.view_images.retain(|&(w, h, f), _| {
+            plans
+                .iter()
+                .any(|p| !p.whole && (p.view.0.size.x, p.view.0.size.y, format_of(p.target)) == (w, h, f))
+        });
         let mut cleared: Vec<ViewTarget> = Vec::with_capacity(plans.len());
         let mut reports = Vec::with_capacity(plans.len());
         for plan in plans {
@@ -393,6 +405,11 @@ impl RenderWorld {
     /// The render-to-texture images of the last frame, by id (empty once taken).
     pub fn take_textures(&mut self) -> Vec<(RenderTextureId, image::RgbaImage)> {
         std::mem::take(&mut self.texture_images)
+    }
+
+    /// View-rectangle images alive (one per size and format the last frame's viewports used).
+    pub fn view_image_count(&self) -> usize {
+        self.view_images.len()
     }
 
     /// Names of the passes the last frame ran, in order (view after view).
