@@ -42,3 +42,43 @@ pub fn measure_culling(
         culling_efficiency(&clusters.grid, &projection, &assignment, &clusters.view_spheres, &depth, 64);
     Ok((report, eff))
 }
+
+/// One timed frame of an [`interleaved`] run: its wall-clock milliseconds and its report.
+pub struct TimedFrame {
+    /// Wall-clock time of the whole frame (upload, record, submit, wait).
+    pub ms: f64,
+    /// The frame's report.
+    pub report: FrameReport,
+}
+
+/// Renders the configurations `names` in turns, frame by frame, each on its own renderer (so
+/// its transient textures stay pooled), so that a change in machine load hits them alike: one
+/// warm-up round (pipelines, textures, cluster buffers), then `frames` timed rounds.
+/// `snapshot(i, frame)` gives configuration `i`'s snapshot of round `frame`. Returns the
+/// adapter's name and, per configuration, its timed frames.
+pub fn interleaved(
+    names: &[String],
+    frames: u32,
+    what: &'static str,
+    mut snapshot: impl FnMut(usize, u64) -> FrameSnapshot,
+) -> Result<(String, Vec<Vec<TimedFrame>>)> {
+    let mut renderers = names.iter().map(|_| HeadlessRenderer::new()).collect::<Result<Vec<_>, _>>()?;
+    let adapter = renderers.first().map(|r| r.render_world.gpu().info.name.clone()).unwrap_or_default();
+    let mut timed: Vec<Vec<TimedFrame>> = names.iter().map(|_| Vec::new()).collect();
+    let mut progress = crate::progress::Progress::new(u64::from(frames) + 1, what);
+    for f in 0..=frames {
+        for (i, (name, renderer)) in names.iter().zip(&mut renderers).enumerate() {
+            progress.set_message(name.clone());
+            let snap = snapshot(i, u64::from(f));
+            let start = std::time::Instant::now();
+            let (report, _) = renderer.render(snap, false)?;
+            let ms = start.elapsed().as_secs_f64() * 1e3;
+            if f > 0 {
+                timed[i].push(TimedFrame { ms, report });
+            }
+        }
+        progress.step(|| if f == 0 { "warm-up".to_string() } else { format!("frame {f}") });
+    }
+    progress.finish();
+    Ok((adapter, timed))
+}

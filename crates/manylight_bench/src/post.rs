@@ -4,16 +4,13 @@
 //! the frame without post stages, and the post passes' GPU time.
 
 use crate::bench::median;
-use crate::direct::snapshot;
-use crate::progress::Progress;
+use crate::direct::{interleaved, snapshot};
 use crate::report::Report;
 use anyhow::Result;
 use glam::{Mat4, UVec2};
-use manylight_app::render_world::HeadlessRenderer;
 use manylight_render::{BloomSettings, FrameReport, FrameSettings, FrameSnapshot, MotionBlurSettings};
 use manylight_scene::{Scene, light_rig};
 use std::fmt::Write as _;
-use std::time::Instant;
 
 /// Camera yaw between the previous and the current frame under motion blur (radians; about
 /// 20 px of motion at 1280 px wide).
@@ -104,35 +101,19 @@ pub fn run(
 ) -> Result<Report> {
     let rig = light_rig(lights, scene.bounds(), 1);
     let configs = configurations();
-    let mut renderers = configs.iter().map(|_| HeadlessRenderer::new()).collect::<Result<Vec<_>, _>>()?;
-    let adapter = renderers.first().map(|r| r.render_world.gpu().info.name.clone()).unwrap_or_default();
-    // Per configuration: frame wall times, and per frame the post passes grouped by name.
-    let mut times: Vec<Vec<f64>> = vec![Vec::new(); configs.len()];
-    let mut passes: Vec<Vec<Vec<(String, f64, u32)>>> = vec![Vec::new(); configs.len()];
-    let mut texture_bytes = vec![0u64; configs.len()];
-    let mut progress = Progress::new(u64::from(frames) + 1, "rounds of every configuration");
-    for f in 0..=frames {
-        for (i, (config, renderer)) in configs.iter().zip(&mut renderers).enumerate() {
-            progress.set_message(config.name);
-            let snap = apply(snapshot(scene, &rig, 0.0, size, base, f as u64), config);
-            let start = Instant::now();
-            let (report, _) = renderer.render(snap, false)?;
-            if f > 0 {
-                // Frame 0 warms up (pipelines, textures).
-                times[i].push(start.elapsed().as_secs_f64() * 1e3);
-                passes[i].push(post_gpu_ms(&report).1);
-            }
-            texture_bytes[i] = report.transient_bytes;
-        }
-        progress.step(|| if f == 0 { "warm-up".to_string() } else { format!("frame {f}") });
-    }
-    progress.finish();
+    let names: Vec<String> = configs.iter().map(|c| c.name.to_string()).collect();
+    let (adapter, timed) = interleaved(&names, frames, "rounds of every configuration", |i, f| {
+        apply(snapshot(scene, &rig, 0.0, size, base, f), &configs[i])
+    })?;
     let rows: Vec<PostRow> = configs
         .iter()
-        .zip(times)
-        .zip(passes)
-        .zip(texture_bytes)
-        .map(|(((config, times), passes), transient_bytes)| {
+        .zip(timed)
+        .map(|(config, timed)| {
+            let times: Vec<f64> = timed.iter().map(|t| t.ms).collect();
+            // Per frame, the post passes grouped by name.
+            let passes: Vec<Vec<(String, f64, u32)>> =
+                timed.iter().map(|t| post_gpu_ms(&t.report).1).collect();
+            let transient_bytes = timed.last().map_or(0, |t| t.report.transient_bytes);
             let post_gpu_ms = median(
                 &passes.iter().map(|frame| frame.iter().fold(0.0, |sum, p| sum + p.1)).collect::<Vec<_>>(),
             );

@@ -4,15 +4,12 @@
 //! lights are uploaded once per frame whatever the number of views.
 
 use crate::bench::median;
-use crate::direct::snapshot;
-use crate::progress::Progress;
+use crate::direct::{interleaved, snapshot};
 use anyhow::Result;
 use glam::{Mat4, UVec2};
-use manylight_app::render_world::HeadlessRenderer;
 use manylight_render::{ExtractedView, FrameReport, FrameSettings, FrameSnapshot, ViewRect, ViewTarget};
 use manylight_scene::{Scene, light_rig};
 use std::fmt::Write as _;
-use std::time::Instant;
 
 /// The view counts compared.
 pub const VIEW_COUNTS: [u32; 3] = [1, 2, 4];
@@ -63,30 +60,18 @@ pub fn run(
     base: FrameSettings,
 ) -> Result<String> {
     let rig = light_rig(lights, scene.bounds(), 1);
-    let mut renderers = VIEW_COUNTS.iter().map(|_| HeadlessRenderer::new()).collect::<Result<Vec<_>, _>>()?;
-    let adapter = renderers.first().map(|r| r.render_world.gpu().info.name.clone()).unwrap_or_default();
-    let mut times: Vec<Vec<f64>> = vec![Vec::new(); VIEW_COUNTS.len()];
-    let mut last: Vec<FrameReport> = vec![FrameReport::default(); VIEW_COUNTS.len()];
-    let mut progress = Progress::new(u64::from(frames) + 1, "rounds of 1, 2 and 4 views");
-    for f in 0..=frames {
-        for (i, (&count, renderer)) in VIEW_COUNTS.iter().zip(&mut renderers).enumerate() {
-            let snap = split(snapshot(scene, &rig, 0.0, size, base, f as u64), count);
-            let start = Instant::now();
-            let (report, _) = renderer.render(snap, false)?;
-            if f > 0 {
-                // Frame 0 warms up (pipelines, textures, cluster buffers).
-                times[i].push(start.elapsed().as_secs_f64() * 1e3);
-            }
-            last[i] = report;
-        }
-        progress.step(|| if f == 0 { "warm-up".to_string() } else { format!("frame {f}") });
-    }
-    progress.finish();
+    let names: Vec<String> = VIEW_COUNTS.iter().map(|n| format!("{n} view(s)")).collect();
+    let (adapter, timed) = interleaved(&names, frames, "rounds of 1, 2 and 4 views", |i, f| {
+        split(snapshot(scene, &rig, 0.0, size, base, f), VIEW_COUNTS[i])
+    })?;
     let rows: Vec<Row> = VIEW_COUNTS
         .iter()
-        .zip(times)
-        .zip(last)
-        .map(|((&views, times), last)| Row { views, frame_ms: median(&times), last })
+        .zip(timed)
+        .map(|(&views, mut timed)| {
+            let frame_ms = median(&timed.iter().map(|t| t.ms).collect::<Vec<_>>());
+            let last = timed.pop().map(|t| t.report).unwrap_or_default();
+            Row { views, frame_ms, last }
+        })
         .collect();
     let context = format!(
         "{}×{} in all, {scene_name}, {} rig lights + {} scene lights, {}, median of {frames} frames after 1 warm-up \
