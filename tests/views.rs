@@ -206,3 +206,19 @@ fn viewport_images_of_old_sizes_are_freed() {
         assert_eq!(renderer.render_world.view_image_count(), 1, "frame {frame}");
     }
 }
+
+/// A camera that cannot be looked through is counted and skipped, also when another camera of
+/// the frame renders.
+#[test]
+fn an_invalid_camera_beside_a_valid_one_is_counted() {
+    let _gpu = gpu();
+    let mut renderer = manylight::app::render_world::HeadlessRenderer::new().expect("adapter");
+    let mut snap =
+        manylight::app::scene::scene_snapshot(&default_scene(), Vec::new(), SIZE, Default::default(), 0);
+    let camera = *snap.camera().expect("a camera");
+    let broken = manylight::render::ExtractedCamera { world_from_view: glam::Mat4::ZERO, ..camera };
+    snap.views.push(manylight::render::ExtractedView::main(broken));
+    let (report, _) = renderer.render(snap, false).expect("renders");
+    assert_eq!(report.invalid_cameras, 1);
+    assert_eq!(report.views.len(), 1);
+}

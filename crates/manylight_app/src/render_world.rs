@@ -502,19 +502,21 @@ fn copy_into(
 /// One frame's report from its views' reports: their passes one view after the other, the
 /// first view's cluster statistics, the sums of their GPU times and non-finite pixels.
 fn merge_view_reports(views: Vec<(ViewReport, FrameReport)>, snapshot: &FrameSnapshot) -> FrameReport {
-    let mut merged = FrameReport { ..empty_report(snapshot) };
+    // The frame-wide figures (lights, instances) are the same in every view's report.
+    let mut merged = match views.first() {
+        Some((_, first)) => FrameReport {
+            width: snapshot.viewport.x,
+            height: snapshot.viewport.y,
+            passes: Vec::new(),
+            views: Vec::new(),
+            nonfinite_pixels: None,
+            clusters: None,
+            ..first.clone()
+        },
+        None => empty_report(snapshot),
+    };
     let mut gpu_ms: Option<f64> = None;
-    for (i, (view, report)) in views.into_iter().enumerate() {
-        if i == 0 {
-            merged = FrameReport {
-                passes: Vec::new(),
-                views: Vec::new(),
-                nonfinite_pixels: None,
-                ..report.clone()
-            };
-            merged.width = snapshot.viewport.x;
-            merged.height = snapshot.viewport.y;
-        }
+    for (view, report) in views {
         merged.passes.extend(report.passes);
         merged.clusters = merged.clusters.or(report.clusters);
         if let Some(n) = report.nonfinite_pixels {
@@ -809,11 +811,11 @@ impl DeviceSink for HeadlessRenderer {
         snapshot: FrameSnapshot,
         readback: bool,
     ) -> Result<(FrameReport, Option<image::RgbaImage>), RenderError> {
-        let mut snapshot = snapshot;
-        let invalid_cameras = snapshot.reject_invalid_camera();
         let size = snapshot.viewport;
-        if size.x == 0 || size.y == 0 || snapshot.views.is_empty() {
+        if size.x == 0 || size.y == 0 || !snapshot.views.iter().any(|v| v.camera.is_valid()) {
             // Nothing to look through or at.
+            let mut snapshot = snapshot;
+            let invalid_cameras = snapshot.reject_invalid_camera();
             return Ok((FrameReport { invalid_cameras, ..empty_report(&snapshot) }, None));
         }
         let gpu = self.render_world.gpu().clone();
