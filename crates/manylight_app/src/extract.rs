@@ -68,7 +68,8 @@ pub fn build_snapshot(
     lights: &Query<LightItem>,
 ) -> FrameSnapshot {
     let mut views: Vec<ExtractedView> = Vec::with_capacity(cameras.iter().len());
-    let mut seen = Vec::with_capacity(views.capacity());
+    // Last frame's cameras; the map is rebuilt from this frame's, so removed ones go.
+    let prev_cameras = std::mem::take(&mut state.prev_cameras);
     for (entity, t, projection, camera, bloom, motion_blur, debug) in cameras.iter() {
         let camera = camera.copied().unwrap_or_default();
         if !camera.is_active {
@@ -101,14 +102,12 @@ pub fn build_snapshot(
         // Last frame's camera at this frame's size: a resize alone moves no pixel, so motion
         // blur does not smear the first frame after one.
         let size = view.rect_in(target_size).size;
-        view.camera.prev_clip_from_world = state.prev_cameras.get(&entity).map(|p| p.clip_from_world(size));
+        view.camera.prev_clip_from_world = prev_cameras.get(&entity).map(|p| p.clip_from_world(size));
         state.prev_cameras.insert(entity, view.camera);
-        seen.push(entity);
         views.push(view);
     }
     // Lower order first; equal orders keep query order.
     views.sort_by_key(|v| v.order);
-    state.prev_cameras.retain(|e, _| seen.contains(e));
     let default_material =
         state.default_material.get_or_insert_with(|| Arc::new(MaterialData::default())).clone();
     let instances = meshes
