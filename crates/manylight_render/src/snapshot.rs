@@ -571,10 +571,4 @@ impl FrameSnapshot {
     pub fn has_lights(&self) -> bool {
         self.lights.iter().any(|l| l.is_valid())
     }
-
-    /// True when some view needs the cluster build (see [`RenderView::needs_clusters`]).
-    pub fn needs_clusters(&self) -> bool {
-        let has_lights = self.has_lights();
-        (0..self.views.len()).any(|i| self.render_view(i).needs_clusters(has_lights))
-    }
 }
