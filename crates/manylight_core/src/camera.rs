@@ -70,7 +70,12 @@ impl Projection {
     /// Half the visible width and height in world units for an orthographic projection at
     /// `aspect` (sanitised), `None` for a perspective one.
     pub fn orthographic_half_extent(&self, aspect: f32) -> Option<Vec2> {
-        match self.sanitized().kind {
+        self.sanitized().half_extent_of_sanitized(aspect)
+    }
+
+    /// [`Projection::orthographic_half_extent`] of a projection already sanitised.
+    fn half_extent_of_sanitized(&self, aspect: f32) -> Option<Vec2> {
+        match self.kind {
             ProjectionKind::Orthographic { height } => {
                 Some(Vec2::new(0.5 * height * aspect_or_one(aspect), 0.5 * height))
             }
@@ -134,7 +139,7 @@ impl Projection {
     pub fn matrix(&self, aspect: f32) -> Mat4 {
         let p = self.sanitized();
         let aspect = aspect_or_one(aspect);
-        if let Some(half) = p.orthographic_half_extent(aspect) {
+        if let Some(half) = p.half_extent_of_sanitized(aspect) {
             let range = p.far - p.near;
             return Mat4::from_cols(
                 glam::Vec4::new(1.0 / half.x, 0.0, 0.0, 0.0),
@@ -183,24 +188,26 @@ impl Projection {
     /// View distance (positive, along −Z) of a reverse-Z depth-buffer value: for a perspective
     /// projection [`linearize_depth_reverse_z`], for an orthographic one the linear map back.
     pub fn linearize_depth(&self, depth: f32) -> f32 {
-        let p = self.sanitized();
-        match p.kind {
-            ProjectionKind::Orthographic { .. } => p.far - depth * (p.far - p.near),
-            ProjectionKind::Perspective => linearize_depth_reverse_z(depth, p.near, p.far),
+        self.sanitized().linearize_sanitized(depth)
+    }
+
+    /// [`Projection::linearize_depth`] of a projection already sanitised.
+    fn linearize_sanitized(&self, depth: f32) -> f32 {
+        match self.kind {
+            ProjectionKind::Orthographic { .. } => self.far - depth * (self.far - self.near),
+            ProjectionKind::Perspective => linearize_depth_reverse_z(depth, self.near, self.far),
         }
     }
 
     /// The view-space point at normalised device coordinates `ndc` and reverse-Z `depth`, for a
     /// target of `aspect`.
     pub fn view_position(&self, ndc: Vec2, depth: f32, aspect: f32) -> Vec3 {
-        let d = self.linearize_depth(depth);
-        let half = match self.orthographic_half_extent(aspect) {
-            Some(half) => half,
-            None => {
-                let tan_y = (0.5 * self.sanitized().fov_y).tan();
-                Vec2::new(tan_y * aspect_or_one(aspect), tan_y) * d
-            }
-        };
+        let p = self.sanitized();
+        let d = p.linearize_sanitized(depth);
+        let half = p.half_extent_of_sanitized(aspect).unwrap_or_else(|| {
+            let tan_y = (0.5 * p.fov_y).tan();
+            Vec2::new(tan_y * aspect_or_one(aspect), tan_y) * d
+        });
         (ndc * half).extend(-d)
     }
 }
