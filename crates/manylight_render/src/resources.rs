@@ -365,9 +365,9 @@ impl SceneResources {
             if inst.mesh.indices.is_empty() {
                 continue;
             }
-            let mesh = self.mesh_entry(device, &inst.mesh)?;
-            let material = self.material_entry(gpu, &inst.material)?;
-            let order = (self.materials[&material].order, self.meshes[&mesh].order);
+            let (mesh, mesh_order) = self.mesh_entry(device, &inst.mesh)?;
+            let (material, material_order) = self.material_entry(gpu, &inst.material)?;
+            let order = (material_order, mesh_order);
             self.draws.push(Draw { mesh, material, instance: instance_data.len() as u32, order });
             instance_data.push(gpu_instance);
         }
@@ -398,7 +398,11 @@ impl SceneResources {
 
     /// The mesh's GPU buffers, uploaded on first use; refused, naming the limit, when a buffer
     /// would exceed the device's `max_buffer_size`.
-    fn mesh_entry(&mut self, device: &wgpu::Device, mesh: &Arc<MeshData>) -> Result<usize, RenderError> {
+    fn mesh_entry(
+        &mut self,
+        device: &wgpu::Device,
+        mesh: &Arc<MeshData>,
+    ) -> Result<(usize, u64), RenderError> {
         let k = key(mesh);
         let frame = self.frame;
         if !self.meshes.contains_key(&k) {
@@ -416,13 +420,10 @@ impl SceneResources {
                 }
             }
         }
-        let order = self.uploads;
-        let entry = self.meshes.entry(k);
-        if matches!(entry, std::collections::hash_map::Entry::Vacant(_)) {
-            self.uploads += 1;
-        }
-        entry
-            .or_insert_with(|| GpuMesh {
+        let uploads = &mut self.uploads;
+        let entry = self.meshes.entry(k).or_insert_with(|| {
+            *uploads += 1;
+            GpuMesh {
                 _source: mesh.clone(),
                 vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some(&mesh.label),
@@ -435,18 +436,19 @@ impl SceneResources {
                     usage: wgpu::BufferUsages::INDEX,
                 }),
                 index_count: mesh.indices.len() as u32,
-                order,
+                order: *uploads,
                 last_used: frame,
-            })
-            .last_used = frame;
-        Ok(k)
+            }
+        });
+        entry.last_used = frame;
+        Ok((k, entry.order))
     }
 
     fn material_entry(
         &mut self,
         gpu: &GpuContext,
         material: &Arc<MaterialData>,
-    ) -> Result<usize, RenderError> {
+    ) -> Result<(usize, u64), RenderError> {
         let k = key(material);
         let frame = self.frame;
         if let Some(m) = self.materials.get_mut(&k) {
@@ -455,7 +457,7 @@ impl SceneResources {
             {
                 t.last_used = frame;
             }
-            return Ok(k);
+            return Ok((k, m.order));
         }
         let view = match &material.base_color_texture {
             Some(tex) => {
@@ -498,11 +500,11 @@ impl SceneResources {
                 wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.sampler) },
             ],
         });
-        let order = self.uploads;
         self.uploads += 1;
+        let order = self.uploads;
         self.materials
             .insert(k, GpuMaterialBinding { _source: material.clone(), bind_group, order, last_used: frame });
-        Ok(k)
+        Ok((k, order))
     }
 
     /// The GPU mesh of a draw.
