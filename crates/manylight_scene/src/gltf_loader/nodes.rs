@@ -356,32 +356,8 @@ impl Ctx<'_> {
             camera,
             problem: problem.into(),
         };
-        let placement = |bad: &dyn Fn(&str) -> SceneError| {
-            let (_, rotation, translation) = world.to_scale_rotation_translation();
-            let transform = Mat4::from_rotation_translation(rotation.normalize(), translation);
-            if transform.is_finite() {
-                Ok(transform)
-            } else {
-                Err(bad(&format!("node {node} gives it a degenerate transform")))
-            }
-        };
-        if let (Checked::Valid(CameraType::Orthographic), Some(o)) = (&c.type_, &c.orthographic) {
-            if !(o.ymag.is_finite() && o.ymag > 0.0 && o.xmag.is_finite() && o.xmag > 0.0) {
-                return Err(bad("xmag and ymag must be finite and positive"));
-            }
-            if !(o.znear.is_finite() && o.znear >= 0.0 && o.zfar.is_finite() && o.zfar > o.znear) {
-                return Err(bad("znear must be finite and at least 0, zfar finite and greater than znear"));
-            }
-            // The renderer needs a positive near plane: znear 0 moves to zfar × 10⁻⁶. The view's
-            // aspect ratio comes from the target, as for perspective cameras (xmag is not used).
-            let near = if o.znear > 0.0 { o.znear } else { o.zfar * 1e-6 };
-            let projection = Projection::orthographic(2.0 * o.ymag, near, o.zfar);
-            let transform = placement(&bad)?;
-            self.scene.cameras.push(SceneCamera { transform, projection: projection.sanitized() });
-            return Ok(());
-        }
-        match (&c.type_, &c.perspective) {
-            (Checked::Valid(CameraType::Perspective), Some(p)) => {
+        let projection = match (&c.type_, &c.perspective, &c.orthographic) {
+            (Checked::Valid(CameraType::Perspective), Some(p), _) => {
                 if !(p.yfov.is_finite() && p.yfov > 0.0 && p.yfov < std::f32::consts::PI) {
                     return Err(bad("yfov must be in (0, pi)"));
                 }
@@ -395,18 +371,40 @@ impl Ctx<'_> {
                     Some(f) if f.is_finite() && f > p.znear => f,
                     Some(_) => return Err(bad("zfar must be finite and greater than znear")),
                 };
-                let projection = Projection::perspective(p.yfov, p.znear, far);
-                let transform = placement(&bad)?;
-                self.scene.cameras.push(SceneCamera { transform, projection: projection.sanitized() });
+                Projection::perspective(p.yfov, p.znear, far)
             }
-            (Checked::Valid(CameraType::Perspective), None) => {
+            (Checked::Valid(CameraType::Orthographic), _, Some(o)) => {
+                if !(o.ymag.is_finite() && o.ymag > 0.0 && o.xmag.is_finite() && o.xmag > 0.0) {
+                    return Err(bad("xmag and ymag must be finite and positive"));
+                }
+                if !(o.znear.is_finite() && o.znear >= 0.0 && o.zfar.is_finite() && o.zfar > o.znear) {
+                    return Err(bad(
+                        "znear must be finite and at least 0, zfar finite and greater than znear",
+                    ));
+                }
+                // The renderer needs a positive near plane: znear 0 moves to zfar × 10⁻⁶. The
+                // view's aspect ratio comes from the target, as for perspective cameras (xmag is
+                // not used).
+                let near = if o.znear > 0.0 { o.znear } else { o.zfar * 1e-6 };
+                Projection::orthographic(2.0 * o.ymag, near, o.zfar)
+            }
+            (Checked::Valid(CameraType::Perspective), None, _) => {
                 return Err(bad("perspective camera without perspective parameters"));
             }
-            (Checked::Valid(CameraType::Orthographic), None) => {
+            (Checked::Valid(CameraType::Orthographic), _, None) => {
                 return Err(bad("orthographic camera without orthographic parameters"));
             }
-            _ => tracing::warn!(file = %self.path.display(), camera, "camera of an unknown type skipped"),
+            _ => {
+                tracing::warn!(file = %self.path.display(), camera, "camera of an unknown type skipped");
+                return Ok(());
+            }
+        };
+        let (_, rotation, translation) = world.to_scale_rotation_translation();
+        let transform = Mat4::from_rotation_translation(rotation.normalize(), translation);
+        if !transform.is_finite() {
+            return Err(bad(&format!("node {node} gives it a degenerate transform")));
         }
+        self.scene.cameras.push(SceneCamera { transform, projection: projection.sanitized() });
         Ok(())
     }
 }
