@@ -114,6 +114,10 @@ pub struct FrameTimes {
     pub exit_when_done: bool,
     /// Measured frame times in ms.
     pub samples: Vec<f64>,
+    /// Render-side CPU times (`FrameReport::frame_cpu_ms`) of the frames reported while
+    /// measuring.
+    pub render_cpu: Vec<f64>,
+    last_reported: Option<u64>,
     last: Option<Instant>,
     seen: u32,
     done: bool,
@@ -213,6 +217,10 @@ pub fn time_frames(
         times.seen += 1;
         if times.seen > times.warmup {
             times.samples.push((now - last).as_secs_f64() * 1e3);
+            if let Some(report) = stats.last.as_ref().filter(|r| times.last_reported != Some(r.frame_index)) {
+                times.last_reported = Some(report.frame_index);
+                times.render_cpu.push(report.frame_cpu_ms);
+            }
         }
     }
     times.last = Some(now);
@@ -221,9 +229,10 @@ pub fn time_frames(
     }
     times.done = true;
     let (median, mean) = median_mean(&times.samples);
+    let (render_cpu, _) = median_mean(&times.render_cpu);
     let lights = stats.last.as_ref().map_or(0, |r| r.light_count);
     println!(
-        "median_frame_ms={median:.2} mean_frame_ms={mean:.2} frames={} lights={lights} pipeline={}",
+        "median_frame_ms={median:.2} mean_frame_ms={mean:.2} median_render_cpu_ms={render_cpu:.2} frames={} lights={lights} pipeline={}",
         times.samples.len(),
         settings.pipeline.name()
     );
@@ -238,6 +247,16 @@ pub fn time_frames(
             })
             .collect();
         println!("last_frame_gpu_ms: {} render_cpu_ms={:.2}", passes.join(" "), report.frame_cpu_ms);
+        println!(
+            "last_reported_frame={} submitted={} frames_in_flight={}/{} blocking_waits={} buffers_created={} bind_groups_created={}",
+            report.frame_index,
+            stats.submitted,
+            report.frames_in_flight,
+            report.frames_in_flight_limit,
+            report.blocking_waits,
+            report.buffers_created,
+            report.bind_groups_created
+        );
     }
     if times.exit_when_done {
         exit.write(AppExit::Success);

@@ -5,7 +5,7 @@
 mod support;
 
 use manylight::app::backend::{FrameSink, RenderBackend, RenderThread};
-use manylight::app::render_world::HeadlessRenderer;
+use manylight::app::render_world::{HeadlessRenderer, SinkFrame};
 use manylight::app::{FrameStats, RenderFailure};
 use manylight::prelude::*;
 use manylight::render::{FrameReport, FrameSnapshot, RenderError};
@@ -29,11 +29,7 @@ struct FailingSink {
 }
 
 impl FrameSink for FailingSink {
-    fn render_frame(
-        &mut self,
-        snapshot: FrameSnapshot,
-        readback: bool,
-    ) -> Result<(FrameReport, Option<image::RgbaImage>), RenderError> {
+    fn render_frame(&mut self, snapshot: FrameSnapshot, readback: bool) -> Result<SinkFrame, RenderError> {
         self.frames += 1;
         if self.frames == self.fail_at {
             match self.failure {
@@ -44,6 +40,10 @@ impl FrameSink for FailingSink {
             }
         }
         self.inner.render_frame(snapshot, readback)
+    }
+
+    fn drain(&mut self) -> Result<Vec<FrameReport>, RenderError> {
+        self.inner.drain()
     }
 }
 
@@ -62,7 +62,7 @@ fn failing_app(pipelined: bool, frames: u32, fail_at: u32, failure: Failure, out
     let backend = if pipelined {
         RenderBackend::Pipelined(RenderThread::spawn(Box::new(sink)).expect("render thread"))
     } else {
-        RenderBackend::Sync { sink: Box::new(sink), pending: Vec::new() }
+        RenderBackend::sync(Box::new(sink))
     };
     app.insert_resource(backend);
     app

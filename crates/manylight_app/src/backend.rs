@@ -3,7 +3,7 @@
 //! overlaps the rendering of frame N; the channel holds one frame, so the simulation never runs
 //! more than one frame ahead).
 
-use crate::render_world::DeviceLoss;
+use crate::render_world::{DeviceLoss, SinkFrame};
 use crate::resources::{FrameStats, HeadlessCapture, RenderFailure, RenderedImages};
 use bevy_ecs::prelude::*;
 use crossbeam_channel::{Receiver, Sender, bounded, unbounded};
@@ -11,12 +11,15 @@ use manylight_render::{FrameReport, FrameSnapshot, RenderError, RenderTextureId}
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::thread::JoinHandle;
 
-/// What a rendered frame gives back: its report, its image if asked, and the images of its
-/// render-to-texture cameras.
+/// What rendering a frame gives back: the reports of the frames whose GPU figures arrived
+/// meanwhile (with frames in flight, earlier frames'; each names its frame), the frame's image
+/// if asked, and the images of its render-to-texture cameras.
 #[derive(Debug)]
 pub struct RenderedFrame {
-    /// The frame's report.
-    pub report: FrameReport,
+    /// The frame that was rendered.
+    pub frame_index: u64,
+    /// Complete reports, oldest first.
+    pub reports: Vec<FrameReport>,
     /// The main target's image, when read back.
     pub image: Option<image::RgbaImage>,
     /// The render-to-texture images, by id.
@@ -45,12 +48,14 @@ pub enum RenderFailed {
 
 /// Something that renders snapshots: the headless renderer or a window surface.
 pub trait FrameSink: Send + Sync + 'static {
-    /// Renders one snapshot; reads the image back when `readback` is set.
-    fn render_frame(
-        &mut self,
-        snapshot: FrameSnapshot,
-        readback: bool,
-    ) -> Result<(FrameReport, Option<image::RgbaImage>), RenderError>;
+    /// Renders one snapshot without waiting for the GPU, unless `readback` asks for its image
+    /// (then every frame in flight is waited for); returns the reports that have arrived.
+    fn render_frame(&mut self, snapshot: FrameSnapshot, readback: bool) -> Result<SinkFrame, RenderError>;
+
+    /// Waits for the frames in flight and returns their reports (at shutdown).
+    fn drain(&mut self) -> Result<Vec<FrameReport>, RenderError> {
+        Ok(Vec::new())
+    }
 
     /// Destroys the GPU device, as a driver reset would, at the point `when` says; the renderer
     /// finds it lost and recreates it. For fault-injection tests and the soak run; sinks
@@ -66,12 +71,12 @@ pub trait FrameSink: Send + Sync + 'static {
 }
 
 impl FrameSink for crate::render_world::HeadlessRenderer {
-    fn render_frame(
-        &mut self,
-        snapshot: FrameSnapshot,
-        readback: bool,
-    ) -> Result<(FrameReport, Option<image::RgbaImage>), RenderError> {
-        self.render(snapshot, readback)
+    fn render_frame(&mut self, snapshot: FrameSnapshot, readback: bool) -> Result<SinkFrame, RenderError> {
+        self.render_in_flight(snapshot, readback)
+    }
+
+    fn drain(&mut self) -> Result<Vec<FrameReport>, RenderError> {
+        self.render_world.take_reports(true)
     }
 
     fn lose_device(&mut self, when: DeviceLoss) {
@@ -95,11 +100,29 @@ fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
 /// Renders one frame, turning a panic of the renderer into an error like any other failed
 /// frame (the app ends on it; the render thread stops).
 fn render_caught(sink: &mut dyn FrameSink, snapshot: FrameSnapshot, readback: bool) -> FrameResult {
+    let frame_index = snapshot.frame_index;
     match catch_unwind(AssertUnwindSafe(|| sink.render_frame(snapshot, readback))) {
         Ok(result) => result
-            .map(|(report, image)| RenderedFrame { report, image, textures: sink.take_textures() })
+            .map(|SinkFrame { reports, image }| RenderedFrame {
+                frame_index,
+                reports,
+                image,
+                textures: sink.take_textures(),
+            })
             .map_err(RenderFailed::Render),
         Err(payload) => Err(RenderFailed::Panic(panic_message(payload.as_ref()))),
+    }
+}
+
+/// Waits for the sink's frames in flight; their reports as one result (none: `None`).
+fn drain_caught(sink: &mut dyn FrameSink, last_frame: u64) -> Option<FrameResult> {
+    match catch_unwind(AssertUnwindSafe(|| sink.drain())) {
+        Ok(Ok(reports)) if reports.is_empty() => None,
+        Ok(Ok(reports)) => {
+            Some(Ok(RenderedFrame { frame_index: last_frame, reports, image: None, textures: Vec::new() }))
+        }
+        Ok(Err(e)) => Some(Err(RenderFailed::Render(e))),
+        Err(payload) => Some(Err(RenderFailed::Panic(panic_message(payload.as_ref())))),
     }
 }
 
@@ -121,7 +144,10 @@ impl RenderThread {
         let (frame_tx, frame_rx) = bounded::<ToRenderThread>(1);
         let (result_tx, result_rx) = unbounded::<FrameResult>();
         let handle = std::thread::Builder::new().name("manylight-render".into()).spawn(move || {
-            // Ends when the sender is dropped (app shut down) or a frame fails.
+            // Ends when the sender is dropped (app shut down) or a frame fails; then the frames
+            // still in flight are waited for and reported.
+            let mut last_frame = 0;
+            let mut failed = false;
             while let Ok(message) = frame_rx.recv() {
                 let (snapshot, readback) = match message {
                     ToRenderThread::Frame(snapshot, readback) => (snapshot, readback),
@@ -130,11 +156,15 @@ impl RenderThread {
                         continue;
                     }
                 };
+                last_frame = snapshot.frame_index;
                 let result = render_caught(sink.as_mut(), *snapshot, readback);
-                let failed = result.is_err();
+                failed = result.is_err();
                 if result_tx.send(result).is_err() || failed {
                     break;
                 }
+            }
+            if !failed && let Some(result) = drain_caught(sink.as_mut(), last_frame) {
+                let _ = result_tx.send(result);
             }
             tracing::debug!("render thread finished");
         })?;
@@ -170,6 +200,8 @@ pub enum RenderBackend {
         sink: Box<dyn FrameSink>,
         /// Results not yet collected.
         pending: Vec<FrameResult>,
+        /// The last frame submitted.
+        last_frame: u64,
     },
     /// Render on a render thread.
     Pipelined(RenderThread),
@@ -178,11 +210,17 @@ pub enum RenderBackend {
 }
 
 impl RenderBackend {
+    /// Renders on the calling thread through `sink`.
+    pub fn sync(sink: Box<dyn FrameSink>) -> RenderBackend {
+        RenderBackend::Sync { sink, pending: Vec::new(), last_frame: 0 }
+    }
+
     /// Hands a snapshot over (renders it now in sync mode).
     pub fn submit(&mut self, snapshot: FrameSnapshot, readback: bool) {
         match self {
             RenderBackend::Pending => {}
-            RenderBackend::Sync { sink, pending } => {
+            RenderBackend::Sync { sink, pending, last_frame } => {
+                *last_frame = snapshot.frame_index;
                 pending.push(render_caught(sink.as_mut(), snapshot, readback));
             }
             RenderBackend::Pipelined(thread) => {
@@ -245,6 +283,14 @@ impl RenderBackend {
     pub fn flush(&mut self) -> Vec<FrameResult> {
         let panic = match self {
             RenderBackend::Pipelined(thread) => thread.shutdown(),
+            RenderBackend::Sync { sink, pending, last_frame } => {
+                if !pending.iter().any(|r| r.is_err())
+                    && let Some(result) = drain_caught(sink.as_mut(), *last_frame)
+                {
+                    pending.push(result);
+                }
+                None
+            }
             _ => None,
         };
         let mut results = self.drain();
@@ -264,16 +310,19 @@ pub fn record_results(world: &mut World, results: Vec<FrameResult>) -> bool {
     let mut failed = false;
     for result in results {
         match result {
-            Ok(RenderedFrame { report, image, textures }) => {
+            Ok(RenderedFrame { frame_index, reports, image, textures }) => {
                 if !textures.is_empty()
                     && let Some(mut images) = world.get_resource_mut::<RenderedImages>()
                 {
                     for (id, texture) in textures {
-                        images.insert(id, report.frame_index, texture);
+                        images.insert(id, frame_index, texture);
                     }
                 }
                 if let Some(mut stats) = world.get_resource_mut::<FrameStats>() {
-                    stats.record(report);
+                    stats.submitted = stats.submitted.max(frame_index);
+                    for report in reports {
+                        stats.record(report);
+                    }
                 }
                 if let (Some(image), Some(mut capture)) = (image, world.get_resource_mut::<HeadlessCapture>())
                 {

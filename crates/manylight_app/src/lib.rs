@@ -33,8 +33,8 @@ pub use components::{
 };
 pub use plugin::{HEADLESS_TIME_STEP, HeadlessConfig, ManyLightPlugin, ManyLightSet, OutputMode};
 pub use resources::{
-    DebugView, FrameStats, HeadlessCapture, LightControls, RenderFailure, RenderSettings, RenderedImages,
-    ViewportSize,
+    DebugView, FrameStats, FrameTotals, FramesInFlight, HeadlessCapture, LightControls, RenderFailure,
+    RenderSettings, RenderedImages, ViewportSize,
 };
 pub use window::{Overlay, PressedKeys, WindowConfig, WindowRequests};
 

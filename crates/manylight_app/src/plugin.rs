@@ -3,7 +3,9 @@
 use crate::backend::{RenderBackend, RenderThread};
 use crate::extract::{animate_lights, collect_results, extract_and_render};
 use crate::render_world::HeadlessRenderer;
-use crate::resources::{DebugView, FrameStats, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize};
+use crate::resources::{
+    DebugView, FrameStats, FramesInFlight, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize,
+};
 use crate::window::WindowConfig;
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
@@ -57,18 +59,27 @@ pub struct ManyLightPlugin {
     /// Render on a separate thread (frame N+1 simulates while N renders). Default: true for
     /// windows, false headless (deterministic, results available right after `update`).
     pub pipelined: bool,
+    /// Frames the GPU may still be working on when the next is submitted; their statistics
+    /// are read back without waiting and arrive in [`FrameStats`] that many frames later.
+    /// Default [`manylight_render::DEFAULT_FRAMES_IN_FLIGHT`] (2); 1 to
+    /// [`manylight_render::MAX_FRAMES_IN_FLIGHT`].
+    pub frames_in_flight: u32,
 }
 
 impl Default for ManyLightPlugin {
     fn default() -> Self {
-        Self { mode: OutputMode::Window(WindowConfig::default()), pipelined: true }
+        Self::window(WindowConfig::default())
     }
 }
 
 impl ManyLightPlugin {
     /// A window with the given configuration.
     pub fn window(config: WindowConfig) -> Self {
-        Self { mode: OutputMode::Window(config), pipelined: true }
+        Self {
+            mode: OutputMode::Window(config),
+            pipelined: true,
+            frames_in_flight: manylight_render::DEFAULT_FRAMES_IN_FLIGHT,
+        }
     }
 
     /// Headless rendering at `size` (synchronous, one frame per `App::update`).
@@ -76,6 +87,7 @@ impl ManyLightPlugin {
         Self {
             mode: OutputMode::Headless(HeadlessConfig { size, frames: 1, output: None }),
             pipelined: false,
+            frames_in_flight: manylight_render::DEFAULT_FRAMES_IN_FLIGHT,
         }
     }
 
@@ -92,6 +104,12 @@ impl ManyLightPlugin {
         if let OutputMode::Headless(h) = &mut self.mode {
             h.output = Some(path.into());
         }
+        self
+    }
+
+    /// Sets the most frames in flight ([`ManyLightPlugin::frames_in_flight`]).
+    pub fn with_frames_in_flight(mut self, frames: u32) -> Self {
+        self.frames_in_flight = frames.clamp(1, manylight_render::MAX_FRAMES_IN_FLIGHT);
         self
     }
 
@@ -116,6 +134,7 @@ impl Plugin for ManyLightPlugin {
             PostUpdate,
             crate::visibility::propagate_visibility.after(TransformSystems::Propagate),
         );
+        app.insert_resource(FramesInFlight(self.frames_in_flight));
         app.init_resource::<RenderSettings>()
             .init_resource::<DebugView>()
             .init_resource::<FrameStats>()
@@ -138,12 +157,12 @@ impl Plugin for ManyLightPlugin {
                     .set_runner(move |app| crate::window::run_window(app, config, pipelined));
             }
             OutputMode::Headless(config) => {
-                let backend = match HeadlessRenderer::new() {
+                let backend = match HeadlessRenderer::with_frames_in_flight(self.frames_in_flight) {
                     Ok(r) if self.pipelined => match RenderThread::spawn(Box::new(r)) {
                         Ok(t) => RenderBackend::Pipelined(t),
                         Err(e) => RenderBackend::Failed(format!("could not start the render thread: {e}")),
                     },
-                    Ok(r) => RenderBackend::Sync { sink: Box::new(r), pending: Vec::new() },
+                    Ok(r) => RenderBackend::sync(Box::new(r)),
                     Err(e) => RenderBackend::Failed(e.to_string()),
                 };
                 let config = config.clone();

@@ -146,13 +146,22 @@ pub struct RenderWorld {
     /// The render-to-texture images of the last frame, until taken.
     texture_images: Vec<(RenderTextureId, image::RgbaImage)>,
     last_passes: Vec<&'static str>,
+    /// Device recoveries not yet counted in a finished frame's report.
+    recoveries: u32,
 }
 
 impl RenderWorld {
-    /// Builds the render world around a GPU context.
+    /// Builds the render world around a GPU context, with
+    /// [`manylight_render::DEFAULT_FRAMES_IN_FLIGHT`] frames in flight.
     pub fn new(gpu: GpuContext) -> RenderWorld {
+        Self::with_frames_in_flight(gpu, manylight_render::DEFAULT_FRAMES_IN_FLIGHT)
+    }
+
+    /// Builds the render world around a GPU context; at most `frames_in_flight` frames are
+    /// submitted and not yet read back.
+    pub fn with_frames_in_flight(gpu: GpuContext, frames_in_flight: u32) -> RenderWorld {
         let mut world = World::new();
-        world.insert_resource(RendererResource(Renderer::new(gpu)));
+        world.insert_resource(RendererResource(Renderer::with_frames_in_flight(gpu, frames_in_flight)));
         world.init_resource::<CurrentSnapshot>();
         world.init_resource::<FrameGraph>();
         world.init_resource::<FrameOutcome>();
@@ -170,6 +179,7 @@ impl RenderWorld {
             view_images: HashMap::new(),
             texture_images: Vec::new(),
             last_passes: Vec::new(),
+            recoveries: 0,
         }
     }
 
@@ -199,8 +209,11 @@ impl RenderWorld {
             .map_err(|e| RenderError::DeviceLost { reason: reason.clone(), why: e.to_string() })?;
         tracing::warn!("the GPU device was {reason} in frame {frame}; recreated it on `{}`", gpu.info.name);
         let losses = std::mem::take(&mut self.losses);
-        *self = RenderWorld::new(gpu);
+        let frames_in_flight = self.renderer().frames_in_flight();
+        let recoveries = self.recoveries;
+        *self = RenderWorld::with_frames_in_flight(gpu, frames_in_flight);
         self.losses = losses;
+        self.recoveries = recoveries + 1;
         Ok(())
     }
 
@@ -214,9 +227,36 @@ impl RenderWorld {
         &self.world.resource::<RendererResource>().0
     }
 
+    /// Ends the frame [`RenderWorld::render`] recorded: its report (with any passes recorded
+    /// after it, such as the window overlay) goes in flight, and comes back complete from
+    /// [`RenderWorld::take_reports`].
+    pub fn finish_frame(&mut self, mut report: FrameReport) {
+        report.device_recoveries += std::mem::take(&mut self.recoveries);
+        self.world.resource_mut::<RendererResource>().0.finish_frame(report);
+    }
+
+    /// The reports of finished frames whose GPU figures have arrived, oldest first; with
+    /// `wait`, waits for every frame in flight first.
+    pub fn take_reports(&mut self, wait: bool) -> Result<Vec<FrameReport>, RenderError> {
+        self.world.resource_mut::<RendererResource>().0.take_reports(wait)
+    }
+
+    /// The renderer, to record a pass outside the graph (the window overlay).
+    pub fn renderer_mut(&mut self) -> &mut Renderer {
+        &mut self.world.resource_mut::<RendererResource>().into_inner().0
+    }
+
+    /// A frame that rendered nothing: its report is counted with the pending recoveries and
+    /// returned as it is (nothing of it is on the GPU).
+    pub fn report_empty(&mut self, mut report: FrameReport) -> FrameReport {
+        report.device_recoveries += std::mem::take(&mut self.recoveries);
+        report
+    }
+
     /// Renders `snapshot` into `output`: each view in order, into its rectangle of `output`
     /// or into its render-to-texture target (read back afterwards: [`RenderWorld::take_textures`]).
-    /// A frame without views draws the clear colour.
+    /// A frame without views draws the clear colour. Returns the frame's report as recorded:
+    /// pass [`RenderWorld::finish_frame`] it once everything of the frame is recorded.
     pub fn render(
         &mut self,
         snapshot: FrameSnapshot,
@@ -723,36 +763,55 @@ fn execute(
     }
 }
 
+/// What a sink gives back for a frame: the reports that arrived meanwhile (in pipelined use,
+/// those of earlier frames), and the frame's image if asked.
+#[derive(Debug, Default)]
+pub struct SinkFrame {
+    /// Complete reports, oldest first.
+    pub reports: Vec<FrameReport>,
+    /// The frame's image, when read back.
+    pub image: Option<image::RgbaImage>,
+}
+
 /// A renderer on a device that can be lost: it renders a frame on its device and recreates the
 /// device after a loss; [`DeviceSink::render_recovering`] puts the two together.
 pub(crate) trait DeviceSink {
     /// The current device.
     fn gpu(&self) -> &GpuContext;
+    /// The render world.
+    fn render_world(&mut self) -> &mut RenderWorld;
     /// Recreates the device after it was lost (`reason`, found in `frame`).
     fn recover(&mut self, reason: String, frame: u64) -> Result<(), RenderError>;
-    /// Renders one frame on the current device.
+    /// Renders one frame on the current device and finishes it; `Some` report when the frame
+    /// rendered nothing (it is complete at once).
     fn render_on_device(
         &mut self,
         snapshot: FrameSnapshot,
         readback: bool,
-    ) -> Result<(FrameReport, Option<image::RgbaImage>), RenderError>;
+    ) -> Result<(Option<FrameReport>, Option<image::RgbaImage>), RenderError>;
 
     /// Renders one frame, recreating the device first if it was lost since the last frame, or
     /// after the frame if it was lost during it. That frame's work went to the lost device: it
-    /// is reported with no passes, and rendering goes on from the next frame.
+    /// is reported with no passes, and rendering goes on from the next frame (frames still in
+    /// flight on the lost device report nothing). With `readback` the frame's image is read
+    /// and every frame in flight is waited for; without, the reports that have arrived are
+    /// returned and nothing waits.
     fn render_recovering(
         &mut self,
         snapshot: FrameSnapshot,
         readback: bool,
-    ) -> Result<(FrameReport, Option<image::RgbaImage>), RenderError> {
+    ) -> Result<SinkFrame, RenderError> {
         let frame = snapshot.frame_index;
-        let mut recoveries = 0;
         if let Some(reason) = self.gpu().lost() {
             self.recover(reason, frame)?;
-            recoveries += 1;
         }
         let (viewport, pipeline) = (snapshot.viewport, snapshot.settings.pipeline);
         let result = self.render_on_device(snapshot, readback);
+        let result = result.and_then(|(empty, image)| {
+            let mut reports = self.render_world().take_reports(readback)?;
+            reports.extend(empty);
+            Ok(SinkFrame { reports, image })
+        });
         match self.gpu().lost() {
             Some(reason) => {
                 if let Err(e) = &result {
@@ -760,17 +819,16 @@ pub(crate) trait DeviceSink {
                 }
                 self.recover(reason, frame)?;
                 let lost_frame = report_without_passes(frame, viewport, pipeline);
-                Ok((FrameReport { device_recoveries: recoveries + 1, ..lost_frame }, None))
+                let lost_frame = self.render_world().report_empty(lost_frame);
+                Ok(SinkFrame { reports: vec![lost_frame], image: None })
             }
-            None => {
-                result.map(|(report, image)| (FrameReport { device_recoveries: recoveries, ..report }, image))
-            }
+            None => result,
         }
     }
 }
 
-/// Synchronous headless rendering: a render world plus an offscreen target that follows the
-/// snapshot's viewport size.
+/// Headless rendering: a render world plus an offscreen target that follows the snapshot's
+/// viewport size.
 pub struct HeadlessRenderer {
     /// The render world.
     pub render_world: RenderWorld,
@@ -778,19 +836,43 @@ pub struct HeadlessRenderer {
 }
 
 impl HeadlessRenderer {
-    /// Creates a headless GPU context and render world.
+    /// Creates a headless GPU context and render world with
+    /// [`manylight_render::DEFAULT_FRAMES_IN_FLIGHT`] frames in flight.
     pub fn new() -> Result<HeadlessRenderer, RenderError> {
-        Ok(HeadlessRenderer { render_world: RenderWorld::new(GpuContext::headless()?), target: None })
+        Self::with_frames_in_flight(manylight_render::DEFAULT_FRAMES_IN_FLIGHT)
     }
 
-    /// Renders a snapshot; when `readback` is set, returns the image too. A device found lost
-    /// is recreated (see [`RenderWorld::recover_device`]); the frame in which the loss is found
-    /// renders nothing and says so in [`FrameReport::device_recoveries`].
+    /// Creates a headless GPU context and render world; at most `frames_in_flight` frames are
+    /// submitted and not yet read back.
+    pub fn with_frames_in_flight(frames_in_flight: u32) -> Result<HeadlessRenderer, RenderError> {
+        let render_world = RenderWorld::with_frames_in_flight(GpuContext::headless()?, frames_in_flight);
+        Ok(HeadlessRenderer { render_world, target: None })
+    }
+
+    /// Renders a snapshot and waits for it (the reference path for tests and measurements: the
+    /// report is complete when this returns); when `readback` is set, returns the image too. A
+    /// device found lost is recreated (see [`RenderWorld::recover_device`]); the frame in
+    /// which the loss is found renders nothing and says so in
+    /// [`FrameReport::device_recoveries`].
     pub fn render(
         &mut self,
         snapshot: FrameSnapshot,
         readback: bool,
     ) -> Result<(FrameReport, Option<image::RgbaImage>), RenderError> {
+        let mut frame = self.render_recovering(snapshot, readback)?;
+        frame.reports.extend(self.render_world.take_reports(true)?);
+        let report =
+            frame.reports.pop().ok_or_else(|| RenderError::Graph("the frame gave no report".into()))?;
+        Ok((report, frame.image))
+    }
+
+    /// Renders a snapshot without waiting for the GPU (unless `readback` asks for the image):
+    /// returns the reports that have arrived, oldest first.
+    pub fn render_in_flight(
+        &mut self,
+        snapshot: FrameSnapshot,
+        readback: bool,
+    ) -> Result<SinkFrame, RenderError> {
         self.render_recovering(snapshot, readback)
     }
 }
@@ -798,6 +880,10 @@ impl HeadlessRenderer {
 impl DeviceSink for HeadlessRenderer {
     fn gpu(&self) -> &GpuContext {
         self.render_world.gpu()
+    }
+
+    fn render_world(&mut self) -> &mut RenderWorld {
+        &mut self.render_world
     }
 
     fn recover(&mut self, reason: String, frame: u64) -> Result<(), RenderError> {
@@ -810,13 +896,14 @@ impl DeviceSink for HeadlessRenderer {
         &mut self,
         snapshot: FrameSnapshot,
         readback: bool,
-    ) -> Result<(FrameReport, Option<image::RgbaImage>), RenderError> {
+    ) -> Result<(Option<FrameReport>, Option<image::RgbaImage>), RenderError> {
         let size = snapshot.viewport;
         if size.x == 0 || size.y == 0 || !snapshot.views.iter().any(|v| v.camera.is_valid()) {
             // Nothing to look through or at.
             let mut snapshot = snapshot;
             let invalid_cameras = snapshot.reject_invalid_camera();
-            return Ok((FrameReport { invalid_cameras, ..empty_report(&snapshot) }, None));
+            let report = FrameReport { invalid_cameras, ..empty_report(&snapshot) };
+            return Ok((Some(self.render_world.report_empty(report)), None));
         }
         let gpu = self.render_world.gpu().clone();
         let limit = gpu.device.limits().max_texture_dimension_2d;
@@ -832,7 +919,8 @@ impl DeviceSink for HeadlessRenderer {
         let view = target.view().clone();
         let report = self.render_world.render(snapshot, &view, manylight_render::HEADLESS_FORMAT)?;
         let image = if readback { Some(target.read(&gpu)?) } else { None };
-        Ok((report, image))
+        self.render_world.finish_frame(report);
+        Ok((None, image))
     }
 }
 

@@ -110,17 +110,38 @@ impl DebugView {
 }
 
 /// The statistics of the most recently finished frame: passes in order with GPU/CPU ms, light
-/// count and more (see [`FrameReport`]). In pipelined mode it lags the simulation by a frame.
+/// count and more (see [`FrameReport`]). A frame's GPU figures are read back without waiting,
+/// so its report arrives up to `frames_in_flight` frames after it was submitted (in pipelined
+/// mode a frame more); [`FrameReport::frame_index`] says which frame it is.
 #[derive(Resource, Clone, Debug, Default)]
 pub struct FrameStats {
     /// The last report (None before the first frame finished).
     pub last: Option<FrameReport>,
+    /// The latest frame handed to the GPU (its report may not have arrived yet).
+    pub submitted: u64,
     /// Frames rendered so far.
     pub frames_rendered: u64,
     /// CPU time of the main-world update that produced the last snapshot.
     pub simulation_cpu_ms: f64,
     /// Times the GPU device was lost and recreated since start-up.
     pub device_recoveries: u64,
+    /// Sums since start-up of every reported frame's [`FrameReport::blocking_waits`],
+    /// [`FrameReport::buffers_created`] and [`FrameReport::bind_groups_created`]: flat in steady
+    /// state.
+    pub totals: FrameTotals,
+}
+
+/// Sums over the reported frames (see [`FrameStats::totals`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FrameTotals {
+    /// Frames reported.
+    pub frames: u64,
+    /// Blocking GPU waits.
+    pub blocking_waits: u64,
+    /// Buffers created.
+    pub buffers_created: u64,
+    /// Bind groups created.
+    pub bind_groups_created: u64,
 }
 
 impl FrameStats {
@@ -130,6 +151,10 @@ impl FrameStats {
     pub fn record(&mut self, report: FrameReport) {
         self.frames_rendered += u64::from(!report.passes.is_empty());
         self.device_recoveries += u64::from(report.device_recoveries);
+        self.totals.frames += 1;
+        self.totals.blocking_waits += report.blocking_waits;
+        self.totals.buffers_created += report.buffers_created;
+        self.totals.bind_groups_created += report.bind_groups_created;
         self.last = Some(report);
     }
 
@@ -138,6 +163,11 @@ impl FrameStats {
         self.last.as_ref().map(|r| r.passes.iter().map(|p| p.name.clone()).collect()).unwrap_or_default()
     }
 }
+
+/// The most frames the renderer keeps in flight (submitted, not yet read back); set by
+/// [`crate::ManyLightPlugin::frames_in_flight`] and read when the renderer is created.
+#[derive(Resource, Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FramesInFlight(pub u32);
 
 /// Size of the render target in pixels (the window's inner size, or the headless size).
 #[derive(Resource, Clone, Copy, Debug, PartialEq, Eq)]

@@ -65,6 +65,22 @@ pub struct ClusterReport {
     pub z_slicing: String,
 }
 
+impl ClusterReport {
+    /// Fills the figures that come from the GPU build's counters.
+    pub fn apply_counters(&mut self, c: &GpuClusterCounters) {
+        let total = u64::from(c.total_entries);
+        self.non_empty = c.non_empty;
+        self.total_entries = total;
+        self.max_per_cluster = c.max_count;
+        self.max_per_tile = c.max_tile_lights;
+        self.mean_per_cluster = total as f64 / f64::from(self.clusters.max(1));
+        self.mean_per_non_empty = total as f64 / f64::from(c.non_empty.max(1));
+        self.dropped_pairs = u64::from(c.dropped_pairs);
+        self.clusters_overflowed = c.clusters_overflowed;
+        self.tile_entries = u64::from(c.tile_entries);
+    }
+}
+
 /// GPU buffers and bind groups of the cluster build and of clustered shading.
 pub struct ClusterResources {
     /// The grid of the current frame.
@@ -91,7 +107,6 @@ pub struct ClusterResources {
     tile_ranges: GrowableBuffer,
     tile_indices: GrowableBuffer,
     counters: wgpu::Buffer,
-    counters_readback: wgpu::Buffer,
     bounds_of: Option<ClusterGrid>,
     generations: [u64; 7],
     /// The view-space spheres uploaded this frame (for the CPU reference in tests and stats).
@@ -132,7 +147,7 @@ impl ClusterResources {
             label: Some("cluster_lists"),
             entries: &[uniform_entry(0, shade), storage_entry(1, shade, true), storage_entry(2, shade, true)],
         });
-        let params_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        let params_buffer = gpu.create_buffer(&wgpu::BufferDescriptor {
             label: Some("cluster_params"),
             size: std::mem::size_of::<GpuClusterParams>() as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
@@ -140,30 +155,24 @@ impl ClusterResources {
         });
         let storage = wgpu::BufferUsages::STORAGE;
         let copy = wgpu::BufferUsages::COPY_SRC;
-        let bounds = GrowableBuffer::new(device, "cluster_bounds", storage, 128 * 1024);
-        let spheres = GrowableBuffer::new(device, "light_view_spheres", storage, 16 * 1024);
-        let ranges = GrowableBuffer::new(device, "cluster_ranges", storage | copy, 8 * 8192);
+        let bounds = GrowableBuffer::new(gpu, "cluster_bounds", storage, 128 * 1024);
+        let spheres = GrowableBuffer::new(gpu, "light_view_spheres", storage, 16 * 1024);
+        let ranges = GrowableBuffer::new(gpu, "cluster_ranges", storage | copy, 8 * 8192);
         let indices =
-            GrowableBuffer::new(device, "light_index_list", storage | copy, 4 * INITIAL_INDEX_CAPACITY);
-        let tile_bounds = GrowableBuffer::new(device, "tile_bounds", storage, 128 * 256);
-        let tile_ranges = GrowableBuffer::new(device, "tile_ranges", storage, 8 * 256);
+            GrowableBuffer::new(gpu, "light_index_list", storage | copy, 4 * INITIAL_INDEX_CAPACITY);
+        let tile_bounds = GrowableBuffer::new(gpu, "tile_bounds", storage, 128 * 256);
+        let tile_ranges = GrowableBuffer::new(gpu, "tile_ranges", storage, 8 * 256);
         let tile_indices =
-            GrowableBuffer::new(device, "tile_light_index_list", storage, 4 * INITIAL_TILE_INDEX_CAPACITY);
+            GrowableBuffer::new(gpu, "tile_light_index_list", storage, 4 * INITIAL_TILE_INDEX_CAPACITY);
         let counters_size = std::mem::size_of::<GpuClusterCounters>() as u64;
-        let counters = device.create_buffer(&wgpu::BufferDescriptor {
+        let counters = gpu.create_buffer(&wgpu::BufferDescriptor {
             label: Some("cluster_counters"),
             size: counters_size,
             usage: storage | copy | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let counters_readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("cluster_counters_readback"),
-            size: counters_size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
         let (build_bind_group, shading_bind_group) = Self::bind_groups(
-            device,
+            gpu,
             &build_layout,
             &shading_layout,
             &params_buffer,
@@ -186,7 +195,6 @@ impl ClusterResources {
             tile_ranges,
             tile_indices,
             counters,
-            counters_readback,
             bounds_of: None,
             generations: [0; 7],
             view_spheres: Vec::new(),
@@ -197,7 +205,7 @@ impl ClusterResources {
     }
 
     fn bind_groups(
-        device: &wgpu::Device,
+        gpu: &GpuContext,
         build_layout: &wgpu::BindGroupLayout,
         shading_layout: &wgpu::BindGroupLayout,
         params: &wgpu::Buffer,
@@ -207,7 +215,7 @@ impl ClusterResources {
         fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
             wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() }
         }
-        let build = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let build = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("cluster_build"),
             layout: build_layout,
             entries: &[
@@ -222,7 +230,7 @@ impl ClusterResources {
                 entry(8, tile_indices.buffer()),
             ],
         });
-        let shading = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let shading = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("cluster_lists"),
             layout: shading_layout,
             entries: &[entry(0, params), entry(1, ranges.buffer()), entry(2, indices.buffer())],
@@ -230,7 +238,7 @@ impl ClusterResources {
         (build, shading)
     }
 
-    fn rebind_if_grown(&mut self, device: &wgpu::Device) {
+    fn rebind_if_grown(&mut self, gpu: &GpuContext) {
         let generations = [
             self.bounds.generation(),
             self.spheres.generation(),
@@ -242,7 +250,7 @@ impl ClusterResources {
         ];
         if generations != self.generations {
             let (b, s) = Self::bind_groups(
-                device,
+                gpu,
                 &self.build_layout,
                 &self.shading_layout,
                 &self.params_buffer,
@@ -273,7 +281,6 @@ impl ClusterResources {
         view_from_world: &Mat4,
         lights: &[(glam::Vec3, f32)],
     ) -> Result<(), RenderError> {
-        let device = &gpu.device;
         let queue = &gpu.queue;
         let settings = &view.settings.clusters;
         let grid_config = settings.grid_for(view.settings.pipeline);
@@ -301,7 +308,7 @@ impl ClusterResources {
                     }
                 }
             }
-            self.bounds.write(device, queue, bytemuck::cast_slice(&bounds))?;
+            self.bounds.write(gpu, bytemuck::cast_slice(&bounds))?;
             // Level 1 of the build: the same tiles with one slice from near to far.
             let tile_grid = ClusterGrid::new(
                 view.size,
@@ -322,17 +329,17 @@ impl ClusterResources {
                     });
                 }
             }
-            self.tile_bounds.write(device, queue, bytemuck::cast_slice(&tiles))?;
+            self.tile_bounds.write(gpu, bytemuck::cast_slice(&tiles))?;
             self.bounds_of = Some(self.grid);
         }
         let spheres: Vec<[f32; 4]> =
             self.view_spheres.iter().map(|s| s.center.extend(s.radius).to_array()).collect();
         if spheres.is_empty() {
-            self.spheres.write(device, queue, &[0u8; 16])?;
+            self.spheres.write(gpu, &[0u8; 16])?;
         } else {
-            self.spheres.write(device, queue, bytemuck::cast_slice(&spheres))?;
+            self.spheres.write(gpu, bytemuck::cast_slice(&spheres))?;
         }
-        self.ranges.reserve(device, count as u64 * 8)?;
+        self.ranges.reserve(gpu, count as u64 * 8)?;
         // Lists sized before the frame is submitted, from a CPU bound of what the build can
         // write (`list_bounds`): the GPU lists cannot overflow, so the frame is never rendered
         // twice. A bound beyond what the device can bind reserves what it can; then the build's
@@ -340,13 +347,23 @@ impl ClusterResources {
         let started = std::time::Instant::now();
         self.bounds_estimate = list_bounds(&self.grid, &self.view_spheres, settings.cull);
         self.bound_cpu_ms = started.elapsed().as_secs_f64() * 1e3;
+        // A quarter of headroom: lights that move a little do not grow the lists every frame
+        // (growing creates a buffer and rebinds), and the buffers grow in powers of two.
         let bytes =
             |entries: u64, buffer: &crate::pool::GrowableBuffer| (entries.max(1) * 4).min(buffer.max_bytes());
-        self.indices.reserve(device, bytes(self.bounds_estimate.cluster_pairs, &self.indices))?;
-        self.tile_indices.reserve(device, bytes(self.bounds_estimate.tile_entries, &self.tile_indices))?;
+        let with_headroom = |entries: u64, buffer: &crate::pool::GrowableBuffer| {
+            if buffer.capacity() >= bytes(entries, buffer) {
+                bytes(entries, buffer)
+            } else {
+                bytes(entries + entries / 4, buffer)
+            }
+        };
+        self.indices.reserve(gpu, with_headroom(self.bounds_estimate.cluster_pairs, &self.indices))?;
+        self.tile_indices
+            .reserve(gpu, with_headroom(self.bounds_estimate.tile_entries, &self.tile_indices))?;
         let tiles = self.grid.dims.x as u64 * self.grid.dims.y as u64;
         let tile_chunks = (spheres.len() as u32).div_ceil(TILE_LIGHT_CHUNK).max(1);
-        self.tile_ranges.reserve(device, tiles * tile_chunks as u64 * 8)?;
+        self.tile_ranges.reserve(gpu, tiles * tile_chunks as u64 * 8)?;
         let (near, far) = (self.grid.near, self.grid.far);
         self.params = GpuClusterParams {
             dims: [self.grid.dims.x, self.grid.dims.y, self.grid.dims.z, count],
@@ -366,18 +383,19 @@ impl ClusterResources {
         };
         queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
         queue.write_buffer(&self.counters, 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
-        self.rebind_if_grown(device);
+        self.rebind_if_grown(gpu);
         Ok(())
     }
 
-    /// Records the copy of the counters to the readback buffer (after the build).
-    pub fn copy_counters(&self, encoder: &mut wgpu::CommandEncoder) {
-        encoder.copy_buffer_to_buffer(&self.counters, 0, &self.counters_readback, 0, self.counters.size());
+    /// The buffer the build writes its counters into (the renderer copies it into the frame's
+    /// read-back slot after the view's passes).
+    pub fn counters_buffer(&self) -> &wgpu::Buffer {
+        &self.counters
     }
 
-    /// Reads the counters of the last submitted frame (waits for the GPU).
+    /// Reads the counters of the last submitted view (waits for the GPU).
     pub fn read_counters(&self, gpu: &GpuContext) -> Result<GpuClusterCounters, RenderError> {
-        let bytes = read_buffer(gpu, &self.counters_readback, 0, self.counters.size())?;
+        let bytes = read_buffer(gpu, &self.counters, 0, self.counters.size())?;
         Ok(bytemuck::pod_read_unaligned(&bytes[..std::mem::size_of::<GpuClusterCounters>()]))
     }
 
@@ -413,36 +431,25 @@ impl ClusterResources {
             return Ok(false);
         }
         if tiles_short {
-            self.tile_indices.reserve(&gpu.device, counters.tile_entries as u64 * 4)?;
+            self.tile_indices.reserve(gpu, counters.tile_entries as u64 * 4)?;
             self.params.tile_index_capacity = (self.tile_indices.capacity() / 4).min(u32::MAX as u64) as u32;
         }
         if clusters_short {
-            self.indices.reserve(&gpu.device, counters.total_entries as u64 * 4)?;
+            self.indices.reserve(gpu, counters.total_entries as u64 * 4)?;
             self.params.index_capacity = (self.indices.capacity() / 4).min(u32::MAX as u64) as u32;
         }
         gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
         gpu.queue.write_buffer(&self.counters, 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
-        self.rebind_if_grown(&gpu.device);
+        self.rebind_if_grown(gpu);
         Ok(true)
     }
 
     /// The report of a frame from its counters.
     pub fn report(&self, c: &GpuClusterCounters, regrows: u32) -> ClusterReport {
-        let clusters = self.params.dims[3];
-        let total = c.total_entries as u64;
-        ClusterReport {
+        let mut report = ClusterReport {
             dims: [self.grid.dims.x, self.grid.dims.y, self.grid.dims.z],
-            clusters,
-            non_empty: c.non_empty,
-            total_entries: total,
-            max_per_cluster: c.max_count,
-            max_per_tile: c.max_tile_lights,
-            mean_per_cluster: total as f64 / clusters.max(1) as f64,
-            mean_per_non_empty: total as f64 / c.non_empty.max(1) as f64,
-            dropped_pairs: c.dropped_pairs as u64,
-            clusters_overflowed: c.clusters_overflowed,
+            clusters: self.params.dims[3],
             index_capacity: self.params.index_capacity as u64,
-            tile_entries: c.tile_entries as u64,
             regrows,
             pair_bound: self.bounds_estimate.cluster_pairs,
             tile_entry_bound: self.bounds_estimate.tile_entries,
@@ -450,7 +457,20 @@ impl ClusterResources {
             buffer_bytes: self.buffer_bytes(),
             cull_test: self.cull.name().to_string(),
             z_slicing: self.grid.slicing.name().to_string(),
-        }
+            ..Default::default()
+        };
+        report.apply_counters(c);
+        report
+    }
+
+    /// True when this frame's lists might not hold what the build writes, which is known
+    /// before the frame is submitted: a bound exceeds the capacity the device could give, or,
+    /// on a `loop_limited` adapter, the longest tile list could exceed `loop_limit`. Such a
+    /// view waits for its counters instead of trusting the bound.
+    pub fn bound_can_fail(&self, loop_limited: bool, loop_limit: u32) -> bool {
+        self.bounds_estimate.cluster_pairs > u64::from(self.params.index_capacity)
+            || self.bounds_estimate.tile_entries > u64::from(self.params.tile_index_capacity)
+            || (loop_limited && self.bounds_estimate.max_tile_lights > loop_limit)
     }
 
     /// Bytes of the GPU buffers held (capacities, not what this frame filled).
@@ -464,10 +484,7 @@ impl ClusterResources {
             &self.tile_ranges,
             &self.tile_indices,
         ];
-        growable.iter().map(|b| b.capacity()).sum::<u64>()
-            + self.params_buffer.size()
-            + self.counters.size()
-            + self.counters_readback.size()
+        growable.iter().map(|b| b.capacity()).sum::<u64>() + self.params_buffer.size() + self.counters.size()
     }
 
     /// Reads the GPU's assignment back into the CPU structure (tests compare it with

@@ -1,6 +1,7 @@
 //! The GPU context: instance, adapter, device and queue, for headless rendering or a surface.
 
 use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
 use thiserror::Error;
 
 /// What to tell a user whose machine has no usable GPU adapter.
@@ -159,18 +160,93 @@ pub struct GpuContext {
     pub errors: Arc<std::sync::Mutex<Vec<String>>>,
     /// Set by the device-lost callback: why the device was lost.
     lost: Arc<std::sync::Mutex<Option<String>>>,
+    /// What this device was asked to create and wait for (see [`GpuCounts`]).
+    counters: Arc<GpuCounters>,
+}
+
+/// Running totals of what a [`GpuContext`] created and how often the CPU waited for the GPU.
+/// The renderer creates every buffer and bind group and does every wait through the context,
+/// so the totals are complete; a frame reports its share in `FrameReport`.
+#[derive(Debug, Default)]
+struct GpuCounters {
+    buffers: AtomicU64,
+    bind_groups: AtomicU64,
+    blocking_waits: AtomicU64,
+}
+
+/// A copy of a context's totals ([`GpuContext::counts`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GpuCounts {
+    /// Buffers created.
+    pub buffers: u64,
+    /// Bind groups created.
+    pub bind_groups: u64,
+    /// Times the CPU blocked until the GPU finished submitted work.
+    pub blocking_waits: u64,
+}
+
+impl GpuCounts {
+    /// What happened between `earlier` and `self`.
+    pub fn since(self, earlier: GpuCounts) -> GpuCounts {
+        GpuCounts {
+            buffers: self.buffers.saturating_sub(earlier.buffers),
+            bind_groups: self.bind_groups.saturating_sub(earlier.bind_groups),
+            blocking_waits: self.blocking_waits.saturating_sub(earlier.blocking_waits),
+        }
+    }
 }
 
 impl GpuContext {
-    /// Waits until the GPU has finished all submitted work, at most [`GPU_WAIT_TIMEOUT`].
+    /// Waits until the GPU has finished all submitted work, at most [`GPU_WAIT_TIMEOUT`]
+    /// (a blocking wait: counted in [`GpuCounts::blocking_waits`]).
     pub fn wait_idle(&self) -> Result<(), RenderError> {
+        self.wait_for(None)
+    }
+
+    /// Waits until the GPU has finished `submission` (all submitted work when `None`), at most
+    /// [`GPU_WAIT_TIMEOUT`]; counted in [`GpuCounts::blocking_waits`].
+    pub fn wait_for(&self, submission: Option<wgpu::SubmissionIndex>) -> Result<(), RenderError> {
+        self.counters.blocking_waits.fetch_add(1, Ordering::Relaxed);
         self.device
-            .poll(wgpu::PollType::Wait { submission_index: None, timeout: Some(GPU_WAIT_TIMEOUT) })
+            .poll(wgpu::PollType::Wait { submission_index: submission, timeout: Some(GPU_WAIT_TIMEOUT) })
             .map(|_| ())
             .map_err(|e| RenderError::GpuTimeout {
                 seconds: GPU_WAIT_TIMEOUT.as_secs(),
                 message: e.to_string(),
             })
+    }
+
+    /// Lets finished GPU work run its callbacks (mapped read-backs) without waiting.
+    pub fn poll(&self) {
+        let _ = self.device.poll(wgpu::PollType::Poll);
+    }
+
+    /// Creates a buffer (counted in [`GpuCounts::buffers`]).
+    pub fn create_buffer(&self, desc: &wgpu::BufferDescriptor<'_>) -> wgpu::Buffer {
+        self.counters.buffers.fetch_add(1, Ordering::Relaxed);
+        self.device.create_buffer(desc)
+    }
+
+    /// Creates a buffer with its contents (counted in [`GpuCounts::buffers`]).
+    pub fn create_buffer_init(&self, desc: &wgpu::util::BufferInitDescriptor<'_>) -> wgpu::Buffer {
+        use wgpu::util::DeviceExt;
+        self.counters.buffers.fetch_add(1, Ordering::Relaxed);
+        self.device.create_buffer_init(desc)
+    }
+
+    /// Creates a bind group (counted in [`GpuCounts::bind_groups`]).
+    pub fn create_bind_group(&self, desc: &wgpu::BindGroupDescriptor<'_>) -> wgpu::BindGroup {
+        self.counters.bind_groups.fetch_add(1, Ordering::Relaxed);
+        self.device.create_bind_group(desc)
+    }
+
+    /// What this context created and waited for so far.
+    pub fn counts(&self) -> GpuCounts {
+        GpuCounts {
+            buffers: self.counters.buffers.load(Ordering::Relaxed),
+            bind_groups: self.counters.bind_groups.load(Ordering::Relaxed),
+            blocking_waits: self.counters.blocking_waits.load(Ordering::Relaxed),
+        }
     }
 
     /// Creates a context without a surface (headless rendering, tests, benchmarks).
@@ -253,7 +329,8 @@ impl GpuContext {
             info.backend,
             info.driver_info
         );
-        Ok(GpuContext { instance, adapter, device, queue, info, timestamps, errors, lost })
+        let counters = Arc::new(GpuCounters::default());
+        Ok(GpuContext { instance, adapter, device, queue, info, timestamps, errors, lost, counters })
     }
 
     /// A new device and queue on the same instance, after this one was lost; `surface`, when
@@ -269,7 +346,7 @@ impl GpuContext {
             return Some(reason);
         }
         // A lost device may answer the poll with an error; the callback has fired by then.
-        let _ = self.device.poll(wgpu::PollType::Poll);
+        self.poll();
         self.lost_reason()
     }
 

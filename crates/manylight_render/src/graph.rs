@@ -6,7 +6,8 @@
 //! 2. [`RenderGraph::compile`] keeps the passes that contribute to [`OUTPUT`] and orders them
 //!    so that every reader comes after the writers of what it reads (ties keep insertion order);
 //! 3. [`crate::renderer::Renderer::execute`] allocates transient textures from its pool,
-//!    records each pass inside timestamp queries, and submits.
+//!    records each pass inside timestamp queries, and submits without waiting (the figures
+//!    arrive later: [`crate::inflight`]).
 
 use crate::context::{GpuContext, RenderError};
 use crate::pipelines::PipelineCache;
@@ -62,6 +63,9 @@ pub struct PassContext<'a> {
     pub pipelines: &'a PipelineCache,
     /// Cluster buffers, when the frame uses clusters.
     pub clusters: Option<&'a crate::clusters::ClusterResources>,
+    /// Bind groups and uniform buffers kept across frames (record creates none in steady
+    /// state).
+    pub bindings: &'a crate::bindings::BindingCache,
     /// The frame's command encoder.
     pub encoder: &'a mut wgpu::CommandEncoder,
     /// Format of [`OUTPUT`].
@@ -73,6 +77,33 @@ pub struct PassContext<'a> {
 }
 
 impl<'a> PassContext<'a> {
+    /// The bind group of `layout` with `bindings` (binding `i` is `bindings[i]`), kept across
+    /// frames while its resources live ([`crate::bindings::BindingCache::bind_group`]).
+    pub fn bind_group(
+        &self,
+        label: &'static str,
+        layout: &wgpu::BindGroupLayout,
+        bindings: &[crate::bindings::Binding<'_>],
+    ) -> wgpu::BindGroup {
+        let numbered: Vec<_> = bindings.iter().enumerate().map(|(i, &b)| (i as u32, b)).collect();
+        self.bindings.bind_group(self.gpu, label, layout, &numbered)
+    }
+
+    /// [`PassContext::bind_group`] with explicit binding indices.
+    pub fn bind_group_numbered(
+        &self,
+        label: &'static str,
+        layout: &wgpu::BindGroupLayout,
+        bindings: &[(u32, crate::bindings::Binding<'_>)],
+    ) -> wgpu::BindGroup {
+        self.bindings.bind_group(self.gpu, label, layout, bindings)
+    }
+
+    /// A persistent uniform buffer holding `contents` ([`crate::bindings::BindingCache::uniform`]).
+    pub fn uniform(&self, key: crate::bindings::UniformKey, contents: &[u8]) -> wgpu::Buffer {
+        self.bindings.uniform(self.gpu, key, contents)
+    }
+
     /// The view of a graph texture (transient or [`OUTPUT`]).
     pub fn texture(&self, name: ResourceName) -> Result<&'a wgpu::TextureView, RenderError> {
         self.textures

@@ -4,10 +4,12 @@
 //! drive it directly. The app crate decides which passes a frame needs.
 #![warn(missing_docs)]
 
+pub mod bindings;
 pub mod clusters;
 pub mod context;
 pub mod gpu_types;
 pub mod graph;
+pub mod inflight;
 pub mod passes;
 pub mod pipelines;
 pub mod pool;
@@ -17,10 +19,10 @@ pub mod resources;
 pub mod shaders;
 pub mod snapshot;
 pub mod stats;
-pub mod timing;
 
-pub use context::{GpuContext, NO_ADAPTER_HELP, RenderError};
+pub use context::{GpuContext, GpuCounts, NO_ADAPTER_HELP, RenderError};
 pub use graph::{OUTPUT, Pass, PassContext, RenderGraph, ResourceName, TextureSpec};
+pub use inflight::{DEFAULT_FRAMES_IN_FLIGHT, MAX_FRAMES_IN_FLIGHT};
 pub use readback::{HEADLESS_FORMAT, HeadlessTarget};
 pub use renderer::Renderer;
 pub use snapshot::{

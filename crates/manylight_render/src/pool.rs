@@ -1,6 +1,6 @@
 //! Transient textures, pooled by descriptor and reused across frames, and growable buffers.
 
-use crate::context::RenderError;
+use crate::context::{GpuContext, RenderError};
 
 /// What a transient texture is: the pool's key.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -145,17 +145,12 @@ fn max_binding_bytes(device: &wgpu::Device) -> (u64, &'static str) {
 
 impl GrowableBuffer {
     /// Creates a buffer of at least `min_bytes`.
-    pub fn new(
-        device: &wgpu::Device,
-        label: &'static str,
-        usage: wgpu::BufferUsages,
-        min_bytes: u64,
-    ) -> Self {
-        let (max_bytes, limit_name) = max_binding_bytes(device);
+    pub fn new(gpu: &GpuContext, label: &'static str, usage: wgpu::BufferUsages, min_bytes: u64) -> Self {
+        let (max_bytes, limit_name) = max_binding_bytes(&gpu.device);
         // Powers of two keep regrowth rare; near the device's limit the buffer takes the limit.
         let capacity =
             min_bytes.max(16).next_power_of_two().min(max_bytes.max(16)).max(min_bytes.min(max_bytes));
-        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        let buffer = gpu.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
             size: capacity,
             usage: usage | wgpu::BufferUsages::COPY_DST,
@@ -166,22 +161,17 @@ impl GrowableBuffer {
 
     /// Uploads `data`, growing the buffer (to the next power of two) when it does not fit.
     /// Returns true when the buffer was re-created (bind groups that use it must be rebuilt).
-    pub fn write(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        data: &[u8],
-    ) -> Result<bool, RenderError> {
-        let grew = self.reserve(device, data.len() as u64)?;
+    pub fn write(&mut self, gpu: &GpuContext, data: &[u8]) -> Result<bool, RenderError> {
+        let grew = self.reserve(gpu, data.len() as u64)?;
         if !data.is_empty() {
-            queue.write_buffer(&self.buffer, 0, data);
+            gpu.queue.write_buffer(&self.buffer, 0, data);
         }
         Ok(grew)
     }
 
     /// Makes room for `bytes`; returns true when the buffer was re-created.
     /// Refused, naming the limit, when `bytes` exceed what the device can bind.
-    pub fn reserve(&mut self, device: &wgpu::Device, bytes: u64) -> Result<bool, RenderError> {
+    pub fn reserve(&mut self, gpu: &GpuContext, bytes: u64) -> Result<bool, RenderError> {
         if bytes <= self.capacity {
             return Ok(false);
         }
@@ -195,7 +185,7 @@ impl GrowableBuffer {
         }
         *self = GrowableBuffer {
             generation: self.generation + 1,
-            ..Self::new(device, self.label, self.usage, bytes)
+            ..Self::new(gpu, self.label, self.usage, bytes)
         };
         Ok(true)
     }

@@ -73,7 +73,7 @@ pub fn read_texture(
     let row = width * bytes_per_pixel;
     let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let size = padded as u64 * height as u64;
-    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+    let buffer = gpu.create_buffer(&wgpu::BufferDescriptor {
         label: Some("texture_readback"),
         size,
         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
@@ -115,7 +115,7 @@ pub fn read_buffer(
     let staging_needed = !buffer.usage().contains(wgpu::BufferUsages::MAP_READ);
     let staging;
     let (source, start) = if staging_needed {
-        staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        staging = gpu.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
             size,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,

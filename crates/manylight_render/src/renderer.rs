@@ -1,16 +1,26 @@
-//! The renderer: scene resources, the transient pool, pipelines and the GPU timer, and the
-//! execution of one frame's graph.
+//! The renderer: scene resources, the transient pool, pipelines, the ring of frames in flight,
+//! and the execution of one frame's graph.
+//!
+//! A frame is [`Renderer::prepare`]d (its shared uploads; it takes a read-back slot, waiting
+//! only when every slot still holds a frame on the GPU), then each view is
+//! [`Renderer::prepare_view`]ed and [`Renderer::execute`]d (recorded and submitted, no wait),
+//! then [`Renderer::finish_frame`] hands the frame's report to its slot. Reports come back
+//! complete, with GPU times and cluster counts, from [`Renderer::take_reports`] once the GPU
+//! has finished them.
 
+use crate::bindings::BindingCache;
 use crate::clusters::ClusterResources;
+use crate::context::GpuCounts;
 use crate::context::{GpuContext, RenderError};
+use crate::gpu_types::GpuClusterCounters;
 use crate::gpu_types::LAVAPIPE_LOOP_LIMIT;
 use crate::graph::{OUTPUT, PassContext, RenderGraph};
+use crate::inflight::{DEFAULT_FRAMES_IN_FLIGHT, FrameRing};
 use crate::pipelines::PipelineCache;
 use crate::pool::{TextureKey, TransientPool};
 use crate::resources::SceneResources;
 use crate::snapshot::{FrameSnapshot, RenderView};
 use crate::stats::{FrameReport, PassTiming};
-use crate::timing::{GpuTimer, MAX_TIMED_PASSES};
 use std::collections::HashMap;
 use std::time::Instant;
 
@@ -26,30 +36,50 @@ pub struct Renderer {
     /// time the view needs them: views keep their own grids, lists and statistics.
     pub clusters: Vec<Option<ClusterResources>>,
     pool: TransientPool,
-    timer: Option<GpuTimer>,
+    bindings: BindingCache,
+    ring: FrameRing,
+    /// Reports completed and not yet taken.
+    arrived: Vec<FrameReport>,
+    /// The context's counts when the frame began.
+    counts_at_begin: GpuCounts,
     cpu_adapter: bool,
     last_textures: HashMap<crate::graph::ResourceName, wgpu::TextureView>,
 }
 
 impl Renderer {
-    /// Creates the renderer on a context.
+    /// Creates the renderer on a context, with [`DEFAULT_FRAMES_IN_FLIGHT`] frames in flight.
     pub fn new(gpu: GpuContext) -> Renderer {
-        let timer = GpuTimer::new(&gpu.device, &gpu.queue, gpu.timestamps);
+        Self::with_frames_in_flight(gpu, DEFAULT_FRAMES_IN_FLIGHT)
+    }
+
+    /// Creates the renderer on a context; at most `frames_in_flight` frames (1 to
+    /// [`crate::MAX_FRAMES_IN_FLIGHT`]) are submitted and not yet read back.
+    pub fn with_frames_in_flight(gpu: GpuContext, frames_in_flight: u32) -> Renderer {
         let cpu_adapter = gpu.info.device_type == wgpu::DeviceType::Cpu;
         Renderer {
             scene: SceneResources::new(&gpu),
             pipelines: PipelineCache::default(),
             clusters: Vec::new(),
             pool: TransientPool::default(),
-            timer,
+            bindings: BindingCache::default(),
+            ring: FrameRing::new(&gpu, frames_in_flight),
+            arrived: Vec::new(),
+            counts_at_begin: gpu.counts(),
             cpu_adapter,
             last_textures: HashMap::new(),
             gpu,
         }
     }
 
+    /// The most frames that can be in flight.
+    pub fn frames_in_flight(&self) -> u32 {
+        self.ring.frames_in_flight()
+    }
+
     /// Uploads the data the frame's views share (the `Prepare` step): lights, instances,
-    /// meshes and materials, once per frame; starts the frame's transient textures.
+    /// meshes and materials, once per frame; starts the frame's transient textures and takes
+    /// its read-back slot (waiting for the frame that held it only when every slot is in
+    /// flight).
     pub fn prepare(&mut self, snapshot: &FrameSnapshot) -> Result<(), RenderError> {
         let settings = &snapshot.settings;
         if settings.pipeline.is_deferred() && !settings.gbuffer.supports(settings.normal_codec) {
@@ -59,7 +89,11 @@ impl Renderer {
                 settings.normal_codec.name()
             )));
         }
+        self.counts_at_begin = self.gpu.counts();
+        let arrived = self.ring.begin(&self.gpu, snapshot.views.len().max(1))?;
+        self.arrived.extend(arrived);
         self.pool.begin_frame();
+        self.bindings.begin_frame();
         self.scene.prepare(&self.gpu, snapshot)?;
         // Views that went away free their cluster buffers.
         self.clusters.truncate(snapshot.views.len().max(1));
@@ -105,12 +139,16 @@ impl Renderer {
         &self.pool
     }
 
-    /// Runs `graph` for `view` into `output` (the `Execute` step) and waits for the GPU to
-    /// finish. The light lists were sized by their CPU bounds in [`Renderer::prepare_view`], so
-    /// the build cannot overflow them; only when a bound exceeded what the device can bind (and
-    /// the lists were sized to the limit) can the counters show a list short, and then it grows
-    /// and the frame is rendered again (`ClusterReport::regrows`), so no light is ever lost to
-    /// a buffer size.
+    /// Records `graph` for `view` into `output` and submits it (the `Execute` step), without
+    /// waiting for the GPU: the returned report has the CPU-side figures, and its GPU times
+    /// and cluster counts arrive with the frame's read-back ([`Renderer::take_reports`]).
+    ///
+    /// The light lists were sized by their CPU bounds in [`Renderer::prepare_view`], so the
+    /// build cannot overflow them. Only when a bound could fail (it exceeds what the device can
+    /// bind, or on a loop-limited adapter the longest tile list could pass the loop limit),
+    /// which the frame knows before it is submitted, does the view wait for its counters: a
+    /// list found short grows and the view is rendered again (`ClusterReport::regrows`), so no
+    /// light is ever lost to a buffer size.
     pub fn execute(
         &mut self,
         graph: &RenderGraph,
@@ -131,19 +169,29 @@ impl Renderer {
                 limit: LAVAPIPE_LOOP_LIMIT,
             });
         }
+        let verify = builds_clusters
+            && self
+                .view_clusters(view.index)
+                .is_some_and(|c| c.bound_can_fail(loop_limited, LAVAPIPE_LOOP_LIMIT));
         let mut regrows = 0;
         loop {
+            let first_pass = self.ring.passes_recorded();
             let mut report = self.execute_once(graph, snapshot, view, output, output_format)?;
             let Some(clusters) =
                 self.clusters.get_mut(view.index).and_then(Option::as_mut).filter(|_| builds_clusters)
             else {
                 return Ok(report);
             };
+            if !verify {
+                report.clusters = Some(clusters.report(&GpuClusterCounters::default(), regrows));
+                return Ok(report);
+            }
             let counters = clusters.read_counters(&self.gpu)?;
             ClusterResources::check_saturation(&counters)?;
             if regrows < 4 && clusters.grow_if_needed(&self.gpu, &counters)? {
                 regrows += 1;
                 tracing::debug!("light-index list grew to {} entries", clusters.params.index_capacity);
+                self.ring.rewind_view(first_pass);
                 continue;
             }
             if clusters.lists_short(&counters) {
@@ -168,6 +216,44 @@ impl Renderer {
             report.clusters = Some(clusters.report(&counters, regrows));
             return Ok(report);
         }
+    }
+
+    /// Ends the frame: `report` (the frame's views merged) goes to the frame's read-back slot,
+    /// with what the frame created and waited for, and comes back complete from
+    /// [`Renderer::take_reports`].
+    pub fn finish_frame(&mut self, mut report: FrameReport) {
+        let counts = self.gpu.counts().since(self.counts_at_begin);
+        report.blocking_waits = counts.blocking_waits;
+        report.buffers_created = counts.buffers;
+        report.bind_groups_created = counts.bind_groups;
+        report.frames_in_flight = self.ring.pending() + 1;
+        report.frames_in_flight_limit = self.ring.frames_in_flight();
+        self.ring.finish(&self.gpu, report);
+    }
+
+    /// The reports of the frames whose GPU figures have arrived, oldest first; with `wait`,
+    /// waits for every frame in flight first (a blocking wait).
+    pub fn take_reports(&mut self, wait: bool) -> Result<Vec<FrameReport>, RenderError> {
+        let collected = self.ring.collect(&self.gpu, wait)?;
+        self.arrived.extend(collected);
+        Ok(std::mem::take(&mut self.arrived))
+    }
+
+    /// Frames submitted whose reports have not arrived yet.
+    pub fn frames_pending(&self) -> u32 {
+        self.ring.pending()
+    }
+
+    /// The query set and index for a pass recorded outside the graph (the window overlay), if
+    /// it can be timed; call [`Renderer::pass_recorded`] after it.
+    pub fn pass_timer(&self) -> Option<(&wgpu::QuerySet, u32)> {
+        self.ring.timer()
+    }
+
+    /// Notes a pass recorded outside the graph (`timed`: both its timestamps were written); its
+    /// timing must be the next entry of the frame report's passes.
+    pub fn pass_recorded(&mut self, timed: bool) {
+        self.ring.pass_recorded(timed);
     }
 
     fn execute_once(
@@ -201,26 +287,28 @@ impl Renderer {
         let mut encoder =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         let mut passes = Vec::with_capacity(order.len());
-        let mut written = Vec::with_capacity(order.len());
-        for (slot, &i) in order.iter().enumerate() {
+        let clusters = self.clusters.get(view.index).and_then(Option::as_ref);
+        for &i in &order {
             let pass = graph.pass(i);
-            let timed = self.timer.as_ref().filter(|_| (slot as u32) < MAX_TIMED_PASSES);
+            let timer = self.ring.timer();
             let mut ctx = PassContext {
                 gpu: &self.gpu,
                 scene: &self.scene,
                 pipelines: &self.pipelines,
-                clusters: self.clusters.get(view.index).and_then(Option::as_ref),
+                clusters,
+                bindings: &self.bindings,
                 encoder: &mut encoder,
                 output_format,
                 textures: &textures,
-                timer: timed.map(|t| t.query_set()),
-                pass_index: slot as u32,
+                timer: timer.map(|(query_set, _)| query_set),
+                pass_index: timer.map_or(0, |(_, index)| index),
                 stamps: (false, false),
             };
             let start = Instant::now();
             pass.record(&mut ctx)?;
             let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
-            written.push(ctx.stamps.0 && ctx.stamps.1);
+            let timed = ctx.stamps.0 && ctx.stamps.1;
+            self.ring.pass_recorded(timed);
             passes.push(PassTiming {
                 name: pass.name().to_string(),
                 gpu_ms: None,
@@ -228,42 +316,34 @@ impl Renderer {
                 cpu_ms,
             });
         }
-        if let Some(t) = &self.timer {
-            t.resolve(&mut encoder, order.len() as u32);
-        }
+        // The view's counters go to the frame's read-back slot, after the passes wrote them.
+        let tonemapped = passes.iter().any(|p| p.name == crate::passes::tonemap::TONEMAP);
+        let counters = clusters.filter(|_| order.iter().any(|&i| graph.pass(i).name() == "cluster_build"));
+        self.ring.end_view(
+            &mut encoder,
+            counters.map(|c| c.counters_buffer()),
+            tonemapped.then_some(&self.scene.nonfinite.counter),
+            passes.len(),
+        );
         self.gpu.queue.submit([encoder.finish()]);
-        self.gpu.wait_idle()?;
-        if let Some(t) = &self.timer {
-            for (p, ms) in passes.iter_mut().zip(t.read(&self.gpu.device, &written)) {
-                p.gpu_ms = ms;
-            }
-        }
         self.last_textures = textures;
         let errors = self.gpu.take_errors();
         if !errors.is_empty() {
             return Err(RenderError::Device(errors.join("; ")));
         }
-        let nonfinite_pixels = match passes.iter().any(|p| p.name == crate::passes::tonemap::TONEMAP) {
-            true => Some(self.scene.nonfinite.read(&self.gpu)?),
-            false => None,
-        };
-        if let Some(n) = nonfinite_pixels.filter(|&n| n > 0) {
-            tracing::warn!("frame {}: {n} pixels have a NaN or infinite HDR colour", snapshot.frame_index);
-        }
-        let gpu_times: Vec<f64> = passes.iter().filter_map(|p| p.gpu_ms).collect();
         Ok(FrameReport {
             frame_index: snapshot.frame_index,
             width: size.x,
             height: size.y,
             pipeline: view.settings.pipeline.name().to_string(),
-            frame_gpu_ms: (!gpu_times.is_empty()).then(|| gpu_times.iter().sum()),
+            frame_gpu_ms: None,
             passes,
             frame_cpu_ms: frame_start.elapsed().as_secs_f64() * 1e3,
             light_count: self.scene.light_count,
             invalid_lights: self.scene.invalid_lights,
             invalid_cameras: 0,
             sanitized_cameras: 0,
-            nonfinite_pixels,
+            nonfinite_pixels: None,
             instance_count: self.scene.draws.len() as u32,
             invalid_instances: self.scene.invalid_instances,
             collapsed_instances: self.scene.collapsed_instances,
@@ -275,6 +355,7 @@ impl Renderer {
             light_uploads: 0,
             light_upload_bytes: 0,
             device_recoveries: 0,
+            ..Default::default()
         })
     }
 }

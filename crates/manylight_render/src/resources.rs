@@ -12,7 +12,6 @@ use glam::{Mat4, Vec4};
 use manylight_core::{MaterialData, MeshData, TextureData, Vertex};
 use std::collections::HashMap;
 use std::sync::Arc;
-use wgpu::util::DeviceExt;
 
 /// Frames a mesh/material/texture stays on the GPU after its last use.
 const KEEP_FRAMES: u64 = 60;
@@ -114,36 +113,27 @@ pub struct SceneResources {
 /// A GPU counter of pixels whose HDR colour is NaN or infinite, written by the tone map and
 /// read back into [`FrameReport::nonfinite_pixels`](crate::stats::FrameReport).
 pub struct NonFiniteCounter {
-    /// The `atomic<u32>` the tone map increments (cleared by the pass before it draws).
+    /// The `atomic<u32>` the tone map increments (cleared by the pass before it draws; the
+    /// renderer copies it into the frame's read-back slot after the view).
     pub counter: wgpu::Buffer,
-    readback: wgpu::Buffer,
 }
 
 impl NonFiniteCounter {
-    fn new(device: &wgpu::Device) -> NonFiniteCounter {
-        let buffer = |label, usage| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: 4,
-                usage,
-                mapped_at_creation: false,
-            })
-        };
+    fn new(gpu: &GpuContext) -> NonFiniteCounter {
         use wgpu::BufferUsages as U;
         NonFiniteCounter {
-            counter: buffer("nonfinite_pixels", U::STORAGE | U::COPY_SRC | U::COPY_DST),
-            readback: buffer("nonfinite_pixels_readback", U::MAP_READ | U::COPY_DST),
+            counter: gpu.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("nonfinite_pixels"),
+                size: 4,
+                usage: U::STORAGE | U::COPY_SRC | U::COPY_DST,
+                mapped_at_creation: false,
+            }),
         }
     }
 
-    /// Records the copy of the counter into the mappable buffer (after the tone map's draw).
-    pub fn copy_for_readback(&self, encoder: &mut wgpu::CommandEncoder) {
-        encoder.copy_buffer_to_buffer(&self.counter, 0, &self.readback, 0, 4);
-    }
-
-    /// The count of the last frame that ran the tone map (waits for the GPU).
+    /// The count of the last view that ran the tone map (waits for the GPU).
     pub fn read(&self, gpu: &GpuContext) -> Result<u32, RenderError> {
-        let bytes = crate::readback::read_buffer(gpu, &self.readback, 0, 4)?;
+        let bytes = crate::readback::read_buffer(gpu, &self.counter, 0, 4)?;
         Ok(bytemuck::pod_read_unaligned(&bytes[..4]))
     }
 }
@@ -215,7 +205,7 @@ impl SceneResources {
                 },
             ],
         });
-        let view_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        let view_buffer = gpu.create_buffer(&wgpu::BufferDescriptor {
             label: Some("view_uniform"),
             size: std::mem::size_of::<ViewUniform>() as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
@@ -223,10 +213,10 @@ impl SceneResources {
         });
         let storage_usage = wgpu::BufferUsages::STORAGE;
         // One placeholder light (every pipeline binds the buffer); it grows when lights appear.
-        let lights = GrowableBuffer::new(device, "point_lights", storage_usage, 32);
-        let instances = GrowableBuffer::new(device, "instances", storage_usage, 64 * 128);
+        let lights = GrowableBuffer::new(gpu, "point_lights", storage_usage, 32);
+        let instances = GrowableBuffer::new(gpu, "instances", storage_usage, 64 * 128);
         let view_bind_group =
-            Self::make_view_bind_group(device, &view_layout, &view_buffer, &lights, &instances);
+            Self::make_view_bind_group(gpu, &view_layout, &view_buffer, &lights, &instances);
         let white = upload_texture(
             gpu,
             &TextureData { label: "white".into(), width: 1, height: 1, rgba8: vec![255; 4], srgb: true },
@@ -256,7 +246,7 @@ impl SceneResources {
             invalid_instances: 0,
             collapsed_instances: 0,
             light_spheres: Vec::new(),
-            nonfinite: NonFiniteCounter::new(device),
+            nonfinite: NonFiniteCounter::new(gpu),
             meshes: HashMap::new(),
             materials: HashMap::new(),
             textures: HashMap::new(),
@@ -270,13 +260,13 @@ impl SceneResources {
     }
 
     fn make_view_bind_group(
-        device: &wgpu::Device,
+        gpu: &GpuContext,
         layout: &wgpu::BindGroupLayout,
         view: &wgpu::Buffer,
         lights: &GrowableBuffer,
         instances: &GrowableBuffer,
     ) -> wgpu::BindGroup {
-        device.create_bind_group(&wgpu::BindGroupDescriptor {
+        gpu.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("view_bind_group"),
             layout,
             entries: &[
@@ -326,8 +316,6 @@ impl SceneResources {
     /// frame whatever the number of views.
     pub fn prepare(&mut self, gpu: &GpuContext, snapshot: &FrameSnapshot) -> Result<(), RenderError> {
         self.frame += 1;
-        let device = &gpu.device;
-        let queue = &gpu.queue;
 
         // Lights: invalid ones (NaN, inf, negative) are dropped and counted, never uploaded.
         let gpu_lights: Vec<GpuPointLight> = snapshot
@@ -345,7 +333,7 @@ impl SceneResources {
         self.light_count = gpu_lights.len() as u32;
         let light_bytes: &[u8] =
             if gpu_lights.is_empty() { &[0u8; 32] } else { bytemuck::cast_slice(&gpu_lights) };
-        self.lights.write(device, queue, light_bytes)?;
+        self.lights.write(gpu, light_bytes)?;
         self.light_upload_bytes = light_bytes.len() as u64;
 
         // Meshes, materials, instances.
@@ -365,7 +353,7 @@ impl SceneResources {
             if inst.mesh.indices.is_empty() {
                 continue;
             }
-            let (mesh, mesh_order) = self.mesh_entry(device, &inst.mesh)?;
+            let (mesh, mesh_order) = self.mesh_entry(gpu, &inst.mesh)?;
             let (material, material_order) = self.material_entry(gpu, &inst.material)?;
             let order = (material_order, mesh_order);
             self.draws.push(Draw { mesh, material, instance: instance_data.len() as u32, order });
@@ -375,12 +363,12 @@ impl SceneResources {
         if instance_data.is_empty() {
             instance_data.push(GpuInstance::new(Mat4::IDENTITY));
         }
-        self.instances.write(device, queue, bytemuck::cast_slice(&instance_data))?;
+        self.instances.write(gpu, bytemuck::cast_slice(&instance_data))?;
 
         let generations = (self.lights.generation(), self.instances.generation());
         if generations != self.bound_generations {
             self.view_bind_group = Self::make_view_bind_group(
-                device,
+                gpu,
                 &self.view_layout,
                 &self.view_buffer,
                 &self.lights,
@@ -398,15 +386,11 @@ impl SceneResources {
 
     /// The mesh's GPU buffers, uploaded on first use; refused, naming the limit, when a buffer
     /// would exceed the device's `max_buffer_size`.
-    fn mesh_entry(
-        &mut self,
-        device: &wgpu::Device,
-        mesh: &Arc<MeshData>,
-    ) -> Result<(usize, u64), RenderError> {
+    fn mesh_entry(&mut self, gpu: &GpuContext, mesh: &Arc<MeshData>) -> Result<(usize, u64), RenderError> {
         let k = key(mesh);
         let frame = self.frame;
         if !self.meshes.contains_key(&k) {
-            let limit = device.limits().max_buffer_size;
+            let limit = gpu.device.limits().max_buffer_size;
             let vertex_bytes = std::mem::size_of_val(mesh.vertices.as_slice()) as u64;
             let index_bytes = std::mem::size_of_val(mesh.indices.as_slice()) as u64;
             for (what, bytes) in [("vertex", vertex_bytes), ("index", index_bytes)] {
@@ -425,12 +409,12 @@ impl SceneResources {
             *uploads += 1;
             GpuMesh {
                 _source: mesh.clone(),
-                vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                vertices: gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some(&mesh.label),
                     contents: bytemuck::cast_slice::<Vertex, u8>(&mesh.vertices),
                     usage: wgpu::BufferUsages::VERTEX,
                 }),
-                indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                indices: gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some(&mesh.label),
                     contents: bytemuck::cast_slice(&mesh.indices),
                     usage: wgpu::BufferUsages::INDEX,
@@ -486,12 +470,12 @@ impl SceneResources {
             shading_model: material.shading.map_or(SHADING_GLOBAL, |s| s.gpu_id()),
             has_texture: material.base_color_texture.is_some() as u32,
         };
-        let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        let buffer = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some(&material.label),
             contents: bytemuck::bytes_of(&uniform),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let bind_group = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some(&material.label),
             layout: &self.material_layout,
             entries: &[

@@ -28,7 +28,8 @@ pub struct FrameReport {
     pub pipeline: String,
     /// Passes that ran, in order.
     pub passes: Vec<PassTiming>,
-    /// CPU time of the whole frame on the render side (prepare, record, submit, wait).
+    /// CPU time of the frame on the render side: uploads, cluster bounds, recording and
+    /// submitting every view (and any wait the frame had: [`FrameReport::blocking_waits`]).
     pub frame_cpu_ms: f64,
     /// Sum of the passes' GPU times, when known.
     pub frame_gpu_ms: Option<f64>,
@@ -74,6 +75,20 @@ pub struct FrameReport {
     /// normally). A frame in which the loss was found reports no passes: its work went to the
     /// lost device, and the next frame renders on the new one.
     pub device_recoveries: u32,
+    /// Times the CPU blocked until the GPU finished work while this frame was prepared and
+    /// recorded: 0 in steady state. A frame waits when every read-back slot is still in
+    /// flight, when a list bound could fail (`ClusterReport::regrows`), and when pixels are
+    /// read back (a capture, a render-to-texture camera).
+    pub blocking_waits: u64,
+    /// GPU buffers created while this frame was prepared and recorded (0 in steady state: only
+    /// new meshes, materials, grown lists and changed sizes create any).
+    pub buffers_created: u64,
+    /// Bind groups created while this frame was prepared and recorded (0 in steady state).
+    pub bind_groups_created: u64,
+    /// Frames submitted and not yet read back when this frame was submitted, itself included.
+    pub frames_in_flight: u32,
+    /// The most frames that may be in flight (the renderer's setting).
+    pub frames_in_flight_limit: u32,
 }
 
 /// What one view of a frame did.

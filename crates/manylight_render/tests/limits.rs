@@ -10,11 +10,11 @@ fn a_buffer_past_the_binding_limit_is_refused_naming_it() {
     let gpu = GpuContext::headless().unwrap_or_else(|e| panic!("GPU test needs an adapter: {e}"));
     let limits = gpu.device.limits();
     let limit = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size) & !3;
-    let mut lights = GrowableBuffer::new(&gpu.device, "point_lights", wgpu::BufferUsages::STORAGE, 32);
+    let mut lights = GrowableBuffer::new(&gpu, "point_lights", wgpu::BufferUsages::STORAGE, 32);
     // Growing to a size the device binds works (a small step, so the test stays light).
-    assert_eq!(lights.reserve(&gpu.device, 4096).ok(), Some(true));
+    assert_eq!(lights.reserve(&gpu, 4096).ok(), Some(true));
     assert!(lights.capacity() >= 4096);
-    let err = lights.reserve(&gpu.device, limit + 4).expect_err("past the limit");
+    let err = lights.reserve(&gpu, limit + 4).expect_err("past the limit");
     let message = err.to_string();
     assert!(
         message.contains("max_storage_buffer_binding_size") && message.contains(&limit.to_string()),

@@ -283,7 +283,12 @@ impl ApplicationHandler for WinitRunner {
             Ok(w) => Arc::new(w),
             Err(e) => return self.fail(event_loop, format!("could not open a window: {e}")),
         };
-        let mut sink = match SurfaceSink::new(window.clone(), self.config.vsync) {
+        let frames_in_flight = self
+            .app
+            .world()
+            .get_resource::<crate::resources::FramesInFlight>()
+            .map_or(manylight_render::DEFAULT_FRAMES_IN_FLIGHT, |f| f.0);
+        let mut sink = match SurfaceSink::new(window.clone(), self.config.vsync, frames_in_flight) {
             Ok(s) => s,
             Err(e) => return self.fail(event_loop, e.to_string()),
         };
@@ -299,7 +304,7 @@ impl ApplicationHandler for WinitRunner {
                 Err(e) => return self.fail(event_loop, format!("could not start the render thread: {e}")),
             }
         } else {
-            RenderBackend::Sync { sink: Box::new(sink), pending: Vec::new() }
+            RenderBackend::sync(Box::new(sink))
         };
         self.app.world_mut().insert_resource(backend);
         let size = window.inner_size();

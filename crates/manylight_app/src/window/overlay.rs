@@ -24,7 +24,6 @@ use glam::{UVec2, UVec3};
 use manylight_core::ShadingModel;
 use manylight_core::cluster::{CullTest, ZSlicing};
 use manylight_core::codec::NormalCodec;
-use manylight_render::timing::GpuTimer;
 use manylight_render::{DebugViewMode, GBufferLayout, GpuContext, PassTiming, PipelineKind};
 use std::collections::VecDeque;
 use std::sync::{Arc, Mutex};
@@ -403,6 +402,17 @@ fn timings_ui(ui: &mut egui::Ui, world: &mut World, history: &VecDeque<Sample>, 
         report.transient_textures,
         report.transient_bytes as f64 / (1024.0 * 1024.0)
     ));
+    let submitted = world.get_resource::<FrameStats>().map_or(report.frame_index, |s| s.submitted);
+    ui.monospace(format!(
+        "frame {} ({} later): {}/{} in flight, {} GPU waits, {} buffers and {} bind groups created",
+        report.frame_index,
+        submitted.saturating_sub(report.frame_index),
+        report.frames_in_flight,
+        report.frames_in_flight_limit,
+        report.blocking_waits,
+        report.buffers_created,
+        report.bind_groups_created
+    ));
     if report.invalid_lights > 0 {
         ui.colored_label(Color32::LIGHT_RED, format!("{} invalid lights dropped", report.invalid_lights));
     }
@@ -480,7 +490,7 @@ fn plot(ui: &mut egui::Ui, history: &VecDeque<Sample>) {
 /// Draws the overlay on the render side: an egui-wgpu renderer for the surface format.
 pub struct OverlayPainter {
     shared: SharedFrame,
-    renderer: Option<(egui_wgpu::Renderer, wgpu::TextureFormat, Option<GpuTimer>)>,
+    renderer: Option<(egui_wgpu::Renderer, wgpu::TextureFormat)>,
     primitives: Vec<ClippedPrimitive>,
     pixels_per_point: f32,
     /// Every texture's uploads since its last full image, replayed into a new renderer after
@@ -496,14 +506,17 @@ impl OverlayPainter {
     }
 
     /// Draws the latest UI onto `view` (the presented image, `size` pixels) as the pass
-    /// [`OVERLAY_PASS`]; returns its timing, or `None` when nothing was drawn.
+    /// [`OVERLAY_PASS`], inside the timestamps `timer` gives (the frame's read-back slot:
+    /// its GPU time arrives with the frame's report); returns its timing and whether it was
+    /// timed, or `None` when nothing was drawn.
     pub fn paint(
         &mut self,
         gpu: &GpuContext,
         view: &wgpu::TextureView,
         format: wgpu::TextureFormat,
         size: UVec2,
-    ) -> Option<PassTiming> {
+        timer: Option<(&wgpu::QuerySet, u32)>,
+    ) -> Option<(PassTiming, bool)> {
         let start = Instant::now();
         let mut textures = TexturesDelta::default();
         if let Ok(mut frame) = self.shared.lock() {
@@ -514,7 +527,7 @@ impl OverlayPainter {
             textures = std::mem::take(&mut frame.textures);
         }
         let (device, queue) = (&gpu.device, &gpu.queue);
-        if self.renderer.as_ref().is_some_and(|(_, f, _)| *f != format) {
+        if self.renderer.as_ref().is_some_and(|(_, f)| *f != format) {
             // Textures live in the renderer; egui would not send its font atlas again.
             tracing::warn!(
                 "overlay: the surface format changed to {format:?}; the overlay is no longer drawn"
@@ -523,7 +536,7 @@ impl OverlayPainter {
             return None;
         }
         let log = &mut self.texture_log;
-        let (renderer, _, timer) = self.renderer.get_or_insert_with(|| {
+        let (renderer, _) = self.renderer.get_or_insert_with(|| {
             let mut renderer =
                 egui_wgpu::Renderer::new(device, format, egui_wgpu::RendererOptions::default());
             for (id, deltas) in log.iter() {
@@ -531,8 +544,7 @@ impl OverlayPainter {
                     renderer.update_texture(device, queue, *id, delta);
                 }
             }
-            let stamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
-            (renderer, format, GpuTimer::new(device, queue, stamps))
+            (renderer, format)
         });
         for (id, deltas) in &textures.set {
             for delta in deltas {
@@ -545,7 +557,6 @@ impl OverlayPainter {
             }
         }
         let drawn = !self.primitives.is_empty();
-        let mut gpu_ms = None;
         if drawn {
             let screen = egui_wgpu::ScreenDescriptor {
                 size_in_pixels: [size.x, size.y],
@@ -565,33 +576,30 @@ impl OverlayPainter {
                         ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
                     })],
                     depth_stencil_attachment: None,
-                    timestamp_writes: timer.as_ref().map(|t| wgpu::RenderPassTimestampWrites {
-                        query_set: t.query_set(),
-                        beginning_of_pass_write_index: Some(0),
-                        end_of_pass_write_index: Some(1),
+                    timestamp_writes: timer.map(|(query_set, index)| wgpu::RenderPassTimestampWrites {
+                        query_set,
+                        beginning_of_pass_write_index: Some(index * 2),
+                        end_of_pass_write_index: Some(index * 2 + 1),
                     }),
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
                 renderer.render(&mut pass.forget_lifetime(), &self.primitives, &screen);
             }
-            if let Some(t) = timer.as_ref() {
-                t.resolve(&mut encoder, 1);
-            }
             commands.push(encoder.finish());
             queue.submit(commands);
-            gpu_ms = timer.as_ref().and_then(|t| t.read(device, &[true]).first().copied().flatten());
         }
         for id in &textures.free {
             renderer.free_texture(id);
             log.remove(id);
         }
         textures.clear();
-        drawn.then(|| PassTiming {
+        let timing = PassTiming {
             name: OVERLAY_PASS.into(),
-            gpu_ms,
-            gpu_trusted: gpu_ms.is_some(),
+            gpu_ms: None,
+            gpu_trusted: true,
             cpu_ms: start.elapsed().as_secs_f64() * 1e3,
-        })
+        };
+        drawn.then_some((timing, timer.is_some()))
     }
 }

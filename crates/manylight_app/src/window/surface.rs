@@ -5,7 +5,7 @@
 
 use super::overlay::OverlayPainter;
 use crate::backend::FrameSink;
-use crate::render_world::{DeviceSink, RenderWorld, empty_report};
+use crate::render_world::{DeviceSink, RenderWorld, SinkFrame, empty_report};
 use glam::UVec2;
 use manylight_render::{FrameReport, FrameSnapshot, GpuContext, RenderError};
 use std::sync::Arc;
@@ -24,8 +24,9 @@ pub struct SurfaceSink {
 }
 
 impl SurfaceSink {
-    /// Creates the surface and a GPU context able to present to it.
-    pub fn new(window: Arc<Window>, vsync: bool) -> Result<SurfaceSink, RenderError> {
+    /// Creates the surface and a GPU context able to present to it; at most
+    /// `frames_in_flight` frames are submitted and not yet read back.
+    pub fn new(window: Arc<Window>, vsync: bool, frames_in_flight: u32) -> Result<SurfaceSink, RenderError> {
         let instance = manylight_render::context::new_instance();
         let surface =
             instance.create_surface(window.clone()).map_err(|e| RenderError::Surface(e.to_string()))?;
@@ -34,7 +35,7 @@ impl SurfaceSink {
             window,
             surface,
             config: None,
-            render_world: RenderWorld::new(gpu),
+            render_world: RenderWorld::with_frames_in_flight(gpu, frames_in_flight),
             vsync,
             warned_too_large: false,
             warned_readback: false,
@@ -165,18 +166,22 @@ impl FrameSink for SurfaceSink {
         self.render_world.take_textures()
     }
 
-    fn render_frame(
-        &mut self,
-        snapshot: FrameSnapshot,
-        readback: bool,
-    ) -> Result<(FrameReport, Option<image::RgbaImage>), RenderError> {
+    fn render_frame(&mut self, snapshot: FrameSnapshot, readback: bool) -> Result<SinkFrame, RenderError> {
         self.render_recovering(snapshot, readback)
+    }
+
+    fn drain(&mut self) -> Result<Vec<FrameReport>, RenderError> {
+        self.render_world.take_reports(true)
     }
 }
 
 impl DeviceSink for SurfaceSink {
     fn gpu(&self) -> &GpuContext {
         self.render_world.gpu()
+    }
+
+    fn render_world(&mut self) -> &mut RenderWorld {
+        &mut self.render_world
     }
 
     /// A new surface for the window, a new render world on a device that can present to it,
@@ -197,10 +202,11 @@ impl DeviceSink for SurfaceSink {
         &mut self,
         snapshot: FrameSnapshot,
         readback: bool,
-    ) -> Result<(FrameReport, Option<image::RgbaImage>), RenderError> {
+    ) -> Result<(Option<FrameReport>, Option<image::RgbaImage>), RenderError> {
         let size = snapshot.viewport;
         if size.x == 0 || size.y == 0 {
-            return Ok((empty_report(&snapshot), None)); // minimised: nothing to draw
+            // Minimised: nothing to draw.
+            return Ok((Some(self.render_world.report_empty(empty_report(&snapshot))), None));
         }
         let max = self.render_world.gpu().device.limits().max_texture_dimension_2d;
         if size.x > max || size.y > max {
@@ -208,22 +214,27 @@ impl DeviceSink for SurfaceSink {
                 tracing::warn!("window is {}x{}, larger than this GPU's {max}: not drawing", size.x, size.y);
                 self.warned_too_large = true;
             }
-            return Ok((empty_report(&snapshot), None));
+            return Ok((Some(self.render_world.report_empty(empty_report(&snapshot))), None));
         }
         let Some(frame) = self.acquire(size)? else {
-            return Ok((empty_report(&snapshot), None));
+            return Ok((Some(self.render_world.report_empty(empty_report(&snapshot))), None));
         };
         let format = frame.texture.format();
         let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
         let mut report = self.render_world.render(snapshot, &view, format)?;
         let image = if readback { self.read_back(&frame.texture)? } else { None };
-        if let Some(painter) = self.overlay.as_mut()
-            && let Some(timing) = painter.paint(self.render_world.gpu(), &view, format, size)
-        {
-            report.passes.push(timing);
+        if let Some(painter) = self.overlay.as_mut() {
+            let renderer = self.render_world.renderer_mut();
+            if let Some((timing, timed)) =
+                painter.paint(&renderer.gpu, &view, format, size, renderer.pass_timer())
+            {
+                renderer.pass_recorded(timed);
+                report.passes.push(timing);
+            }
         }
+        self.render_world.finish_frame(report);
         self.window.pre_present_notify();
         self.render_world.gpu().queue.present(frame);
-        Ok((report, image))
+        Ok((None, image))
     }
 }

@@ -184,9 +184,16 @@ proptest! {
         for test in CullTest::ALL {
             let bounds = list_bounds(&grid, &lights, test);
             let pairs = assign_lights_brute_force(&grid, &lights, test, None).indices.len() as u64;
-            let tiles = assign_lights_brute_force(&columns, &inflated, test, None).indices.len() as u64;
+            let tile_lists = assign_lights_brute_force(&columns, &inflated, test, None);
+            let tiles = tile_lists.indices.len() as u64;
+            let longest = (0..columns.cluster_count()).map(|t| tile_lists.lights_of(t).len()).max().unwrap_or(0);
             prop_assert!(bounds.cluster_pairs >= pairs, "{test:?}: {bounds:?} < {pairs} pairs, {grid:?}");
             prop_assert!(bounds.tile_entries >= tiles, "{test:?}: {bounds:?} < {tiles} tile entries, {grid:?}");
+            prop_assert!(
+                bounds.max_tile_lights as usize >= longest,
+                "{test:?}: {bounds:?} < a tile list of {longest}, {grid:?}"
+            );
+            prop_assert!(u64::from(bounds.max_tile_lights) <= bounds.tile_entries);
         }
     }
 

@@ -14,10 +14,10 @@
 
 use super::HDR;
 use super::common::{FullscreenPipelineDesc, fullscreen_pipeline_desc};
+use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::resources::HDR_FORMAT;
-use wgpu::util::DeviceExt;
 
 /// Most levels (iterations) of the chain.
 pub const MAX_BLOOM_LEVELS: usize = 6;
@@ -246,26 +246,12 @@ fn draw(
 ) -> Result<(), RenderError> {
     let device = &ctx.gpu.device;
     let pipeline = ctx.pipelines.get_or_create(stage as u64, || BloomPipeline::new(device, stage))?;
-    let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("bloom_params"),
-        contents: bytemuck::bytes_of(&params),
-        usage: wgpu::BufferUsages::UNIFORM,
-    });
-    let mut entries = vec![
-        wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
-        wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&pipeline.sampler) },
-    ];
-    for (i, &name) in sources.iter().enumerate() {
-        entries.push(wgpu::BindGroupEntry {
-            binding: 2 + i as u32,
-            resource: wgpu::BindingResource::TextureView(ctx.texture(name)?),
-        });
-    }
-    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("bloom"),
-        layout: &pipeline.layout,
-        entries: &entries,
-    });
+    // One uniform per draw of the chain: its stage and the level it writes.
+    let params = ctx.uniform((target, stage as u64), bytemuck::bytes_of(&params));
+    let textures = sources.iter().map(|&name| ctx.texture(name)).collect::<Result<Vec<_>, _>>()?;
+    let mut bindings = vec![Binding::Buffer(&params), Binding::Sampler(&pipeline.sampler)];
+    bindings.extend(textures.into_iter().map(Binding::Texture));
+    let bind_group = ctx.bind_group("bloom", &pipeline.layout, &bindings);
     let view = ctx.texture(target)?;
     let timestamps = ctx.render_timestamps(true, true);
     // The composite loads the HDR image and adds to it; the other stages replace their level.

@@ -138,7 +138,6 @@ impl Pass for ClusterBuildPass {
                 pass.dispatch_workgroups(workgroups[0], workgroups[1], 1);
             }
         }
-        clusters.copy_counters(ctx.encoder);
         Ok(())
     }
 }

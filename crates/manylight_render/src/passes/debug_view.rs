@@ -8,11 +8,11 @@
 
 use super::common::{draw_fullscreen, fullscreen_pipeline, storage_entry, texture_entry, uniform_entry};
 use super::{CLUSTERS, DEPTH, GBUFFER_ALBEDO, GBUFFER_NORMAL};
+use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{OUTPUT, Pass, PassContext, ResourceName};
 use crate::pipelines::format_key;
 use crate::snapshot::DebugViewMode;
-use wgpu::util::DeviceExt;
 
 /// The data a debug view reads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -116,48 +116,32 @@ impl Pass for DebugViewPass {
         let key = format_key(format).wrapping_add(family as u64);
         let pipeline = ctx.pipelines.get_or_create(key, || DebugViewPipeline::new(device, family, format))?;
         let depth_far = depth_view_far(ctx.scene);
-        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("debug_view_params"),
-            contents: bytemuck::cast_slice(&[
-                self.view.gpu_id(),
-                self.heatmap_max.max(1),
-                depth_far.to_bits(),
-                0,
-            ]),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let texture = |binding: u32, name: ResourceName| -> Result<wgpu::BindGroupEntry<'_>, RenderError> {
-            Ok(wgpu::BindGroupEntry {
-                binding,
-                resource: wgpu::BindingResource::TextureView(ctx.texture(name)?),
-            })
-        };
-        let mut entries = vec![
-            wgpu::BindGroupEntry { binding: 0, resource: ctx.scene.view_buffer.as_entire_binding() },
-            texture(1, DEPTH)?,
-            wgpu::BindGroupEntry { binding: 4, resource: params.as_entire_binding() },
+        let params = ctx.uniform(
+            ("debug_view", 0),
+            bytemuck::cast_slice(&[self.view.gpu_id(), self.heatmap_max.max(1), depth_far.to_bits(), 0]),
+        );
+        let mut bindings = vec![
+            (0, Binding::Buffer(&ctx.scene.view_buffer)),
+            (1, Binding::Texture(ctx.texture(DEPTH)?)),
+            (4, Binding::Buffer(&params)),
         ];
         match family {
             Family::Clusters => {
                 let clusters = ctx
                     .clusters
                     .ok_or_else(|| RenderError::Graph("debug_view needs cluster resources".into()))?;
-                entries.extend([
-                    wgpu::BindGroupEntry { binding: 2, resource: clusters.params_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: clusters.ranges.buffer().as_entire_binding(),
-                    },
+                bindings.extend([
+                    (2, Binding::Buffer(&clusters.params_buffer)),
+                    (3, Binding::Buffer(clusters.ranges.buffer())),
                 ]);
             }
             Family::Depth => {}
-            Family::Surface => entries.extend([texture(5, GBUFFER_ALBEDO)?, texture(6, GBUFFER_NORMAL)?]),
+            Family::Surface => bindings.extend([
+                (5, Binding::Texture(ctx.texture(GBUFFER_ALBEDO)?)),
+                (6, Binding::Texture(ctx.texture(GBUFFER_NORMAL)?)),
+            ]),
         }
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("debug_view"),
-            layout: &pipeline.layout,
-            entries: &entries,
-        });
+        let bind_group = ctx.bind_group_numbered("debug_view", &pipeline.layout, &bindings);
         let output = ctx.texture(OUTPUT)?;
         let timestamps = ctx.render_timestamps(true, true);
         draw_fullscreen(ctx.encoder, "debug_view", output, timestamps, &pipeline.pipeline, &[&bind_group]);

@@ -9,11 +9,11 @@ use super::{
     GBUFFER_ALBEDO, GBUFFER_COMPACT, GBUFFER_NORMAL, GBUFFER_PACKED_ALBEDO, GBUFFER_PACKED_POSITION,
     GBUFFER_POSITION,
 };
+use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{PassContext, ResourceName};
 use crate::snapshot::GBufferLayout;
 use manylight_core::codec::NormalCodec;
-use wgpu::util::DeviceExt;
 
 /// The G-buffer targets of a layout: name and format.
 pub fn targets(layout: GBufferLayout) -> &'static [(ResourceName, wgpu::TextureFormat)] {
@@ -90,28 +90,13 @@ pub fn gbuffer_read_bind_group(
     layout: GBufferLayout,
     clear_color: [f32; 3],
 ) -> Result<wgpu::BindGroup, RenderError> {
-    let device = &ctx.gpu.device;
     let [r, g, b] = clear_color;
-    let clear = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("gbuffer_clear_color"),
-        contents: bytemuck::cast_slice(&[r, g, b, 1.0f32]),
-        usage: wgpu::BufferUsages::UNIFORM,
-    });
-    let mut entries = Vec::new();
+    let clear = ctx.uniform(("gbuffer_clear_color", 0), bytemuck::cast_slice(&[r, g, b, 1.0f32]));
+    let mut bindings = Vec::new();
     for &(name, _) in targets(layout) {
-        entries.push(wgpu::BindGroupEntry {
-            binding: binding_of(name),
-            resource: wgpu::BindingResource::TextureView(ctx.texture(name)?),
-        });
+        bindings.push((binding_of(name), Binding::Texture(ctx.texture(name)?)));
     }
-    entries.push(wgpu::BindGroupEntry {
-        binding: 4,
-        resource: wgpu::BindingResource::TextureView(ctx.texture(DEPTH)?),
-    });
-    entries.push(wgpu::BindGroupEntry { binding: 5, resource: clear.as_entire_binding() });
-    Ok(device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("gbuffer_read"),
-        layout: bind_group_layout,
-        entries: &entries,
-    }))
+    bindings.push((4, Binding::Texture(ctx.texture(DEPTH)?)));
+    bindings.push((5, Binding::Buffer(&clear)));
+    Ok(ctx.bind_group_numbered("gbuffer_read", bind_group_layout, &bindings))
 }

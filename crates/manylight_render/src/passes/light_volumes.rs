@@ -9,13 +9,13 @@ use super::gbuffer_layout::{
     codec_constants, gbuffer_read_bind_group, gbuffer_read_layout, targets, variant_key,
 };
 use super::{DEPTH, HDR, LIGHT_ACCUM};
-use crate::context::RenderError;
+use crate::bindings::Binding;
+use crate::context::{GpuContext, RenderError};
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::resources::{DEPTH_FORMAT, HDR_FORMAT};
 use crate::snapshot::GBufferLayout;
 use manylight_core::codec::NormalCodec;
 use manylight_core::icosphere::Icosphere;
-use wgpu::util::DeviceExt;
 
 /// Subdivision level of the sphere proxy: 320 triangles, at most 4.6 % larger than the sphere.
 pub const PROXY_SUBDIVISIONS: u32 = 2;
@@ -42,12 +42,13 @@ fn entry_suffix(layout: GBufferLayout) -> &'static str {
 
 impl LightVolumesPipeline {
     fn new(
-        device: &wgpu::Device,
+        gpu: &GpuContext,
         view_layout: &wgpu::BindGroupLayout,
         layout: GBufferLayout,
         codec: NormalCodec,
         accumulation: wgpu::TextureFormat,
     ) -> Result<Self, RenderError> {
+        let device = &gpu.device;
         let module = crate::shaders::create_module(device, "light_volumes.wgsl")?;
         let gbuffer_layout = gbuffer_read_layout(device, layout);
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -151,7 +152,7 @@ impl LightVolumesPipeline {
             None
         };
         let proxy = Icosphere::circumscribing_unit_sphere(PROXY_SUBDIVISIONS);
-        let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        let vertices = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("light_volume_proxy_vertices"),
             contents: bytemuck::cast_slice(&proxy.positions.iter().map(|p| p.to_array()).collect::<Vec<_>>()),
             usage: wgpu::BufferUsages::VERTEX,
@@ -161,7 +162,7 @@ impl LightVolumesPipeline {
         if index_data.len() % 2 == 1 {
             index_data.push(0);
         }
-        let indices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        let indices = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("light_volume_proxy_indices"),
             contents: bytemuck::cast_slice(&index_data),
             usage: wgpu::BufferUsages::INDEX,
@@ -227,24 +228,17 @@ impl Pass for LightVolumesPass {
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
         let (layout, codec, accumulation) = (self.layout, self.codec, self.accumulation);
         let scene = ctx.scene;
-        let device = &ctx.gpu.device;
+        let gpu = ctx.gpu;
         let key = variant_key(layout, codec) | (self.accumulates_separately() as u64) << 16;
         let pipeline = ctx.pipelines.get_or_create(key, || {
-            LightVolumesPipeline::new(device, &scene.view_layout, layout, codec, accumulation)
+            LightVolumesPipeline::new(gpu, &scene.view_layout, layout, codec, accumulation)
         })?;
         let gbuffer = gbuffer_read_bind_group(ctx, &pipeline.gbuffer_layout, layout, self.clear_color)?;
         let hdr = ctx.texture(HDR)?;
         let target = if self.accumulates_separately() { ctx.texture(LIGHT_ACCUM)? } else { hdr };
         let depth = ctx.texture(DEPTH)?;
         let resolve = pipeline.resolve.as_ref().map(|(resolve, accum_layout)| {
-            let accum = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("light_accum"),
-                layout: accum_layout,
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(target),
-                }],
-            });
+            let accum = ctx.bind_group("light_accum", accum_layout, &[Binding::Texture(target)]);
             (resolve, accum)
         });
         let timestamps = ctx.render_timestamps(true, resolve.is_none());

@@ -17,10 +17,10 @@ use super::common::{
     uniform_entry,
 };
 use super::{DEPTH, HDR};
+use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::resources::HDR_FORMAT;
-use wgpu::util::DeviceExt;
 
 /// Graph resource: the blurred image before it is copied back into HDR.
 pub const MOTION_BLUR: ResourceName = "motion_blur";
@@ -149,34 +149,24 @@ impl Pass for MotionBlurPass {
             max_pixels: if s.max_pixels.is_finite() { s.max_pixels.max(0.0) } else { 0.0 },
             _pad: [0; 2],
         };
-        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("motion_blur_params"),
-            contents: bytemuck::bytes_of(&params),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
+        let params = ctx.uniform(("motion_blur", 0), bytemuck::bytes_of(&params));
         let hdr = ctx.texture(HDR)?;
         let blurred = ctx.texture(MOTION_BLUR)?;
-        let blur_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("motion_blur"),
-            layout: &pipeline.blur_layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: ctx.scene.view_buffer.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: params.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(hdr) },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::TextureView(ctx.texture(DEPTH)?),
-                },
+        let blur_group = ctx.bind_group(
+            "motion_blur",
+            &pipeline.blur_layout,
+            &[
+                Binding::Buffer(&ctx.scene.view_buffer),
+                Binding::Buffer(&params),
+                Binding::Texture(hdr),
+                Binding::Texture(ctx.texture(DEPTH)?),
             ],
-        });
-        let copy_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("motion_blur_copy"),
-            layout: &pipeline.copy_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 4,
-                resource: wgpu::BindingResource::TextureView(blurred),
-            }],
-        });
+        );
+        let copy_group = ctx.bind_group_numbered(
+            "motion_blur_copy",
+            &pipeline.copy_layout,
+            &[(4, Binding::Texture(blurred))],
+        );
         let first = ctx.render_timestamps(true, false);
         draw_fullscreen(ctx.encoder, "motion_blur", blurred, first, &pipeline.blur, &[&blur_group]);
         let last = ctx.render_timestamps(false, true);

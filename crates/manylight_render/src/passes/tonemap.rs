@@ -2,6 +2,7 @@
 
 use super::HDR;
 use super::common::{draw_fullscreen, fullscreen_pipeline, storage_entry, texture_entry, uniform_entry};
+use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{OUTPUT, Pass, PassContext, ResourceName};
 use crate::pipelines::format_key;
@@ -49,26 +50,19 @@ impl Pass for TonemapPass {
         let device = &ctx.gpu.device;
         let pipeline =
             ctx.pipelines.get_or_create(format_key(format), || TonemapPipeline::new(device, format))?;
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("tonemap"),
-            layout: &pipeline.layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: ctx.scene.view_buffer.as_entire_binding() },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(ctx.texture(HDR)?),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: ctx.scene.nonfinite.counter.as_entire_binding(),
-                },
+        let bind_group = ctx.bind_group(
+            "tonemap",
+            &pipeline.layout,
+            &[
+                Binding::Buffer(&ctx.scene.view_buffer),
+                Binding::Texture(ctx.texture(HDR)?),
+                Binding::Buffer(&ctx.scene.nonfinite.counter),
             ],
-        });
+        );
         let output = ctx.texture(OUTPUT)?;
         ctx.encoder.clear_buffer(&ctx.scene.nonfinite.counter, 0, None);
         let timestamps = ctx.render_timestamps(true, true);
         draw_fullscreen(ctx.encoder, "tonemap", output, timestamps, &pipeline.pipeline, &[&bind_group]);
-        ctx.scene.nonfinite.copy_for_readback(ctx.encoder);
         Ok(())
     }
 }
