@@ -1,39 +1,64 @@
-//! Pipelines created on first use and kept for the life of the renderer.
+//! Pipelines created on first use and kept for the life of the renderer, keyed by typed
+//! descriptors.
+//!
+//! A pass describes the pipeline it needs with a key type of its own that holds every choice
+//! the pipeline depends on (a target format, a G-buffer layout and normal codec, a sample
+//! count), compared field by field: two different descriptors can never share a pipeline, as
+//! hashed variant numbers could. The key type names the pipeline objects it creates
+//! ([`PipelineKey::Pipeline`]).
 
 use std::any::{Any, TypeId};
 use std::collections::HashMap;
+use std::fmt::Debug;
+use std::hash::Hash;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
-/// A cache of pipeline objects keyed by their Rust type and a variant key (e.g. the target
-/// format), so a pass creates its pipeline once, not every frame.
+/// A typed pipeline descriptor: everything a pipeline depends on.
+pub trait PipelineKey: Clone + Eq + Hash + Debug + Send + Sync + 'static {
+    /// The pipeline objects (pipelines and their bind group layouts) this key creates.
+    type Pipeline: Send + Sync + 'static;
+}
+
+/// The pipelines of one key type.
+struct Family<K: PipelineKey>(HashMap<K, Arc<K::Pipeline>>);
+
+/// A cache of pipeline objects by their descriptors, so a pass creates its pipeline once, not
+/// every frame.
 #[derive(Default)]
 pub struct PipelineCache {
-    map: Mutex<HashMap<(TypeId, u64), Arc<dyn Any + Send + Sync>>>,
+    /// One map per key type (the type only finds the map; the key is the descriptor).
+    families: Mutex<HashMap<TypeId, Box<dyn Any + Send + Sync>>>,
+    created: AtomicUsize,
 }
 
 impl PipelineCache {
-    /// The cached `T` for `variant`, created by `create` on first use.
-    pub fn get_or_create<T: Any + Send + Sync, E>(
+    /// The pipeline for `key`, created by `create` on first use.
+    pub fn get_or_create<K: PipelineKey, E>(
         &self,
-        variant: u64,
-        create: impl FnOnce() -> Result<T, E>,
-    ) -> Result<Arc<T>, E> {
-        let key = (TypeId::of::<T>(), variant);
-        if let Some(found) = self.map.lock().ok().and_then(|m| m.get(&key).cloned())
-            && let Ok(t) = found.downcast::<T>()
-        {
-            return Ok(t);
+        key: K,
+        create: impl FnOnce(&K) -> Result<K::Pipeline, E>,
+    ) -> Result<Arc<K::Pipeline>, E> {
+        let found = self.with_family::<K, _>(|family| family.0.get(&key).cloned());
+        if let Some(pipeline) = found.flatten() {
+            return Ok(pipeline);
         }
-        let created = Arc::new(create()?);
-        if let Ok(mut m) = self.map.lock() {
-            m.insert(key, created.clone());
-        }
+        let created = Arc::new(create(&key)?);
+        self.with_family::<K, _>(|family| family.0.insert(key, created.clone()));
+        self.created.fetch_add(1, Ordering::Relaxed);
         Ok(created)
+    }
+
+    fn with_family<K: PipelineKey, R>(&self, f: impl FnOnce(&mut Family<K>) -> R) -> Option<R> {
+        let mut families = self.families.lock().unwrap_or_else(|e| e.into_inner());
+        let entry =
+            families.entry(TypeId::of::<K>()).or_insert_with(|| Box::new(Family::<K>(HashMap::new())));
+        entry.downcast_mut::<Family<K>>().map(f)
     }
 
     /// Number of pipelines created.
     pub fn len(&self) -> usize {
-        self.map.lock().map(|m| m.len()).unwrap_or(0)
+        self.created.load(Ordering::Relaxed)
     }
 
     /// True when no pipeline was created yet.
@@ -42,10 +67,33 @@ impl PipelineCache {
     }
 }
 
-/// A stable number for a texture format, for use as a cache variant key.
-pub fn format_key(format: wgpu::TextureFormat) -> u64 {
-    use std::hash::{Hash, Hasher};
-    let mut h = std::collections::hash_map::DefaultHasher::new();
-    format.hash(&mut h);
-    h.finish()
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+    struct A(u32);
+    impl PipelineKey for A {
+        type Pipeline = String;
+    }
+    #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+    struct B(u32);
+    impl PipelineKey for B {
+        type Pipeline = u64;
+    }
+
+    #[test]
+    fn descriptors_are_compared_whole_and_by_type() {
+        let cache = PipelineCache::default();
+        let first = cache.get_or_create(A(1), |k| Ok::<_, ()>(format!("a{}", k.0))).unwrap();
+        let again = cache.get_or_create(A(1), |_| Err(())).unwrap();
+        assert!(Arc::ptr_eq(&first, &again), "the same descriptor is created once");
+        assert_eq!(*cache.get_or_create(A(2), |k| Ok::<_, ()>(format!("a{}", k.0))).unwrap(), "a2");
+        // Another key type with equal fields is another pipeline.
+        assert_eq!(*cache.get_or_create(B(1), |k| Ok::<_, ()>(u64::from(k.0) + 10)).unwrap(), 11);
+        assert_eq!(cache.len(), 3);
+        // A failed creation caches nothing.
+        assert!(cache.get_or_create(B(7), |_| Err::<u64, _>("no")).is_err());
+        assert_eq!(cache.len(), 3);
+    }
 }

@@ -17,6 +17,7 @@ use super::common::{FullscreenPipelineDesc, fullscreen_pipeline_desc};
 use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::pipelines::PipelineKey;
 use crate::resources::HDR_FORMAT;
 
 /// Most levels (iterations) of the chain.
@@ -157,7 +158,7 @@ fn level_spec(name: ResourceName, scale: f32) -> TextureSpec {
 }
 
 /// Which entry point of `bloom.wgsl` a pipeline runs.
-#[derive(Clone, Copy, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 enum Stage {
     Bright,
     Blur,
@@ -170,6 +171,16 @@ impl Stage {
     fn adds(self) -> bool {
         matches!(self, Stage::Upsample | Stage::Composite)
     }
+}
+
+/// Bloom's pipelines: one per stage.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+struct BloomKey {
+    stage: Stage,
+}
+
+impl PipelineKey for BloomKey {
+    type Pipeline = BloomPipeline;
 }
 
 /// The pipeline of one bloom stage.
@@ -245,7 +256,8 @@ fn draw(
     target: ResourceName,
 ) -> Result<(), RenderError> {
     let device = &ctx.gpu.device;
-    let pipeline = ctx.pipelines.get_or_create(stage as u64, || BloomPipeline::new(device, stage))?;
+    let pipeline =
+        ctx.pipelines.get_or_create(BloomKey { stage }, |k| BloomPipeline::new(device, k.stage))?;
     // One uniform per draw of the chain: its stage and the level it writes.
     let params = ctx.uniform((target, stage as u64), bytemuck::bytes_of(&params));
     let textures = sources.iter().map(|&name| ctx.texture(name)).collect::<Result<Vec<_>, _>>()?;

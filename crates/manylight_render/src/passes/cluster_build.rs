@@ -5,6 +5,18 @@
 use super::CLUSTERS;
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName};
+use crate::pipelines::PipelineKey;
+
+/// The cluster build's pipelines: per workgroup size.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ClusterBuildKey {
+    /// Invocations per workgroup.
+    pub workgroup_size: u32,
+}
+
+impl PipelineKey for ClusterBuildKey {
+    type Pipeline = ClusterBuildPipelines;
+}
 
 /// The six compute pipelines of the build (three per level), for one workgroup size.
 pub struct ClusterBuildPipelines {
@@ -102,9 +114,9 @@ impl Pass for ClusterBuildPass {
             ctx.clusters.ok_or_else(|| RenderError::Graph("cluster_build needs cluster resources".into()))?;
         let wg = self.workgroup_size.clamp(1, 1024);
         let layout = &clusters.build_layout;
-        let pipelines = ctx
-            .pipelines
-            .get_or_create(wg as u64, || ClusterBuildPipelines::new(&ctx.gpu.device, layout, wg))?;
+        let pipelines = ctx.pipelines.get_or_create(ClusterBuildKey { workgroup_size: wg }, |k| {
+            ClusterBuildPipelines::new(&ctx.gpu.device, layout, k.workgroup_size)
+        })?;
         let max_groups = ctx.gpu.device.limits().max_compute_workgroups_per_dimension;
         let groups = dispatch_size(clusters.params.dims[3], wg, max_groups)?;
         // Level 1 runs one invocation per (tile, chunk of lights).

@@ -6,7 +6,19 @@ use super::scene_draw::record_scene_pass;
 use super::{CLUSTERS, DEPTH, HDR};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::pipelines::PipelineKey;
 use crate::resources::{DEPTH_FORMAT, HDR_FORMAT};
+
+/// Clustered shading's pipeline: with or without a depth pre-pass before it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ClusteredForwardKey {
+    /// Depth tested `GreaterEqual` without writes, after the pre-pass.
+    pub after_prepass: bool,
+}
+
+impl PipelineKey for ClusteredForwardKey {
+    type Pipeline = ClusteredForwardPipeline;
+}
 
 /// The pipeline of [`ClusteredForwardPass`] (one per depth mode).
 pub struct ClusteredForwardPipeline {
@@ -78,9 +90,9 @@ impl Pass for ClusteredForwardPass {
             .ok_or_else(|| RenderError::Graph("clustered_forward needs cluster resources".into()))?;
         let layouts = [&scene.view_layout, &scene.material_layout, &clusters.shading_layout];
         let after = self.after_prepass;
-        let pipeline = ctx
-            .pipelines
-            .get_or_create(after as u64, || ClusteredForwardPipeline::new(&ctx.gpu.device, layouts, after))?;
+        let pipeline = ctx.pipelines.get_or_create(ClusteredForwardKey { after_prepass: after }, |k| {
+            ClusteredForwardPipeline::new(&ctx.gpu.device, layouts, k.after_prepass)
+        })?;
         let color = color_attachment(ctx.texture(HDR)?, clear_color(self.clear_color));
         let depth = ctx.texture(DEPTH)?;
         let extra = [&clusters.shading_bind_group];

@@ -11,11 +11,11 @@ use super::{CLUSTERS, DEPTH, GBUFFER_ALBEDO, GBUFFER_NORMAL};
 use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{OUTPUT, Pass, PassContext, ResourceName};
-use crate::pipelines::format_key;
+use crate::pipelines::PipelineKey;
 use crate::snapshot::DebugViewMode;
 
 /// The data a debug view reads.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 enum Family {
     Clusters,
     Depth,
@@ -32,6 +32,17 @@ impl Family {
             Family::Depth
         }
     }
+}
+
+/// The debug views' pipelines: per data read and output format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+struct DebugViewKey {
+    family: Family,
+    format: wgpu::TextureFormat,
+}
+
+impl PipelineKey for DebugViewKey {
+    type Pipeline = DebugViewPipeline;
 }
 
 /// The pipeline of [`DebugViewPass`] for one family and output format.
@@ -113,8 +124,9 @@ impl Pass for DebugViewPass {
         let family = Family::of(self.view);
         let format = ctx.output_format;
         let device = &ctx.gpu.device;
-        let key = format_key(format).wrapping_add(family as u64);
-        let pipeline = ctx.pipelines.get_or_create(key, || DebugViewPipeline::new(device, family, format))?;
+        let key = DebugViewKey { family, format };
+        let pipeline =
+            ctx.pipelines.get_or_create(key, |k| DebugViewPipeline::new(device, k.family, k.format))?;
         let depth_far = depth_view_far(ctx.scene);
         let params = ctx.uniform(
             ("debug_view", 0),

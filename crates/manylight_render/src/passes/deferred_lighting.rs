@@ -3,14 +3,28 @@
 
 use super::common::{FullscreenPipelineDesc, draw_fullscreen, fullscreen_pipeline_desc};
 use super::gbuffer_layout::{
-    codec_constants, fragment_entry, gbuffer_read_bind_group, gbuffer_read_layout, targets, variant_key,
+    codec_constants, fragment_entry, gbuffer_read_bind_group, gbuffer_read_layout, targets,
 };
 use super::{CLUSTERS, DEPTH, HDR};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::pipelines::PipelineKey;
 use crate::resources::HDR_FORMAT;
 use crate::snapshot::GBufferLayout;
 use manylight_core::codec::NormalCodec;
+
+/// Deferred lighting's pipelines: per G-buffer layout and normal codec.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct DeferredLightingKey {
+    /// The G-buffer read.
+    pub layout: GBufferLayout,
+    /// Its normal codec.
+    pub codec: NormalCodec,
+}
+
+impl PipelineKey for DeferredLightingKey {
+    type Pipeline = DeferredLightingPipeline;
+}
 
 /// The pipeline of [`DeferredLightingPass`] for one layout.
 pub struct DeferredLightingPipeline {
@@ -77,8 +91,8 @@ impl Pass for DeferredLightingPass {
         let device = &ctx.gpu.device;
         let (layout, codec) = (self.layout, self.codec);
         let view_layout = &ctx.scene.view_layout;
-        let pipeline = ctx.pipelines.get_or_create(variant_key(layout, codec), || {
-            DeferredLightingPipeline::new(device, view_layout, &clusters.shading_layout, layout, codec)
+        let pipeline = ctx.pipelines.get_or_create(DeferredLightingKey { layout, codec }, |k| {
+            DeferredLightingPipeline::new(device, view_layout, &clusters.shading_layout, k.layout, k.codec)
         })?;
         let gbuffer = gbuffer_read_bind_group(ctx, &pipeline.gbuffer_layout, layout, self.clear_color)?;
         let hdr = ctx.texture(HDR)?;

@@ -5,7 +5,16 @@ use super::common::{MeshPipelineDesc, mesh_pipeline};
 use super::scene_draw::record_scene_pass;
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::pipelines::PipelineKey;
 use crate::resources::{DEPTH_FORMAT, SceneResources};
+
+/// The depth pre-pass's pipeline (there is one).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct DepthPrepassKey;
+
+impl PipelineKey for DepthPrepassKey {
+    type Pipeline = DepthPrepassPipeline;
+}
 
 /// The pipeline of [`DepthPrepass`].
 pub struct DepthPrepassPipeline {
@@ -48,8 +57,9 @@ impl Pass for DepthPrepass {
     }
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
         let scene = ctx.scene;
-        let pipeline =
-            ctx.pipelines.get_or_create(0, || DepthPrepassPipeline::new(&ctx.gpu.device, scene))?;
+        let pipeline = ctx
+            .pipelines
+            .get_or_create(DepthPrepassKey, |_| DepthPrepassPipeline::new(&ctx.gpu.device, scene))?;
         let depth = ctx.texture(DEPTH)?;
         record_scene_pass(ctx, "depth_prepass", &[], depth, true, &pipeline.pipeline, &[]);
         Ok(())

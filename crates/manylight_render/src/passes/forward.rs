@@ -6,7 +6,16 @@ use super::scene_draw::record_scene_pass;
 use super::{DEPTH, HDR};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::pipelines::PipelineKey;
 use crate::resources::{DEPTH_FORMAT, HDR_FORMAT, SceneResources};
+
+/// Naive forward's pipeline (there is one).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ForwardKey;
+
+impl PipelineKey for ForwardKey {
+    type Pipeline = ForwardPipeline;
+}
 
 /// The pipeline of [`ForwardPass`].
 pub struct ForwardPipeline {
@@ -56,7 +65,8 @@ impl Pass for ForwardPass {
     }
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
         let scene = ctx.scene;
-        let pipeline = ctx.pipelines.get_or_create(0, || ForwardPipeline::new(&ctx.gpu.device, scene))?;
+        let pipeline =
+            ctx.pipelines.get_or_create(ForwardKey, |_| ForwardPipeline::new(&ctx.gpu.device, scene))?;
         let color = color_attachment(ctx.texture(HDR)?, clear_color(self.clear_color));
         let depth = ctx.texture(DEPTH)?;
         record_scene_pass(ctx, "forward", &[color], depth, true, &pipeline.pipeline, &[]);

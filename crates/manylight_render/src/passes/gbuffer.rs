@@ -2,14 +2,28 @@
 //! normal, albedo, shading parameters) in the chosen [`GBufferLayout`].
 
 use super::common::{MeshPipelineDesc, color_attachment, mesh_pipeline_with_constants};
-use super::gbuffer_layout::{codec_constants, fragment_entry, targets, variant_key};
+use super::gbuffer_layout::{codec_constants, fragment_entry, targets};
 use super::scene_draw::record_scene_pass;
 use super::{DEPTH, DEPTH_USAGE};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::pipelines::PipelineKey;
 use crate::resources::{DEPTH_FORMAT, SceneResources};
 use crate::snapshot::GBufferLayout;
 use manylight_core::codec::NormalCodec;
+
+/// The G-buffer pass's pipelines: per layout and normal codec.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct GBufferKey {
+    /// The layout written.
+    pub layout: GBufferLayout,
+    /// Its normal codec.
+    pub codec: NormalCodec,
+}
+
+impl PipelineKey for GBufferKey {
+    type Pipeline = GBufferPipeline;
+}
 
 /// The pipeline of [`GBufferPass`] for one layout and codec.
 pub struct GBufferPipeline {
@@ -70,8 +84,8 @@ impl Pass for GBufferPass {
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
         let scene = ctx.scene;
         let (layout, codec) = (self.layout, self.codec);
-        let pipeline = ctx.pipelines.get_or_create(variant_key(layout, codec), || {
-            GBufferPipeline::new(&ctx.gpu.device, scene, layout, codec)
+        let pipeline = ctx.pipelines.get_or_create(GBufferKey { layout, codec }, |k| {
+            GBufferPipeline::new(&ctx.gpu.device, scene, k.layout, k.codec)
         })?;
         let views =
             targets(layout).iter().map(|&(name, _)| ctx.texture(name)).collect::<Result<Vec<_>, _>>()?;

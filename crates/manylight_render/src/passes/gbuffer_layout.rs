@@ -47,11 +47,6 @@ pub fn codec_constants(codec: NormalCodec) -> [(&'static str, f64); 1] {
     [("NORMAL_CODEC", codec.gpu_id() as f64)]
 }
 
-/// Pipeline-cache key of a (layout, codec) pair.
-pub fn variant_key(layout: GBufferLayout, codec: NormalCodec) -> u64 {
-    (layout as u64) << 8 | codec.gpu_id() as u64
-}
-
 /// Binding number of each G-buffer target in `shaders/common/gbuffer_read.wgsl`, group 1.
 fn binding_of(name: ResourceName) -> u32 {
     match name {

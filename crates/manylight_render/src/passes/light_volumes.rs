@@ -5,13 +5,12 @@
 
 use super::common::{FullscreenPipelineDesc, fullscreen_pipeline_desc, texture_entry};
 use super::common::{clear_color, color_attachment, draw_fullscreen};
-use super::gbuffer_layout::{
-    codec_constants, gbuffer_read_bind_group, gbuffer_read_layout, targets, variant_key,
-};
+use super::gbuffer_layout::{codec_constants, gbuffer_read_bind_group, gbuffer_read_layout, targets};
 use super::{DEPTH, HDR, LIGHT_ACCUM};
 use crate::bindings::Binding;
 use crate::context::{GpuContext, RenderError};
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::pipelines::PipelineKey;
 use crate::resources::{DEPTH_FORMAT, HDR_FORMAT};
 use crate::snapshot::GBufferLayout;
 use manylight_core::codec::NormalCodec;
@@ -19,6 +18,21 @@ use manylight_core::icosphere::Icosphere;
 
 /// Subdivision level of the sphere proxy: 320 triangles, at most 4.6 % larger than the sphere.
 pub const PROXY_SUBDIVISIONS: u32 = 2;
+
+/// Light volumes' pipelines: per G-buffer layout, normal codec and accumulation format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct LightVolumesKey {
+    /// The G-buffer read.
+    pub layout: GBufferLayout,
+    /// Its normal codec.
+    pub codec: NormalCodec,
+    /// Where the lights are summed.
+    pub accumulation: wgpu::TextureFormat,
+}
+
+impl PipelineKey for LightVolumesKey {
+    type Pipeline = LightVolumesPipeline;
+}
 
 /// The pipelines and proxy mesh of [`LightVolumesPass`] for one layout and codec.
 pub struct LightVolumesPipeline {
@@ -229,9 +243,9 @@ impl Pass for LightVolumesPass {
         let (layout, codec, accumulation) = (self.layout, self.codec, self.accumulation);
         let scene = ctx.scene;
         let gpu = ctx.gpu;
-        let key = variant_key(layout, codec) | (self.accumulates_separately() as u64) << 16;
-        let pipeline = ctx.pipelines.get_or_create(key, || {
-            LightVolumesPipeline::new(gpu, &scene.view_layout, layout, codec, accumulation)
+        let key = LightVolumesKey { layout, codec, accumulation };
+        let pipeline = ctx.pipelines.get_or_create(key, |k| {
+            LightVolumesPipeline::new(gpu, &scene.view_layout, k.layout, k.codec, k.accumulation)
         })?;
         let gbuffer = gbuffer_read_bind_group(ctx, &pipeline.gbuffer_layout, layout, self.clear_color)?;
         let hdr = ctx.texture(HDR)?;

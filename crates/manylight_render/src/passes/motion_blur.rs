@@ -20,6 +20,7 @@ use super::{DEPTH, HDR};
 use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::pipelines::PipelineKey;
 use crate::resources::HDR_FORMAT;
 
 /// Graph resource: the blurred image before it is copied back into HDR.
@@ -50,6 +51,16 @@ struct MotionBlurParams {
     strength: f32,
     max_pixels: f32,
     _pad: [u32; 2],
+}
+
+/// Motion blur's pipelines: one per sample count.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+struct MotionBlurKey {
+    samples: u32,
+}
+
+impl PipelineKey for MotionBlurKey {
+    type Pipeline = MotionBlurPipeline;
 }
 
 /// The two pipelines of [`MotionBlurPass`] for one tap count.
@@ -142,8 +153,9 @@ impl Pass for MotionBlurPass {
         let device = &ctx.gpu.device;
         let s = self.settings;
         let samples = s.samples.clamp(2, 64);
-        let pipeline =
-            ctx.pipelines.get_or_create(u64::from(samples), || MotionBlurPipeline::new(device, samples))?;
+        let pipeline = ctx
+            .pipelines
+            .get_or_create(MotionBlurKey { samples }, |k| MotionBlurPipeline::new(device, k.samples))?;
         let params = MotionBlurParams {
             strength: if s.strength.is_finite() { s.strength.max(0.0) } else { 0.0 },
             max_pixels: if s.max_pixels.is_finite() { s.max_pixels.max(0.0) } else { 0.0 },

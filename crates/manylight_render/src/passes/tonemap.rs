@@ -5,10 +5,21 @@ use super::common::{draw_fullscreen, fullscreen_pipeline, storage_entry, texture
 use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{OUTPUT, Pass, PassContext, ResourceName};
-use crate::pipelines::format_key;
+use crate::pipelines::PipelineKey;
 
 /// The tone map's pass name (the renderer reads the non-finite count after it ran).
 pub const TONEMAP: &str = "tonemap";
+
+/// The tone map's pipeline: one per output format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct TonemapKey {
+    /// Format of [`OUTPUT`].
+    pub format: wgpu::TextureFormat,
+}
+
+impl PipelineKey for TonemapKey {
+    type Pipeline = TonemapPipeline;
+}
 
 /// The pipeline of [`TonemapPass`] for one output format.
 pub struct TonemapPipeline {
@@ -49,7 +60,7 @@ impl Pass for TonemapPass {
         let format = ctx.output_format;
         let device = &ctx.gpu.device;
         let pipeline =
-            ctx.pipelines.get_or_create(format_key(format), || TonemapPipeline::new(device, format))?;
+            ctx.pipelines.get_or_create(TonemapKey { format }, |k| TonemapPipeline::new(device, k.format))?;
         let bind_group = ctx.bind_group(
             "tonemap",
             &pipeline.layout,
