@@ -238,3 +238,141 @@ fn removing_bloom_frees_its_textures() {
     }
     assert_eq!(live(&app), without);
 }
+
+/// A pass of the kind docs/architecture.md walks through: its module (here, this test), its
+/// WGSL (below), and one registration line. It adds a constant red to the HDR image.
+mod red_tint {
+    use manylight::render::graph::{Pass, PassContext, ResourceName};
+    use manylight::render::passes::HDR;
+    use manylight::render::pipelines::PipelineKey;
+    use manylight::render::resources::HDR_FORMAT;
+    use manylight::render::{PlanInputs, RenderError};
+
+    /// The pass's WGSL.
+    const WGSL: &str = "
+        @vertex fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+            let p = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
+            return vec4<f32>(p * 2.0 - 1.0, 0.0, 1.0);
+        }
+        @fragment fn fs() -> @location(0) vec4<f32> { return vec4<f32>(0.25, 0.0, 0.0, 0.0); }
+    ";
+
+    /// Its pipeline has one variant.
+    #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+    struct RedTintKey;
+
+    impl PipelineKey for RedTintKey {
+        type Pipeline = wgpu::RenderPipeline;
+    }
+
+    /// Adds red to the HDR image.
+    pub struct RedTint;
+
+    /// When it is needed: whenever the image is shown (no debug view).
+    pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn Pass>>) {
+        if p.shows_image() {
+            out.push(Box::new(RedTint));
+        }
+    }
+
+    fn pipeline(device: &wgpu::Device) -> wgpu::RenderPipeline {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("red_tint"),
+            source: wgpu::ShaderSource::Wgsl(WGSL.into()),
+        });
+        let add = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::One,
+            dst_factor: wgpu::BlendFactor::One,
+            operation: wgpu::BlendOperation::Add,
+        };
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("red_tint"),
+            layout: None,
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: HDR_FORMAT,
+                    blend: Some(wgpu::BlendState { color: add, alpha: add }),
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            multiview_mask: None,
+            cache: None,
+        })
+    }
+
+    impl Pass for RedTint {
+        fn name(&self) -> &'static str {
+            "red_tint"
+        }
+        fn reads(&self) -> Vec<ResourceName> {
+            vec![HDR]
+        }
+        fn writes(&self) -> Vec<ResourceName> {
+            vec![HDR]
+        }
+        fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
+            let device = &ctx.gpu.device;
+            let pipeline =
+                ctx.pipelines.get_or_create(RedTintKey, |_| Ok::<_, RenderError>(pipeline(device)))?;
+            let view = ctx.texture(HDR)?;
+            let timestamps = ctx.render_timestamps(true, true);
+            let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("red_tint"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: timestamps,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&pipeline);
+            pass.draw(0..3, 0..1);
+            Ok(())
+        }
+    }
+}
+
+#[test]
+fn a_pass_added_by_one_registration_line_runs_in_its_place() {
+    let _gpu = gpu();
+    let point = Point { lights: true, bloom: true, motion_blur: false, deferred: false, debug: false };
+    let snapshot = || snapshot(point);
+    let mut renderer = manylight::app::render_world::HeadlessRenderer::new().expect("adapter");
+    let (plain, plain_image) = renderer.render(snapshot(), true).expect("renders");
+    // The one registration line.
+    assert_eq!(pipeline(point), PipelineKind::ClusteredForward);
+    let shading = "clustered_forward";
+    renderer.render_world.planner_mut().insert_after(shading, "red_tint", red_tint::plan);
+    let (tinted, tinted_image) = renderer.render(snapshot(), true).expect("renders");
+    let names = tinted.pass_names();
+    let at = |n: &str| names.iter().position(|p| *p == n).unwrap_or_else(|| panic!("{n} missing: {names:?}"));
+    assert!(at(shading) < at("red_tint") && at("red_tint") < at("bloom_bright"), "{names:?}");
+    assert_eq!(names.len(), plain.pass_names().len() + 1, "{names:?}");
+    let mean = |img: &image::RgbaImage, c: usize| {
+        img.pixels().map(|p| f64::from(p.0[c])).sum::<f64>() / (img.len() / 4) as f64
+    };
+    let (plain_image, tinted_image) = (plain_image.expect("image"), tinted_image.expect("image"));
+    assert!(mean(&tinted_image, 0) > mean(&plain_image, 0) + 10.0, "red does not rise");
+    assert!((mean(&tinted_image, 2) - mean(&plain_image, 2)).abs() < 3.0, "blue changed");
+    // A debug view replaces the image: the stage adds nothing then.
+    let mut debug = snapshot();
+    debug.settings.debug_view = DebugViewMode::Depth;
+    let (report, _) = renderer.render(debug, false).expect("renders");
+    assert!(!report.pass_names().contains(&"red_tint"), "{:?}", report.pass_names());
+}

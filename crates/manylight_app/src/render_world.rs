@@ -9,12 +9,9 @@
 
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::ScheduleLabel;
-use manylight_render::passes::{
-    ClusterBuildPass, ClusteredForwardPass, DebugViewPass, DeferredLightingPass, DepthPrepass, ForwardPass,
-    GBufferPass, LightVolumesPass, MotionBlurPass, TonemapPass,
-};
+use manylight_render::passes::LightVolumesPass;
 use manylight_render::{
-    DebugViewMode, FrameReport, FrameSnapshot, GBufferLayout, GpuContext, HeadlessTarget, PipelineKind,
+    FramePlanner, FrameReport, FrameSnapshot, GpuContext, HeadlessTarget, PipelineKind, PlanInputs,
     RenderError, RenderGraph, RenderTextureId, RenderView, Renderer, ViewReport, ViewTarget,
 };
 use std::collections::HashMap;
@@ -48,10 +45,6 @@ impl CurrentView {
     /// View `index` of `snapshot`.
     pub fn of(snapshot: &FrameSnapshot, index: usize) -> CurrentView {
         CurrentView(snapshot.render_view(index), snapshot.has_lights())
-    }
-
-    fn settings(&self) -> &manylight_render::FrameSettings {
-        &self.0.settings
     }
 
     fn has_lights(&self) -> bool {
@@ -165,6 +158,7 @@ impl RenderWorld {
         world.init_resource::<CurrentSnapshot>();
         world.init_resource::<FrameGraph>();
         world.init_resource::<FrameOutcome>();
+        world.init_resource::<Planner>();
         let mut schedule = Schedule::new(RenderSchedule);
         schedule.configure_sets((RenderSet::Prepare, RenderSet::Graph, RenderSet::Execute).chain());
         schedule.add_systems(prepare.in_set(RenderSet::Prepare));
@@ -211,7 +205,9 @@ impl RenderWorld {
         let losses = std::mem::take(&mut self.losses);
         let frames_in_flight = self.renderer().frames_in_flight();
         let recoveries = self.recoveries;
+        let planner = self.world.resource::<Planner>().clone();
         *self = RenderWorld::with_frames_in_flight(gpu, frames_in_flight);
+        self.world.insert_resource(planner);
         self.losses = losses;
         self.recoveries = recoveries + 1;
         Ok(())
@@ -239,6 +235,13 @@ impl RenderWorld {
     /// `wait`, waits for every frame in flight first.
     pub fn take_reports(&mut self, wait: bool) -> Result<Vec<FrameReport>, RenderError> {
         self.world.resource_mut::<RendererResource>().0.take_reports(wait)
+    }
+
+    /// The stages views are planned with: insert a stage of your own
+    /// ([`FramePlanner::insert_after`]) to add a pass to every view that calls for it. A
+    /// recreated device keeps them.
+    pub fn planner_mut(&mut self) -> &mut FramePlanner {
+        &mut self.world.resource_mut::<Planner>().into_inner().0
     }
 
     /// The renderer, to record a pass outside the graph (the window overlay).
@@ -574,41 +577,33 @@ fn merge_view_reports(views: Vec<(ViewReport, FrameReport)>, snapshot: &FrameSna
     merged
 }
 
-/// Adds the `Graph` systems, in order: each adds its pass only if the snapshot calls for it.
+/// Adds the `Graph` system: the view's plan ([`FramePlanner`]) fills the graph.
 fn add_graph_systems(schedule: &mut Schedule) {
-    schedule.add_systems(
-        (
-            add_depth_prepass,
-            add_cluster_build,
-            add_forward_pass,
-            add_clustered_forward_pass,
-            add_gbuffer_pass,
-            add_deferred_lighting_pass,
-            add_light_volumes_pass,
-            add_motion_blur_pass,
-            add_bloom_passes,
-            add_output_pass,
-        )
-            .chain()
-            .in_set(RenderSet::Graph),
-    );
+    schedule.add_systems(plan_graph.in_set(RenderSet::Graph));
 }
 
-/// The passes the `Graph` systems would run for `snapshot`, in order, without a GPU (tests and
-/// tools use it to see what a scene calls for).
+/// The stages a view is planned with (the render crate's [`manylight_render::plan::STAGES`],
+/// plus any an app inserted: [`RenderWorld::planner_mut`]).
+#[derive(Resource, Default, Clone, Debug)]
+pub struct Planner(pub FramePlanner);
+
+/// The passes the plan runs for `snapshot`, in order, without a GPU (tests and tools use it
+/// to see what a scene calls for).
 pub fn plan_passes(snapshot: FrameSnapshot) -> Result<Vec<&'static str>, RenderError> {
     plan_view_passes(&snapshot, 0)
 }
 
-/// The passes the `Graph` systems would run for view `index` of `snapshot`, in order.
+/// The passes the plan runs for view `index` of `snapshot`, in order.
 pub fn plan_view_passes(snapshot: &FrameSnapshot, index: usize) -> Result<Vec<&'static str>, RenderError> {
-    let mut world = World::new();
-    world.insert_resource(CurrentView::of(snapshot, index));
-    world.init_resource::<FrameGraph>();
-    let mut schedule = Schedule::new(RenderSchedule);
-    add_graph_systems(&mut schedule);
-    schedule.run(&mut world);
-    world.resource::<FrameGraph>().0.pass_names()
+    let view = CurrentView::of(snapshot, index);
+    let inputs = PlanInputs {
+        view: &view.0,
+        has_lights: view.1,
+        accumulation: manylight_render::resources::HDR_FORMAT,
+    };
+    let mut graph = RenderGraph::new();
+    FramePlanner::default().plan_into(&inputs, &mut graph);
+    graph.pass_names()
 }
 
 fn prepare(
@@ -621,129 +616,16 @@ fn prepare(
     }
 }
 
-/// True when the view shades with cluster lists (a tiled/clustered pipeline with lights).
-fn shades_with_clusters(view: &CurrentView) -> bool {
-    view.settings().pipeline.uses_clusters() && view.has_lights() && !replaces_shading(view)
-}
-
-/// True when the view is shaded deferred: a G-buffer, then a full-screen lighting pass
-/// (clustered deferred) or light volumes. Without lights the forward pass draws the ambient.
-fn shades_deferred(view: &CurrentView) -> bool {
-    view.settings().pipeline.is_deferred() && view.has_lights() && !replaces_shading(view)
-}
-
-/// True when the view runs a depth pre-pass (forward pipelines only).
-fn runs_depth_prepass(view: &CurrentView) -> bool {
-    let s = view.settings();
-    shades_with_clusters(view)
-        && !shades_deferred(view)
-        && (s.pipeline == PipelineKind::ForwardPlus || s.clusters.depth_prepass)
-}
-
-/// True when a debug view shows surface attributes (albedo, normal): the view then draws the
-/// Full G-buffer instead of shading (the debug view replaces the image), in every pipeline.
-fn shows_surfaces(view: &CurrentView) -> bool {
-    view.settings().debug_view.uses_surfaces()
-}
-
-/// True when a debug view that needs neither lighting nor clusters replaces the image: albedo
-/// and normal draw the Full G-buffer, depth only the depth pre-pass, in every pipeline.
-fn replaces_shading(view: &CurrentView) -> bool {
-    shows_surfaces(view) || view.settings().debug_view == DebugViewMode::Depth
-}
-
-fn add_depth_prepass(view: Res<CurrentView>, mut graph: ResMut<FrameGraph>) {
-    if runs_depth_prepass(&view) || view.settings().debug_view == DebugViewMode::Depth {
-        graph.0.add(DepthPrepass);
-    }
-}
-
-fn add_cluster_build(view: Res<CurrentView>, mut graph: ResMut<FrameGraph>) {
-    if view.0.needs_clusters(view.has_lights()) {
-        graph.0.add(ClusterBuildPass { workgroup_size: view.settings().clusters.workgroup_size });
-    }
-}
-
-fn add_forward_pass(view: Res<CurrentView>, mut graph: ResMut<FrameGraph>) {
-    // Naive forward, and the other pipelines when there are no lights to assign.
-    if !shades_with_clusters(&view) && !shades_deferred(&view) && !replaces_shading(&view) {
-        graph.0.add(ForwardPass { clear_color: view.settings().clear_color });
-    }
-}
-
-fn add_gbuffer_pass(view: Res<CurrentView>, mut graph: ResMut<FrameGraph>) {
-    let s = view.settings();
-    if shows_surfaces(&view) {
-        graph.0.add(GBufferPass { layout: GBufferLayout::Full, codec: s.normal_codec });
-    } else if shades_deferred(&view) {
-        graph.0.add(GBufferPass { layout: s.gbuffer, codec: s.normal_codec });
-    }
-}
-
-fn add_deferred_lighting_pass(view: Res<CurrentView>, mut graph: ResMut<FrameGraph>) {
-    let s = view.settings();
-    if shades_deferred(&view) && s.pipeline == PipelineKind::ClusteredDeferred {
-        let (layout, codec, clear_color) = (s.gbuffer, s.normal_codec, s.clear_color);
-        graph.0.add(DeferredLightingPass { layout, codec, clear_color });
-    }
-}
-
-fn add_light_volumes_pass(
+/// Plans the view's passes into the graph.
+fn plan_graph(
     view: Res<CurrentView>,
-    renderer: Option<Res<RendererResource>>,
+    renderer: Res<RendererResource>,
+    planner: Res<Planner>,
     mut graph: ResMut<FrameGraph>,
 ) {
-    let s = view.settings();
-    if shades_deferred(&view) && s.pipeline == PipelineKind::LightVolumes {
-        let (layout, codec, clear_color) = (s.gbuffer, s.normal_codec, s.clear_color);
-        // Planning without a GPU (`plan_passes`) lists the same passes with either format.
-        let accumulation = renderer.map_or(manylight_render::resources::HDR_FORMAT, |r| {
-            LightVolumesPass::accumulation_format(&r.0.gpu.device)
-        });
-        graph.0.add(LightVolumesPass { layout, codec, clear_color, accumulation });
-    }
-}
-
-fn add_clustered_forward_pass(view: Res<CurrentView>, mut graph: ResMut<FrameGraph>) {
-    if shades_with_clusters(&view) && !shades_deferred(&view) {
-        graph.0.add(ClusteredForwardPass {
-            clear_color: view.settings().clear_color,
-            after_prepass: runs_depth_prepass(&view),
-        });
-    }
-}
-
-/// Camera-motion blur, when the camera has it (and no debug view replaces the image).
-fn add_motion_blur_pass(view: Res<CurrentView>, mut graph: ResMut<FrameGraph>) {
-    let v = &view.0;
-    if let Some(pass) = v.camera.and_then(|c| MotionBlurPass::for_camera(&c, v.size))
-        && v.settings.debug_view == DebugViewMode::None
-    {
-        graph.0.add(pass);
-    }
-}
-
-/// Bloom's bright pass, blur chain and composite, when the camera has bloom (and no debug view
-/// replaces the image).
-fn add_bloom_passes(view: Res<CurrentView>, mut graph: ResMut<FrameGraph>) {
-    let v = &view.0;
-    if let Some(bloom) = v.camera.and_then(|c| c.bloom)
-        && v.settings.debug_view == DebugViewMode::None
-    {
-        for pass in bloom.passes() {
-            graph.0.add_boxed(pass);
-        }
-    }
-}
-
-/// Tone mapping, or the debug view that replaces it.
-fn add_output_pass(view: Res<CurrentView>, mut graph: ResMut<FrameGraph>) {
-    let s = view.settings();
-    if s.debug_view == DebugViewMode::None {
-        graph.0.add(TonemapPass);
-    } else {
-        graph.0.add(DebugViewPass { view: s.debug_view, heatmap_max: s.debug_heatmap_max });
-    }
+    let accumulation = LightVolumesPass::accumulation_format(&renderer.0.gpu.device);
+    let inputs = PlanInputs { view: &view.0, has_lights: view.has_lights(), accumulation };
+    planner.0.plan_into(&inputs, &mut graph.0);
 }
 
 fn execute(

@@ -12,6 +12,7 @@ pub mod graph;
 pub mod inflight;
 pub mod passes;
 pub mod pipelines;
+pub mod plan;
 pub mod pool;
 pub mod readback;
 pub mod renderer;
@@ -23,6 +24,7 @@ pub mod stats;
 pub use context::{GpuContext, GpuCounts, NO_ADAPTER_HELP, RenderError};
 pub use graph::{OUTPUT, Pass, PassContext, RenderGraph, ResourceName, TextureSpec};
 pub use inflight::{DEFAULT_FRAMES_IN_FLIGHT, MAX_FRAMES_IN_FLIGHT};
+pub use plan::{FramePlanner, PlanInputs};
 pub use readback::{HEADLESS_FORMAT, HeadlessTarget};
 pub use renderer::Renderer;
 pub use snapshot::{

@@ -18,6 +18,7 @@ use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::pipelines::PipelineKey;
+use crate::plan::PlanInputs;
 use crate::resources::HDR_FORMAT;
 
 /// Most levels (iterations) of the chain.
@@ -401,5 +402,15 @@ impl Pass for BloomCompositePass {
         let levels = self.levels.clamp(1, MAX_BLOOM_LEVELS) as u32;
         let params = BloomParams { intensity: self.intensity, level_count: levels, ..BloomParams::new() };
         draw(ctx, Stage::Composite, params, &[BLOOM_LEVELS[0]], HDR)
+    }
+}
+
+/// Bright pass, blur chain and composite: needed when the camera has bloom and no debug view
+/// replaces the image.
+pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn Pass>>) {
+    if let Some(bloom) = p.view.camera.and_then(|c| c.bloom)
+        && p.shows_image()
+    {
+        out.extend(bloom.passes());
     }
 }

@@ -6,6 +6,7 @@ use super::CLUSTERS;
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName};
 use crate::pipelines::PipelineKey;
+use crate::plan::PlanInputs;
 
 /// The cluster build's pipelines: per workgroup size.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -151,6 +152,13 @@ impl Pass for ClusterBuildPass {
             }
         }
         Ok(())
+    }
+}
+
+/// Needed when the view shades with clusters, or shows a view of cluster data.
+pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
+    if p.view.needs_clusters(p.has_lights) {
+        out.push(Box::new(ClusterBuildPass { workgroup_size: p.settings().clusters.workgroup_size }));
     }
 }
 

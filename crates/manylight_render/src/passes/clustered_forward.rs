@@ -7,6 +7,7 @@ use super::{CLUSTERS, DEPTH, HDR};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::pipelines::PipelineKey;
+use crate::plan::PlanInputs;
 use crate::resources::{DEPTH_FORMAT, HDR_FORMAT};
 
 /// Clustered shading's pipeline: with or without a depth pre-pass before it.
@@ -98,5 +99,15 @@ impl Pass for ClusteredForwardPass {
         let extra = [&clusters.shading_bind_group];
         record_scene_pass(ctx, "clustered_forward", &[color], depth, !after, &pipeline.pipeline, &extra);
         Ok(())
+    }
+}
+
+/// Needed for Forward+ and clustered forward with lights.
+pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
+    if p.shades_with_clusters() && !p.shades_deferred() {
+        out.push(Box::new(ClusteredForwardPass {
+            clear_color: p.settings().clear_color,
+            after_prepass: p.runs_depth_prepass(),
+        }));
     }
 }

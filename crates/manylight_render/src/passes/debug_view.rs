@@ -12,6 +12,7 @@ use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{OUTPUT, Pass, PassContext, ResourceName};
 use crate::pipelines::PipelineKey;
+use crate::plan::PlanInputs;
 use crate::snapshot::DebugViewMode;
 
 /// The data a debug view reads.
@@ -158,5 +159,13 @@ impl Pass for DebugViewPass {
         let timestamps = ctx.render_timestamps(true, true);
         draw_fullscreen(ctx.encoder, "debug_view", output, timestamps, &pipeline.pipeline, &[&bind_group]);
         Ok(())
+    }
+}
+
+/// Needed when the view shows a debug view (it replaces the tone map).
+pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn Pass>>) {
+    let s = p.settings();
+    if !p.shows_image() {
+        out.push(Box::new(DebugViewPass { view: s.debug_view, heatmap_max: s.debug_heatmap_max }));
     }
 }

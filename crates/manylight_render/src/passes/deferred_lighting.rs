@@ -9,6 +9,7 @@ use super::{CLUSTERS, DEPTH, HDR};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::pipelines::PipelineKey;
+use crate::plan::PlanInputs;
 use crate::resources::HDR_FORMAT;
 use crate::snapshot::GBufferLayout;
 use manylight_core::codec::NormalCodec;
@@ -100,5 +101,14 @@ impl Pass for DeferredLightingPass {
         let groups = [&ctx.scene.view_bind_group, &gbuffer, &clusters.shading_bind_group];
         draw_fullscreen(ctx.encoder, "deferred_lighting", hdr, timestamps, &pipeline.pipeline, &groups);
         Ok(())
+    }
+}
+
+/// Needed for clustered deferred with lights.
+pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
+    let s = p.settings();
+    if p.shades_deferred() && s.pipeline == crate::snapshot::PipelineKind::ClusteredDeferred {
+        let (layout, codec, clear_color) = (s.gbuffer, s.normal_codec, s.clear_color);
+        out.push(Box::new(DeferredLightingPass { layout, codec, clear_color }));
     }
 }

@@ -6,6 +6,7 @@ use super::scene_draw::record_scene_pass;
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::pipelines::PipelineKey;
+use crate::plan::PlanInputs;
 use crate::resources::{DEPTH_FORMAT, SceneResources};
 
 /// The depth pre-pass's pipeline (there is one).
@@ -63,5 +64,13 @@ impl Pass for DepthPrepass {
         let depth = ctx.texture(DEPTH)?;
         record_scene_pass(ctx, "depth_prepass", &[], depth, true, &pipeline.pipeline, &[]);
         Ok(())
+    }
+}
+
+/// Needed before forward clustered shading that asks for it (Forward+ always), and for the
+/// depth debug view.
+pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
+    if p.runs_depth_prepass() || p.settings().debug_view == crate::snapshot::DebugViewMode::Depth {
+        out.push(Box::new(DepthPrepass));
     }
 }

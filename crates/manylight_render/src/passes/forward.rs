@@ -7,6 +7,7 @@ use super::{DEPTH, HDR};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::pipelines::PipelineKey;
+use crate::plan::PlanInputs;
 use crate::resources::{DEPTH_FORMAT, HDR_FORMAT, SceneResources};
 
 /// Naive forward's pipeline (there is one).
@@ -71,5 +72,13 @@ impl Pass for ForwardPass {
         let depth = ctx.texture(DEPTH)?;
         record_scene_pass(ctx, "forward", &[color], depth, true, &pipeline.pipeline, &[]);
         Ok(())
+    }
+}
+
+/// Needed for naive forward, and for every pipeline when there are no lights to assign (it
+/// draws the ambient), unless a debug view replaces the image.
+pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
+    if !p.shades_with_clusters() && !p.shades_deferred() && !p.replaces_shading() {
+        out.push(Box::new(ForwardPass { clear_color: p.settings().clear_color }));
     }
 }

@@ -8,6 +8,7 @@ use super::{DEPTH, DEPTH_USAGE};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::pipelines::PipelineKey;
+use crate::plan::PlanInputs;
 use crate::resources::{DEPTH_FORMAT, SceneResources};
 use crate::snapshot::GBufferLayout;
 use manylight_core::codec::NormalCodec;
@@ -94,6 +95,17 @@ impl Pass for GBufferPass {
             views.iter().map(|view| color_attachment(view, wgpu::Color::TRANSPARENT)).collect();
         record_scene_pass(ctx, "gbuffer", &attachments, depth, true, &pipeline.pipeline, &[]);
         Ok(())
+    }
+}
+
+/// Needed for the deferred pipelines with lights (the view's layout), and for the surface
+/// debug views (the Full layout) in every pipeline.
+pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
+    let s = p.settings();
+    if p.shows_surfaces() {
+        out.push(Box::new(GBufferPass { layout: GBufferLayout::Full, codec: s.normal_codec }));
+    } else if p.shades_deferred() {
+        out.push(Box::new(GBufferPass { layout: s.gbuffer, codec: s.normal_codec }));
     }
 }
 

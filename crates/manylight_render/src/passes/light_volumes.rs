@@ -11,6 +11,7 @@ use crate::bindings::Binding;
 use crate::context::{GpuContext, RenderError};
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::pipelines::PipelineKey;
+use crate::plan::PlanInputs;
 use crate::resources::{DEPTH_FORMAT, HDR_FORMAT};
 use crate::snapshot::GBufferLayout;
 use manylight_core::codec::NormalCodec;
@@ -286,5 +287,14 @@ impl Pass for LightVolumesPass {
             draw_fullscreen(ctx.encoder, "light_volumes_resolve", hdr, timestamps, resolve, &groups);
         }
         Ok(())
+    }
+}
+
+/// Needed for deferred light volumes with lights.
+pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
+    let s = p.settings();
+    if p.shades_deferred() && s.pipeline == crate::snapshot::PipelineKind::LightVolumes {
+        let (layout, codec, clear_color) = (s.gbuffer, s.normal_codec, s.clear_color);
+        out.push(Box::new(LightVolumesPass { layout, codec, clear_color, accumulation: p.accumulation }));
     }
 }

@@ -21,6 +21,7 @@ use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::pipelines::PipelineKey;
+use crate::plan::PlanInputs;
 use crate::resources::HDR_FORMAT;
 
 /// Graph resource: the blurred image before it is copied back into HDR.
@@ -184,5 +185,14 @@ impl Pass for MotionBlurPass {
         let last = ctx.render_timestamps(false, true);
         draw_fullscreen(ctx.encoder, "motion_blur_copy", hdr, last, &pipeline.copy, &[&copy_group]);
         Ok(())
+    }
+}
+
+/// Needed when the camera has motion blur and no debug view replaces the image.
+pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
+    if let Some(pass) = p.view.camera.and_then(|c| MotionBlurPass::for_camera(&c, p.view.size))
+        && p.shows_image()
+    {
+        out.push(Box::new(pass));
     }
 }

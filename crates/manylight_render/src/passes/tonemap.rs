@@ -6,6 +6,7 @@ use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{OUTPUT, Pass, PassContext, ResourceName};
 use crate::pipelines::PipelineKey;
+use crate::plan::PlanInputs;
 
 /// The tone map's pass name (the renderer reads the non-finite count after it ran).
 pub const TONEMAP: &str = "tonemap";
@@ -75,5 +76,12 @@ impl Pass for TonemapPass {
         let timestamps = ctx.render_timestamps(true, true);
         draw_fullscreen(ctx.encoder, "tonemap", output, timestamps, &pipeline.pipeline, &[&bind_group]);
         Ok(())
+    }
+}
+
+/// Needed unless a debug view replaces the image.
+pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn Pass>>) {
+    if p.shows_image() {
+        out.push(Box::new(TonemapPass));
     }
 }

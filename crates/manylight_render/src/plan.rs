@@ -1,0 +1,127 @@
+//! The frame plan: which passes a view runs, as a pure function of the view.
+//!
+//! Each pass module says, next to its code, when its pass is needed: a `plan` function that
+//! reads the view ([`PlanInputs`]) and adds its pass, or nothing. [`FramePlanner`] calls them in
+//! the order of [`STAGES`], and the graph then orders the passes by what they read and write.
+//! Adding a pass means its module (with its `plan` function), its WGSL file, and one line in
+//! [`STAGES`]; an app can also add a stage at run time with [`FramePlanner::insert_after`].
+
+use crate::graph::{Pass, RenderGraph};
+use crate::passes;
+use crate::snapshot::{DebugViewMode, FrameSettings, PipelineKind, RenderView};
+
+/// What a view's plan depends on.
+#[derive(Clone, Copy, Debug)]
+pub struct PlanInputs<'a> {
+    /// The view: camera, image size, settings.
+    pub view: &'a RenderView,
+    /// The frame has a valid light (`FrameSnapshot::has_lights`).
+    pub has_lights: bool,
+    /// Where light volumes sum their lights (`LightVolumesPass::accumulation_format` of the
+    /// device; `HDR_FORMAT` when planning without one).
+    pub accumulation: wgpu::TextureFormat,
+}
+
+impl PlanInputs<'_> {
+    /// The view's settings.
+    pub fn settings(&self) -> &FrameSettings {
+        &self.view.settings
+    }
+
+    /// True when a debug view that needs neither lighting nor clusters replaces the image:
+    /// albedo and normal draw the Full G-buffer, depth only the depth pre-pass.
+    pub fn replaces_shading(&self) -> bool {
+        self.shows_surfaces() || self.settings().debug_view == DebugViewMode::Depth
+    }
+
+    /// True when a debug view shows surface attributes (albedo, normal): the view draws the
+    /// Full G-buffer instead of shading, in every pipeline.
+    pub fn shows_surfaces(&self) -> bool {
+        self.settings().debug_view.uses_surfaces()
+    }
+
+    /// True when the view shades with cluster lists (a tiled/clustered pipeline with lights).
+    pub fn shades_with_clusters(&self) -> bool {
+        self.settings().pipeline.uses_clusters() && self.has_lights && !self.replaces_shading()
+    }
+
+    /// True when the view is shaded deferred: a G-buffer, then a full-screen lighting pass or
+    /// light volumes. Without lights the forward pass draws the ambient.
+    pub fn shades_deferred(&self) -> bool {
+        self.settings().pipeline.is_deferred() && self.has_lights && !self.replaces_shading()
+    }
+
+    /// True when the view runs a depth pre-pass before forward clustered shading.
+    pub fn runs_depth_prepass(&self) -> bool {
+        let s = self.settings();
+        self.shades_with_clusters()
+            && !self.shades_deferred()
+            && (s.pipeline == PipelineKind::ForwardPlus || s.clusters.depth_prepass)
+    }
+
+    /// True when no debug view replaces the image (post stages run).
+    pub fn shows_image(&self) -> bool {
+        self.settings().debug_view == DebugViewMode::None
+    }
+}
+
+/// One stage of the plan: adds the passes it is needed for, or none.
+pub type Planner = fn(&PlanInputs<'_>, &mut Vec<Box<dyn Pass>>);
+
+/// The stages, in order: each pass module's `plan` function.
+pub const STAGES: [(&str, Planner); 11] = [
+    ("depth_prepass", passes::depth_prepass::plan),
+    ("cluster_build", passes::cluster_build::plan),
+    ("forward", passes::forward::plan),
+    ("clustered_forward", passes::clustered_forward::plan),
+    ("gbuffer", passes::gbuffer::plan),
+    ("deferred_lighting", passes::deferred_lighting::plan),
+    ("light_volumes", passes::light_volumes::plan),
+    ("motion_blur", passes::motion_blur::plan),
+    ("bloom", passes::bloom::plan),
+    ("tonemap", passes::tonemap::plan),
+    ("debug_view", passes::debug_view::plan),
+];
+
+/// The stages a frame is planned with.
+#[derive(Clone, Debug)]
+pub struct FramePlanner {
+    stages: Vec<(&'static str, Planner)>,
+}
+
+impl Default for FramePlanner {
+    fn default() -> Self {
+        FramePlanner { stages: STAGES.to_vec() }
+    }
+}
+
+impl FramePlanner {
+    /// Adds stage `name` right after stage `after` (at the end when there is none of that
+    /// name).
+    pub fn insert_after(&mut self, after: &str, name: &'static str, planner: Planner) {
+        let at = self.stages.iter().position(|(n, _)| *n == after).map_or(self.stages.len(), |i| i + 1);
+        self.stages.insert(at, (name, planner));
+    }
+
+    /// Names of the stages, in order.
+    pub fn stage_names(&self) -> Vec<&'static str> {
+        self.stages.iter().map(|(n, _)| *n).collect()
+    }
+
+    /// The passes `inputs` call for, stage after stage.
+    pub fn passes(&self, inputs: &PlanInputs<'_>) -> Vec<Box<dyn Pass>> {
+        let mut out = Vec::new();
+        for (_, planner) in &self.stages {
+            planner(inputs, &mut out);
+        }
+        out
+    }
+
+    /// Fills `graph` with the passes `inputs` call for (it is cleared first).
+    pub fn plan_into(&self, inputs: &PlanInputs<'_>, graph: &mut RenderGraph) {
+        graph.clear();
+        for pass in self.passes(inputs) {
+            graph.add_boxed(pass);
+        }
+    }
+}
