@@ -269,89 +269,15 @@ pub struct Material(pub Arc<MaterialData>);
 #[derive(Component, Clone, Copy, Debug)]
 pub struct LightAnimation(pub manylight_scene::AnimatedLight);
 
-/// Bloom on the camera: light brighter than `threshold` spreads into its surroundings (bright
-/// pass, separable gaussian blur over `iterations`, added to the HDR image before tone mapping).
-/// A camera without it gets no bloom passes and no bloom textures.
-#[derive(Component, Clone, Copy, Debug, PartialEq)]
-pub struct Bloom {
-    /// HDR brightness (largest channel, before exposure) where bloom starts.
-    pub threshold: f32,
-    /// Width of the soft knee below the threshold (0 = hard cut).
-    pub knee: f32,
-    /// Weight of the blurred light added back.
-    pub intensity: f32,
-    /// Blur iterations (two passes each), 1 to 6.
-    pub iterations: u32,
-    /// Downsampled chain (default) or full-resolution separable 1×9/9×1 kernels.
-    pub chain: manylight_render::BloomChain,
-}
+/// Bloom on the camera (bright pass, blur, added before tone mapping): the render crate's
+/// [`BloomSettings`](manylight_render::BloomSettings) itself, a component (no mirror to keep in
+/// step). A camera without it gets no bloom passes and no bloom textures.
+pub type Bloom = manylight_render::BloomSettings;
 
-impl Default for Bloom {
-    fn default() -> Self {
-        Bloom::from(manylight_render::BloomSettings::default())
-    }
-}
-
-impl From<manylight_render::BloomSettings> for Bloom {
-    fn from(s: manylight_render::BloomSettings) -> Self {
-        Bloom {
-            threshold: s.threshold,
-            knee: s.knee,
-            intensity: s.intensity,
-            iterations: s.iterations,
-            chain: s.chain,
-        }
-    }
-}
-
-impl Bloom {
-    /// Full-resolution separable blur: 1×9 / 9×1 kernels × 5 iterations at the viewport's size.
-    pub fn full_resolution() -> Bloom {
-        Bloom::from(manylight_render::BloomSettings::full_resolution())
-    }
-
-    /// The render side's copy.
-    pub fn settings(&self) -> manylight_render::BloomSettings {
-        manylight_render::BloomSettings {
-            threshold: self.threshold,
-            knee: self.knee,
-            intensity: self.intensity,
-            iterations: self.iterations,
-            chain: self.chain,
-        }
-    }
-}
-
-/// Camera-motion blur on the camera: each pixel is blurred along its screen motion since the
-/// previous frame (reprojected from depth). A still camera leaves the image unchanged. A camera
+/// Camera-motion blur on the camera: the render crate's
+/// [`MotionBlurSettings`](manylight_render::MotionBlurSettings) itself, a component. A camera
 /// without it gets no motion-blur pass.
-#[derive(Component, Clone, Copy, Debug, PartialEq)]
-pub struct MotionBlur {
-    /// Taps along the motion (2 to 64).
-    pub samples: u32,
-    /// Fraction of the frame-to-frame motion blurred (1 = shutter open the whole frame).
-    pub strength: f32,
-    /// Longest blur in pixels.
-    pub max_pixels: f32,
-}
-
-impl Default for MotionBlur {
-    fn default() -> Self {
-        let s = manylight_render::MotionBlurSettings::default();
-        MotionBlur { samples: s.samples, strength: s.strength, max_pixels: s.max_pixels }
-    }
-}
-
-impl MotionBlur {
-    /// The render side's copy.
-    pub fn settings(&self) -> manylight_render::MotionBlurSettings {
-        manylight_render::MotionBlurSettings {
-            samples: self.samples,
-            strength: self.strength,
-            max_pixels: self.max_pixels,
-        }
-    }
-}
+pub type MotionBlur = manylight_render::MotionBlurSettings;
 
 #[cfg(test)]
 mod tests {

@@ -53,8 +53,12 @@ impl BloomChain {
     }
 }
 
-/// Bloom parameters (the render side's copy of the camera's `Bloom` component).
+/// Bloom on a camera: light brighter than `threshold` spreads into its surroundings (bright
+/// pass, blur over `iterations`, added to the HDR image before tone mapping). With the `bevy`
+/// feature it is a component: the app's `Bloom` is this type, so a new setting is added here
+/// only. A camera without it gets no bloom passes and no bloom textures.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_ecs::component::Component))]
 pub struct BloomSettings {
     /// HDR brightness (largest channel, before exposure) where bloom starts.
     pub threshold: f32,

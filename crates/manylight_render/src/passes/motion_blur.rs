@@ -27,8 +27,12 @@ use crate::resources::HDR_FORMAT;
 /// Graph resource: the blurred image before it is copied back into HDR.
 pub const MOTION_BLUR: ResourceName = "motion_blur";
 
-/// Motion-blur parameters (the render side's copy of the camera's `MotionBlur` component).
+/// Camera-motion blur on a camera: each pixel is blurred along its screen motion since the
+/// previous frame (reprojected from depth); a still camera leaves the image unchanged. With the
+/// `bevy` feature it is a component: the app's `MotionBlur` is this type. A camera without it
+/// gets no motion-blur pass.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_ecs::component::Component))]
 pub struct MotionBlurSettings {
     /// Taps along the velocity (2 to 64).
     pub samples: u32,
