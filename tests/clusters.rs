@@ -34,12 +34,15 @@ fn light(position: Vec3, radius: f32) -> ExtractedPointLight {
 
 fn clustered(cull: CullTest, slicing: ZSlicing, cap: Option<u32>) -> FrameSettings {
     FrameSettings {
-        pipeline: PipelineKind::ClusteredForward,
-        clusters: ClusterSettings {
-            grid: GridConfig { slicing, ..GridConfig::default() },
-            cull,
-            cap,
-            ..ClusterSettings::default()
+        render: RenderSettings {
+            pipeline: PipelineKind::ClusteredForward,
+            clusters: ClusterSettings {
+                grid: GridConfig { slicing, ..GridConfig::default() },
+                cull,
+                cap,
+                ..ClusterSettings::default()
+            },
+            ..Default::default()
         },
         ..FrameSettings::default()
     }

@@ -139,9 +139,12 @@ fn count_views_show_the_cpu_reference_of_each_pixels_cluster() {
         (DebugViewMode::Overflow, None),
     ] {
         let settings = FrameSettings {
-            pipeline: PipelineKind::ClusteredForward,
+            render: RenderSettings {
+                pipeline: PipelineKind::ClusteredForward,
+                clusters: ClusterSettings { cap, ..ClusterSettings::default() },
+                ..Default::default()
+            },
             debug_view: mode,
-            clusters: ClusterSettings { cap, ..ClusterSettings::default() },
             ..FrameSettings::default()
         };
         let heatmap_max = settings.debug_heatmap_max.max(1);
@@ -222,7 +225,7 @@ fn the_depth_view_scales_to_the_far_plane_or_to_the_lights_reach() {
         let projection = manylight::core::Projection { far, ..camera.projection };
         scene.cameras = vec![manylight::scene::SceneCamera { projection, ..camera }];
         let settings = FrameSettings {
-            pipeline: PipelineKind::ClusteredForward,
+            render: RenderSettings { pipeline: PipelineKind::ClusteredForward, ..Default::default() },
             debug_view: DebugViewMode::Depth,
             ..FrameSettings::default()
         };

@@ -212,7 +212,10 @@ fn light_volumes_plan_only_what_they_need() {
     use manylight::app::scene::scene_snapshot;
     use manylight::render::{ExtractedPointLight, FrameSettings};
     let light = ExtractedPointLight { position: Vec3::ZERO, color: Vec3::ONE, intensity: 1.0, radius: 2.0 };
-    let settings = FrameSettings { pipeline: PipelineKind::LightVolumes, ..FrameSettings::default() };
+    let settings = FrameSettings {
+        render: RenderSettings { pipeline: PipelineKind::LightVolumes, ..Default::default() },
+        ..FrameSettings::default()
+    };
     let lit = scene_snapshot(&default_scene(), vec![light], UVec2::new(64, 36), settings, 0);
     assert_eq!(plan_passes(lit).expect("plan"), ["gbuffer", "light_volumes", "tonemap"]);
     let unlit = scene_snapshot(&default_scene(), Vec::new(), UVec2::new(64, 36), settings, 0);

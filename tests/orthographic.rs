@@ -98,12 +98,15 @@ fn orthographic_gpu_lists_equal_the_cpu_reference() {
     for cull in [CullTest::Aabb, CullTest::Planes, CullTest::Both] {
         for pipeline in [PipelineKind::ClusteredForward, PipelineKind::ForwardPlus] {
             let settings = FrameSettings {
-                pipeline,
-                clusters: ClusterSettings {
-                    // Exponential is asked for; an orthographic grid slices linearly anyway.
-                    grid: GridConfig { slicing: ZSlicing::Exponential, ..GridConfig::default() },
-                    cull,
-                    ..ClusterSettings::default()
+                render: RenderSettings {
+                    pipeline,
+                    clusters: ClusterSettings {
+                        // Exponential is asked for; an orthographic grid slices linearly anyway.
+                        grid: GridConfig { slicing: ZSlicing::Exponential, ..GridConfig::default() },
+                        cull,
+                        ..ClusterSettings::default()
+                    },
+                    ..Default::default()
                 },
                 ..FrameSettings::default()
             };

@@ -93,7 +93,7 @@ fn snapshot(p: Point) -> manylight::render::FrameSnapshot {
     };
     assert!(!p.lights || !lights.is_empty(), "the default scene brings lights");
     let settings = FrameSettings {
-        pipeline: pipeline(p),
+        render: RenderSettings { pipeline: pipeline(p), ..Default::default() },
         debug_view: if p.debug { DEBUG_MODE } else { DebugViewMode::None },
         ..FrameSettings::default()
     };

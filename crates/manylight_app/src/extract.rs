@@ -135,7 +135,7 @@ pub fn build_snapshot(
         views,
         instances,
         lights,
-        settings: settings.frame_settings(debug),
+        settings: crate::resources::frame_settings(settings, debug),
     };
     state.frame_index += 1;
     snapshot

@@ -2,66 +2,14 @@
 
 use bevy_ecs::prelude::*;
 use glam::UVec2;
-use manylight_core::ShadingModel;
-use manylight_core::codec::NormalCodec;
-use manylight_render::{
-    ClusterSettings, DebugViewMode, FrameReport, FrameSettings, GBufferLayout, PipelineKind,
-};
+use manylight_render::{DebugViewMode, FrameReport, FrameSettings};
 
-/// How frames are rendered; changes apply from the next frame.
-#[derive(Resource, Clone, Copy, Debug, PartialEq)]
-pub struct RenderSettings {
-    /// The many-light pipeline.
-    pub pipeline: PipelineKind,
-    /// Shading model for materials that do not choose one.
-    pub shading: ShadingModel,
-    /// Multiplier before tone mapping.
-    pub exposure: f32,
-    /// Constant ambient term (fraction of albedo).
-    pub ambient: f32,
-    /// Linear colour behind everything.
-    pub clear_color: [f32; 3],
-    /// Cluster grid, culling test, optional cap and depth pre-pass of the tiled and clustered
-    /// pipelines.
-    pub clusters: ClusterSettings,
-    /// G-buffer layout of the deferred pipelines.
-    pub gbuffer: GBufferLayout,
-    /// Normal encoding of the `Packed` and `Compact` G-buffer layouts.
-    pub normal_codec: NormalCodec,
-}
+pub use manylight_render::RenderSettings;
 
-impl Default for RenderSettings {
-    fn default() -> Self {
-        let f = FrameSettings::default();
-        Self {
-            pipeline: f.pipeline,
-            shading: f.shading,
-            exposure: f.exposure,
-            ambient: f.ambient,
-            clear_color: f.clear_color,
-            clusters: f.clusters,
-            gbuffer: f.gbuffer,
-            normal_codec: f.normal_codec,
-        }
-    }
-}
-
-impl RenderSettings {
-    /// The render side's copy, with the debug view of `debug`.
-    pub fn frame_settings(&self, debug: &DebugView) -> FrameSettings {
-        FrameSettings {
-            pipeline: self.pipeline,
-            shading: self.shading,
-            exposure: self.exposure,
-            ambient: self.ambient,
-            clear_color: self.clear_color,
-            clusters: self.clusters,
-            debug_view: debug.mode,
-            debug_heatmap_max: debug.heatmap_max,
-            gbuffer: self.gbuffer,
-            normal_codec: self.normal_codec,
-        }
-    }
+/// What views are rendered with: `settings` and the debug view of `debug` (a camera's
+/// `CameraDebugView` replaces it for that camera).
+pub fn frame_settings(settings: &RenderSettings, debug: &DebugView) -> FrameSettings {
+    FrameSettings { render: *settings, debug_view: debug.mode, debug_heatmap_max: debug.heatmap_max }
 }
 
 /// The debug view shown instead of the tone-mapped image; systems may change it at run time

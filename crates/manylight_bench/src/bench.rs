@@ -6,7 +6,7 @@ use crate::progress::Progress;
 use anyhow::{Context, Result};
 use glam::UVec2;
 use manylight_app::render_world::HeadlessRenderer;
-use manylight_render::{FrameReport, FrameSettings, GBufferLayout, PipelineKind};
+use manylight_render::{FrameReport, FrameSettings, GBufferLayout, PipelineKind, RenderSettings};
 use manylight_scene::{Scene, light_rig};
 use std::fmt::Write as _;
 use std::time::Instant;
@@ -86,8 +86,14 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
         };
         progress.set_message(label.clone());
         let rig = light_rig(lights, scene.bounds(), 1);
-        let settings =
-            FrameSettings { pipeline, gbuffer: gbuffer.unwrap_or(sweep.settings.gbuffer), ..sweep.settings };
+        let settings = FrameSettings {
+            render: RenderSettings {
+                pipeline,
+                gbuffer: gbuffer.unwrap_or(sweep.settings.gbuffer),
+                ..sweep.settings.render
+            },
+            ..sweep.settings
+        };
         let mut frame_ms = Vec::new();
         let mut last = None;
         for f in 0..sweep.warmup + sweep.frames {

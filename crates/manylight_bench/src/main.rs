@@ -404,11 +404,14 @@ fn render(args: RenderArgs) -> Result<()> {
         let rig = manylight_scene::light_rig(lights, scene.bounds(), args.seed);
         let t = args.frames.max(1).saturating_sub(1) as f32 / 60.0;
         let settings = manylight_render::FrameSettings {
-            pipeline: args.pipeline,
-            shading: args.shading,
-            clusters: args.clusters.settings(),
-            gbuffer: args.clusters.gbuffer,
-            normal_codec: args.clusters.normal_codec,
+            render: manylight_render::RenderSettings {
+                pipeline: args.pipeline,
+                shading: args.shading,
+                clusters: args.clusters.settings(),
+                gbuffer: args.clusters.gbuffer,
+                normal_codec: args.clusters.normal_codec,
+                ..Default::default()
+            },
             ..Default::default()
         };
         let snap = direct::snapshot(&scene, &rig, t, args.size, settings, 0);
@@ -527,7 +530,10 @@ fn write_plots(dir: &std::path::Path, name: &str, csv: &str) -> Result<()> {
 
 fn report_cmd(args: ReportArgs) -> Result<()> {
     let scene = load_scene(&args.scene, &LoadOptions::default())?;
-    let base = manylight_render::FrameSettings { clusters: args.clusters.settings(), ..Default::default() };
+    let base = manylight_render::FrameSettings {
+        render: manylight_render::RenderSettings { clusters: args.clusters.settings(), ..Default::default() },
+        ..Default::default()
+    };
     let name = scene_name(&args.scene);
     let report = report::run(&scene, &name, args.lights, args.size, args.frames.max(1), base)?;
     print!("{}", report.markdown);
@@ -539,7 +545,10 @@ fn report_cmd(args: ReportArgs) -> Result<()> {
 
 fn post_cmd(args: ReportArgs) -> Result<()> {
     let scene = load_scene(&args.scene, &LoadOptions::default())?;
-    let base = manylight_render::FrameSettings { clusters: args.clusters.settings(), ..Default::default() };
+    let base = manylight_render::FrameSettings {
+        render: manylight_render::RenderSettings { clusters: args.clusters.settings(), ..Default::default() },
+        ..Default::default()
+    };
     let name = scene_name(&args.scene);
     let report = post::run(&scene, &name, args.lights, args.size, args.frames.max(1), base)?;
     print!("{}", report.markdown);
@@ -551,7 +560,10 @@ fn post_cmd(args: ReportArgs) -> Result<()> {
 
 fn views_cmd(args: ViewsArgs) -> Result<()> {
     let scene = load_scene(&args.scene, &LoadOptions::default())?;
-    let base = manylight_render::FrameSettings { clusters: args.clusters.settings(), ..Default::default() };
+    let base = manylight_render::FrameSettings {
+        render: manylight_render::RenderSettings { clusters: args.clusters.settings(), ..Default::default() },
+        ..Default::default()
+    };
     let name = scene_name(&args.scene);
     print!("{}", views::run(&scene, &name, args.lights, args.size, args.frames.max(1), base)?);
     Ok(())
@@ -586,9 +598,12 @@ fn bench_cmd(args: BenchArgs) -> Result<()> {
         culling_efficiency: args.culling_efficiency,
         gbuffers: args.gbuffers,
         settings: manylight_render::FrameSettings {
-            clusters: args.clusters.settings(),
-            gbuffer: args.clusters.gbuffer,
-            normal_codec: args.clusters.normal_codec,
+            render: manylight_render::RenderSettings {
+                clusters: args.clusters.settings(),
+                gbuffer: args.clusters.gbuffer,
+                normal_codec: args.clusters.normal_codec,
+                ..Default::default()
+            },
             ..Default::default()
         },
     };

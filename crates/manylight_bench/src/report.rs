@@ -11,7 +11,9 @@ use manylight_app::render_world::HeadlessRenderer;
 use manylight_core::cluster::CullTest;
 use manylight_core::codec::NormalCodec;
 use manylight_core::image_metrics::flip_compare;
-use manylight_render::{ClusterSettings, FrameReport, FrameSettings, GBufferLayout, PipelineKind};
+use manylight_render::{
+    ClusterSettings, FrameReport, FrameSettings, GBufferLayout, PipelineKind, RenderSettings,
+};
 use manylight_scene::{Scene, light_rig};
 use std::fmt::Write as _;
 use std::time::Instant;
@@ -48,17 +50,32 @@ fn measure(
 /// pipelines, each culling test, a cluster cap, and both deferred pipelines with every G-buffer
 /// layout and (for `Packed` and `Compact`) every normal codec the layout can store.
 fn configurations(base: FrameSettings) -> Vec<(String, FrameSettings)> {
-    let mut configs =
-        vec![("forward-plus".to_string(), FrameSettings { pipeline: PipelineKind::ForwardPlus, ..base })];
+    let mut configs = vec![(
+        "forward-plus".to_string(),
+        FrameSettings {
+            render: RenderSettings { pipeline: PipelineKind::ForwardPlus, ..base.render },
+            ..base
+        },
+    )];
     for cull in [CullTest::Both, CullTest::Aabb, CullTest::Planes] {
         let clusters = ClusterSettings { cull, ..base.clusters };
-        let settings = FrameSettings { pipeline: PipelineKind::ClusteredForward, clusters, ..base };
+        let settings = FrameSettings {
+            render: RenderSettings { pipeline: PipelineKind::ClusteredForward, clusters, ..base.render },
+            ..base
+        };
         configs.push((format!("clustered-forward, cull {}", cull.name()), settings));
     }
     let capped = ClusterSettings { cap: Some(8), ..base.clusters };
     configs.push((
         "clustered-forward, cap 8 lights/cluster".into(),
-        FrameSettings { pipeline: PipelineKind::ClusteredForward, clusters: capped, ..base },
+        FrameSettings {
+            render: RenderSettings {
+                pipeline: PipelineKind::ClusteredForward,
+                clusters: capped,
+                ..base.render
+            },
+            ..base
+        },
     ));
     for pipeline in [PipelineKind::ClusteredDeferred, PipelineKind::LightVolumes] {
         for gbuffer in GBufferLayout::ALL {
@@ -80,7 +97,13 @@ fn configurations(base: FrameSettings) -> Vec<(String, FrameSettings)> {
                 } else {
                     format!("{}, {} G-buffer", pipeline.name(), gbuffer.name())
                 };
-                configs.push((name, FrameSettings { pipeline, gbuffer, normal_codec, ..base }));
+                configs.push((
+                    name,
+                    FrameSettings {
+                        render: RenderSettings { pipeline, gbuffer, normal_codec, ..base.render },
+                        ..base
+                    },
+                ));
             }
         }
     }
@@ -120,7 +143,10 @@ pub fn run(
     let configs = configurations(base);
     let mut progress = Progress::new(configs.len() as u64 + 1, "configurations");
     progress.set_message("naive forward (reference)");
-    let naive = FrameSettings { pipeline: PipelineKind::NaiveForward, ..base };
+    let naive = FrameSettings {
+        render: RenderSettings { pipeline: PipelineKind::NaiveForward, ..base.render },
+        ..base
+    };
     let (naive_ms, naive_report, reference) = measure(&mut renderer, scene, lights, size, naive, frames)?;
     progress.step(|| format!("naive forward (reference): {naive_ms:.0} ms"));
     let mut rows = vec![ReportRow {

@@ -30,6 +30,6 @@ pub use renderer::Renderer;
 pub use snapshot::{
     BloomChain, BloomSettings, ClusterSettings, DebugViewMode, ExtractedCamera, ExtractedInstance,
     ExtractedPointLight, ExtractedView, FrameSettings, FrameSnapshot, GBufferLayout, MotionBlurSettings,
-    PipelineKind, RenderTextureId, RenderView, ViewRect, ViewTarget,
+    PipelineKind, RenderSettings, RenderTextureId, RenderView, ViewRect, ViewTarget,
 };
 pub use stats::{FrameReport, PassTiming, ViewReport};

@@ -254,10 +254,13 @@ impl ClusterSettings {
     }
 }
 
-/// Settings the render side needs, copied from the app's `RenderSettings` each frame.
+/// How frames are rendered. With the `bevy` feature it is a resource: the app's
+/// `RenderSettings` is this type, so a new setting is added here only. Changes apply from the
+/// next frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct FrameSettings {
-    /// The pipeline to use.
+#[cfg_attr(feature = "bevy", derive(bevy_ecs::prelude::Resource))]
+pub struct RenderSettings {
+    /// The many-light pipeline.
     pub pipeline: PipelineKind,
     /// The shading model for materials that do not choose one.
     pub shading: ShadingModel,
@@ -267,19 +270,16 @@ pub struct FrameSettings {
     pub ambient: f32,
     /// Colour the HDR target is cleared to (linear RGB).
     pub clear_color: [f32; 3],
-    /// Light assignment of the tiled and clustered pipelines.
+    /// Cluster grid, culling test, optional cap and depth pre-pass of the tiled and clustered
+    /// pipelines.
     pub clusters: ClusterSettings,
-    /// Debug view (replaces tone mapping when not `None`).
-    pub debug_view: DebugViewMode,
-    /// Light count shown as the hottest colour of the light-count heatmap.
-    pub debug_heatmap_max: u32,
     /// G-buffer layout of the deferred pipelines.
     pub gbuffer: GBufferLayout,
     /// Normal encoding of the `Packed` and `Compact` G-buffer layouts.
     pub normal_codec: NormalCodec,
 }
 
-impl Default for FrameSettings {
+impl Default for RenderSettings {
     fn default() -> Self {
         Self {
             pipeline: PipelineKind::ClusteredForward,
@@ -288,11 +288,48 @@ impl Default for FrameSettings {
             ambient: 0.03,
             clear_color: [0.005, 0.006, 0.01],
             clusters: ClusterSettings::default(),
-            debug_view: DebugViewMode::None,
-            debug_heatmap_max: 32,
             gbuffer: GBufferLayout::Full,
             normal_codec: NormalCodec::Octa16,
         }
+    }
+}
+
+/// What a view is rendered with: the [`RenderSettings`] and the debug view (the app's
+/// `DebugView` resource, or a camera's `CameraDebugView`). Reads of the render settings go
+/// through `Deref` (`settings.pipeline`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameSettings {
+    /// The render settings.
+    pub render: RenderSettings,
+    /// Debug view (replaces tone mapping when not `None`).
+    pub debug_view: DebugViewMode,
+    /// Light count shown as the hottest colour of the light-count heatmap.
+    pub debug_heatmap_max: u32,
+}
+
+impl Default for FrameSettings {
+    fn default() -> Self {
+        FrameSettings::from(RenderSettings::default())
+    }
+}
+
+impl From<RenderSettings> for FrameSettings {
+    /// `render` without a debug view.
+    fn from(render: RenderSettings) -> Self {
+        FrameSettings { render, debug_view: DebugViewMode::None, debug_heatmap_max: 32 }
+    }
+}
+
+impl std::ops::Deref for FrameSettings {
+    type Target = RenderSettings;
+    fn deref(&self) -> &RenderSettings {
+        &self.render
+    }
+}
+
+impl std::ops::DerefMut for FrameSettings {
+    fn deref_mut(&mut self) -> &mut RenderSettings {
+        &mut self.render
     }
 }
 
