@@ -376,3 +376,25 @@ fn a_pass_added_by_one_registration_line_runs_in_its_place() {
     let (report, _) = renderer.render(debug, false).expect("renders");
     assert!(!report.pass_names().contains(&"red_tint"), "{:?}", report.pass_names());
 }
+
+#[test]
+fn the_graph_is_compiled_when_the_plan_changes_not_every_frame() {
+    let _gpu = gpu();
+    let mut renderer = manylight::app::render_world::HeadlessRenderer::new().expect("adapter");
+    let compilations = |r: &manylight::app::render_world::HeadlessRenderer| {
+        r.render_world.world.resource::<manylight::app::render_world::FrameGraph>().0.compilations()
+    };
+    let plain = Point { lights: true, bloom: false, motion_blur: false, deferred: false, debug: false };
+    let bloom = Point { bloom: true, ..plain };
+    renderer.render(snapshot(plain), false).expect("renders");
+    let first = compilations(&renderer);
+    for _ in 0..3 {
+        renderer.render(snapshot(plain), false).expect("renders");
+    }
+    assert_eq!(compilations(&renderer), first, "an unchanged plan is not compiled again");
+    renderer.render(snapshot(bloom), false).expect("renders");
+    assert_eq!(compilations(&renderer), first + 1, "bloom changes the plan");
+    renderer.render(snapshot(plain), false).expect("renders");
+    renderer.render(snapshot(bloom), false).expect("renders");
+    assert_eq!(compilations(&renderer), first + 1, "both plans are kept");
+}

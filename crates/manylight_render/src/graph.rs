@@ -145,10 +145,19 @@ impl<'a> PassContext<'a> {
     }
 }
 
-/// The passes of one frame.
+/// What the order of a graph depends on: each pass's name, reads and writes.
+type Signature = Vec<(&'static str, Vec<ResourceName>, Vec<ResourceName>)>;
+
+/// Compiled orders kept (one per distinct plan seen lately; the oldest is dropped).
+const KEPT_ORDERS: usize = 16;
+
+/// The passes of one frame. The graph is refilled for every view, but compiled only when the
+/// plan changes: the order of each distinct plan (its passes' names, reads and writes) is kept.
 #[derive(Default)]
 pub struct RenderGraph {
     passes: Vec<Box<dyn Pass>>,
+    orders: std::sync::Mutex<Vec<(Signature, Vec<usize>)>>,
+    compilations: std::sync::atomic::AtomicU64,
 }
 
 impl RenderGraph {
@@ -167,9 +176,15 @@ impl RenderGraph {
         self.passes.push(pass);
     }
 
-    /// Removes every pass (the graph is rebuilt each frame).
+    /// Removes every pass (the graph is refilled for each view; compiled orders are kept).
     pub fn clear(&mut self) {
         self.passes.clear();
+    }
+
+    /// Times a plan was compiled (ordered from scratch) since the graph was created: it grows
+    /// only when a view's plan changes.
+    pub fn compilations(&self) -> u64 {
+        self.compilations.load(std::sync::atomic::Ordering::Relaxed)
     }
 
     /// Names of the passes as added (before culling).
@@ -187,8 +202,25 @@ impl RenderGraph {
         self.passes[index].as_ref()
     }
 
-    /// Indices of the passes that contribute to [`OUTPUT`], in execution order.
+    /// Indices of the passes that contribute to [`OUTPUT`], in execution order: the kept
+    /// order when this plan was compiled before.
     pub fn compile(&self) -> Result<Vec<usize>, RenderError> {
+        let signature: Signature = self.passes.iter().map(|p| (p.name(), p.reads(), p.writes())).collect();
+        let mut orders = self.orders.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, order)) = orders.iter().find(|(s, _)| *s == signature) {
+            return Ok(order.clone());
+        }
+        let order = self.order()?;
+        self.compilations.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        if orders.len() >= KEPT_ORDERS {
+            orders.remove(0);
+        }
+        orders.push((signature, order.clone()));
+        Ok(order)
+    }
+
+    /// Orders the passes from scratch (see [`RenderGraph::compile`]).
+    fn order(&self) -> Result<Vec<usize>, RenderError> {
         let n = self.passes.len();
         let reads: Vec<Vec<ResourceName>> = self.passes.iter().map(|p| p.reads()).collect();
         let writes: Vec<Vec<ResourceName>> = self.passes.iter().map(|p| p.writes()).collect();
@@ -274,6 +306,29 @@ mod tests {
         let mut g = RenderGraph::new();
         g.add(Fake("tonemap", vec!["hdr"], vec![OUTPUT]));
         assert!(matches!(g.compile(), Err(RenderError::Graph(_))));
+    }
+
+    #[test]
+    fn a_plan_is_compiled_once_until_it_changes() {
+        let mut g = RenderGraph::new();
+        let fill = |g: &mut RenderGraph, bloom: bool| {
+            g.clear();
+            g.add(Fake("forward", vec![], vec!["hdr"]));
+            if bloom {
+                g.add(Fake("bloom", vec!["hdr"], vec!["hdr"]));
+            }
+            g.add(Fake("tonemap", vec!["hdr"], vec![OUTPUT]));
+        };
+        fill(&mut g, false);
+        assert_eq!(g.pass_names().unwrap(), vec!["forward", "tonemap"]);
+        fill(&mut g, false);
+        assert_eq!(g.pass_names().unwrap(), vec!["forward", "tonemap"]);
+        assert_eq!(g.compilations(), 1);
+        fill(&mut g, true);
+        assert_eq!(g.pass_names().unwrap(), vec!["forward", "bloom", "tonemap"]);
+        fill(&mut g, false);
+        g.compile().unwrap();
+        assert_eq!(g.compilations(), 2, "both plans are kept");
     }
 
     #[test]
