@@ -140,25 +140,8 @@ fn headless_frames_in_flight_never_wait_or_allocate() {
 
 #[test]
 fn window_frames_in_flight_never_wait_or_allocate() {
-    let ci = std::env::var("CI").is_ok_and(|v| v == "true" || v == "1");
-    let _xvfb = if manylight::app::window::xvfb::has_display() {
-        None
-    } else {
-        match manylight::app::window::xvfb::Xvfb::start() {
-            Ok(x) => {
-                // SAFETY: set before the event loop and the renderer start; the other test of
-                // this binary reads no environment variable.
-                unsafe { std::env::set_var("DISPLAY", format!(":{}", x.display)) };
-                Some(x)
-            }
-            Err(e) if ci => panic!("CI=true but no display and {e}: install Xvfb (package xvfb)"),
-            Err(e) => {
-                eprintln!(
-                    "\n\n*** SKIPPING the window test: no DISPLAY and {e}. Install Xvfb to run it. ***\n"
-                );
-                return;
-            }
-        }
+    let Some(_xvfb) = support::window_display() else {
+        return;
     };
     let _gpu = support::gpu();
     let seen = Arc::new(Mutex::new(Seen::default()));

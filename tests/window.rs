@@ -13,6 +13,8 @@
 //! Without a display and without `Xvfb` the test says so loudly and passes, unless `CI=true`,
 //! where it fails.
 
+mod support;
+
 use manylight::app::backend::RenderBackend;
 use manylight::app::render_world::DeviceLoss;
 use manylight::app::window::{WindowConfig, WindowRequests};
@@ -373,26 +375,8 @@ fn thread_names() -> Vec<String> {
 
 #[test]
 fn window_resize_minimise_close() {
-    let ci = std::env::var("CI").is_ok_and(|v| v == "true" || v == "1");
-    let has_display = manylight::app::window::xvfb::has_display();
-    let _xvfb = if has_display {
-        None
-    } else {
-        match manylight::app::window::xvfb::Xvfb::start() {
-            Ok(x) => {
-                // SAFETY: set before any other thread of this test binary reads the environment
-                // (the event loop and the renderer start below); this file has one test.
-                unsafe { std::env::set_var("DISPLAY", format!(":{}", x.display)) };
-                Some(x)
-            }
-            Err(e) if ci => panic!("CI=true but no display and {e}: install Xvfb (package xvfb)"),
-            Err(e) => {
-                eprintln!(
-                    "\n\n*** SKIPPING the window test: no DISPLAY and {e}. Install Xvfb to run it. ***\n"
-                );
-                return;
-            }
-        }
+    let Some(_xvfb) = support::window_display() else {
+        return;
     };
     // Stops a hung event loop from hanging the test run (the Xvfb child dies with the guard
     // only on a normal exit, so kill it here too).

@@ -161,3 +161,29 @@ pub fn assert_finite(frame: &manylight::app::headless::HeadlessFrame) {
         report.pipeline
     );
 }
+
+/// A display for a window test: the one set, or a new Xvfb server (kept alive by the returned
+/// guard, and named in `DISPLAY`). `None` when there is neither: the caller skips, loudly,
+/// except under `CI=true`, where this panics.
+///
+/// Call it before anything starts a thread that reads the environment (the event loop, the
+/// renderer): it sets `DISPLAY`.
+pub fn window_display() -> Option<Option<manylight::app::window::xvfb::Xvfb>> {
+    let ci = std::env::var("CI").is_ok_and(|v| v == "true" || v == "1");
+    if manylight::app::window::xvfb::has_display() {
+        return Some(None);
+    }
+    match manylight::app::window::xvfb::Xvfb::start() {
+        Ok(x) => {
+            // SAFETY: the caller runs this before any other thread of its test binary reads the
+            // environment (window tests have one test per binary that opens a window).
+            unsafe { std::env::set_var("DISPLAY", format!(":{}", x.display)) };
+            Some(Some(x))
+        }
+        Err(e) if ci => panic!("CI=true but no display and {e}: install Xvfb (package xvfb)"),
+        Err(e) => {
+            eprintln!("\n\n*** SKIPPING the window test: no DISPLAY and {e}. Install Xvfb to run it. ***\n");
+            None
+        }
+    }
+}
