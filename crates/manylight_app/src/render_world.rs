@@ -582,7 +582,7 @@ fn add_graph_systems(schedule: &mut Schedule) {
     schedule.add_systems(plan_graph.in_set(RenderSet::Graph));
 }
 
-/// The stages a view is planned with (the render crate's [`manylight_render::plan::STAGES`],
+/// The stages a view is planned with (the render crate's [`manylight_render::planner::STAGES`],
 /// plus any an app inserted: [`RenderWorld::planner_mut`]).
 #[derive(Resource, Default, Clone, Debug)]
 pub struct Planner(pub FramePlanner);

@@ -10,7 +10,7 @@ use crate::gpu_types::{
     CLUSTER_NO_CAP, CULL_AABB, CULL_BOTH, CULL_PLANES, GpuClusterBounds, GpuClusterCounters,
     GpuClusterParams, TILE_LIGHT_CHUNK,
 };
-use crate::passes::common::{storage_entry, uniform_entry};
+use crate::layouts::{storage_entry, uniform_entry};
 use crate::pool::GrowableBuffer;
 use crate::readback::read_buffer;
 use crate::snapshot::RenderView;

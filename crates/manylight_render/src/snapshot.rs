@@ -7,8 +7,7 @@ use manylight_core::codec::NormalCodec;
 use manylight_core::{MaterialData, MeshData, Projection, ShadingModel};
 use std::sync::Arc;
 
-pub use crate::passes::bloom::{BloomChain, BloomSettings};
-pub use crate::passes::motion_blur::MotionBlurSettings;
+pub use crate::settings::{BloomChain, BloomSettings, MotionBlurSettings};
 
 /// Which many-light pipeline renders the frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]

@@ -20,9 +20,7 @@ use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 use crate::resources::HDR_FORMAT;
-
-/// Most levels (iterations) of the chain.
-pub const MAX_BLOOM_LEVELS: usize = 6;
+pub use crate::settings::{BloomChain, BloomSettings, MAX_BLOOM_LEVELS};
 
 /// Graph resources: the blurred levels of the chain.
 pub const BLOOM_LEVELS: [ResourceName; MAX_BLOOM_LEVELS] =
@@ -32,109 +30,38 @@ pub const BLOOM_LEVELS: [ResourceName; MAX_BLOOM_LEVELS] =
 pub const BLOOM_TEMPS: [ResourceName; MAX_BLOOM_LEVELS] =
     ["bloom_tmp_0", "bloom_tmp_1", "bloom_tmp_2", "bloom_tmp_3", "bloom_tmp_4", "bloom_tmp_5"];
 
-/// How the blur iterations are laid out.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum BloomChain {
-    /// Each iteration halves the resolution (1/2, 1/4, …); the composite sums every level.
-    #[default]
-    Downsampled,
-    /// Every iteration blurs at full resolution (separable 9-tap: 1×9 then 9×1): the
-    /// straightforward layout, several times the cost of the downsampled chain.
-    FullResolution,
-}
-
-impl BloomChain {
-    /// Name used on the command line and in reports.
-    pub fn name(self) -> &'static str {
-        match self {
-            BloomChain::Downsampled => "downsampled",
-            BloomChain::FullResolution => "full-resolution",
-        }
+/// The passes of `bloom`, in order.
+pub fn bloom_passes(bloom: &BloomSettings) -> Vec<Box<dyn Pass>> {
+    let settings = bloom.sanitized();
+    let levels = bloom.levels();
+    let mut passes: Vec<Box<dyn Pass>> = Vec::with_capacity(2 + 2 * levels);
+    let full = bloom.chain == BloomChain::FullResolution;
+    let scale = |k: usize| if full { 1.0 } else { 0.5f32.powi(k as i32 + 1) };
+    passes.push(Box::new(BloomBrightPass { settings, scale: scale(0) }));
+    for k in 0..levels {
+        // Downsampled: level k from level k-1 (level 0 blurs the bright pass in place).
+        // Full resolution: level 0 again and again.
+        let (level, source) = if full { (0, 0) } else { (k, k.saturating_sub(1)) };
+        let creates = !full || k == 0;
+        passes.push(Box::new(BloomBlurPass {
+            source: BLOOM_LEVELS[source],
+            target: BLOOM_TEMPS[level],
+            horizontal: true,
+            create: creates.then_some(scale(level)),
+        }));
+        passes.push(Box::new(BloomBlurPass {
+            source: BLOOM_TEMPS[level],
+            target: BLOOM_LEVELS[level],
+            horizontal: false,
+            create: (creates && level > 0).then_some(scale(level)),
+        }));
     }
-}
-
-/// Bloom on a camera: light brighter than `threshold` spreads into its surroundings (bright
-/// pass, blur over `iterations`, added to the HDR image before tone mapping). With the `bevy`
-/// feature it is a component: the app's `Bloom` is this type, so a new setting is added here
-/// only. A camera without it gets no bloom passes and no bloom textures.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "bevy", derive(bevy_ecs::component::Component))]
-pub struct BloomSettings {
-    /// HDR brightness (largest channel, before exposure) where bloom starts.
-    pub threshold: f32,
-    /// Width of the soft knee below the threshold (0 = hard cut).
-    pub knee: f32,
-    /// Weight of the blurred light added back to the image.
-    pub intensity: f32,
-    /// Blur iterations (levels of the chain), 1 to [`MAX_BLOOM_LEVELS`].
-    pub iterations: u32,
-    /// Downsampled chain or the full-resolution one.
-    pub chain: BloomChain,
-}
-
-impl Default for BloomSettings {
-    fn default() -> Self {
-        Self { threshold: 1.0, knee: 0.5, intensity: 0.3, iterations: 5, chain: BloomChain::Downsampled }
+    let used = if full { 1 } else { levels };
+    for k in (1..used).rev() {
+        passes.push(Box::new(BloomUpsamplePass { source: BLOOM_LEVELS[k], target: BLOOM_LEVELS[k - 1] }));
     }
-}
-
-impl BloomSettings {
-    /// Full-resolution separable blur: 1×9 / 9×1 kernels, 5 iterations, every one at the
-    /// viewport's size.
-    pub fn full_resolution() -> Self {
-        Self { chain: BloomChain::FullResolution, iterations: 5, ..Self::default() }
-    }
-
-    /// Iterations clamped to what the chain supports (1 to [`MAX_BLOOM_LEVELS`]).
-    pub fn levels(&self) -> usize {
-        (self.iterations as usize).clamp(1, MAX_BLOOM_LEVELS)
-    }
-
-    /// The settings with non-finite or negative values replaced: a NaN or infinite threshold
-    /// blooms nothing, a NaN intensity adds nothing (never a NaN pixel).
-    pub fn sanitized(&self) -> BloomSettings {
-        let finite_or = |v: f32, fallback: f32| if v.is_finite() { v.max(0.0) } else { fallback };
-        BloomSettings {
-            threshold: finite_or(self.threshold, f32::MAX),
-            knee: finite_or(self.knee, 0.0),
-            intensity: finite_or(self.intensity, 0.0),
-            ..*self
-        }
-    }
-
-    /// The passes of this bloom, in order (the app adds them to the graph).
-    pub fn passes(&self) -> Vec<Box<dyn Pass>> {
-        let settings = self.sanitized();
-        let levels = self.levels();
-        let mut passes: Vec<Box<dyn Pass>> = Vec::with_capacity(2 + 2 * levels);
-        let full = self.chain == BloomChain::FullResolution;
-        let scale = |k: usize| if full { 1.0 } else { 0.5f32.powi(k as i32 + 1) };
-        passes.push(Box::new(BloomBrightPass { settings, scale: scale(0) }));
-        for k in 0..levels {
-            // Downsampled: level k from level k-1 (level 0 blurs the bright pass in place).
-            // Full resolution: level 0 again and again.
-            let (level, source) = if full { (0, 0) } else { (k, k.saturating_sub(1)) };
-            let creates = !full || k == 0;
-            passes.push(Box::new(BloomBlurPass {
-                source: BLOOM_LEVELS[source],
-                target: BLOOM_TEMPS[level],
-                horizontal: true,
-                create: creates.then_some(scale(level)),
-            }));
-            passes.push(Box::new(BloomBlurPass {
-                source: BLOOM_TEMPS[level],
-                target: BLOOM_LEVELS[level],
-                horizontal: false,
-                create: (creates && level > 0).then_some(scale(level)),
-            }));
-        }
-        let used = if full { 1 } else { levels };
-        for k in (1..used).rev() {
-            passes.push(Box::new(BloomUpsamplePass { source: BLOOM_LEVELS[k], target: BLOOM_LEVELS[k - 1] }));
-        }
-        passes.push(Box::new(BloomCompositePass { levels: used, intensity: settings.intensity }));
-        passes
-    }
+    passes.push(Box::new(BloomCompositePass { levels: used, intensity: settings.intensity }));
+    passes
 }
 
 /// Uniforms of the bloom shader (`BloomParams` in `shaders/bloom.wgsl`).
@@ -415,6 +342,6 @@ pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn Pass>>) {
     if let Some(bloom) = p.view.camera.and_then(|c| c.bloom)
         && p.shows_image()
     {
-        out.extend(bloom.passes());
+        out.extend(bloom_passes(&bloom));
     }
 }

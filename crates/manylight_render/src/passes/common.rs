@@ -5,46 +5,7 @@ use crate::context::RenderError;
 use crate::resources::DEPTH_FORMAT;
 use manylight_core::Vertex;
 
-/// A uniform-buffer layout entry.
-pub fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    buffer_entry(binding, visibility, wgpu::BufferBindingType::Uniform)
-}
-
-/// A storage-buffer layout entry.
-pub fn storage_entry(
-    binding: u32,
-    visibility: wgpu::ShaderStages,
-    read_only: bool,
-) -> wgpu::BindGroupLayoutEntry {
-    buffer_entry(binding, visibility, wgpu::BufferBindingType::Storage { read_only })
-}
-
-fn buffer_entry(
-    binding: u32,
-    visibility: wgpu::ShaderStages,
-    ty: wgpu::BufferBindingType,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
-        count: None,
-    }
-}
-
-/// A fragment-stage 2D texture layout entry (no sampler: passes use `textureLoad`).
-pub fn texture_entry(binding: u32, sample_type: wgpu::TextureSampleType) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Texture {
-            sample_type,
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        },
-        count: None,
-    }
-}
+pub use crate::layouts::{storage_entry, texture_entry, uniform_entry};
 
 fn pipeline_layout(
     device: &wgpu::Device,

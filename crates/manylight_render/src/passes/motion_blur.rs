@@ -23,30 +23,10 @@ use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 use crate::resources::HDR_FORMAT;
+pub use crate::settings::MotionBlurSettings;
 
 /// Graph resource: the blurred image before it is copied back into HDR.
 pub const MOTION_BLUR: ResourceName = "motion_blur";
-
-/// Camera-motion blur on a camera: each pixel is blurred along its screen motion since the
-/// previous frame (reprojected from depth); a still camera leaves the image unchanged. With the
-/// `bevy` feature it is a component: the app's `MotionBlur` is this type. A camera without it
-/// gets no motion-blur pass.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "bevy", derive(bevy_ecs::component::Component))]
-pub struct MotionBlurSettings {
-    /// Taps along the velocity (2 to 64).
-    pub samples: u32,
-    /// Fraction of the frame-to-frame motion that is blurred (1 = a full-frame shutter).
-    pub strength: f32,
-    /// Longest blur in pixels (velocities are clamped to it).
-    pub max_pixels: f32,
-}
-
-impl Default for MotionBlurSettings {
-    fn default() -> Self {
-        Self { samples: 8, strength: 1.0, max_pixels: 64.0 }
-    }
-}
 
 /// Uniforms of `shaders/motion_blur.wgsl` (`MotionBlurParams`); the tap count is the
 /// pipeline's `SAMPLES` override.
