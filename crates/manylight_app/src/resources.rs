@@ -59,8 +59,9 @@ impl DebugView {
 
 /// The statistics of the most recently finished frame: passes in order with GPU/CPU ms, light
 /// count and more (see [`FrameReport`]). A frame's GPU figures are read back without waiting,
-/// so its report arrives up to `frames_in_flight` frames after it was submitted (in pipelined
-/// mode a frame more); [`FrameReport::frame_index`] says which frame it is.
+/// so its report arrives up to `frames_in_flight` frames after it was submitted;
+/// [`FrameReport::frame_index`] says which frame it is, [`FrameStats::submitted`] which frame
+/// the renderer submitted last (pipelined, the main world is a frame ahead of it).
 #[derive(Resource, Clone, Debug, Default)]
 pub struct FrameStats {
     /// The last report (None before the first frame finished).
