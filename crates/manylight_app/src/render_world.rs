@@ -226,8 +226,8 @@ impl RenderWorld {
     /// Ends the frame [`RenderWorld::render`] recorded: its report (with any passes recorded
     /// after it, such as the window overlay) goes in flight, and comes back complete from
     /// [`RenderWorld::take_reports`].
-    pub fn finish_frame(&mut self, mut report: FrameReport) {
-        report.device_recoveries += std::mem::take(&mut self.recoveries);
+    pub fn finish_frame(&mut self, report: FrameReport) {
+        let report = self.report_empty(report);
         self.world.resource_mut::<RendererResource>().0.finish_frame(report);
     }
 
@@ -249,8 +249,9 @@ impl RenderWorld {
         &mut self.world.resource_mut::<RendererResource>().into_inner().0
     }
 
-    /// A frame that rendered nothing: its report is counted with the pending recoveries and
-    /// returned as it is (nothing of it is on the GPU).
+    /// `report` with the device recoveries not yet counted in a frame's report. A frame that
+    /// rendered nothing is reported this way, at once (nothing of it is on the GPU);
+    /// [`RenderWorld::finish_frame`] counts them into the frame it sends in flight.
     pub fn report_empty(&mut self, mut report: FrameReport) -> FrameReport {
         report.device_recoveries += std::mem::take(&mut self.recoveries);
         report

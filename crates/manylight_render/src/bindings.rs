@@ -138,9 +138,4 @@ impl BindingCache {
         let uniforms = self.uniforms.get_mut().unwrap_or_else(|e| e.into_inner());
         uniforms.retain(|_, u| frame - u.used <= KEEP_FRAMES);
     }
-
-    /// Bind groups held.
-    pub fn bind_groups(&self) -> usize {
-        self.groups.lock().map(|g| g.len()).unwrap_or(0)
-    }
 }

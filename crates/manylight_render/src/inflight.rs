@@ -22,8 +22,11 @@ pub const MAX_FRAMES_IN_FLIGHT: u32 = 8;
 /// Most passes one frame can time (over all its views; later passes report no GPU time).
 pub const MAX_TIMED_PASSES: u32 = 128;
 
+/// Bytes of a view's cluster counters.
+const COUNTER_BYTES: u64 = std::mem::size_of::<GpuClusterCounters>() as u64;
+
 /// Bytes of one view's record in a slot: its cluster counters, then its non-finite count.
-const VIEW_RECORD_BYTES: u64 = (std::mem::size_of::<GpuClusterCounters>() as u64 + 4).next_multiple_of(8);
+const VIEW_RECORD_BYTES: u64 = (COUNTER_BYTES + 4).next_multiple_of(8);
 
 /// Bytes of the timestamps at the start of a slot.
 const TIMESTAMP_BYTES: u64 = MAX_TIMED_PASSES as u64 * 2 * 8;
@@ -161,17 +164,17 @@ impl FrameRing {
             return;
         };
         let view = self.views.len();
-        if view < slot.views {
+        // A view past the slot's records (more views than the frame said) keeps no figures.
+        let kept = view < slot.views;
+        if kept {
             let offset = TIMESTAMP_BYTES + view as u64 * VIEW_RECORD_BYTES;
-            let counter_bytes = std::mem::size_of::<GpuClusterCounters>() as u64;
             if let Some(c) = counters {
-                encoder.copy_buffer_to_buffer(c, 0, &slot.staging, offset, counter_bytes);
+                encoder.copy_buffer_to_buffer(c, 0, &slot.staging, offset, COUNTER_BYTES);
             }
             if let Some(n) = nonfinite {
-                encoder.copy_buffer_to_buffer(n, 0, &slot.staging, offset + counter_bytes, 4);
+                encoder.copy_buffer_to_buffer(n, 0, &slot.staging, offset + COUNTER_BYTES, 4);
             }
         }
-        let kept = view < slot.views;
         self.views.push(ViewRecord {
             counters: kept && counters.is_some(),
             nonfinite: kept && nonfinite.is_some(),
@@ -302,29 +305,24 @@ fn complete(pending: Pending, figures: Option<&[u8]>, period_ns: f64) -> Result<
     let mut nonfinite: Option<u32> = None;
     for (v, record) in views.iter().enumerate() {
         let offset = (TIMESTAMP_BYTES + v as u64 * VIEW_RECORD_BYTES) as usize;
-        let counter_bytes = std::mem::size_of::<GpuClusterCounters>();
+        let nonfinite_at = offset + COUNTER_BYTES as usize;
         let end = (first_pass + record.passes).min(report.passes.len());
         let view_gpu_ms = gpu_ms(&report.passes[first_pass.min(end)..end]);
         first_pass = end;
-        let view = report.views.get_mut(v);
-        if record.counters {
-            let counters: GpuClusterCounters =
-                bytemuck::pod_read_unaligned(&bytes[offset..offset + counter_bytes]);
-            crate::clusters::ClusterResources::check_saturation(&counters)?;
-            if let Some(clusters) = view.as_ref().and_then(|v| v.clusters.as_ref()) {
-                let mut filled = clusters.clone();
-                filled.apply_counters(&counters);
-                if let Some(view) = report.views.get_mut(v) {
-                    view.clusters = Some(filled);
-                }
-            }
+        let counters = record
+            .counters
+            .then(|| bytemuck::pod_read_unaligned::<GpuClusterCounters>(&bytes[offset..nonfinite_at]));
+        if let Some(c) = &counters {
+            crate::clusters::ClusterResources::check_saturation(c)?;
         }
         if record.nonfinite {
-            let n: u32 =
-                bytemuck::pod_read_unaligned(&bytes[offset + counter_bytes..offset + counter_bytes + 4]);
+            let n: u32 = bytemuck::pod_read_unaligned(&bytes[nonfinite_at..nonfinite_at + 4]);
             nonfinite = Some(nonfinite.unwrap_or(0) + n);
         }
         if let Some(view) = report.views.get_mut(v) {
+            if let (Some(c), Some(clusters)) = (&counters, view.clusters.as_mut()) {
+                clusters.apply_counters(c);
+            }
             view.gpu_ms = view_gpu_ms;
         }
     }

@@ -41,11 +41,6 @@ impl FramePlanner {
         self.stages.insert(at, (name, planner));
     }
 
-    /// Names of the stages, in order.
-    pub fn stage_names(&self) -> Vec<&'static str> {
-        self.stages.iter().map(|(n, _)| *n).collect()
-    }
-
     /// The passes `inputs` call for, stage after stage.
     pub fn passes(&self, inputs: &PlanInputs<'_>) -> Vec<Box<dyn Pass>> {
         let mut out = Vec::new();

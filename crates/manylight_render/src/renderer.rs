@@ -10,11 +10,9 @@
 
 use crate::bindings::BindingCache;
 use crate::clusters::ClusterResources;
-use crate::context::GpuCounts;
-use crate::context::{GpuContext, RenderError};
-use crate::gpu_types::GpuClusterCounters;
-use crate::gpu_types::LAVAPIPE_LOOP_LIMIT;
-use crate::graph::{OUTPUT, PassContext, RenderGraph};
+use crate::context::{GpuContext, GpuCounts, RenderError};
+use crate::gpu_types::{GpuClusterCounters, LAVAPIPE_LOOP_LIMIT};
+use crate::graph::{OUTPUT, Pass, PassContext, RenderGraph};
 use crate::inflight::{DEFAULT_FRAMES_IN_FLIGHT, FrameRing};
 use crate::pipelines::PipelineCache;
 use crate::pool::{TextureKey, TransientPool};
@@ -157,7 +155,8 @@ impl Renderer {
         output: &wgpu::TextureView,
         output_format: wgpu::TextureFormat,
     ) -> Result<FrameReport, RenderError> {
-        let names = graph.pass_names()?;
+        let passes: Vec<&dyn Pass> = graph.compile()?.into_iter().map(|i| graph.pass(i)).collect();
+        let names: Vec<&str> = passes.iter().map(|p| p.name()).collect();
         let builds_clusters = names.contains(&"cluster_build");
         let loop_limited = crate::gpu_types::has_loop_limit(&self.gpu.info);
         // Naive forward loops over every light, four per iteration.
@@ -176,7 +175,8 @@ impl Renderer {
         let mut regrows = 0;
         loop {
             let first_pass = self.ring.passes_recorded();
-            let mut report = self.execute_once(graph, snapshot, view, output, output_format)?;
+            let mut report =
+                self.execute_once(&passes, builds_clusters, snapshot, view, output, output_format)?;
             let Some(clusters) =
                 self.clusters.get_mut(view.index).and_then(Option::as_mut).filter(|_| builds_clusters)
             else {
@@ -239,11 +239,6 @@ impl Renderer {
         Ok(std::mem::take(&mut self.arrived))
     }
 
-    /// Frames submitted whose reports have not arrived yet.
-    pub fn frames_pending(&self) -> u32 {
-        self.ring.pending()
-    }
-
     /// The query set and index for a pass recorded outside the graph (the window overlay), if
     /// it can be timed; call [`Renderer::pass_recorded`] after it.
     pub fn pass_timer(&self) -> Option<(&wgpu::QuerySet, u32)> {
@@ -256,23 +251,25 @@ impl Renderer {
         self.ring.pass_recorded(timed);
     }
 
+    /// Records `passes` (in order) for `view` and submits them; `builds_clusters` says whether
+    /// one of them is the cluster build, whose counters go to the read-back slot.
     fn execute_once(
         &mut self,
-        graph: &RenderGraph,
+        passes: &[&dyn Pass],
+        builds_clusters: bool,
         snapshot: &FrameSnapshot,
         view: &RenderView,
         output: &wgpu::TextureView,
         output_format: wgpu::TextureFormat,
     ) -> Result<FrameReport, RenderError> {
         let frame_start = Instant::now();
-        let order = graph.compile()?;
         // Views of one frame run one after the other: they may share transient textures.
         self.pool.release_all();
         let size = view.size;
         let mut textures = HashMap::new();
         textures.insert(OUTPUT, output.clone());
-        for &i in &order {
-            for spec in graph.pass(i).creates() {
+        for pass in passes {
+            for spec in pass.creates() {
                 let scaled = |v: u32| ((v as f32 * spec.scale).round() as u32).max(1);
                 let key = TextureKey {
                     width: scaled(size.x),
@@ -286,10 +283,9 @@ impl Renderer {
 
         let mut encoder =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
-        let mut passes = Vec::with_capacity(order.len());
+        let mut timings = Vec::with_capacity(passes.len());
         let clusters = self.clusters.get(view.index).and_then(Option::as_ref);
-        for &i in &order {
-            let pass = graph.pass(i);
+        for pass in passes {
             let timer = self.ring.timer();
             let mut ctx = PassContext {
                 gpu: &self.gpu,
@@ -309,7 +305,7 @@ impl Renderer {
             let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
             let timed = ctx.stamps.0 && ctx.stamps.1;
             self.ring.pass_recorded(timed);
-            passes.push(PassTiming {
+            timings.push(PassTiming {
                 name: pass.name().to_string(),
                 gpu_ms: None,
                 gpu_trusted: !(pass.is_compute() && self.cpu_adapter),
@@ -317,13 +313,12 @@ impl Renderer {
             });
         }
         // The view's counters go to the frame's read-back slot, after the passes wrote them.
-        let tonemapped = passes.iter().any(|p| p.name == crate::passes::tonemap::TONEMAP);
-        let counters = clusters.filter(|_| order.iter().any(|&i| graph.pass(i).name() == "cluster_build"));
+        let tonemapped = passes.iter().any(|p| p.name() == crate::passes::tonemap::TONEMAP);
         self.ring.end_view(
             &mut encoder,
-            counters.map(|c| c.counters_buffer()),
+            clusters.filter(|_| builds_clusters).map(|c| c.counters_buffer()),
             tonemapped.then_some(&self.scene.nonfinite.counter),
-            passes.len(),
+            timings.len(),
         );
         self.gpu.queue.submit([encoder.finish()]);
         self.last_textures = textures;
@@ -337,7 +332,7 @@ impl Renderer {
             height: size.y,
             pipeline: view.settings.pipeline.name().to_string(),
             frame_gpu_ms: None,
-            passes,
+            passes: timings,
             frame_cpu_ms: frame_start.elapsed().as_secs_f64() * 1e3,
             light_count: self.scene.light_count,
             invalid_lights: self.scene.invalid_lights,

@@ -130,12 +130,6 @@ impl NonFiniteCounter {
             }),
         }
     }
-
-    /// The count of the last view that ran the tone map (waits for the GPU).
-    pub fn read(&self, gpu: &GpuContext) -> Result<u32, RenderError> {
-        let bytes = crate::readback::read_buffer(gpu, &self.counter, 0, 4)?;
-        Ok(bytemuck::pod_read_unaligned(&bytes[..4]))
-    }
 }
 
 fn key<T>(a: &Arc<T>) -> usize {
