@@ -12,7 +12,8 @@
 fn fs_main(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
     let p = surface_point(view, in.clip_position.xy, in.camera_offset);
     let albedo = surface_albedo(material, base_color_texture, base_color_sampler, in.uv);
-    let s = surface_params(material, view.shading_model, albedo.rgb, in.world_normal, front_facing);
+    let metal_rough = surface_metal_rough(material, metallic_roughness_texture, base_color_sampler, in.uv);
+    let s = surface_params(material, view.shading_model, albedo.rgb, metal_rough, in.world_normal, front_facing);
     let view_dir = direction_to_eye(view, p.world_position);
     let cluster = cluster_index(cluster_params, in.clip_position.xy, p.view_depth);
     let range = cluster_ranges[cluster];

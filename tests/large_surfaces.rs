@@ -199,6 +199,13 @@ fn floor_scene_at(mesh: MeshData, far: f32, transform: Mat4) -> Scene {
 /// intersected with `y = 0`, Blinn-Phong under [`lights`] with the default ambient and
 /// exposure, the ACES fit and the sRGB encoding of the output (`shaders/common/brdf.wgsl`,
 /// `shaders/tonemap.wgsl`).
+/// `pipeline` with Blinn-Phong shading, the model `analytic_floor` evaluates (in f64, so the
+/// reference keeps its precision at 10⁷ units; the PBR model is checked against its twin in
+/// `tests/pbr.rs`).
+fn settings_for(pipeline: PipelineKind) -> RenderSettings {
+    RenderSettings { pipeline, shading: ShadingModel::BlinnPhong, ..RenderSettings::default() }
+}
+
 fn analytic_floor(extent: f64, far: f64, settings: &RenderSettings) -> image::RgbaImage {
     type V = [f64; 3];
     let sub = |a: V, b: V| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
@@ -271,7 +278,7 @@ fn analytic_floor(extent: f64, far: f64, settings: &RenderSettings) -> image::Rg
 fn configurations() -> Vec<(String, RenderSettings)> {
     let mut out = Vec::new();
     for pipeline in PipelineKind::ALL {
-        let base = RenderSettings { pipeline, ..RenderSettings::default() };
+        let base = settings_for(pipeline);
         if !matches!(pipeline, PipelineKind::ClusteredDeferred | PipelineKind::LightVolumes) {
             out.push((pipeline.name().to_string(), base));
             continue;
@@ -316,7 +323,7 @@ const FAR: f32 = 1e8;
 #[test]
 fn ring_floor_matches_the_analytic_floor() {
     let _gpu = gpu();
-    let naive = RenderSettings { pipeline: PipelineKind::NaiveForward, ..RenderSettings::default() };
+    let naive = settings_for(PipelineKind::NaiveForward);
     let rings = render(floor_scene(ring_floor(HUGE), FAR), SIZE, 0, naive);
     let analytic = analytic_floor(HUGE, f64::from(FAR), &naive);
     let worst = worst_channel(&analytic, &rings.image);
@@ -332,7 +339,7 @@ fn ring_floor_matches_the_analytic_floor() {
 #[test]
 fn huge_floor_matches_the_tessellated_reference_in_every_pipeline() {
     let _gpu = gpu();
-    let naive = RenderSettings { pipeline: PipelineKind::NaiveForward, ..RenderSettings::default() };
+    let naive = settings_for(PipelineKind::NaiveForward);
     let reference = render(floor_scene(ring_floor(HUGE), FAR), SIZE, 0, naive);
     for (name, settings) in configurations() {
         let frame = render(floor_scene(quad_floor(HUGE), FAR), SIZE, 0, settings);
@@ -361,7 +368,7 @@ fn huge_floor_matches_the_tessellated_reference_in_every_pipeline() {
 #[test]
 fn an_infinite_projection_clips_nothing_in_every_pipeline() {
     let _gpu = gpu();
-    let naive = RenderSettings { pipeline: PipelineKind::NaiveForward, ..RenderSettings::default() };
+    let naive = settings_for(PipelineKind::NaiveForward);
     let reference = render(floor_scene(ring_floor(HUGE), f32::INFINITY), SIZE, 0, naive);
     let analytic = analytic_floor(HUGE, f64::INFINITY, &naive);
     // The frame shows floor beyond 1 000 units: a far plane there would change pixels.
@@ -406,7 +413,7 @@ fn measure_large_floor() {
         .collect();
     let far: f32 = std::env::var("MANYLIGHT_LARGE_FAR").map(|s| s.parse().expect("far")).unwrap_or(1e8);
     let only = std::env::var("MANYLIGHT_LARGE_ONLY").ok();
-    let naive = RenderSettings { pipeline: PipelineKind::NaiveForward, ..RenderSettings::default() };
+    let naive = settings_for(PipelineKind::NaiveForward);
     let out = support::output_dir();
     for extent in extents {
         let reference = render(floor_scene(ring_floor(extent), far), SIZE, 0, naive);
@@ -449,7 +456,7 @@ fn measure_tilted_floor() {
     let inv = tilt.inverse();
     let eye = inv.transform_point3(EYE);
     let forward = inv.transform_vector3((TARGET - EYE).normalize());
-    let naive = RenderSettings { pipeline: PipelineKind::NaiveForward, ..RenderSettings::default() };
+    let naive = settings_for(PipelineKind::NaiveForward);
     for extent in [10.0, 1e4, 1e7] {
         let reference =
             render(floor_scene_at(ring_floor_seen_from(extent, eye, forward), 1e8, tilt), SIZE, 0, naive);

@@ -1,12 +1,33 @@
 // Shading models (ids: SHADING_* constants, generated from Rust `ShadingModel::gpu_id`).
 //!include common/lights.wgsl
+// Rust twin: `manylight_core::brdf` (same operations, same order).
 struct SurfaceParams {
     albedo: vec3<f32>,
     normal: vec3<f32>,
+    // Blinn-Phong exponent and strength (Blinn-Phong, toon)
     shininess: f32,
     specular: f32,
+    // metalness 0..1 and perceptual roughness PBR_MIN_ROUGHNESS..1 (PBR)
+    metallic: f32,
+    roughness: f32,
     model: u32,
 };
+
+// The two material parameters the surface's model reads, as the G-buffers store them:
+// (shininess, specular) for Blinn-Phong and toon, (roughness, metallic) for PBR.
+fn material_slots(s: SurfaceParams) -> vec2<f32> {
+    return select(vec2<f32>(s.shininess, s.specular), vec2<f32>(s.roughness, s.metallic), s.model == SHADING_PBR);
+}
+
+// `s` with the parameters of `material_slots` read back (each model reads only its own pair).
+fn with_material_slots(s: SurfaceParams, slots: vec2<f32>) -> SurfaceParams {
+    var out = s;
+    out.shininess = slots.x;
+    out.specular = slots.y;
+    out.roughness = slots.x;
+    out.metallic = slots.y;
+    return out;
+}
 
 // Radiance a point light adds at `position` seen from `view_dir` (unit, towards the eye).
 fn shade_point_light(s: SurfaceParams, position: vec3<f32>, view_dir: vec3<f32>, light: GpuPointLight) -> vec3<f32> {
@@ -20,6 +41,12 @@ fn shade_point_light(s: SurfaceParams, position: vec3<f32>, view_dir: vec3<f32>,
     let n_dot_l = max(dot(s.normal, l), 0.0);
     if s.model == SHADING_TOON {
         return toon_point_light(s, n_dot_l, view_dir, l) * light.color.rgb * att;
+    }
+    if s.model == SHADING_PBR {
+        if n_dot_l <= 0.0 {
+            return vec3<f32>(0.0);
+        }
+        return pbr_point_light(s, n_dot_l, view_dir, l) * light.color.rgb * att;
     }
     var result = s.albedo * n_dot_l;
     if s.model == SHADING_BLINN_PHONG && n_dot_l > 0.0 {
@@ -40,4 +67,33 @@ fn toon_point_light(s: SurfaceParams, n_dot_l: f32, view_dir: vec3<f32>, l: vec3
     let n_dot_v = max(dot(s.normal, view_dir), 0.0);
     let rim = pow(1.0 - n_dot_v, 4.0) * smoothstep(-0.2, 0.1, dot(s.normal, l));
     return s.albedo * band + s.albedo * (TOON_RIM_STRENGTH * rim);
+}
+
+// glTF 2.0 metallic-roughness (Appendix B) times n.l, for a light in direction `l` with
+// n_dot_l > 0: GGX distribution, height-correlated Smith visibility, Schlick Fresnel, Lambert
+// diffuse, split by metallic.
+fn pbr_point_light(s: SurfaceParams, n_dot_l: f32, view_dir: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
+    let metallic = clamp(s.metallic, 0.0, 1.0);
+    let roughness = clamp(s.roughness, PBR_MIN_ROUGHNESS, 1.0);
+    let a = roughness * roughness;
+    let a2 = a * a;
+    let hv = l + view_dir;
+    let hl = length(hv);
+    let h = select(s.normal, hv / hl, hl > 0.0);
+    let n_dot_v = max(dot(s.normal, view_dir), PBR_MIN_N_DOT_V);
+    let n_dot_h = max(dot(s.normal, h), 0.0);
+    let v_dot_h = clamp(dot(view_dir, h), 0.0, 1.0);
+    let f0 = mix(vec3<f32>(PBR_DIELECTRIC_F0), s.albedo, metallic);
+    let c_diff = s.albedo * (1.0 - metallic);
+    let x = 1.0 - v_dot_h;
+    let x2 = x * x;
+    let fresnel = f0 + (vec3<f32>(1.0) - f0) * (x2 * x2 * x);
+    let d_denom = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0;
+    let d = a2 / (BRDF_PI * d_denom * d_denom);
+    let vis_l = n_dot_l + sqrt(a2 + (1.0 - a2) * n_dot_l * n_dot_l);
+    let vis_v = n_dot_v + sqrt(a2 + (1.0 - a2) * n_dot_v * n_dot_v);
+    let vis = 1.0 / (vis_l * vis_v);
+    let diffuse = (vec3<f32>(1.0) - fresnel) * c_diff * BRDF_FRAC_1_PI;
+    let specular = fresnel * (d * vis);
+    return (diffuse + specular) * n_dot_l;
 }

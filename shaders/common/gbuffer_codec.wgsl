@@ -65,17 +65,19 @@ fn gbuffer_decode_components(c: vec2<f32>, view_from_world: mat4x4<f32>) -> vec3
 // ---- Packed: material parameters in the integer parts of the albedo channels ----
 // Each albedo channel stores a + 2k with a = saturate(albedo) in [0, 1] and k a small integer:
 //   r: k = shading model (0..3)
-//   g: k = round(saturate(specular) * 1023)
-//   b: k = round(clamp(log2(shininess), 0, 13) * 64)   (shininess 1..8192, steps of 0.54 %)
+//   g: k = round(saturate(specular) * 1023)             (PBR: round(metallic * 1023))
+//   b: k = round(clamp(log2(shininess), 0, 13) * 64)   (shininess 1..8192, steps of 0.54 %;
+//                                                       PBR: round(roughness * 1023))
 // With k <= 1023 the value stays below 2048, where f32 keeps the albedo to 2^-12 (better than
 // the f16 albedo of the Full layout); decoding is floor(v / 2) and an exact subtraction.
 
 fn gbuffer_pack_albedo_params(s: SurfaceParams) -> vec3<f32> {
     let a = saturate(s.albedo);
+    let pbr = s.model == SHADING_PBR;
     let k = vec3<f32>(
         f32(min(s.model, 3u)),
-        round(saturate(s.specular) * 1023.0),
-        round(clamp(log2(max(s.shininess, 1.0)), 0.0, 13.0) * 64.0),
+        round(saturate(select(s.specular, s.metallic, pbr)) * 1023.0),
+        select(round(clamp(log2(max(s.shininess, 1.0)), 0.0, 13.0) * 64.0), round(saturate(s.roughness) * 1023.0), pbr),
     );
     return a + 2.0 * k;
 }
@@ -88,6 +90,8 @@ fn gbuffer_unpack_albedo_params(v: vec3<f32>) -> SurfaceParams {
     s.model = u32(k.x);
     s.specular = k.y * (1.0 / 1023.0);
     s.shininess = exp2(k.z * (1.0 / 64.0));
+    s.metallic = k.y * (1.0 / 1023.0);
+    s.roughness = k.z * (1.0 / 1023.0);
     return s;
 }
 

@@ -37,9 +37,8 @@ fn gbuffer_read_full(px: vec2<i32>) -> GSurface {
     var g: GSurface;
     g.params.albedo = a.rgb;
     g.params.normal = normalize(n.xyz);
-    g.params.shininess = n.w;
-    g.params.specular = a.a;
     g.params.model = u32(p.w + 0.5);
+    g.params = with_material_slots(g.params, vec2<f32>(n.w, a.a));
     g.world_position = p.xyz;
     return g;
 }
@@ -69,9 +68,8 @@ fn gbuffer_read_compact(px: vec2<i32>) -> GSurface {
     var out: GSurface;
     out.params.albedo = gbuffer_unpack_albedo(g.x);
     out.params.normal = gbuffer_decode_word(g.y);
-    out.params.shininess = params.x;
-    out.params.specular = params.y;
     out.params.model = gbuffer_unpack_model(g.x);
+    out.params = with_material_slots(out.params, params);
     let uv = (vec2<f32>(px) + 0.5) * view.viewport.zw;
     out.world_position = gbuffer_position_from_depth(uv, bitcast<f32>(g.w));
     return out;

@@ -12,6 +12,10 @@ struct GpuMaterial {
     // SHADING_* id, or SHADING_GLOBAL to use the view's model
     shading_model: u32,
     has_texture: u32,
+    metallic: f32,
+    roughness: f32,
+    has_metallic_roughness_texture: u32,
+    _pad: u32,
 };
 
 struct VertexIn {

@@ -13,6 +13,8 @@
 @group(1) @binding(0) var<uniform> material: GpuMaterial;
 @group(1) @binding(1) var base_color_texture: texture_2d<f32>;
 @group(1) @binding(2) var base_color_sampler: sampler;
+// glTF metallic-roughness: blue = metalness, green = roughness (linear)
+@group(1) @binding(3) var metallic_roughness_texture: texture_2d<f32>;
 
 @vertex
 fn vs_main(v: VertexIn, @builtin(instance_index) instance_index: u32) -> SurfaceVertexOut {

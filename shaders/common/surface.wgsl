@@ -30,7 +30,13 @@ fn surface_albedo(m: GpuMaterial, t: texture_2d<f32>, smp: sampler, uv: vec2<f32
     return m.base_color * select(vec4<f32>(1.0), textureSample(t, smp, uv), m.has_texture != 0u);
 }
 
-fn surface_params(m: GpuMaterial, global_model: u32, albedo: vec3<f32>, normal: vec3<f32>, front_facing: bool) -> SurfaceParams {
+// Metalness and roughness of the material at `uv` (factors times the texture's blue and green).
+fn surface_metal_rough(m: GpuMaterial, t: texture_2d<f32>, smp: sampler, uv: vec2<f32>) -> vec2<f32> {
+    let texel = select(vec4<f32>(1.0), textureSample(t, smp, uv), m.has_metallic_roughness_texture != 0u);
+    return vec2<f32>(m.metallic * texel.b, m.roughness * texel.g);
+}
+
+fn surface_params(m: GpuMaterial, global_model: u32, albedo: vec3<f32>, metal_rough: vec2<f32>, normal: vec3<f32>, front_facing: bool) -> SurfaceParams {
     let len = length(normal);
     var n = select(vec3<f32>(0.0, 1.0, 0.0), normal / len, len > 1e-8);
     // Two-sided lighting: shade the face the camera sees.
@@ -40,6 +46,8 @@ fn surface_params(m: GpuMaterial, global_model: u32, albedo: vec3<f32>, normal: 
     s.normal = n;
     s.shininess = m.shininess;
     s.specular = m.specular;
+    s.metallic = saturate(metal_rough.x);
+    s.roughness = clamp(metal_rough.y, PBR_MIN_ROUGHNESS, 1.0);
     s.model = select(m.shading_model, global_model, m.shading_model == SHADING_GLOBAL);
     return s;
 }

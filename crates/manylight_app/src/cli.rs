@@ -20,7 +20,7 @@ pub fn parse_pipeline(s: &str) -> Result<PipelineKind, String> {
     named("pipeline", s, &PipelineKind::ALL, PipelineKind::name)
 }
 
-/// `lambert`, `blinn-phong` or `toon`.
+/// `pbr`, `lambert`, `blinn-phong` or `toon`.
 pub fn parse_shading(s: &str) -> Result<ShadingModel, String> {
     named("shading model", s, &ShadingModel::ALL, ShadingModel::name)
 }

@@ -175,6 +175,9 @@ struct BenchArgs {
     gbuffers: Vec<GBufferLayout>,
     #[command(flatten)]
     clusters: ClusterArgs,
+    /// Shading model for materials without their own: pbr (default), lambert, blinn-phong or toon.
+    #[arg(long, default_value = "pbr", value_parser = parse_shading)]
+    shading: ShadingModel,
     /// CSV output.
     #[arg(long)]
     out: PathBuf,
@@ -193,8 +196,8 @@ struct RenderArgs {
     pipeline: PipelineKind,
     #[command(flatten)]
     clusters: ClusterArgs,
-    /// Shading model for materials without their own: lambert, blinn-phong or toon.
-    #[arg(long, default_value = "blinn-phong", value_parser = parse_shading)]
+    /// Shading model for materials without their own: pbr (default), lambert, blinn-phong or toon.
+    #[arg(long, default_value = "pbr", value_parser = parse_shading)]
     shading: ShadingModel,
     /// Animated lights added to the scene's own lights (default: 64 for a scene that has no
     /// lights of its own, so it is not black; 0 otherwise). For `sphere-shell`: the lights of
@@ -602,6 +605,7 @@ fn bench_cmd(args: BenchArgs) -> Result<()> {
                 clusters: args.clusters.settings(),
                 gbuffer: args.clusters.gbuffer,
                 normal_codec: args.clusters.normal_codec,
+                shading: args.shading,
                 ..Default::default()
             },
             ..Default::default()

@@ -5,6 +5,7 @@
 #![warn(missing_docs)]
 
 pub mod attenuation;
+pub mod brdf;
 pub mod camera;
 pub mod cluster;
 pub mod codec;
@@ -13,6 +14,7 @@ pub mod icosphere;
 pub mod image_metrics;
 pub mod material;
 pub mod mesh;
+pub mod tonemap;
 
 pub use attenuation::{attenuation, radius_for_intensity};
 pub use camera::{Projection, ProjectionKind, linearize_depth_reverse_z};

@@ -9,11 +9,14 @@ pub enum ShadingModel {
     /// Diffuse only.
     Lambert,
     /// Diffuse plus a Blinn-Phong specular lobe.
-    #[default]
     BlinnPhong,
     /// Cel shading: each light's diffuse term in [`TOON_BANDS`] flat bands, plus a rim light
     /// on silhouettes the light reaches (`shade_point_light` in `shaders/common/brdf.wgsl`).
     Toon,
+    /// glTF 2.0 metallic-roughness: GGX distribution, height-correlated Smith visibility,
+    /// Schlick Fresnel and Lambert diffuse, split by metallic ([`crate::brdf`]).
+    #[default]
+    Pbr,
 }
 
 /// Number of flat diffuse bands of [`ShadingModel::Toon`] (shared with WGSL).
@@ -28,11 +31,13 @@ impl ShadingModel {
             ShadingModel::Lambert => 0,
             ShadingModel::BlinnPhong => 1,
             ShadingModel::Toon => 2,
+            ShadingModel::Pbr => 3,
         }
     }
 
     /// Every model, in `gpu_id` order.
-    pub const ALL: [ShadingModel; 3] = [ShadingModel::Lambert, ShadingModel::BlinnPhong, ShadingModel::Toon];
+    pub const ALL: [ShadingModel; 4] =
+        [ShadingModel::Lambert, ShadingModel::BlinnPhong, ShadingModel::Toon, ShadingModel::Pbr];
 
     /// The name used on the command line.
     pub fn name(self) -> &'static str {
@@ -40,6 +45,7 @@ impl ShadingModel {
             ShadingModel::Lambert => "lambert",
             ShadingModel::BlinnPhong => "blinn-phong",
             ShadingModel::Toon => "toon",
+            ShadingModel::Pbr => "pbr",
         }
     }
 
@@ -73,11 +79,18 @@ pub struct MaterialData {
     pub base_color: Vec4,
     /// Optional sRGB base colour texture.
     pub base_color_texture: Option<Arc<TextureData>>,
+    /// PBR metalness factor (0 dielectric .. 1 metal).
+    pub metallic: f32,
+    /// PBR perceptual roughness factor (0 mirror .. 1 rough).
+    pub roughness: f32,
+    /// Optional linear metallic-roughness texture (glTF: blue = metalness, green =
+    /// roughness), multiplied with the factors.
+    pub metallic_roughness_texture: Option<Arc<TextureData>>,
     /// Per-material shading model; `None` uses the global one from the render settings.
     pub shading: Option<ShadingModel>,
-    /// Blinn-Phong exponent.
+    /// Blinn-Phong exponent (the Blinn-Phong and toon models).
     pub shininess: f32,
-    /// Strength of the specular lobe (0 = none).
+    /// Strength of the Blinn-Phong specular lobe (0 = none).
     pub specular: f32,
 }
 
@@ -87,6 +100,9 @@ impl Default for MaterialData {
             label: "default".into(),
             base_color: Vec4::ONE,
             base_color_texture: None,
+            metallic: 0.0,
+            roughness: 0.5,
+            metallic_roughness_texture: None,
             shading: None,
             shininess: 32.0,
             specular: 0.25,

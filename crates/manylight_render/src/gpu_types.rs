@@ -52,6 +52,7 @@ pub fn shared_u32_constants() -> Vec<(&'static str, u32)> {
         ("SHADING_LAMBERT", ShadingModel::Lambert.gpu_id()),
         ("SHADING_BLINN_PHONG", ShadingModel::BlinnPhong.gpu_id()),
         ("SHADING_TOON", ShadingModel::Toon.gpu_id()),
+        ("SHADING_PBR", ShadingModel::Pbr.gpu_id()),
         ("TOON_BANDS", manylight_core::material::TOON_BANDS),
         ("NORMAL_CODEC_XYZ", NormalCodec::Xyz.gpu_id()),
         ("NORMAL_CODEC_SPHERICAL", NormalCodec::Spherical.gpu_id()),
@@ -188,6 +189,14 @@ pub struct GpuMaterial {
     pub shading_model: u32,
     /// 1 when a base colour texture is bound.
     pub has_texture: u32,
+    /// PBR metalness factor.
+    pub metallic: f32,
+    /// PBR perceptual roughness factor.
+    pub roughness: f32,
+    /// 1 when a metallic-roughness texture is bound.
+    pub has_metallic_roughness_texture: u32,
+    /// Padding to 16 bytes.
+    pub _pad: u32,
 }
 
 /// Constants emitted into WGSL as `const NAME: f32 = VALUE;` (printed so they round-trip).
@@ -196,6 +205,11 @@ pub fn shared_f32_constants() -> Vec<(&'static str, f32)> {
         ("RADIUS_INFLATION", manylight_core::cluster::RADIUS_INFLATION),
         ("TILE_PREFILTER_INFLATION", manylight_core::cluster::TILE_PREFILTER_INFLATION),
         ("TOON_RIM_STRENGTH", manylight_core::material::TOON_RIM_STRENGTH),
+        ("PBR_MIN_ROUGHNESS", manylight_core::brdf::PBR_MIN_ROUGHNESS),
+        ("PBR_MIN_N_DOT_V", manylight_core::brdf::PBR_MIN_N_DOT_V),
+        ("PBR_DIELECTRIC_F0", manylight_core::brdf::PBR_DIELECTRIC_F0),
+        ("BRDF_PI", std::f32::consts::PI),
+        ("BRDF_FRAC_1_PI", std::f32::consts::FRAC_1_PI),
     ]
 }
 

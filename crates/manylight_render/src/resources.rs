@@ -197,6 +197,16 @@ impl SceneResources {
                     ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                     count: None,
                 },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 3,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
             ],
         });
         let view_buffer = gpu.create_buffer(&wgpu::BufferDescriptor {
@@ -429,40 +439,28 @@ impl SceneResources {
     ) -> Result<(usize, u64), RenderError> {
         let k = key(material);
         let frame = self.frame;
+        let textures = [&material.base_color_texture, &material.metallic_roughness_texture];
         if let Some(m) = self.materials.get_mut(&k) {
             m.last_used = frame;
-            if let Some(t) = material.base_color_texture.as_ref().and_then(|t| self.textures.get_mut(&key(t)))
-            {
-                t.last_used = frame;
+            for t in textures.into_iter().flatten() {
+                if let Some(t) = self.textures.get_mut(&key(t)) {
+                    t.last_used = frame;
+                }
             }
             return Ok((k, m.order));
         }
-        let view = match &material.base_color_texture {
-            Some(tex) => {
-                if tex.width > self.max_texture_size || tex.height > self.max_texture_size {
-                    return Err(RenderError::TextureTooLarge {
-                        label: tex.label.clone(),
-                        width: tex.width,
-                        height: tex.height,
-                        limit: self.max_texture_size,
-                    });
-                }
-                let entry = self.textures.entry(key(tex)).or_insert_with(|| CachedTexture {
-                    _source: tex.clone(),
-                    view: upload_texture(gpu, tex),
-                    last_used: frame,
-                });
-                entry.last_used = frame;
-                entry.view.clone()
-            }
-            None => self.white.clone(),
-        };
+        let [base_view, metal_rough_view] = [0, 1].map(|i| self.texture_view(gpu, textures[i].as_ref()));
+        let (base_view, metal_rough_view) = (base_view?, metal_rough_view?);
         let uniform = GpuMaterial {
             base_color: material.base_color,
             shininess: material.shininess.clamp(1.0, 4096.0),
             specular: material.specular.max(0.0),
             shading_model: material.shading.map_or(SHADING_GLOBAL, |s| s.gpu_id()),
             has_texture: material.base_color_texture.is_some() as u32,
+            metallic: if material.metallic.is_finite() { material.metallic.clamp(0.0, 1.0) } else { 0.0 },
+            roughness: if material.roughness.is_finite() { material.roughness.clamp(0.0, 1.0) } else { 1.0 },
+            has_metallic_roughness_texture: material.metallic_roughness_texture.is_some() as u32,
+            _pad: 0,
         };
         let buffer = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some(&material.label),
@@ -474,8 +472,12 @@ impl SceneResources {
             layout: &self.material_layout,
             entries: &[
                 wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&view) },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&base_view) },
                 wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&metal_rough_view),
+                },
             ],
         });
         self.uploads += 1;
@@ -483,6 +485,32 @@ impl SceneResources {
         self.materials
             .insert(k, GpuMaterialBinding { _source: material.clone(), bind_group, order, last_used: frame });
         Ok((k, order))
+    }
+
+    /// The view of `texture`, uploaded on first use (white when there is none); refused,
+    /// naming the limit, when it exceeds the device's largest texture.
+    fn texture_view(
+        &mut self,
+        gpu: &GpuContext,
+        texture: Option<&Arc<TextureData>>,
+    ) -> Result<wgpu::TextureView, RenderError> {
+        let Some(tex) = texture else { return Ok(self.white.clone()) };
+        if tex.width > self.max_texture_size || tex.height > self.max_texture_size {
+            return Err(RenderError::TextureTooLarge {
+                label: tex.label.clone(),
+                width: tex.width,
+                height: tex.height,
+                limit: self.max_texture_size,
+            });
+        }
+        let frame = self.frame;
+        let entry = self.textures.entry(key(tex)).or_insert_with(|| CachedTexture {
+            _source: tex.clone(),
+            view: upload_texture(gpu, tex),
+            last_used: frame,
+        });
+        entry.last_used = frame;
+        Ok(entry.view.clone())
     }
 
     /// The GPU mesh of a draw.

@@ -282,7 +282,7 @@ impl Default for RenderSettings {
     fn default() -> Self {
         Self {
             pipeline: PipelineKind::ClusteredForward,
-            shading: ShadingModel::BlinnPhong,
+            shading: ShadingModel::Pbr,
             exposure: 1.0,
             ambient: 0.03,
             clear_color: [0.005, 0.006, 0.01],

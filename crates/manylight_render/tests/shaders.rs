@@ -121,6 +121,10 @@ fn shared_structs_match_rust() {
             ("specular", offset_of!(GpuMaterial, specular)),
             ("shading_model", offset_of!(GpuMaterial, shading_model)),
             ("has_texture", offset_of!(GpuMaterial, has_texture)),
+            ("metallic", offset_of!(GpuMaterial, metallic)),
+            ("roughness", offset_of!(GpuMaterial, roughness)),
+            ("has_metallic_roughness_texture", offset_of!(GpuMaterial, has_metallic_roughness_texture)),
+            ("_pad", offset_of!(GpuMaterial, _pad)),
         ],
     );
     offsets(

@@ -46,13 +46,16 @@ impl Assembler {
         label: &str,
         color: Vec3,
         tex: Option<&Arc<TextureData>>,
-        shininess: f32,
-        specular: f32,
+        (metallic, roughness): (f32, f32),
+        (shininess, specular): (f32, f32),
     ) -> usize {
         self.scene.materials.push(Arc::new(MaterialData {
             label: format!("default_scene/{label}"),
             base_color: color.extend(1.0),
             base_color_texture: tex.cloned(),
+            metallic,
+            roughness,
+            metallic_roughness_texture: None,
             shading: None,
             shininess,
             specular,
@@ -79,20 +82,20 @@ pub fn default_scene() -> Scene {
     // Textures and materials.
     let [tiles, brick, stone_tex, cloth_tex] =
         [floor_tiles(256), bricks(256), stone(128), cloth(128)].map(Arc::new);
-    let m_floor = a.material("floor", Vec3::ONE, Some(&tiles), 64.0, 0.3);
-    let m_wall = a.material("wall", Vec3::ONE, Some(&brick), 8.0, 0.05);
-    let m_stone = a.material("stone", Vec3::ONE, Some(&stone_tex), 16.0, 0.1);
-    let m_arch = a.material("arch", Vec3::new(1.0, 0.9, 0.8), Some(&stone_tex), 16.0, 0.1);
+    let m_floor = a.material("floor", Vec3::ONE, Some(&tiles), (0.0, 0.35), (64.0, 0.3));
+    let m_wall = a.material("wall", Vec3::ONE, Some(&brick), (0.0, 0.85), (8.0, 0.05));
+    let m_stone = a.material("stone", Vec3::ONE, Some(&stone_tex), (0.0, 0.7), (16.0, 0.1));
+    let m_arch = a.material("arch", Vec3::new(1.0, 0.9, 0.8), Some(&stone_tex), (0.0, 0.7), (16.0, 0.1));
     let m_cloth = [
-        a.material("cloth_red", Vec3::new(0.75, 0.08, 0.06), Some(&cloth_tex), 4.0, 0.02),
-        a.material("cloth_green", Vec3::new(0.08, 0.55, 0.15), Some(&cloth_tex), 4.0, 0.02),
-        a.material("cloth_blue", Vec3::new(0.08, 0.15, 0.7), Some(&cloth_tex), 4.0, 0.02),
+        a.material("cloth_red", Vec3::new(0.75, 0.08, 0.06), Some(&cloth_tex), (0.0, 0.95), (4.0, 0.02)),
+        a.material("cloth_green", Vec3::new(0.08, 0.55, 0.15), Some(&cloth_tex), (0.0, 0.95), (4.0, 0.02)),
+        a.material("cloth_blue", Vec3::new(0.08, 0.15, 0.7), Some(&cloth_tex), (0.0, 0.95), (4.0, 0.02)),
     ];
-    let m_gold = a.material("gold", Vec3::new(1.0, 0.76, 0.33), None, 128.0, 0.9);
-    let m_plaster = a.material("plaster", Vec3::splat(0.9), None, 32.0, 0.2);
-    let m_teal = a.material("teal", Vec3::new(0.1, 0.6, 0.6), None, 256.0, 0.5);
+    let m_gold = a.material("gold", Vec3::new(1.0, 0.76, 0.33), None, (1.0, 0.3), (128.0, 0.9));
+    let m_plaster = a.material("plaster", Vec3::splat(0.9), None, (0.0, 0.6), (32.0, 0.2));
+    let m_teal = a.material("teal", Vec3::new(0.1, 0.6, 0.6), None, (0.0, 0.2), (256.0, 0.5));
     // Matte boxes use the Lambert model so one surface type ignores the global setting.
-    let m_crate = a.material("crate", Vec3::new(0.6, 0.45, 0.3), None, 1.0, 0.0);
+    let m_crate = a.material("crate", Vec3::new(0.6, 0.45, 0.3), None, (0.0, 1.0), (1.0, 0.0));
     if let Some(m) = Arc::get_mut(&mut a.scene.materials[m_crate]) {
         m.shading = Some(ShadingModel::Lambert);
     }
@@ -170,12 +173,13 @@ pub fn default_scene() -> Scene {
         );
     }
 
-    // Six warm lights down the nave, enough to see the hall with no extra lights.
+    // Six warm lights down the nave, enough to see the hall with no extra lights (80 cd: the
+    // PBR model's diffuse lobe is albedo / pi, so this lights the hall as 25 did under Lambert).
     for i in 0..6 {
         a.scene.lights.push(SceneLight {
             position: Vec3::new(-15.0 + 6.0 * i as f32, 4.0, 0.0),
             color: Vec3::new(1.0, 0.78, 0.5),
-            intensity: 25.0,
+            intensity: 80.0,
             radius: 15.0,
         });
     }

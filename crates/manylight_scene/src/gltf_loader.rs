@@ -391,6 +391,7 @@ fn load_inner(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
         options,
         textures: HashMap::new(),
         images: HashMap::new(),
+        linear: HashMap::new(),
         meshes: HashMap::new(),
         materials: HashMap::new(),
         used: Used::default(),
@@ -432,6 +433,8 @@ struct Ctx<'a> {
     textures: HashMap<usize, Arc<TextureData>>,
     /// Decoded images by source: `images` entries naming the same source share one decode.
     images: HashMap<materials::ImageSource<'a>, Arc<TextureData>>,
+    /// Images read as linear data (metallic-roughness), by image index.
+    linear: HashMap<usize, Arc<TextureData>>,
     /// Scene mesh index by (POSITION, NORMAL, TEXCOORD_0, indices) accessors (`None`: the
     /// primitive has no triangles and is skipped).
     meshes: HashMap<[Option<usize>; 4], Option<usize>>,

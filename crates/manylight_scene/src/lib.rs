@@ -9,7 +9,7 @@ mod error;
 mod gltf_loader;
 mod light_rig;
 mod scene_ops;
-mod shapes;
+pub mod shapes;
 mod textures;
 
 pub use default_scene::default_scene;

@@ -31,7 +31,7 @@ impl Builder {
 }
 
 /// An axis-aligned box of full extents `size`, centred on the origin.
-pub(crate) fn cuboid(label: &str, size: Vec3, uv_scale: f32) -> MeshData {
+pub fn cuboid(label: &str, size: Vec3, uv_scale: f32) -> MeshData {
     let h = size * 0.5;
     let mut b = Builder::default();
     // For each face: normal, and the two in-plane axes (u, v) with u x v = n.
@@ -55,7 +55,7 @@ pub(crate) fn cuboid(label: &str, size: Vec3, uv_scale: f32) -> MeshData {
 }
 
 /// A capped cylinder along Y of radius `radius` and height `height`, centred on the origin.
-pub(crate) fn cylinder(label: &str, radius: f32, height: f32, segments: u32, uv_scale: f32) -> MeshData {
+pub fn cylinder(label: &str, radius: f32, height: f32, segments: u32, uv_scale: f32) -> MeshData {
     let segments = segments.max(3);
     let mut b = Builder::default();
     let hy = height * 0.5;
@@ -93,7 +93,7 @@ pub(crate) fn cylinder(label: &str, radius: f32, height: f32, segments: u32, uv_
 /// A UV sphere of radius `radius` with `rings` latitude bands and `segments` longitude
 /// bands. With `inward`, normals point to the centre and faces are wound to be seen from
 /// inside.
-pub(crate) fn uv_sphere(label: &str, radius: f32, rings: u32, segments: u32, inward: bool) -> MeshData {
+pub fn uv_sphere(label: &str, radius: f32, rings: u32, segments: u32, inward: bool) -> MeshData {
     let (rings, segments) = (rings.max(2), segments.max(3));
     let mut b = Builder::default();
     for r in 0..=rings {
@@ -133,14 +133,7 @@ pub(crate) fn uv_sphere(label: &str, radius: f32, rings: u32, segments: u32, inw
 
 /// A semicircular arch in the XY plane (opening downwards, springing at y = 0), inner radius
 /// `inner`, outer radius `outer`, extruded `depth` along Z and centred on Z = 0.
-pub(crate) fn arch(
-    label: &str,
-    inner: f32,
-    outer: f32,
-    depth: f32,
-    segments: u32,
-    uv_scale: f32,
-) -> MeshData {
+pub fn arch(label: &str, inner: f32, outer: f32, depth: f32, segments: u32, uv_scale: f32) -> MeshData {
     let segments = segments.max(2);
     let mut b = Builder::default();
     let hz = depth * 0.5;

@@ -51,7 +51,8 @@ pub fn blinn_phong_from_pbr(roughness: f32, metallic: f32) -> (f32, f32) {
 }
 
 impl<'a> Ctx<'a> {
-    /// Converts material `index` (its base colour, base-colour texture and roughness).
+    /// Converts material `index`: base colour, metallic and roughness factors and their
+    /// textures.
     pub(super) fn material(&mut self, index: usize) -> Result<MaterialData, SceneError> {
         let root = self.root;
         let m = &root.materials[index]; // the caller checked the index
@@ -63,33 +64,78 @@ impl<'a> Ctx<'a> {
         }
         let base = base.clamp(Vec4::ZERO, Vec4::splat(f32::MAX));
         let texture = match &pbr.base_color_texture {
-            Some(info) => {
-                if info.tex_coord != 0 {
-                    tracing::warn!(
-                        file = %self.path.display(),
-                        material = index,
-                        "baseColorTexture uses TEXCOORD_{}, only TEXCOORD_0 is loaded",
-                        info.tex_coord
-                    );
-                }
-                let what = format!("material {index} baseColorTexture");
-                let tex = self.lookup(&root.textures, info.index.value(), &what, "texture")?;
-                let image = tex.source.value();
-                let what = format!("texture {}", info.index.value());
-                self.lookup(&root.images, image, &what, "image")?;
-                Some(self.image(image)?)
-            }
+            Some(info) => Some(self.texture(index, "baseColorTexture", info, true)?),
             None => None,
         };
-        let (shininess, specular) = blinn_phong_from_pbr(pbr.roughness_factor.0, pbr.metallic_factor.0);
+        let metallic_roughness_texture = match &pbr.metallic_roughness_texture {
+            Some(info) => Some(self.texture(index, "metallicRoughnessTexture", info, false)?),
+            None => None,
+        };
+        let factor = |v: f32, name: &str, default: f32| {
+            if v.is_finite() {
+                v.clamp(0.0, 1.0)
+            } else {
+                tracing::warn!(file = %self.path.display(), material = index, "non-finite {name}, using {default}");
+                default
+            }
+        };
+        let metallic = factor(pbr.metallic_factor.0, "metallicFactor", 1.0);
+        let roughness = factor(pbr.roughness_factor.0, "roughnessFactor", 1.0);
+        let (shininess, specular) = blinn_phong_from_pbr(roughness, metallic);
         Ok(MaterialData {
             label: m.name.clone().unwrap_or_else(|| format!("material {index}")),
             base_color: base,
             base_color_texture: texture,
+            metallic,
+            roughness,
+            metallic_roughness_texture,
             shading: None,
             shininess,
             specular,
         })
+    }
+
+    /// The image of texture `info` of material `material` (`slot` names the material's
+    /// property in errors), as sRGB colour or as linear data.
+    fn texture(
+        &mut self,
+        material: usize,
+        slot: &str,
+        info: &gltf::json::texture::Info,
+        srgb: bool,
+    ) -> Result<Arc<TextureData>, SceneError> {
+        let root = self.root;
+        if info.tex_coord != 0 {
+            tracing::warn!(
+                file = %self.path.display(),
+                material,
+                "{slot} uses TEXCOORD_{}, only TEXCOORD_0 is loaded",
+                info.tex_coord
+            );
+        }
+        let what = format!("material {material} {slot}");
+        let tex = self.lookup(&root.textures, info.index.value(), &what, "texture")?;
+        let image = tex.source.value();
+        let what = format!("texture {}", info.index.value());
+        self.lookup(&root.images, image, &what, "image")?;
+        let data = self.image(image)?;
+        if srgb {
+            return Ok(data);
+        }
+        if let Some(t) = self.linear.get(&image) {
+            return Ok(t.clone());
+        }
+        // The same pixels, sampled without the sRGB decode; counted in the decoded-bytes budget.
+        let needed = self.used.image_bytes.saturating_add(data.rgba8.len() as u64);
+        if needed > self.options.max_image_bytes {
+            let what = format!("image {image} as linear data (with the images decoded before it)");
+            let (unit, limit) = ("bytes of decoded images", self.options.max_image_bytes);
+            return Err(over_budget(self.path, what, needed, unit, limit, "max_image_bytes"));
+        }
+        self.used.image_bytes = needed;
+        let linear = Arc::new(TextureData { srgb: false, ..(*data).clone() });
+        self.linear.insert(image, linear.clone());
+        Ok(linear)
     }
 
     /// Decodes image `index` (cached by index and by source), checking format, size and the

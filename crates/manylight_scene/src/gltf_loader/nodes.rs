@@ -302,7 +302,13 @@ impl Ctx<'_> {
                 self.lookup(&self.root.materials, m, &format!("mesh {mesh} primitive {p}"), "material")?;
                 self.material(m)?
             }
-            None => manylight_core::MaterialData::default(),
+            // The specification's default material: white, metallic 1, roughness 1.
+            None => manylight_core::MaterialData {
+                label: "glTF default material".into(),
+                metallic: 1.0,
+                roughness: 1.0,
+                ..manylight_core::MaterialData::default()
+            },
         };
         self.scene.materials.push(Arc::new(data));
         let i = self.scene.materials.len() - 1;

@@ -1,0 +1,207 @@
+//! The metallic-roughness model on the GPU against its CPU twin: a grid of spheres of known
+//! metallic and roughness under point lights, rendered by naive forward and by a CPU ray
+//! caster that shades with `manylight_core::brdf` and tone-maps with
+//! `manylight_core::tonemap`; then every other pipeline and G-buffer layout against naive
+//! forward on the same spheres.
+
+mod support;
+
+use glam::{Mat4, Vec3};
+use image::RgbaImage;
+use manylight::app::RenderSettings;
+use manylight::app::prelude::GBufferLayout;
+use manylight::core::brdf::{PointLightSample, SurfaceParams, shade_point_light};
+use manylight::core::tonemap::tonemap_to_srgb8;
+use manylight::core::{MaterialData, Projection, ShadingModel};
+use manylight::prelude::*;
+use manylight::scene::shapes::uv_sphere;
+use manylight::scene::{SceneCamera, SceneInstance, SceneLight, camera_looking_at};
+use std::sync::Arc;
+use support::{STRICT, Tolerance, assert_similar, gpu, render_scene};
+
+const SIZE: UVec2 = UVec2::new(256, 128);
+const SPHERE_RADIUS: f32 = 0.42;
+const ROUGHNESS: [f32; 5] = [0.08, 0.25, 0.5, 0.75, 1.0];
+const METALLIC: [f32; 2] = [1.0, 0.0];
+const BASE_COLOR: Vec3 = Vec3::new(0.95, 0.64, 0.32);
+const AMBIENT: f32 = 0.03;
+const EYE: Vec3 = Vec3::new(0.0, 0.0, 7.0);
+const FOV_Y: f32 = 0.5;
+
+/// The tolerance of the GPU image against the CPU twin (the mean is the acceptance figure;
+/// the 99th percentile allows the sphere outlines, where the mesh's polygon meets the exact
+/// circle).
+const TWIN: Tolerance = Tolerance { mean: 0.01, p99: 0.05 };
+
+fn centre(row: usize, column: usize) -> Vec3 {
+    Vec3::new((column as f32 - 2.0) * 1.0, 0.5 - row as f32, 0.0)
+}
+
+fn lights() -> Vec<SceneLight> {
+    vec![
+        SceneLight { position: Vec3::new(2.5, 2.0, 3.5), color: Vec3::ONE, intensity: 30.0, radius: 40.0 },
+        SceneLight {
+            position: Vec3::new(-3.0, 1.0, 3.0),
+            color: Vec3::new(1.0, 0.7, 0.4),
+            intensity: 15.0,
+            radius: 40.0,
+        },
+        SceneLight {
+            position: Vec3::new(0.5, -2.5, 2.0),
+            color: Vec3::new(0.4, 0.6, 1.0),
+            intensity: 12.0,
+            radius: 40.0,
+        },
+    ]
+}
+
+/// Ten spheres: metals on the top row, dielectrics below, roughness rising to the right.
+fn spheres() -> Scene {
+    let mut scene = Scene { name: "pbr spheres".into(), ..Scene::default() };
+    scene.meshes.push(Arc::new(uv_sphere("sphere", SPHERE_RADIUS, 96, 192, false)));
+    for (row, metallic) in METALLIC.into_iter().enumerate() {
+        for (column, roughness) in ROUGHNESS.into_iter().enumerate() {
+            scene.materials.push(Arc::new(MaterialData {
+                label: format!("metallic {metallic} roughness {roughness}"),
+                base_color: BASE_COLOR.extend(1.0),
+                metallic,
+                roughness,
+                ..MaterialData::default()
+            }));
+            scene.instances.push(SceneInstance {
+                mesh: 0,
+                material: scene.materials.len() - 1,
+                transform: Mat4::from_translation(centre(row, column)),
+            });
+        }
+    }
+    scene.lights = lights();
+    scene.cameras.push(SceneCamera {
+        transform: camera_looking_at(EYE, Vec3::ZERO),
+        projection: Projection::perspective(FOV_Y, 0.1, 100.0),
+    });
+    scene
+}
+
+fn settings(pipeline: PipelineKind) -> RenderSettings {
+    RenderSettings {
+        pipeline,
+        shading: ShadingModel::Pbr,
+        ambient: AMBIENT,
+        clear_color: [0.0; 3],
+        exposure: 1.0,
+        ..RenderSettings::default()
+    }
+}
+
+/// The spheres ray-cast at each pixel centre and shaded by the CPU twin.
+fn cpu_twin() -> RgbaImage {
+    let aspect = SIZE.x as f32 / SIZE.y as f32;
+    let clip_from_world = Projection::perspective(FOV_Y, 0.1, 100.0).matrix(aspect)
+        * camera_looking_at(EYE, Vec3::ZERO).inverse();
+    let world_from_clip = clip_from_world.inverse();
+    let unproject = |ndc: Vec3| {
+        let p = world_from_clip * ndc.extend(1.0);
+        p.truncate() / p.w
+    };
+    let lights: Vec<PointLightSample> = lights()
+        .iter()
+        .map(|l| PointLightSample { position: l.position, radius: l.radius, color: l.color * l.intensity })
+        .collect();
+    RgbaImage::from_fn(SIZE.x, SIZE.y, |x, y| {
+        let ndc = Vec3::new(
+            (x as f32 + 0.5) / SIZE.x as f32 * 2.0 - 1.0,
+            1.0 - (y as f32 + 0.5) / SIZE.y as f32 * 2.0,
+            0.5,
+        );
+        let dir = (unproject(ndc) - EYE).normalize();
+        let mut hit: Option<(f32, usize, usize)> = None;
+        for row in 0..METALLIC.len() {
+            for column in 0..ROUGHNESS.len() {
+                let oc = EYE - centre(row, column);
+                let b = oc.dot(dir);
+                let disc = b * b - (oc.length_squared() - SPHERE_RADIUS * SPHERE_RADIUS);
+                if disc < 0.0 {
+                    continue;
+                }
+                let t = -b - disc.sqrt();
+                if t > 0.0 && hit.is_none_or(|(best, _, _)| t < best) {
+                    hit = Some((t, row, column));
+                }
+            }
+        }
+        let hdr = match hit {
+            None => Vec3::ZERO,
+            Some((t, row, column)) => {
+                let p = EYE + dir * t;
+                let s = SurfaceParams {
+                    albedo: BASE_COLOR,
+                    normal: (p - centre(row, column)).normalize(),
+                    shininess: 32.0,
+                    specular: 0.25,
+                    metallic: METALLIC[row],
+                    roughness: ROUGHNESS[column],
+                    model: ShadingModel::Pbr,
+                };
+                let view_dir = (EYE - p).normalize();
+                let mut c = BASE_COLOR * AMBIENT;
+                for l in &lights {
+                    c += shade_point_light(&s, p, view_dir, l);
+                }
+                c
+            }
+        };
+        image::Rgba(tonemap_to_srgb8(hdr, 1.0))
+    })
+}
+
+/// Naive forward's metallic-roughness spheres equal the CPU twin's (FLIP mean <= 0.01), and
+/// the image shows what the parameters mean: metals take the base colour into their
+/// highlights, rough surfaces spread them.
+#[test]
+fn pbr_spheres_match_the_cpu_twin() {
+    let _gpu = gpu();
+    let frame = render_scene(spheres(), SIZE, 0, settings(PipelineKind::NaiveForward));
+    let twin = cpu_twin();
+    let _ = frame.image.save(support::output_dir().join("pbr_spheres.png"));
+    let stats = assert_similar("pbr_spheres_cpu_twin", &twin, &frame.image, TWIN);
+    eprintln!("pbr spheres against the CPU twin: {stats:?}");
+    // Not a flat image: the smooth metal's highlight is far brighter than the rough one's.
+    let peak = |column: usize| {
+        let c = centre(0, column);
+        let half = (SPHERE_RADIUS * SIZE.y as f32 / (2.0 * EYE.z * (FOV_Y * 0.5).tan())) as i32;
+        let cx = ((c.x / (EYE.z * (FOV_Y * 0.5).tan() * 2.0)) * SIZE.y as f32 + SIZE.x as f32 * 0.5) as i32;
+        let cy = (SIZE.y as f32 * 0.5 - c.y / (EYE.z * (FOV_Y * 0.5).tan() * 2.0) * SIZE.y as f32) as i32;
+        let mut best = 0u8;
+        for y in (cy - half).max(0)..(cy + half).min(SIZE.y as i32) {
+            for x in (cx - half).max(0)..(cx + half).min(SIZE.x as i32) {
+                best = best.max(frame.image.get_pixel(x as u32, y as u32)[1]);
+            }
+        }
+        best
+    };
+    assert!(peak(0) > peak(4).saturating_add(40), "smooth metal peak {} vs rough {}", peak(0), peak(4));
+}
+
+/// Every pipeline and G-buffer layout shades the metallic-roughness spheres as naive forward.
+#[test]
+fn every_pipeline_matches_naive_forward_with_pbr() {
+    let _gpu = gpu();
+    let naive = render_scene(spheres(), SIZE, 0, settings(PipelineKind::NaiveForward));
+    let mut variants: Vec<(String, RenderSettings)> = PipelineKind::ALL
+        .into_iter()
+        .filter(|p| *p != PipelineKind::NaiveForward)
+        .map(|p| (format!("pbr_{}", p.name()), settings(p)))
+        .collect();
+    for layout in [GBufferLayout::Packed, GBufferLayout::Compact] {
+        variants.push((
+            format!("pbr_clustered_deferred_{}", layout.name()),
+            RenderSettings { gbuffer: layout, ..settings(PipelineKind::ClusteredDeferred) },
+        ));
+    }
+    for (name, s) in variants {
+        let frame = render_scene(spheres(), SIZE, 0, s);
+        let stats = assert_similar(&name, &naive.image, &frame.image, STRICT);
+        eprintln!("{name}: {stats:?}");
+    }
+}
