@@ -444,8 +444,8 @@ impl SceneResources {
             }
             return Ok((k, m.order));
         }
-        let [base_view, metal_rough_view] = [0, 1].map(|i| self.texture_view(gpu, textures[i].as_ref()));
-        let (base_view, metal_rough_view) = (base_view?, metal_rough_view?);
+        let base_view = self.texture_view(gpu, material.base_color_texture.as_ref())?;
+        let metal_rough_view = self.texture_view(gpu, material.metallic_roughness_texture.as_ref())?;
         let uniform = GpuMaterial {
             base_color: material.base_color,
             shininess: material.shininess.clamp(1.0, 4096.0),
