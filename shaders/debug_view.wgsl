@@ -4,7 +4,8 @@
 //   (clusters whose list hit the cap in red, the others green by how full they are);
 // - fs_depth: the linearised view distance (near white, far black; log scale so both near
 //   and far detail show);
-// - fs_surface: albedo or world-space normal (n * 0.5 + 0.5) from the Full G-buffer.
+// - fs_surface: albedo, world-space normal (n * 0.5 + 0.5), metallic, roughness (PBR surfaces;
+//   others black), emitted radiance (clamped to 1) or ambient occlusion, from the Full G-buffer.
 //!include common/view.wgsl
 //!include common/clusters.wgsl
 //!include common/fullscreen.wgsl
@@ -26,6 +27,8 @@ struct DebugParams {
 @group(0) @binding(4) var<uniform> debug: DebugParams;
 @group(0) @binding(5) var gbuffer_albedo: texture_2d<f32>;
 @group(0) @binding(6) var gbuffer_normal: texture_2d<f32>;
+@group(0) @binding(7) var gbuffer_emissive: texture_2d<f32>;
+@group(0) @binding(8) var gbuffer_position: texture_2d<f32>;
 
 const BACKGROUND = vec4<f32>(0.02, 0.02, 0.02, 1.0);
 
@@ -114,9 +117,22 @@ fn fs_surface(in: FullscreenOut) -> @location(0) vec4<f32> {
     if textureLoad(depth, px, 0) <= 0.0 {
         return BACKGROUND;
     }
+    let albedo = textureLoad(gbuffer_albedo, px, 0);
+    let normal = textureLoad(gbuffer_normal, px, 0);
+    let emissive = textureLoad(gbuffer_emissive, px, 0);
+    // The Full layout's material slots hold roughness (normal.w) and metallic (albedo.a) for PBR.
+    let pbr = u32(textureLoad(gbuffer_position, px, 0).w + 0.5) == SHADING_PBR;
+    var color = saturate(normal.xyz * 0.5 + 0.5);
     if debug.mode == DEBUG_ALBEDO {
-        return vec4<f32>(saturate(textureLoad(gbuffer_albedo, px, 0).rgb), 1.0);
+        color = saturate(albedo.rgb);
+    } else if debug.mode == DEBUG_METALLIC {
+        color = vec3<f32>(select(0.0, saturate(albedo.a), pbr));
+    } else if debug.mode == DEBUG_ROUGHNESS {
+        color = vec3<f32>(select(0.0, saturate(normal.w), pbr));
+    } else if debug.mode == DEBUG_EMISSIVE {
+        color = saturate(emissive.rgb);
+    } else if debug.mode == DEBUG_OCCLUSION {
+        color = vec3<f32>(saturate(emissive.a));
     }
-    let n = textureLoad(gbuffer_normal, px, 0).xyz;
-    return vec4<f32>(saturate(n * 0.5 + 0.5), 1.0);
+    return vec4<f32>(color, 1.0);
 }

@@ -5,11 +5,11 @@
 @fragment
 fn fs_main(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
     let p = surface_point(view, in.clip_position.xy, in.camera_offset);
-    let albedo = surface_albedo(material, base_color_texture, base_color_sampler, in.uv);
-    let metal_rough = surface_metal_rough(material, metallic_roughness_texture, base_color_sampler, in.uv);
-    let s = surface_params(material, view.shading_model, albedo.rgb, metal_rough, in.world_normal, front_facing);
+    let m = sample_material(in, front_facing);
+    let s = m.params;
+    alpha_test(m.base_color);
     let view_dir = direction_to_eye(view, p.world_position);
-    var color = albedo.rgb * view.params.w;
+    var color = surface_base_radiance(s.albedo, view.params.w, m.occlusion, m.emissive);
     // Four lights per iteration, added in order: lavapipe stops an invocation after 65 535 loop
     // iterations, which would drop every light past the 65 535th of the reference.
     let n = view.light_count;

@@ -10,6 +10,8 @@
 //   z = the two material parameters as f16 (`material_slots`: shininess | specular, or
 //   roughness | metallic for PBR), w = the reverse-Z depth of the shading position
 //   (f32 bits); the lighting pass rebuilds the position from that depth.
+// Every layout adds an rgba16f target: the emitted radiance (rgb, clamped to f16's largest
+// value) and the ambient occlusion (a).
 // Every layout stores the shading position of `surface_point` (common/surface.wgsl), not the
 // rasteriser's interpolation or depth, which drift on triangles much larger than their
 // distance from the camera.
@@ -20,51 +22,68 @@ struct FullOut {
     @location(0) position: vec4<f32>,
     @location(1) normal: vec4<f32>,
     @location(2) albedo: vec4<f32>,
+    @location(3) emissive: vec4<f32>,
 };
 
-fn surface_of(in: SurfaceVertexOut, front_facing: bool) -> SurfaceParams {
-    let albedo = surface_albedo(material, base_color_texture, base_color_sampler, in.uv);
-    let metal_rough = surface_metal_rough(material, metallic_roughness_texture, base_color_sampler, in.uv);
-    return surface_params(material, view.shading_model, albedo.rgb, metal_rough, in.world_normal, front_facing);
+// The emissive target's texel: emitted radiance and occlusion.
+fn emissive_texel(m: MaterialSample) -> vec4<f32> {
+    return vec4<f32>(min(m.emissive, vec3<f32>(65504.0)), m.occlusion);
 }
 
 @fragment
 fn fs_full(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> FullOut {
     let p = surface_point(view, in.clip_position.xy, in.camera_offset);
-    let s = surface_of(in, front_facing);
+    let m = sample_material(in, front_facing);
+    alpha_test(m.base_color);
+    let s = m.params;
     var out: FullOut;
     out.position = vec4<f32>(p.world_position, f32(s.model));
     let slots = material_slots(s);
     out.normal = vec4<f32>(s.normal, slots.x);
     out.albedo = vec4<f32>(s.albedo, saturate(slots.y));
+    out.emissive = emissive_texel(m);
     return out;
 }
 
 struct PackedOut {
     @location(0) albedo: vec4<f32>,
     @location(1) position: vec4<f32>,
+    @location(2) emissive: vec4<f32>,
 };
 
 @fragment
 fn fs_packed(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> PackedOut {
     let p = surface_point(view, in.clip_position.xy, in.camera_offset);
-    let s = surface_of(in, front_facing);
+    let m = sample_material(in, front_facing);
+    alpha_test(m.base_color);
+    let s = m.params;
     let n = gbuffer_encode_components(s.normal, view.view_from_world);
     var out: PackedOut;
     out.albedo = vec4<f32>(gbuffer_pack_albedo_params(s), n.x);
     out.position = vec4<f32>(p.world_position, n.y);
+    out.emissive = emissive_texel(m);
     return out;
 }
 
+struct CompactOut {
+    @location(0) surface: vec4<u32>,
+    @location(1) emissive: vec4<f32>,
+};
+
 @fragment
-fn fs_compact(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<u32> {
+fn fs_compact(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> CompactOut {
     let p = surface_point(view, in.clip_position.xy, in.camera_offset);
-    let s = surface_of(in, front_facing);
+    let m = sample_material(in, front_facing);
+    alpha_test(m.base_color);
+    let s = m.params;
     let clip = view.clip_from_world * vec4<f32>(p.world_position, 1.0);
-    return vec4<u32>(
+    var out: CompactOut;
+    out.surface = vec4<u32>(
         gbuffer_pack_albedo_model(s.albedo, s.model),
         gbuffer_encode_word(s.normal),
         pack2x16float(material_slots(s)),
         bitcast<u32>(clip.z / clip.w),
     );
+    out.emissive = emissive_texel(m);
+    return out;
 }

@@ -45,7 +45,7 @@ fn vs_volume(@location(0) position: vec3<f32>, @builtin(instance_index) light_in
 }
 
 fn ambient(g: GSurface) -> vec4<f32> {
-    return vec4<f32>(g.params.albedo * view.params.w, 1.0);
+    return vec4<f32>(gbuffer_base_radiance(g), 1.0);
 }
 
 fn one_light(g: GSurface, light_index: u32) -> vec4<f32> {

@@ -17,6 +17,7 @@ use manylight::app::headless::{HeadlessFrame, render_headless};
 use manylight::app::render_world::HeadlessRenderer;
 use manylight::app::scene::{extracted_light, scene_snapshot};
 use manylight::app::{DebugView, FrameStats};
+use manylight::core::TextureData;
 use manylight::core::camera::linearize_depth_reverse_z;
 use manylight::core::cluster::assign_lights;
 use manylight::prelude::*;
@@ -25,8 +26,36 @@ use support::{STRICT, assert_matches_reference, gpu};
 
 const SIZE: UVec2 = UVec2::new(128, 72);
 
+/// The default scene with an emissive material and an occlusion texture, so that every
+/// surface view has something to show.
+fn scene() -> Scene {
+    let mut scene = default_scene();
+    let checker: Vec<u8> = (0..16 * 16)
+        .flat_map(|i: u32| {
+            let v = if (i % 16 / 4 + i / 64).is_multiple_of(2) { 255 } else { 64 };
+            [v, v, v, 255]
+        })
+        .collect();
+    let occlusion = std::sync::Arc::new(TextureData {
+        label: "checker occlusion".into(),
+        width: 16,
+        height: 16,
+        rgba8: checker,
+        srgb: false,
+    });
+    for (i, material) in scene.materials.iter_mut().enumerate() {
+        let m = std::sync::Arc::make_mut(material);
+        if i == 0 {
+            m.emissive = Vec3::new(1.0, 0.5, 0.2);
+        } else {
+            m.occlusion_texture = Some(occlusion.clone());
+        }
+    }
+    scene
+}
+
 fn render(debug: DebugView, settings: RenderSettings) -> HeadlessFrame {
-    let scene = default_scene();
+    let scene = scene();
     let aspect = SIZE.x as f32 / SIZE.y as f32;
     let bounds = scene.bounds();
     render_headless(SIZE, 1, move |app| {

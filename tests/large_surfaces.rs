@@ -29,7 +29,7 @@ fn camera(far: f32) -> SceneCamera {
 }
 
 fn floor_vertex(x: f64, z: f64) -> Vertex {
-    Vertex { position: [x as f32, 0.0, z as f32], normal: [0.0, 1.0, 0.0], uv: [0.0, 0.0] }
+    Vertex { position: [x as f32, 0.0, z as f32], normal: [0.0, 1.0, 0.0], ..Vertex::default() }
 }
 
 /// The floor as one quad with corners at ±`extent`.

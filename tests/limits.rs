@@ -21,9 +21,13 @@ fn quad_in_front(vertex_count: usize) -> MeshData {
     let corner = |x: f32, y: f32| camera.transform_point3(Vec3::new(x, y, -2.0));
     let normal = camera.transform_vector3(Vec3::Z).normalize();
     let mut vertices =
-        vec![Vertex { position: [0.0; 3], normal: [0.0, 1.0, 0.0], uv: [0.0; 2] }; vertex_count - 4];
+        vec![Vertex { position: [0.0; 3], normal: [0.0, 1.0, 0.0], ..Vertex::default() }; vertex_count - 4];
     for (x, y) in [(-0.4, -0.3), (0.4, -0.3), (0.4, 0.3), (-0.4, 0.3)] {
-        vertices.push(Vertex { position: corner(x, y).to_array(), normal: normal.to_array(), uv: [0.0; 2] });
+        vertices.push(Vertex {
+            position: corner(x, y).to_array(),
+            normal: normal.to_array(),
+            ..Vertex::default()
+        });
     }
     let first = (vertex_count - 4) as u32;
     let indices = [0, 1, 2, 0, 2, 3].map(|i| first + i).to_vec();

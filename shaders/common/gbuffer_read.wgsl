@@ -18,12 +18,31 @@
 // Packed layout
 @group(1) @binding(6) var gb_packed_albedo: texture_2d<f32>;
 @group(1) @binding(7) var gb_packed_position: texture_2d<f32>;
+// Every layout: emitted radiance (rgb) and ambient occlusion (a)
+@group(1) @binding(8) var gb_emissive: texture_2d<f32>;
 
 // A surface read back from the G-buffer.
 struct GSurface {
     params: SurfaceParams,
     world_position: vec3<f32>,
+    emissive: vec3<f32>,
+    occlusion: f32,
 };
+
+// `g` with the emissive target's radiance and occlusion at `px`.
+fn with_emissive(g: GSurface, px: vec2<i32>) -> GSurface {
+    let e = textureLoad(gb_emissive, px, 0);
+    var out = g;
+    out.emissive = e.rgb;
+    out.occlusion = e.a;
+    return out;
+}
+
+// What the surface sends back whatever the point lights (common/surface.wgsl's
+// `surface_base_radiance`, from the G-buffer).
+fn gbuffer_base_radiance(g: GSurface) -> vec3<f32> {
+    return g.params.albedo * view.params.w * g.occlusion + g.emissive;
+}
 
 // Reverse-Z depth of the pixel (0: nothing was drawn there).
 fn gbuffer_depth(px: vec2<i32>) -> f32 {
@@ -40,7 +59,7 @@ fn gbuffer_read_full(px: vec2<i32>) -> GSurface {
     g.params.model = u32(p.w + 0.5);
     g.params = with_material_slots(g.params, vec2<f32>(n.w, a.a));
     g.world_position = p.xyz;
-    return g;
+    return with_emissive(g, px);
 }
 
 fn gbuffer_read_packed(px: vec2<i32>) -> GSurface {
@@ -50,7 +69,7 @@ fn gbuffer_read_packed(px: vec2<i32>) -> GSurface {
     g.params = gbuffer_unpack_albedo_params(a.rgb);
     g.params.normal = gbuffer_decode_components(vec2<f32>(a.a, p.a), view.view_from_world);
     g.world_position = p.xyz;
-    return g;
+    return with_emissive(g, px);
 }
 
 // World position of the pixel centre at `uv` (0..1, top-left origin) and reverse-Z `depth`.
@@ -72,5 +91,5 @@ fn gbuffer_read_compact(px: vec2<i32>) -> GSurface {
     out.params = with_material_slots(out.params, params);
     let uv = (vec2<f32>(px) + 0.5) * view.viewport.zw;
     out.world_position = gbuffer_position_from_depth(uv, bitcast<f32>(g.w));
-    return out;
+    return with_emissive(out, px);
 }

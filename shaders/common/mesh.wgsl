@@ -15,11 +15,21 @@ struct GpuMaterial {
     metallic: f32,
     roughness: f32,
     has_metallic_roughness_texture: u32,
-    _pad: u32,
+    normal_scale: f32,
+    // linear emitted radiance (factor times KHR_materials_emissive_strength)
+    emissive: vec3<f32>,
+    occlusion_strength: f32,
+    has_normal_texture: u32,
+    has_occlusion_texture: u32,
+    has_emissive_texture: u32,
+    // fragments below it are discarded by the ALPHA_MASK pipelines
+    alpha_cutoff: f32,
 };
 
 struct VertexIn {
     @location(0) position: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
+    // xyz along +u, w = bitangent handedness (all zero: no tangent frame)
+    @location(3) tangent: vec4<f32>,
 };

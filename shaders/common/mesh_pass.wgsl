@@ -15,6 +15,47 @@
 @group(1) @binding(2) var base_color_sampler: sampler;
 // glTF metallic-roughness: blue = metalness, green = roughness (linear)
 @group(1) @binding(3) var metallic_roughness_texture: texture_2d<f32>;
+// tangent-space normal map (linear, xyz * 0.5 + 0.5)
+@group(1) @binding(4) var normal_texture: texture_2d<f32>;
+// ambient occlusion (linear, red)
+@group(1) @binding(5) var occlusion_texture: texture_2d<f32>;
+// emitted colour (sRGB)
+@group(1) @binding(6) var emissive_texture: texture_2d<f32>;
+
+// Everything a shading pass needs of the material at a fragment.
+struct MaterialSample {
+    params: SurfaceParams,
+    // linear RGBA base colour (alpha for the mask test)
+    base_color: vec4<f32>,
+    emissive: vec3<f32>,
+    occlusion: f32,
+};
+
+// Samples every texture of the material (in uniform control flow: no texture sample sits
+// behind a branch) and builds the surface: normal map, occlusion, emissive, and the normal
+// turned towards the viewer on the back faces of double-sided materials.
+fn sample_material(in: SurfaceVertexOut, front_facing: bool) -> MaterialSample {
+    let smp = base_color_sampler;
+    var out: MaterialSample;
+    out.base_color = surface_albedo(material, base_color_texture, smp, in.uv);
+    let metal_rough = surface_metal_rough(material, metallic_roughness_texture, smp, in.uv);
+    let normal_texel = textureSample(normal_texture, smp, in.uv);
+    let n = surface_normal(material, normal_texel.xyz, in, front_facing);
+    out.params = surface_params(material, view.shading_model, out.base_color.rgb, metal_rough, n);
+    let occlusion_texel = textureSample(occlusion_texture, smp, in.uv).r;
+    out.occlusion = surface_occlusion(material, occlusion_texel);
+    let emissive_texel = textureSample(emissive_texture, smp, in.uv).rgb;
+    out.emissive = material.emissive * select(vec3<f32>(1.0), emissive_texel, material.has_emissive_texture != 0u);
+    return out;
+}
+
+// Discards the fragment in the ALPHA_MASK pipelines when its alpha is below the cutoff. Call
+// it after every derivative and texture sample of the fragment.
+fn alpha_test(base_color: vec4<f32>) {
+    if ALPHA_MASK && base_color.a < material.alpha_cutoff {
+        discard;
+    }
+}
 
 @vertex
 fn vs_main(v: VertexIn, @builtin(instance_index) instance_index: u32) -> SurfaceVertexOut {

@@ -11,15 +11,28 @@ struct SurfaceVertexOut {
     @location(0) camera_offset: vec3<f32>,
     @location(1) world_normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
+    // World tangent (xyz, transformed like positions) and the bitangent's handedness in world
+    // space (w: the vertex's times the sign of the instance's determinant; 0 without tangent).
+    @location(3) world_tangent: vec4<f32>,
+    // +1, or -1 for a mirrored instance (negative determinant), whose triangles wind the other
+    // way on screen.
+    @location(4) @interpolate(flat) mirror: f32,
 };
+
+// True in the pipelines of alpha-masked materials (Rust: `SurfaceVariant::alpha_mask`).
+override ALPHA_MASK: bool = false;
 
 fn surface_vertex(v: VertexIn, inst: GpuInstance, clip_from_world: mat4x4<f32>, camera: vec3<f32>) -> SurfaceVertexOut {
     let world = inst.world_from_local * vec4<f32>(v.position, 1.0);
+    let m = mat3x3<f32>(inst.world_from_local[0].xyz, inst.world_from_local[1].xyz, inst.world_from_local[2].xyz);
+    let mirror = select(1.0, -1.0, determinant(m) < 0.0);
     var out: SurfaceVertexOut;
     out.clip_position = clip_from_world * world;
     out.camera_offset = world.xyz - camera;
     out.world_normal = (inst.normal_from_local * vec4<f32>(v.normal, 0.0)).xyz;
     out.uv = v.uv;
+    out.world_tangent = vec4<f32>(m * v.tangent.xyz, v.tangent.w * mirror);
+    out.mirror = mirror;
     return out;
 }
 
@@ -36,11 +49,39 @@ fn surface_metal_rough(m: GpuMaterial, t: texture_2d<f32>, smp: sampler, uv: vec
     return vec2<f32>(m.metallic * texel.b, m.roughness * texel.g);
 }
 
-fn surface_params(m: GpuMaterial, global_model: u32, albedo: vec3<f32>, metal_rough: vec2<f32>, normal: vec3<f32>, front_facing: bool) -> SurfaceParams {
-    let len = length(normal);
-    var n = select(vec3<f32>(0.0, 1.0, 0.0), normal / len, len > 1e-8);
-    // Two-sided lighting: shade the face the camera sees.
-    n = select(-n, n, front_facing);
+// The shading normal of a fragment: the interpolated normal, turned to the side the camera
+// sees (the back faces of single-sided materials are culled before they get here), then
+// perturbed by the tangent-space normal map `texel` (0..1 per channel) when the material has
+// one and the vertex a tangent frame (glTF: bitangent = w * cross(normal, tangent), the map's
+// +y along it). On a back face the whole frame turns, as MikkTSpace bakers expect.
+fn surface_normal(m: GpuMaterial, texel: vec3<f32>, in: SurfaceVertexOut, front_facing: bool) -> vec3<f32> {
+    let len = length(in.world_normal);
+    let n0 = select(vec3<f32>(0.0, 1.0, 0.0), in.world_normal / len, len > 1e-8);
+    let side = select(-1.0, 1.0, front_facing == (in.mirror > 0.0));
+    let n = n0 * side;
+    let t = in.world_tangent.xyz * side;
+    let b = cross(n0, in.world_tangent.xyz) * (in.world_tangent.w * side);
+    let tn = vec3<f32>((texel.xy * 2.0 - 1.0) * m.normal_scale, texel.z * 2.0 - 1.0);
+    let mapped = tn.x * t + tn.y * b + tn.z * n;
+    let mapped_len = length(mapped);
+    let usable = m.has_normal_texture != 0u && in.world_tangent.w != 0.0 && mapped_len > 1e-8;
+    return select(n, mapped / mapped_len, usable);
+}
+
+// Ambient occlusion of the material for the occlusion texture's red channel `texel`.
+fn surface_occlusion(m: GpuMaterial, texel: f32) -> f32 {
+    let strength = saturate(m.occlusion_strength);
+    return select(1.0, 1.0 + strength * (texel - 1.0), m.has_occlusion_texture != 0u);
+}
+
+// Radiance a surface sends back whatever the point lights: the ambient term (darkened by
+// occlusion) plus what it emits.
+fn surface_base_radiance(albedo: vec3<f32>, ambient: f32, occlusion: f32, emissive: vec3<f32>) -> vec3<f32> {
+    return albedo * ambient * occlusion + emissive;
+}
+
+// The surface parameters of a fragment whose shading normal `n` is unit length and oriented.
+fn surface_params(m: GpuMaterial, global_model: u32, albedo: vec3<f32>, metal_rough: vec2<f32>, n: vec3<f32>) -> SurfaceParams {
     var s: SurfaceParams;
     s.albedo = albedo;
     s.normal = n;

@@ -48,6 +48,12 @@ impl DebugView {
             DebugViewMode::SliceZ => "cluster z index (alternating colours per depth slice)".into(),
             DebugViewMode::Albedo => "surface albedo".into(),
             DebugViewMode::Normal => "world normal: rgb = n * 0.5 + 0.5 (+x red, +y green, +z blue)".into(),
+            DebugViewMode::Metallic => "PBR metalness: black 0 → white 1 (other shading models black)".into(),
+            DebugViewMode::Roughness => {
+                "PBR perceptual roughness: black 0 → white 1 (other shading models black)".into()
+            }
+            DebugViewMode::Emissive => "emitted radiance (linear, clamped to 1)".into(),
+            DebugViewMode::Occlusion => "ambient occlusion: white = none, black = full".into(),
             DebugViewMode::Depth => "linear view depth, log scale: white near → black far".into(),
             DebugViewMode::Overflow => format!(
                 "cluster overflow: red = list hit the cap; green = fill (of the cap, or of {} without one)",

@@ -18,5 +18,5 @@ pub mod tonemap;
 
 pub use attenuation::{attenuation, radius_for_intensity};
 pub use camera::{Projection, ProjectionKind, linearize_depth_reverse_z};
-pub use material::{MaterialData, ShadingModel, TextureData};
+pub use material::{AlphaMode, MaterialData, ShadingModel, TextureData};
 pub use mesh::{Aabb, MeshData, MeshError, Vertex};

@@ -1,6 +1,6 @@
 //! Materials and textures as plain data (what the GPU side uploads once, shared as `Arc`s).
 
-use glam::Vec4;
+use glam::{Vec3, Vec4};
 use std::sync::Arc;
 
 /// How a surface responds to light. Selected per material or globally in the render settings.
@@ -70,6 +70,35 @@ pub struct TextureData {
     pub srgb: bool,
 }
 
+/// How a material's alpha is used (glTF `alphaMode`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum AlphaMode {
+    /// Alpha is ignored: the surface is fully opaque.
+    #[default]
+    Opaque,
+    /// Fragments whose alpha (base colour factor times texture) is below the cutoff are
+    /// discarded; the rest are opaque.
+    Mask(f32),
+    /// Alpha blends the surface over what lies behind it. Not drawn as a transparent pass yet:
+    /// such materials are drawn opaque (the loader warns).
+    Blend,
+}
+
+impl AlphaMode {
+    /// glTF's default `alphaCutoff`.
+    pub const DEFAULT_CUTOFF: f32 = 0.5;
+
+    /// The cutoff below which fragments are discarded; `None` unless `Mask`. A non-finite
+    /// cutoff becomes the default one.
+    pub fn cutoff(self) -> Option<f32> {
+        match self {
+            AlphaMode::Mask(c) if c.is_finite() => Some(c),
+            AlphaMode::Mask(_) => Some(Self::DEFAULT_CUTOFF),
+            _ => None,
+        }
+    }
+}
+
 /// Surface parameters of a mesh instance.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MaterialData {
@@ -92,6 +121,26 @@ pub struct MaterialData {
     pub shininess: f32,
     /// Strength of the Blinn-Phong specular lobe (0 = none).
     pub specular: f32,
+    /// Optional linear tangent-space normal map (glTF: rgb = xyz * 0.5 + 0.5, +y up in
+    /// texture space); the mesh's tangents (`Vertex::tangent`) give its frame.
+    pub normal_texture: Option<Arc<TextureData>>,
+    /// Scale of the normal map's x and y (glTF `normalTexture.scale`).
+    pub normal_scale: f32,
+    /// Optional linear ambient-occlusion texture (red channel). Occlusion darkens only the
+    /// ambient term, never a point light's contribution (glTF: it applies to indirect light).
+    pub occlusion_texture: Option<Arc<TextureData>>,
+    /// How much of the occlusion applies: `1 + strength * (texel - 1)` (0 = none, 1 = full).
+    pub occlusion_strength: f32,
+    /// Linear emitted radiance, added whatever the lights (glTF `emissiveFactor` times
+    /// `KHR_materials_emissive_strength`).
+    pub emissive: Vec3,
+    /// Optional sRGB emissive texture, multiplied with `emissive`.
+    pub emissive_texture: Option<Arc<TextureData>>,
+    /// Drawn from both sides, the normal flipped on back faces; single-sided materials are not
+    /// drawn where their back faces the camera (glTF `doubleSided`).
+    pub double_sided: bool,
+    /// How alpha is used.
+    pub alpha_mode: AlphaMode,
 }
 
 impl Default for MaterialData {
@@ -106,6 +155,30 @@ impl Default for MaterialData {
             shading: None,
             shininess: 32.0,
             specular: 0.25,
+            normal_texture: None,
+            normal_scale: 1.0,
+            occlusion_texture: None,
+            occlusion_strength: 1.0,
+            emissive: Vec3::ZERO,
+            emissive_texture: None,
+            // Procedural scenes are open shells seen from either side; glTF materials say.
+            double_sided: true,
+            alpha_mode: AlphaMode::Opaque,
         }
+    }
+}
+
+impl MaterialData {
+    /// Every texture the material samples.
+    pub fn textures(&self) -> impl Iterator<Item = &Arc<TextureData>> {
+        [
+            &self.base_color_texture,
+            &self.metallic_roughness_texture,
+            &self.normal_texture,
+            &self.occlusion_texture,
+            &self.emissive_texture,
+        ]
+        .into_iter()
+        .flatten()
     }
 }

@@ -1,7 +1,7 @@
 //! Triangle meshes as plain data.
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Mat4, Vec2, Vec3, Vec4};
 use thiserror::Error;
 
 /// Interleaved vertex as the GPU reads it (`shaders/common/vertex.wgsl`).
@@ -14,6 +14,10 @@ pub struct Vertex {
     pub normal: [f32; 3],
     /// Texture coordinate.
     pub uv: [f32; 2],
+    /// Object-space unit tangent (xyz, along +u) and the handedness of the bitangent (w = ±1:
+    /// `bitangent = w * cross(normal, tangent)`), as glTF's `TANGENT`. All zero when the mesh
+    /// has none: normal maps then leave the normal as it is.
+    pub tangent: [f32; 4],
 }
 
 /// A mesh whose data is not usable.
@@ -125,6 +129,7 @@ impl MeshData {
                     position: p.to_array(),
                     normal: normals.and_then(|n| n.get(i)).map_or([0.0; 3], |n| n.to_array()),
                     uv: uvs.and_then(|u| u.get(i)).map_or([0.0; 2], |u| u.to_array()),
+                    tangent: [0.0; 4],
                 })
                 .collect(),
             indices,
@@ -180,6 +185,59 @@ impl MeshData {
         }
     }
 
+    /// Sets the tangents from an attribute array (glTF `TANGENT`). Each is made unit length
+    /// with a handedness of exactly ±1; a zero, non-finite or missing one becomes all zero
+    /// (no tangent frame at that vertex).
+    pub fn set_tangents(&mut self, tangents: &[Vec4]) {
+        for (i, v) in self.vertices.iter_mut().enumerate() {
+            v.tangent = tangents.get(i).map_or([0.0; 4], |t| sanitize_tangent(*t));
+        }
+    }
+
+    /// Generates tangents with MikkTSpace (`bevy_mikktspace`, as Blender, Substance and the
+    /// glTF sample models' bakers use) from positions, normals and uvs. Vertices the
+    /// algorithm gives no frame (only degenerate triangles touch them) get all-zero tangents.
+    pub fn generate_tangents(&mut self) {
+        struct Geometry<'a>(&'a mut MeshData);
+        impl bevy_mikktspace::Geometry for Geometry<'_> {
+            fn num_faces(&self) -> usize {
+                self.0.indices.len() / 3
+            }
+            fn num_vertices_of_face(&self, _face: usize) -> usize {
+                3
+            }
+            fn position(&self, face: usize, vert: usize) -> [f32; 3] {
+                self.0.vertices[self.0.indices[face * 3 + vert] as usize].position
+            }
+            fn normal(&self, face: usize, vert: usize) -> [f32; 3] {
+                self.0.vertices[self.0.indices[face * 3 + vert] as usize].normal
+            }
+            fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
+                self.0.vertices[self.0.indices[face * 3 + vert] as usize].uv
+            }
+            fn set_tangent(
+                &mut self,
+                tangent_space: Option<bevy_mikktspace::TangentSpace>,
+                face: usize,
+                vert: usize,
+            ) {
+                let i = self.0.indices[face * 3 + vert] as usize;
+                self.0.vertices[i].tangent =
+                    tangent_space.map_or([0.0; 4], |t| sanitize_tangent(Vec4::from(t.tangent_encoded())));
+            }
+        }
+        for v in &mut self.vertices {
+            v.tangent = [0.0; 4];
+        }
+        // The error type has no variants: generation cannot fail.
+        let _ = bevy_mikktspace::generate_tangents(&mut Geometry(self));
+    }
+
+    /// True when at least one vertex has a tangent frame.
+    pub fn has_tangents(&self) -> bool {
+        self.vertices.iter().any(|v| v.tangent[3] != 0.0)
+    }
+
     /// Object-space bounds.
     pub fn bounds(&self) -> Aabb {
         let mut b = Aabb::EMPTY;
@@ -192,6 +250,14 @@ impl MeshData {
     /// Number of triangles.
     pub fn triangle_count(&self) -> usize {
         self.indices.len() / 3
+    }
+}
+
+/// A unit tangent with handedness ±1, or all zero when `t` has no usable direction.
+fn sanitize_tangent(t: Vec4) -> [f32; 4] {
+    match t.truncate().try_normalize() {
+        Some(dir) if t.w.is_finite() => dir.extend(if t.w < 0.0 { -1.0 } else { 1.0 }).to_array(),
+        _ => [0.0; 4],
     }
 }
 
@@ -211,6 +277,42 @@ mod tests {
     fn out_of_range_index_is_an_error() {
         let e = MeshData::from_attributes("bad", &[Vec3::ZERO; 3], None, None, Some(vec![0, 1, 7]));
         assert_eq!(e, Err(MeshError::IndexOutOfRange { index: 7, at: 2, vertices: 3 }));
+    }
+
+    /// A quad in the xy plane with u along +x and v along -y (glTF's uv origin is top-left):
+    /// MikkTSpace gives tangent +x; mirrored uvs (u along -x) flip it and the handedness.
+    #[test]
+    fn generated_tangents_follow_u_and_flip_when_mirrored() {
+        let positions = [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
+        let uvs = [Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, 0.0)];
+        let indices = Some(vec![0, 1, 2, 0, 2, 3]);
+        let mut m = MeshData::from_attributes("quad", &positions, None, Some(&uvs), indices.clone()).unwrap();
+        m.generate_tangents();
+        for v in &m.vertices {
+            let t = Vec4::from(v.tangent);
+            assert!((t - Vec4::new(1.0, 0.0, 0.0, 1.0)).abs().max_element() < 1e-5, "{t}");
+        }
+        let mirrored = uvs.map(|uv| Vec2::new(1.0 - uv.x, uv.y));
+        let mut m =
+            MeshData::from_attributes("mirrored", &positions, None, Some(&mirrored), indices).unwrap();
+        m.generate_tangents();
+        for v in &m.vertices {
+            let t = Vec4::from(v.tangent);
+            assert!((t - Vec4::new(-1.0, 0.0, 0.0, -1.0)).abs().max_element() < 1e-5, "{t}");
+        }
+    }
+
+    #[test]
+    fn unusable_tangents_become_zero() {
+        let mut m =
+            MeshData::from_attributes("tri", &[Vec3::ZERO, Vec3::X, Vec3::Y], None, None, None).unwrap();
+        m.set_tangents(&[Vec4::new(0.0, 0.0, 0.0, 1.0), Vec4::new(2.0, 0.0, 0.0, 0.5), Vec4::NAN]);
+        assert_eq!(m.vertices[0].tangent, [0.0; 4]);
+        assert_eq!(m.vertices[1].tangent, [1.0, 0.0, 0.0, 1.0]);
+        assert_eq!(m.vertices[2].tangent, [0.0; 4]);
+        // Degenerate uvs (all zero) give no frame, not NaN.
+        m.generate_tangents();
+        assert!(m.vertices.iter().all(|v| v.tangent.iter().all(|x| x.is_finite())));
     }
 
     #[test]

@@ -290,6 +290,9 @@ impl GpuContext {
             max_compute_workgroup_storage_size: adapter_limits.max_compute_workgroup_storage_size,
             max_compute_invocations_per_workgroup: adapter_limits.max_compute_invocations_per_workgroup,
             max_compute_workgroup_size_x: adapter_limits.max_compute_workgroup_size_x,
+            // The Full and Packed G-buffers write 40 bytes per pixel (WebGPU's default is 32;
+            // Vulkan, Metal and D3D12 adapters report more).
+            max_color_attachment_bytes_per_sample: adapter_limits.max_color_attachment_bytes_per_sample,
             ..wgpu::Limits::default()
         };
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {

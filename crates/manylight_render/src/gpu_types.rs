@@ -5,7 +5,7 @@
 //! file is their single source.
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec4};
+use glam::{Mat4, Vec3, Vec4};
 use manylight_core::ShadingModel;
 use manylight_core::codec::NormalCodec;
 
@@ -76,6 +76,10 @@ pub fn shared_u32_constants() -> Vec<(&'static str, u32)> {
         ("DEBUG_NORMAL", DebugView::Normal.gpu_id()),
         ("DEBUG_DEPTH", DebugView::Depth.gpu_id()),
         ("DEBUG_OVERFLOW", DebugView::Overflow.gpu_id()),
+        ("DEBUG_METALLIC", DebugView::Metallic.gpu_id()),
+        ("DEBUG_ROUGHNESS", DebugView::Roughness.gpu_id()),
+        ("DEBUG_EMISSIVE", DebugView::Emissive.gpu_id()),
+        ("DEBUG_OCCLUSION", DebugView::Occlusion.gpu_id()),
     ]
 }
 
@@ -195,8 +199,20 @@ pub struct GpuMaterial {
     pub roughness: f32,
     /// 1 when a metallic-roughness texture is bound.
     pub has_metallic_roughness_texture: u32,
-    /// Padding to 16 bytes.
-    pub _pad: u32,
+    /// Scale of the normal map's x and y.
+    pub normal_scale: f32,
+    /// Linear emitted radiance.
+    pub emissive: Vec3,
+    /// How much of the occlusion texture applies (0..1).
+    pub occlusion_strength: f32,
+    /// 1 when a normal map is bound.
+    pub has_normal_texture: u32,
+    /// 1 when an occlusion texture is bound.
+    pub has_occlusion_texture: u32,
+    /// 1 when an emissive texture is bound.
+    pub has_emissive_texture: u32,
+    /// Alpha below which the alpha-mask pipelines discard a fragment.
+    pub alpha_cutoff: f32,
 }
 
 /// Constants emitted into WGSL as `const NAME: f32 = VALUE;` (printed so they round-trip).

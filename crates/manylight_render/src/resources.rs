@@ -51,6 +51,46 @@ pub struct GpuMaterialBinding {
     last_used: u64,
 }
 
+/// How a draw is rasterised beyond what its pass decides: back faces culled (single-sided
+/// materials, the front face following the instance's handedness) and alpha masking. Each
+/// variant the frame draws is a pipeline of every mesh pass, so opaque surfaces keep shaders
+/// without `discard` (early depth testing on real GPUs) and no material branch reaches a
+/// shader (lavapipe compiles a shader again per draw where it can fold a uniform branch).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct SurfaceVariant {
+    /// Cull back faces, with this winding facing front; `None` draws both sides.
+    pub cull_back: Option<wgpu::FrontFace>,
+    /// Discard fragments whose alpha is below the material's cutoff (`ALPHA_MASK` in
+    /// `shaders/common/surface.wgsl`).
+    pub alpha_mask: bool,
+}
+
+impl SurfaceVariant {
+    /// The variant of `material` drawn with a transform whose determinant is negative when
+    /// `mirrored` (its triangles wind the other way on screen).
+    pub fn of(material: &MaterialData, mirrored: bool) -> SurfaceVariant {
+        let front = if mirrored { wgpu::FrontFace::Cw } else { wgpu::FrontFace::Ccw };
+        SurfaceVariant {
+            cull_back: (!material.double_sided).then_some(front),
+            alpha_mask: material.alpha_mode.cutoff().is_some(),
+        }
+    }
+
+    /// Rasteriser state: triangle lists, culling as the variant says.
+    pub fn primitive(self) -> wgpu::PrimitiveState {
+        wgpu::PrimitiveState {
+            front_face: self.cull_back.unwrap_or_default(),
+            cull_mode: self.cull_back.map(|_| wgpu::Face::Back),
+            ..Default::default()
+        }
+    }
+
+    /// The shader's `override` constants for the variant.
+    pub fn constants(self) -> [(&'static str, f64); 1] {
+        [("ALPHA_MASK", if self.alpha_mask { 1.0 } else { 0.0 })]
+    }
+}
+
 /// One draw: an instance of a mesh with a material.
 #[derive(Clone, Copy, Debug)]
 pub struct Draw {
@@ -64,13 +104,15 @@ pub struct Draw {
     /// order that does not depend on where their data lies in memory, so coplanar surfaces
     /// resolve the same way on every run.
     pub order: (u64, u64),
+    /// Its pipeline variant.
+    pub variant: SurfaceVariant,
 }
 
 /// Scene data on the GPU for the current frame.
 pub struct SceneResources {
     /// Layout of group 0: view uniform, lights, instances.
     pub view_layout: wgpu::BindGroupLayout,
-    /// Layout of group 1: material uniform, base colour texture, sampler.
+    /// Layout of group 1: material uniform, sampler and the material's five textures.
     pub material_layout: wgpu::BindGroupLayout,
     /// Group 0 for this frame.
     pub view_bind_group: wgpu::BindGroup,
@@ -82,6 +124,9 @@ pub struct SceneResources {
     pub instances: GrowableBuffer,
     /// Draws sorted by material then mesh.
     pub draws: Vec<Draw>,
+    /// The distinct variants of this frame's draws, in first-drawn order: the pipelines each
+    /// mesh pass needs.
+    pub variants: Vec<SurfaceVariant>,
     /// The frame's view constants as uploaded.
     pub view: ViewUniform,
     /// Lights uploaded this frame.
@@ -202,6 +247,10 @@ impl SceneResources {
                 },
                 // metallic-roughness
                 material_texture(3),
+                // normal map, occlusion, emissive
+                material_texture(4),
+                material_texture(5),
+                material_texture(6),
             ],
         });
         let view_buffer = gpu.create_buffer(&wgpu::BufferDescriptor {
@@ -238,6 +287,7 @@ impl SceneResources {
             lights,
             instances,
             draws: Vec::new(),
+            variants: Vec::new(),
             view: ViewUniform::zeroed_default(),
             light_count: 0,
             light_upload_bytes: 0,
@@ -355,10 +405,18 @@ impl SceneResources {
             let (mesh, mesh_order) = self.mesh_entry(gpu, &inst.mesh)?;
             let (material, material_order) = self.material_entry(gpu, &inst.material)?;
             let order = (material_order, mesh_order);
-            self.draws.push(Draw { mesh, material, instance: instance_data.len() as u32, order });
+            let mirrored = glam::Mat3::from_mat4(inst.world_from_local).determinant() < 0.0;
+            let variant = SurfaceVariant::of(&inst.material, mirrored);
+            self.draws.push(Draw { mesh, material, instance: instance_data.len() as u32, order, variant });
             instance_data.push(gpu_instance);
         }
         self.draws.sort_by_key(|d| d.order);
+        self.variants.clear();
+        for d in &self.draws {
+            if !self.variants.contains(&d.variant) {
+                self.variants.push(d.variant);
+            }
+        }
         if instance_data.is_empty() {
             instance_data.push(GpuInstance::new(Mat4::IDENTITY));
         }
@@ -434,10 +492,9 @@ impl SceneResources {
     ) -> Result<(usize, u64), RenderError> {
         let k = key(material);
         let frame = self.frame;
-        let textures = [&material.base_color_texture, &material.metallic_roughness_texture];
         if let Some(m) = self.materials.get_mut(&k) {
             m.last_used = frame;
-            for t in textures.into_iter().flatten() {
+            for t in material.textures() {
                 if let Some(t) = self.textures.get_mut(&key(t)) {
                     t.last_used = frame;
                 }
@@ -446,6 +503,10 @@ impl SceneResources {
         }
         let base_view = self.texture_view(gpu, material.base_color_texture.as_ref())?;
         let metal_rough_view = self.texture_view(gpu, material.metallic_roughness_texture.as_ref())?;
+        let normal_view = self.texture_view(gpu, material.normal_texture.as_ref())?;
+        let occlusion_view = self.texture_view(gpu, material.occlusion_texture.as_ref())?;
+        let emissive_view = self.texture_view(gpu, material.emissive_texture.as_ref())?;
+        let finite_or = |v: f32, default: f32| if v.is_finite() { v } else { default };
         let uniform = GpuMaterial {
             base_color: material.base_color,
             shininess: material.shininess.clamp(1.0, 4096.0),
@@ -455,7 +516,17 @@ impl SceneResources {
             metallic: if material.metallic.is_finite() { material.metallic.clamp(0.0, 1.0) } else { 0.0 },
             roughness: if material.roughness.is_finite() { material.roughness.clamp(0.0, 1.0) } else { 1.0 },
             has_metallic_roughness_texture: material.metallic_roughness_texture.is_some() as u32,
-            _pad: 0,
+            normal_scale: finite_or(material.normal_scale, 1.0),
+            emissive: if material.emissive.is_finite() {
+                material.emissive.max(glam::Vec3::ZERO)
+            } else {
+                glam::Vec3::ZERO
+            },
+            occlusion_strength: finite_or(material.occlusion_strength, 1.0).clamp(0.0, 1.0),
+            has_normal_texture: material.normal_texture.is_some() as u32,
+            has_occlusion_texture: material.occlusion_texture.is_some() as u32,
+            has_emissive_texture: material.emissive_texture.is_some() as u32,
+            alpha_cutoff: material.alpha_mode.cutoff().unwrap_or(0.0),
         };
         let buffer = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some(&material.label),
@@ -472,6 +543,18 @@ impl SceneResources {
                 wgpu::BindGroupEntry {
                     binding: 3,
                     resource: wgpu::BindingResource::TextureView(&metal_rough_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: wgpu::BindingResource::TextureView(&normal_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::TextureView(&occlusion_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: wgpu::BindingResource::TextureView(&emissive_view),
                 },
             ],
         });

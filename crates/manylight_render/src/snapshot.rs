@@ -70,17 +70,17 @@ impl PipelineKind {
 /// How the deferred pipelines store surfaces (see `shaders/gbuffer.wgsl`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum GBufferLayout {
-    /// Three targets: position rgba32f, normal rgba16f (unencoded xyz), albedo rgba16f
-    /// (+ depth). The normal codec setting does not apply.
+    /// Four targets: position rgba32f, normal rgba16f (unencoded xyz), albedo rgba16f,
+    /// emissive and occlusion rgba16f (+ depth). The normal codec setting does not apply.
     #[default]
     Full,
     /// Two rgba32f targets: (albedo.rgb, n.a) and (position.xyz, n.b), where (n.a, n.b) are the
-    /// normal codec's two components. The albedo channels carry the material parameters in
-    /// their integer parts (`shaders/gbuffer.wgsl` explains how).
+    /// normal codec's two components, plus emissive and occlusion rgba16f. The albedo channels
+    /// carry the material parameters in their integer parts (`shaders/gbuffer.wgsl` explains how).
     Packed,
     /// One rgba32uint target: albedo rgb8 (sRGB-encoded) and the shading model, the normal
-    /// codec's 32-bit word, shininess/specular f16, the shading position's depth (f32); position
-    /// reconstructed from that depth.
+    /// codec's 32-bit word, the two material parameters f16, the shading position's depth (f32),
+    /// plus emissive and occlusion rgba16f; position reconstructed from that depth.
     Compact,
 }
 
@@ -117,9 +117,9 @@ impl GBufferLayout {
     /// Bytes per pixel of the G-buffer, depth (4 bytes) included.
     pub fn bytes_per_pixel(self) -> u32 {
         match self {
-            GBufferLayout::Full => 16 + 8 + 8 + 4,
-            GBufferLayout::Packed => 16 + 16 + 4,
-            GBufferLayout::Compact => 16 + 4,
+            GBufferLayout::Full => 16 + 8 + 8 + 8 + 4,
+            GBufferLayout::Packed => 16 + 16 + 8 + 4,
+            GBufferLayout::Compact => 16 + 8 + 4,
         }
     }
 }
@@ -146,14 +146,26 @@ pub enum DebugViewMode {
     Depth,
     /// Clusters whose list hit the per-cluster cap (red) and how full the others are (green).
     Overflow,
+    /// PBR metalness, black to white (surfaces of other shading models black).
+    Metallic,
+    /// PBR perceptual roughness, black to white (surfaces of other shading models black).
+    Roughness,
+    /// Emitted radiance (linear, clamped to 1).
+    Emissive,
+    /// Ambient occlusion (white: none).
+    Occlusion,
 }
 
 impl DebugViewMode {
     /// Every view, in CLI order.
-    pub const ALL: [DebugViewMode; 9] = [
+    pub const ALL: [DebugViewMode; 13] = [
         DebugViewMode::None,
         DebugViewMode::Albedo,
         DebugViewMode::Normal,
+        DebugViewMode::Metallic,
+        DebugViewMode::Roughness,
+        DebugViewMode::Emissive,
+        DebugViewMode::Occlusion,
         DebugViewMode::Depth,
         DebugViewMode::LightCount,
         DebugViewMode::SliceX,
@@ -174,6 +186,10 @@ impl DebugViewMode {
             DebugViewMode::Normal => "normal",
             DebugViewMode::Depth => "depth",
             DebugViewMode::Overflow => "overflow",
+            DebugViewMode::Metallic => "metallic",
+            DebugViewMode::Roughness => "roughness",
+            DebugViewMode::Emissive => "emissive",
+            DebugViewMode::Occlusion => "occlusion",
         }
     }
 
@@ -201,7 +217,15 @@ impl DebugViewMode {
 
     /// True for views that show surface attributes (they need a G-buffer).
     pub fn uses_surfaces(self) -> bool {
-        matches!(self, DebugViewMode::Albedo | DebugViewMode::Normal)
+        matches!(
+            self,
+            DebugViewMode::Albedo
+                | DebugViewMode::Normal
+                | DebugViewMode::Metallic
+                | DebugViewMode::Roughness
+                | DebugViewMode::Emissive
+                | DebugViewMode::Occlusion
+        )
     }
 
     /// The next view (wrapping), for key-driven cycling.

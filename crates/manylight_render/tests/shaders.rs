@@ -124,7 +124,13 @@ fn shared_structs_match_rust() {
             ("metallic", offset_of!(GpuMaterial, metallic)),
             ("roughness", offset_of!(GpuMaterial, roughness)),
             ("has_metallic_roughness_texture", offset_of!(GpuMaterial, has_metallic_roughness_texture)),
-            ("_pad", offset_of!(GpuMaterial, _pad)),
+            ("normal_scale", offset_of!(GpuMaterial, normal_scale)),
+            ("emissive", offset_of!(GpuMaterial, emissive)),
+            ("occlusion_strength", offset_of!(GpuMaterial, occlusion_strength)),
+            ("has_normal_texture", offset_of!(GpuMaterial, has_normal_texture)),
+            ("has_occlusion_texture", offset_of!(GpuMaterial, has_occlusion_texture)),
+            ("has_emissive_texture", offset_of!(GpuMaterial, has_emissive_texture)),
+            ("alpha_cutoff", offset_of!(GpuMaterial, alpha_cutoff)),
         ],
     );
     offsets(

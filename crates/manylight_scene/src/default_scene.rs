@@ -59,6 +59,7 @@ impl Assembler {
             shading: None,
             shininess,
             specular,
+            ..MaterialData::default()
         }));
         self.scene.materials.len() - 1
     }

@@ -49,7 +49,7 @@ pub use materials::blinn_phong_from_pbr;
 
 use crate::{Scene, SceneError};
 use manylight_core::TextureData;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -93,8 +93,9 @@ pub struct LoadOptions {
     /// read. Default 256 MiB.
     pub max_accessor_bytes: u64,
     /// Most vertices of all meshes together; each distinct combination of POSITION, NORMAL,
-    /// TEXCOORD_0 and index accessors becomes one mesh, and its POSITION `count` is checked
-    /// before any attribute is read. A vertex takes 32 bytes once loaded. Default 16 000 000.
+    /// TEXCOORD_0, TANGENT and index accessors becomes one mesh, and its POSITION `count` is
+    /// checked before any attribute is read. A vertex takes 48 bytes once loaded. Default
+    /// 16 000 000.
     pub max_vertices: u64,
     /// Most indices of all meshes together (an unindexed primitive counts one per vertex);
     /// checked before the index accessor is read. Default 48 000 000 (16 million triangles).
@@ -373,6 +374,7 @@ fn load_inner(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
     // A UTF-8 byte-order mark is not valid JSON but harmless; accept it.
     let json_bytes = json_bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(json_bytes);
     let root = normalize::parse_root(path, json_bytes)?;
+    let emissive_strengths = materials::emissive_strengths(path, json_bytes);
     for ext in &root.extensions_required {
         if UNSUPPORTED_REQUIRED.contains(&ext.as_str()) {
             return Err(SceneError::UnsupportedExtension { path: path.to_owned(), extension: ext.clone() });
@@ -393,7 +395,10 @@ fn load_inner(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
         images: HashMap::new(),
         linear: HashMap::new(),
         meshes: HashMap::new(),
+        generated_tangents: HashSet::new(),
         materials: HashMap::new(),
+        emissive_strengths,
+        warned_blend: false,
         used: Used::default(),
         scene: Scene {
             name: path
@@ -433,13 +438,21 @@ struct Ctx<'a> {
     textures: HashMap<usize, Arc<TextureData>>,
     /// Decoded images by source: `images` entries naming the same source share one decode.
     images: HashMap<materials::ImageSource<'a>, Arc<TextureData>>,
-    /// Images read as linear data (metallic-roughness), by image index.
+    /// Images read as linear data (metallic-roughness, normal and occlusion maps), by image
+    /// index.
     linear: HashMap<usize, Arc<TextureData>>,
-    /// Scene mesh index by (POSITION, NORMAL, TEXCOORD_0, indices) accessors (`None`: the
-    /// primitive has no triangles and is skipped).
-    meshes: HashMap<[Option<usize>; 4], Option<usize>>,
+    /// Scene mesh index by (POSITION, NORMAL, TEXCOORD_0, TANGENT, indices) accessors
+    /// (`None`: the primitive has no triangles and is skipped).
+    meshes: HashMap<[Option<usize>; 5], Option<usize>>,
+    /// Scene meshes whose tangents were generated (MikkTSpace), so a mesh shared by many
+    /// normal-mapped primitives is processed once.
+    generated_tangents: HashSet<usize>,
     /// Scene material index by glTF material index (`None`: the default material).
     materials: HashMap<Option<usize>, usize>,
+    /// `KHR_materials_emissive_strength` by glTF material index (missing: 1).
+    emissive_strengths: Vec<f32>,
+    /// Whether the "BLEND is drawn opaque" warning was logged for this file.
+    warned_blend: bool,
     /// Budget use so far.
     used: Used,
     /// The scene being built.

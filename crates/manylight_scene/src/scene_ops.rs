@@ -80,17 +80,31 @@ impl Scene {
     }
 
     /// Checks that every index is in range and every number is usable (finite transforms,
-    /// non-negative light parameters, valid meshes, textures with the right byte count).
+    /// non-negative light and emissive parameters, valid meshes with finite tangents, every
+    /// texture with the right byte count).
     pub fn validate(&self) -> Result<(), SceneError> {
         let invalid = |problem: String| SceneError::Invalid { path: PathBuf::from(&self.name), problem };
         for (i, m) in self.meshes.iter().enumerate() {
             m.validate().map_err(|e| invalid(format!("mesh {i} (`{}`): {e}", m.label)))?;
+            if let Some(v) = m.vertices.iter().position(|v| !v.tangent.iter().all(|x| x.is_finite())) {
+                return Err(invalid(format!(
+                    "mesh {i} (`{}`): vertex {v} has a non-finite tangent",
+                    m.label
+                )));
+            }
         }
         for (i, m) in self.materials.iter().enumerate() {
-            if !m.base_color.is_finite() || !m.shininess.is_finite() || !m.specular.is_finite() {
-                return Err(invalid(format!("material {i} has non-finite parameters")));
+            let finite = m.base_color.is_finite()
+                && m.shininess.is_finite()
+                && m.specular.is_finite()
+                && m.normal_scale.is_finite()
+                && m.occlusion_strength.is_finite()
+                && m.emissive.is_finite()
+                && m.emissive.min_element() >= 0.0;
+            if !finite {
+                return Err(invalid(format!("material {i} has non-finite or negative parameters")));
             }
-            if let Some(t) = &m.base_color_texture {
+            for t in m.textures() {
                 let expected = t.width as u64 * t.height as u64 * 4;
                 if t.width == 0 || t.height == 0 || t.rgba8.len() as u64 != expected {
                     return Err(invalid(format!(

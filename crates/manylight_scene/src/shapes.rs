@@ -15,7 +15,12 @@ struct Builder {
 
 impl Builder {
     fn vertex(&mut self, p: Vec3, n: Vec3, uv: Vec2) -> u32 {
-        self.vertices.push(Vertex { position: p.to_array(), normal: n.to_array(), uv: uv.to_array() });
+        self.vertices.push(Vertex {
+            position: p.to_array(),
+            normal: n.to_array(),
+            uv: uv.to_array(),
+            tangent: [0.0; 4],
+        });
         (self.vertices.len() - 1) as u32
     }
 
@@ -26,7 +31,9 @@ impl Builder {
     }
 
     fn build(self, label: &str) -> MeshData {
-        MeshData { label: label.to_owned(), vertices: self.vertices, indices: self.indices }
+        let mut mesh = MeshData { label: label.to_owned(), vertices: self.vertices, indices: self.indices };
+        mesh.generate_tangents();
+        mesh
     }
 }
 

@@ -98,3 +98,100 @@ fn shared_primitives_become_one_mesh() {
     assert!(s.instances.len() >= 98);
     assert!(s.meshes.len() < 30, "{} meshes", s.meshes.len());
 }
+
+/// Checks that every tangent of `mesh` is finite and either zero (no frame) or a unit vector
+/// with handedness ±1 perpendicular to the normal; returns how many vertices have a frame.
+fn check_tangents(mesh: &manylight_core::MeshData) -> usize {
+    let mut framed = 0;
+    for (i, v) in mesh.vertices.iter().enumerate() {
+        let t = glam::Vec4::from(v.tangent);
+        assert!(t.is_finite(), "{}: vertex {i} tangent {t:?}", mesh.label);
+        if t == glam::Vec4::ZERO {
+            continue;
+        }
+        framed += 1;
+        assert!((t.truncate().length() - 1.0).abs() < 1e-4, "{}: vertex {i} tangent {t:?}", mesh.label);
+        assert_eq!(t.w.abs(), 1.0, "{}: vertex {i} tangent {t:?}", mesh.label);
+        let dot = t.truncate().dot(glam::Vec3::from(v.normal));
+        assert!(dot.abs() < 1e-2, "{}: vertex {i} tangent {t:?} not ⟂ normal ({dot})", mesh.label);
+    }
+    framed
+}
+
+#[test]
+fn damaged_helmet_has_normal_occlusion_and_emissive_maps_and_generated_tangents() {
+    let s = load("DamagedHelmet/DamagedHelmet.glb");
+    s.validate().unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.materials.len(), 1);
+    let m = &s.materials[0];
+    assert_eq!(m.label, "Material_MR");
+    let normal = m.normal_texture.as_ref().expect("normal texture");
+    let occlusion = m.occlusion_texture.as_ref().expect("occlusion texture");
+    let emissive = m.emissive_texture.as_ref().expect("emissive texture");
+    assert!(!normal.srgb && !occlusion.srgb && emissive.srgb);
+    assert!(m.base_color_texture.as_ref().is_some_and(|t| t.srgb));
+    assert!(m.metallic_roughness_texture.as_ref().is_some_and(|t| !t.srgb));
+    assert_eq!(m.textures().count(), 5);
+    assert_eq!(m.emissive, glam::Vec3::ONE);
+    assert_eq!((m.normal_scale, m.occlusion_strength), (1.0, 1.0));
+    assert!(!m.double_sided, "the file does not say doubleSided");
+    assert_eq!(m.alpha_mode, manylight_core::AlphaMode::Opaque);
+    // The file has no TANGENT: MikkTSpace gives (almost) every vertex a frame.
+    assert_eq!(s.meshes.len(), 1);
+    let mesh = &s.meshes[0];
+    assert!(mesh.has_tangents());
+    let framed = check_tangents(mesh);
+    assert!(framed * 100 >= mesh.vertices.len() * 99, "{framed} of {} vertices", mesh.vertices.len());
+}
+
+#[test]
+fn normal_tangent_tests_have_normal_maps_and_tangents() {
+    // NormalTangentMirrorTest has TANGENT (with both handednesses: mirrored uvs);
+    // NormalTangentTest has none, so they are generated.
+    for (file, mirrored) in [
+        ("NormalTangentMirrorTest/NormalTangentMirrorTest.gltf", true),
+        ("NormalTangentTest/NormalTangentTest.gltf", false),
+    ] {
+        let s = load(file);
+        s.validate().unwrap_or_else(|e| panic!("{file}: {e}"));
+        let m = &s.materials[0];
+        assert!(m.normal_texture.as_ref().is_some_and(|t| !t.srgb), "{file}");
+        // Occlusion and metallic-roughness share one image: one linear copy.
+        let occlusion = m.occlusion_texture.as_ref().expect("occlusion texture");
+        let mr = m.metallic_roughness_texture.as_ref().expect("metallic-roughness texture");
+        assert!(std::sync::Arc::ptr_eq(occlusion, mr), "{file}");
+        assert!(m.double_sided, "{file}");
+        for mesh in &s.meshes {
+            assert!(mesh.has_tangents(), "{file}: {}", mesh.label);
+            let framed = check_tangents(mesh);
+            if mirrored {
+                assert_eq!(framed, mesh.vertices.len(), "{file}: every TANGENT is usable");
+                assert!(mesh.vertices.iter().any(|v| v.tangent[3] == -1.0), "{file}: no mirrored frame");
+                assert!(mesh.vertices.iter().any(|v| v.tangent[3] == 1.0), "{file}");
+            }
+        }
+    }
+}
+
+#[test]
+fn alpha_blend_mode_test_has_the_authored_alpha_modes() {
+    use manylight_core::AlphaMode;
+    let s = load("AlphaBlendModeTest/AlphaBlendModeTest.gltf");
+    let expected = [
+        ("MatBed", AlphaMode::Opaque, false),
+        ("MatBlend", AlphaMode::Blend, true),
+        ("MatCutoff25", AlphaMode::Mask(0.25), true),
+        ("MatCutoff75", AlphaMode::Mask(0.75), true),
+        ("MatCutoffDefault", AlphaMode::Mask(0.5), true),
+        ("MatOpaque", AlphaMode::Opaque, true),
+    ];
+    assert_eq!(s.materials.len(), expected.len());
+    for (label, alpha_mode, double_sided) in expected {
+        let m = s.materials.iter().find(|m| m.label == label).unwrap_or_else(|| panic!("no {label}"));
+        assert_eq!((m.alpha_mode, m.double_sided), (alpha_mode, double_sided), "{label}");
+    }
+    // Every primitive has TANGENT.
+    for mesh in &s.meshes {
+        assert_eq!(check_tangents(mesh), mesh.vertices.len(), "{}", mesh.label);
+    }
+}

@@ -2,19 +2,21 @@
 //! cluster's light list instead of every light.
 
 use super::common::{MeshPipelineDesc, clear_color, color_attachment, mesh_pipeline};
-use super::scene_draw::record_scene_pass;
+use super::scene_draw::{ScenePipeline, record_scene_pass, variant_pipelines};
 use super::{CLUSTERS, DEPTH, HDR};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
-use crate::resources::{DEPTH_FORMAT, HDR_FORMAT};
+use crate::resources::{DEPTH_FORMAT, HDR_FORMAT, SurfaceVariant};
 
 /// Clustered shading's pipeline: with or without a depth pre-pass before it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ClusteredForwardKey {
     /// Depth tested `GreaterEqual` without writes, after the pre-pass.
     pub after_prepass: bool,
+    /// Culling and alpha masking.
+    pub variant: SurfaceVariant,
 }
 
 impl PipelineKey for ClusteredForwardKey {
@@ -30,8 +32,9 @@ impl ClusteredForwardPipeline {
     fn new(
         device: &wgpu::Device,
         layouts: [&wgpu::BindGroupLayout; 3],
-        after_prepass: bool,
+        key: &ClusteredForwardKey,
     ) -> Result<Self, RenderError> {
+        let after_prepass = key.after_prepass;
         let pipeline = mesh_pipeline(
             device,
             &MeshPipelineDesc {
@@ -47,9 +50,16 @@ impl ClusteredForwardPipeline {
                 } else {
                     wgpu::CompareFunction::Greater
                 },
+                variant: key.variant,
             },
         )?;
         Ok(ClusteredForwardPipeline { pipeline })
+    }
+}
+
+impl ScenePipeline for ClusteredForwardPipeline {
+    fn render_pipeline(&self) -> &wgpu::RenderPipeline {
+        &self.pipeline
     }
 }
 
@@ -91,13 +101,15 @@ impl Pass for ClusteredForwardPass {
             .ok_or_else(|| RenderError::Graph("clustered_forward needs cluster resources".into()))?;
         let layouts = [&scene.view_layout, &scene.material_layout, &clusters.shading_layout];
         let after = self.after_prepass;
-        let pipeline = ctx.pipelines.get_or_create(ClusteredForwardKey { after_prepass: after }, |k| {
-            ClusteredForwardPipeline::new(&ctx.gpu.device, layouts, k.after_prepass)
-        })?;
+        let pipelines = variant_pipelines(
+            ctx,
+            |variant| ClusteredForwardKey { after_prepass: after, variant },
+            |k| ClusteredForwardPipeline::new(&ctx.gpu.device, layouts, k),
+        )?;
         let color = color_attachment(ctx.texture(HDR)?, clear_color(self.clear_color));
         let depth = ctx.texture(DEPTH)?;
         let extra = [&clusters.shading_bind_group];
-        record_scene_pass(ctx, "clustered_forward", &[color], depth, !after, &pipeline.pipeline, &extra);
+        record_scene_pass(ctx, "clustered_forward", &[color], depth, !after, &pipelines, &extra);
         Ok(())
     }
 }

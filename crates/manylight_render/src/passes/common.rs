@@ -2,7 +2,7 @@
 //! they use, and bind-group-layout entries.
 
 use crate::context::RenderError;
-use crate::resources::DEPTH_FORMAT;
+use crate::resources::{DEPTH_FORMAT, SurfaceVariant};
 use manylight_core::Vertex;
 
 pub use crate::layouts::{storage_entry, texture_entry, uniform_entry};
@@ -45,10 +45,12 @@ pub struct MeshPipelineDesc<'a> {
     pub depth_write: bool,
     /// Depth comparison (reverse-Z: `Greater`, or `GreaterEqual` after a pre-pass).
     pub depth_compare: wgpu::CompareFunction,
+    /// Culling and alpha masking of the draws it serves.
+    pub variant: SurfaceVariant,
 }
 
-/// Builds a [`MeshPipelineDesc`]. Faces are not culled: glTF double-sided materials and negative
-/// scales need no special case, and the shaders light the face the camera sees.
+/// Builds a [`MeshPipelineDesc`]. Faces are culled as the variant says (single-sided
+/// materials); on faces drawn from both sides the shaders light the side the camera sees.
 pub fn mesh_pipeline(
     device: &wgpu::Device,
     d: &MeshPipelineDesc<'_>,
@@ -62,7 +64,8 @@ pub fn mesh_pipeline_with_constants(
     d: &MeshPipelineDesc<'_>,
     constants: &[(&str, f64)],
 ) -> Result<wgpu::RenderPipeline, RenderError> {
-    let options = || wgpu::PipelineCompilationOptions { constants, ..Default::default() };
+    let constants: Vec<(&str, f64)> = constants.iter().copied().chain(d.variant.constants()).collect();
+    let options = || wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
     let module = crate::shaders::create_module(device, d.shader)?;
     let layout = pipeline_layout(device, d.label, d.layouts);
     let targets = color_targets(d.targets);
@@ -75,7 +78,7 @@ pub fn mesh_pipeline_with_constants(
             compilation_options: options(),
             buffers: &[Some(vertex_layout())],
         },
-        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+        primitive: d.variant.primitive(),
         depth_stencil: Some(wgpu::DepthStencilState {
             format: DEPTH_FORMAT,
             depth_write_enabled: Some(d.depth_write),
@@ -228,11 +231,36 @@ pub fn draw_fullscreen(
 
 /// The vertex buffer layout of [`Vertex`].
 pub fn vertex_layout() -> wgpu::VertexBufferLayout<'static> {
-    const ATTRIBUTES: [wgpu::VertexAttribute; 3] =
-        wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2];
+    const ATTRIBUTES: [wgpu::VertexAttribute; 4] =
+        wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Float32x4];
     wgpu::VertexBufferLayout {
         array_stride: std::mem::size_of::<Vertex>() as u64,
         step_mode: wgpu::VertexStepMode::Vertex,
         attributes: &ATTRIBUTES,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::mem::offset_of;
+
+    /// The vertex buffer layout reads each attribute where `Vertex` stores it
+    /// (`VertexIn` in `shaders/common/mesh.wgsl`: locations 0..3 in field order).
+    #[test]
+    fn vertex_attributes_match_the_rust_vertex() {
+        let layout = vertex_layout();
+        let expected = [
+            offset_of!(Vertex, position),
+            offset_of!(Vertex, normal),
+            offset_of!(Vertex, uv),
+            offset_of!(Vertex, tangent),
+        ];
+        assert_eq!(layout.attributes.len(), expected.len());
+        for (attribute, (location, offset)) in layout.attributes.iter().zip(expected.into_iter().enumerate())
+        {
+            assert_eq!((attribute.shader_location, attribute.offset), (location as u32, offset as u64));
+        }
+        assert_eq!(layout.array_stride, std::mem::size_of::<Vertex>() as u64);
     }
 }

@@ -7,7 +7,7 @@
 //! - surface views (albedo, normal): the Full G-buffer.
 
 use super::common::{draw_fullscreen, fullscreen_pipeline, storage_entry, texture_entry, uniform_entry};
-use super::{CLUSTERS, DEPTH, GBUFFER_ALBEDO, GBUFFER_NORMAL};
+use super::{CLUSTERS, DEPTH, GBUFFER_ALBEDO, GBUFFER_EMISSIVE, GBUFFER_NORMAL, GBUFFER_POSITION};
 use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{OUTPUT, Pass, PassContext, ResourceName};
@@ -68,7 +68,7 @@ impl DebugViewPipeline {
             }
             Family::Depth => "fs_depth",
             Family::Surface => {
-                entries.extend([texture_entry(5, unfiltered), texture_entry(6, unfiltered)]);
+                entries.extend([5, 6, 7, 8].map(|b| texture_entry(b, unfiltered)));
                 "fs_surface"
             }
         };
@@ -115,7 +115,9 @@ impl Pass for DebugViewPass {
         match Family::of(self.view) {
             Family::Clusters => vec![DEPTH, CLUSTERS],
             Family::Depth => vec![DEPTH],
-            Family::Surface => vec![DEPTH, GBUFFER_ALBEDO, GBUFFER_NORMAL],
+            Family::Surface => {
+                vec![DEPTH, GBUFFER_ALBEDO, GBUFFER_NORMAL, GBUFFER_EMISSIVE, GBUFFER_POSITION]
+            }
         }
     }
     fn writes(&self) -> Vec<ResourceName> {
@@ -152,6 +154,8 @@ impl Pass for DebugViewPass {
             Family::Surface => bindings.extend([
                 (5, Binding::Texture(ctx.texture(GBUFFER_ALBEDO)?)),
                 (6, Binding::Texture(ctx.texture(GBUFFER_NORMAL)?)),
+                (7, Binding::Texture(ctx.texture(GBUFFER_EMISSIVE)?)),
+                (8, Binding::Texture(ctx.texture(GBUFFER_POSITION)?)),
             ]),
         }
         let bind_group = ctx.bind_group_numbered("debug_view", &pipeline.layout, &bindings);

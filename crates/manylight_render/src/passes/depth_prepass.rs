@@ -2,16 +2,17 @@
 
 use super::DEPTH;
 use super::common::{MeshPipelineDesc, mesh_pipeline};
-use super::scene_draw::record_scene_pass;
+use super::scene_draw::{ScenePipeline, record_scene_pass, variant_pipelines};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
-use crate::resources::{DEPTH_FORMAT, SceneResources};
+use crate::resources::{DEPTH_FORMAT, SceneResources, SurfaceVariant};
 
-/// The depth pre-pass's pipeline (there is one).
+/// The depth pre-pass's pipeline: one per surface variant (alpha-masked ones run a fragment
+/// stage that discards, the others none).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct DepthPrepassKey;
+pub struct DepthPrepassKey(pub SurfaceVariant);
 
 impl PipelineKey for DepthPrepassKey {
     type Pipeline = DepthPrepassPipeline;
@@ -23,20 +24,31 @@ pub struct DepthPrepassPipeline {
 }
 
 impl DepthPrepassPipeline {
-    fn new(device: &wgpu::Device, scene: &SceneResources) -> Result<Self, RenderError> {
+    fn new(
+        device: &wgpu::Device,
+        scene: &SceneResources,
+        variant: SurfaceVariant,
+    ) -> Result<Self, RenderError> {
         let pipeline = mesh_pipeline(
             device,
             &MeshPipelineDesc {
                 label: "depth_prepass",
                 shader: "depth_prepass.wgsl",
                 layouts: &[&scene.view_layout, &scene.material_layout],
-                fragment: None,
+                fragment: variant.alpha_mask.then_some("fs_mask"),
                 targets: &[],
                 depth_write: true,
                 depth_compare: wgpu::CompareFunction::Greater,
+                variant,
             },
         )?;
         Ok(DepthPrepassPipeline { pipeline })
+    }
+}
+
+impl ScenePipeline for DepthPrepassPipeline {
+    fn render_pipeline(&self) -> &wgpu::RenderPipeline {
+        &self.pipeline
     }
 }
 
@@ -58,11 +70,11 @@ impl Pass for DepthPrepass {
     }
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
         let scene = ctx.scene;
-        let pipeline = ctx
-            .pipelines
-            .get_or_create(DepthPrepassKey, |_| DepthPrepassPipeline::new(&ctx.gpu.device, scene))?;
+        let pipelines = variant_pipelines(ctx, DepthPrepassKey, |k| {
+            DepthPrepassPipeline::new(&ctx.gpu.device, scene, k.0)
+        })?;
         let depth = ctx.texture(DEPTH)?;
-        record_scene_pass(ctx, "depth_prepass", &[], depth, true, &pipeline.pipeline, &[]);
+        record_scene_pass(ctx, "depth_prepass", &[], depth, true, &pipelines, &[]);
         Ok(())
     }
 }

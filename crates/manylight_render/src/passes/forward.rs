@@ -2,17 +2,17 @@
 //! HDR target with a reverse-Z depth test.
 
 use super::common::{MeshPipelineDesc, clear_color, color_attachment, mesh_pipeline};
-use super::scene_draw::record_scene_pass;
+use super::scene_draw::{ScenePipeline, record_scene_pass, variant_pipelines};
 use super::{DEPTH, HDR};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
-use crate::resources::{DEPTH_FORMAT, HDR_FORMAT, SceneResources};
+use crate::resources::{DEPTH_FORMAT, HDR_FORMAT, SceneResources, SurfaceVariant};
 
-/// Naive forward's pipeline (there is one).
+/// Naive forward's pipeline: one per surface variant.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct ForwardKey;
+pub struct ForwardKey(pub SurfaceVariant);
 
 impl PipelineKey for ForwardKey {
     type Pipeline = ForwardPipeline;
@@ -24,7 +24,11 @@ pub struct ForwardPipeline {
 }
 
 impl ForwardPipeline {
-    fn new(device: &wgpu::Device, scene: &SceneResources) -> Result<Self, RenderError> {
+    fn new(
+        device: &wgpu::Device,
+        scene: &SceneResources,
+        variant: SurfaceVariant,
+    ) -> Result<Self, RenderError> {
         let pipeline = mesh_pipeline(
             device,
             &MeshPipelineDesc {
@@ -35,9 +39,16 @@ impl ForwardPipeline {
                 targets: &[HDR_FORMAT],
                 depth_write: true,
                 depth_compare: wgpu::CompareFunction::Greater,
+                variant,
             },
         )?;
         Ok(ForwardPipeline { pipeline })
+    }
+}
+
+impl ScenePipeline for ForwardPipeline {
+    fn render_pipeline(&self) -> &wgpu::RenderPipeline {
+        &self.pipeline
     }
 }
 
@@ -66,11 +77,11 @@ impl Pass for ForwardPass {
     }
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
         let scene = ctx.scene;
-        let pipeline =
-            ctx.pipelines.get_or_create(ForwardKey, |_| ForwardPipeline::new(&ctx.gpu.device, scene))?;
+        let pipelines =
+            variant_pipelines(ctx, ForwardKey, |k| ForwardPipeline::new(&ctx.gpu.device, scene, k.0))?;
         let color = color_attachment(ctx.texture(HDR)?, clear_color(self.clear_color));
         let depth = ctx.texture(DEPTH)?;
-        record_scene_pass(ctx, "forward", &[color], depth, true, &pipeline.pipeline, &[]);
+        record_scene_pass(ctx, "forward", &[color], depth, true, &pipelines, &[]);
         Ok(())
     }
 }

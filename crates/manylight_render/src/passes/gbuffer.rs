@@ -3,13 +3,13 @@
 
 use super::common::{MeshPipelineDesc, color_attachment, mesh_pipeline_with_constants};
 use super::gbuffer_layout::{codec_constants, fragment_entry, targets};
-use super::scene_draw::record_scene_pass;
+use super::scene_draw::{ScenePipeline, record_scene_pass, variant_pipelines};
 use super::{DEPTH, DEPTH_USAGE};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
-use crate::resources::{DEPTH_FORMAT, SceneResources};
+use crate::resources::{DEPTH_FORMAT, SceneResources, SurfaceVariant};
 use crate::snapshot::GBufferLayout;
 use manylight_core::codec::NormalCodec;
 
@@ -20,6 +20,8 @@ pub struct GBufferKey {
     pub layout: GBufferLayout,
     /// Its normal codec.
     pub codec: NormalCodec,
+    /// Culling and alpha masking.
+    pub variant: SurfaceVariant,
 }
 
 impl PipelineKey for GBufferKey {
@@ -32,12 +34,8 @@ pub struct GBufferPipeline {
 }
 
 impl GBufferPipeline {
-    fn new(
-        device: &wgpu::Device,
-        scene: &SceneResources,
-        layout: GBufferLayout,
-        codec: NormalCodec,
-    ) -> Result<Self, RenderError> {
+    fn new(device: &wgpu::Device, scene: &SceneResources, key: &GBufferKey) -> Result<Self, RenderError> {
+        let GBufferKey { layout, codec, variant } = *key;
         let formats: Vec<wgpu::TextureFormat> = targets(layout).iter().map(|&(_, format)| format).collect();
         let pipeline = mesh_pipeline_with_constants(
             device,
@@ -49,10 +47,17 @@ impl GBufferPipeline {
                 targets: &formats,
                 depth_write: true,
                 depth_compare: wgpu::CompareFunction::Greater,
+                variant,
             },
             &codec_constants(codec),
         )?;
         Ok(GBufferPipeline { pipeline })
+    }
+}
+
+impl ScenePipeline for GBufferPipeline {
+    fn render_pipeline(&self) -> &wgpu::RenderPipeline {
+        &self.pipeline
     }
 }
 
@@ -85,15 +90,17 @@ impl Pass for GBufferPass {
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
         let scene = ctx.scene;
         let (layout, codec) = (self.layout, self.codec);
-        let pipeline = ctx.pipelines.get_or_create(GBufferKey { layout, codec }, |k| {
-            GBufferPipeline::new(&ctx.gpu.device, scene, k.layout, k.codec)
-        })?;
+        let pipelines = variant_pipelines(
+            ctx,
+            |variant| GBufferKey { layout, codec, variant },
+            |k| GBufferPipeline::new(&ctx.gpu.device, scene, k),
+        )?;
         let views =
             targets(layout).iter().map(|&(name, _)| ctx.texture(name)).collect::<Result<Vec<_>, _>>()?;
         let depth = ctx.texture(DEPTH)?;
         let attachments: Vec<_> =
             views.iter().map(|view| color_attachment(view, wgpu::Color::TRANSPARENT)).collect();
-        record_scene_pass(ctx, "gbuffer", &attachments, depth, true, &pipeline.pipeline, &[]);
+        record_scene_pass(ctx, "gbuffer", &attachments, depth, true, &pipelines, &[]);
         Ok(())
     }
 }

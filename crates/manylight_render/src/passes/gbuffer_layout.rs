@@ -6,8 +6,8 @@
 use super::DEPTH;
 use super::common::{texture_entry, uniform_entry};
 use super::{
-    GBUFFER_ALBEDO, GBUFFER_COMPACT, GBUFFER_NORMAL, GBUFFER_PACKED_ALBEDO, GBUFFER_PACKED_POSITION,
-    GBUFFER_POSITION,
+    GBUFFER_ALBEDO, GBUFFER_COMPACT, GBUFFER_EMISSIVE, GBUFFER_NORMAL, GBUFFER_PACKED_ALBEDO,
+    GBUFFER_PACKED_POSITION, GBUFFER_POSITION,
 };
 use crate::bindings::Binding;
 use crate::context::RenderError;
@@ -15,7 +15,8 @@ use crate::graph::{PassContext, ResourceName};
 use crate::snapshot::GBufferLayout;
 use manylight_core::codec::NormalCodec;
 
-/// The G-buffer targets of a layout: name and format.
+/// The G-buffer targets of a layout: name and format. Every layout ends with
+/// [`GBUFFER_EMISSIVE`] (rgba16f: emitted radiance and ambient occlusion).
 pub fn targets(layout: GBufferLayout) -> &'static [(ResourceName, wgpu::TextureFormat)] {
     match layout {
         // Albedo is rgba16f, not rgba8: with 8 bits (even sRGB-encoded)
@@ -24,12 +25,17 @@ pub fn targets(layout: GBufferLayout) -> &'static [(ResourceName, wgpu::TextureF
             (GBUFFER_POSITION, wgpu::TextureFormat::Rgba32Float),
             (GBUFFER_NORMAL, wgpu::TextureFormat::Rgba16Float),
             (GBUFFER_ALBEDO, wgpu::TextureFormat::Rgba16Float),
+            (GBUFFER_EMISSIVE, wgpu::TextureFormat::Rgba16Float),
         ],
         GBufferLayout::Packed => &[
             (GBUFFER_PACKED_ALBEDO, wgpu::TextureFormat::Rgba32Float),
             (GBUFFER_PACKED_POSITION, wgpu::TextureFormat::Rgba32Float),
+            (GBUFFER_EMISSIVE, wgpu::TextureFormat::Rgba16Float),
         ],
-        GBufferLayout::Compact => &[(GBUFFER_COMPACT, wgpu::TextureFormat::Rgba32Uint)],
+        GBufferLayout::Compact => &[
+            (GBUFFER_COMPACT, wgpu::TextureFormat::Rgba32Uint),
+            (GBUFFER_EMISSIVE, wgpu::TextureFormat::Rgba16Float),
+        ],
     }
 }
 
@@ -55,6 +61,7 @@ fn binding_of(name: ResourceName) -> u32 {
         GBUFFER_ALBEDO => 2,
         GBUFFER_PACKED_ALBEDO => 6,
         GBUFFER_PACKED_POSITION => 7,
+        GBUFFER_EMISSIVE => 8,
         _ => 3,
     }
 }

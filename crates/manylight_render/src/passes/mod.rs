@@ -48,6 +48,8 @@ pub const GBUFFER_COMPACT: crate::graph::ResourceName = "gbuffer_compact";
 pub const GBUFFER_PACKED_ALBEDO: crate::graph::ResourceName = "gbuffer_packed_albedo";
 /// Packed G-buffer: world position + second normal component (rgba32f).
 pub const GBUFFER_PACKED_POSITION: crate::graph::ResourceName = "gbuffer_packed_position";
+/// Emitted radiance (rgb) and ambient occlusion (a) of every G-buffer layout.
+pub const GBUFFER_EMISSIVE: crate::graph::ResourceName = "gbuffer_emissive";
 /// Light volumes: the sum of the lights, in f32 where the device can blend it.
 pub const LIGHT_ACCUM: crate::graph::ResourceName = "light_accum";
 /// Graph resource: the cluster light lists (persistent buffers, ordered through the graph).

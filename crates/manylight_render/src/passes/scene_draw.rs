@@ -2,20 +2,43 @@
 //! the scene (forward, clustered forward, depth pre-pass, G-buffer).
 
 use super::common::depth_attachment;
+use crate::context::RenderError;
 use crate::graph::PassContext;
-use crate::resources::SceneResources;
+use crate::pipelines::PipelineKey;
+use crate::resources::{SceneResources, SurfaceVariant};
+use std::sync::Arc;
+
+/// A mesh pass's pipeline object: the wgpu pipeline its draws use.
+pub trait ScenePipeline {
+    /// The pipeline to draw with.
+    fn render_pipeline(&self) -> &wgpu::RenderPipeline;
+}
+
+/// A mesh pass's pipeline for each surface variant.
+pub type VariantPipelines<P> = Vec<(SurfaceVariant, Arc<P>)>;
+
+/// The pipelines of a mesh pass for every variant the frame draws (`SceneResources::variants`),
+/// each made by `create` on first use.
+pub fn variant_pipelines<K: PipelineKey>(
+    ctx: &PassContext<'_>,
+    key: impl Fn(SurfaceVariant) -> K,
+    create: impl Fn(&K) -> Result<K::Pipeline, RenderError>,
+) -> Result<VariantPipelines<K::Pipeline>, RenderError> {
+    ctx.scene.variants.iter().map(|&v| Ok((v, ctx.pipelines.get_or_create(key(v), &create)?))).collect()
+}
 
 /// Records the graph pass as one timed wgpu render pass that draws every scene instance with
-/// `pipeline`: group 0 is the view, group 1 each draw's material, `extra` follow from group 2.
+/// the pipeline of its variant in `pipelines`: group 0 is the view, group 1 each draw's
+/// material, `extra` follow from group 2.
 /// The depth attachment is cleared when `clear_depth`, else loaded (after a pre-pass); then the
 /// draws run in reverse order (see [`draw_scene`]).
-pub fn record_scene_pass(
+pub fn record_scene_pass<P: ScenePipeline>(
     ctx: &mut PassContext<'_>,
     label: &str,
     colors: &[Option<wgpu::RenderPassColorAttachment<'_>>],
     depth: &wgpu::TextureView,
     clear_depth: bool,
-    pipeline: &wgpu::RenderPipeline,
+    pipelines: &[(SurfaceVariant, Arc<P>)],
     extra: &[&wgpu::BindGroup],
 ) {
     let scene = ctx.scene;
@@ -28,26 +51,39 @@ pub fn record_scene_pass(
         occlusion_query_set: None,
         multiview_mask: None,
     });
-    pass.set_pipeline(pipeline);
     pass.set_bind_group(0, &scene.view_bind_group, &[]);
     for (i, group) in extra.iter().enumerate() {
         pass.set_bind_group(2 + i as u32, *group, &[]);
     }
-    draw_scene(&mut pass, scene, !clear_depth);
+    draw_scene(&mut pass, scene, pipelines, !clear_depth);
 }
 
-/// Issues one indexed draw per scene draw, switching material bind groups (group 1) and
-/// vertex/index buffers only when they change. `reverse` draws them last to first: a pass after
+/// Issues one indexed draw per scene draw, switching pipelines (by the draw's variant; a draw
+/// whose variant has no pipeline in `pipelines` is skipped), material bind groups (group 1)
+/// and vertex/index buffers only when they change. `reverse` draws them last to first: a pass after
 /// the depth pre-pass tests `GreaterEqual`, so of coplanar surfaces (equal depth) the last
 /// drawn wins, where a pass that tests `Greater` keeps the first; drawn in reverse, both keep
 /// the same one, and every pipeline shows the same surface (ties are exact in orthographic
 /// views, whose depth is linear).
-pub fn draw_scene(pass: &mut wgpu::RenderPass<'_>, scene: &SceneResources, reverse: bool) {
+pub fn draw_scene<P: ScenePipeline>(
+    pass: &mut wgpu::RenderPass<'_>,
+    scene: &SceneResources,
+    pipelines: &[(SurfaceVariant, Arc<P>)],
+    reverse: bool,
+) {
     let (mut bound_material, mut bound_mesh) = (usize::MAX, usize::MAX);
+    let mut bound_variant = None;
     let mut draw = |d: &crate::resources::Draw| {
         let (Some(mesh), Some(material)) = (scene.mesh(d.mesh), scene.material(d.material)) else {
             return;
         };
+        if bound_variant != Some(d.variant) {
+            let Some((_, pipeline)) = pipelines.iter().find(|(v, _)| *v == d.variant) else {
+                return;
+            };
+            pass.set_pipeline(pipeline.render_pipeline());
+            bound_variant = Some(d.variant);
+        }
         if d.material != bound_material {
             pass.set_bind_group(1, &material.bind_group, &[]);
             bound_material = d.material;

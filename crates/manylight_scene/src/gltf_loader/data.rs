@@ -339,6 +339,26 @@ impl Ctx<'_> {
         Ok(self.read_floats::<3>(index, layout)?.into_iter().map(glam::Vec3::from_array).collect())
     }
 
+    /// Checks that accessor `index` is a `TANGENT` accessor: `VEC4` of `FLOAT`, or with
+    /// `KHR_mesh_quantization` of normalized `BYTE` or `SHORT`.
+    pub(super) fn tangent_layout(&self, index: usize, what: &str) -> Result<Layout, SceneError> {
+        use ComponentType::{F32, I8, I16};
+        let (accept, expected): (&dyn Fn(Type, ComponentType, bool) -> bool, _) = if self.quantized() {
+            (
+                &|t, c, n| t == Type::Vec4 && (c == F32 || (n && matches!(c, I8 | I16))),
+                "VEC4 of FLOAT, or of normalized BYTE or SHORT (KHR_mesh_quantization)",
+            )
+        } else {
+            (&|t, c, _| t == Type::Vec4 && c == F32, "VEC4 of FLOAT")
+        };
+        self.layout(index, what, "TANGENT", accept, expected)
+    }
+
+    /// Reads a `VEC4` accessor checked by [`Ctx::tangent_layout`], dequantised to `f32`.
+    pub(super) fn read_vec4(&self, index: usize, layout: Layout) -> Result<Vec<glam::Vec4>, SceneError> {
+        Ok(self.read_floats::<4>(index, layout)?.into_iter().map(glam::Vec4::from_array).collect())
+    }
+
     /// Checks that accessor `index` is a texture-coordinate accessor: `VEC2` of `FLOAT` or
     /// normalized unsigned bytes or shorts, or with `KHR_mesh_quantization` any 8- or 16-bit
     /// integer.

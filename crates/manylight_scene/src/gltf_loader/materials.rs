@@ -1,20 +1,27 @@
-//! glTF materials and their base-colour images.
+//! glTF materials and their images.
 //!
 //! Images are decoded to sRGB RGBA8 once per distinct source (the same resolved file, the same
 //! `data:` URI or the same buffer view), however many `images` entries name it. Dimensions
 //! are read from the image header and checked against `LoadOptions::max_texture_size` and
 //! the `LoadOptions::max_image_bytes` budget before any pixel is decoded, so a tiny file that
 //! declares a huge image, or names one image many times, costs nothing.
+//!
+//! Colour textures (base colour, emissive) use the sRGB decode; data textures
+//! (metallic-roughness, normal, occlusion) use a linear copy of the same pixels, made once per
+//! image and also counted against `max_image_bytes`.
 
 use super::uri::{UriSource, is_data_uri, resolve_uri, split_data_uri};
 use super::{Ctx, MAX_DOWNSCALED_SOURCE, OversizedTextures, over_budget};
 use crate::SceneError;
-use glam::Vec4;
+use glam::{Vec3, Vec4};
+use gltf::json::validation::Checked;
 use image::{ImageDecoder, ImageFormat, ImageReader, Limits};
-use manylight_core::{MaterialData, TextureData};
+use manylight_core::{AlphaMode, MaterialData, TextureData};
+use serde_json::Value;
 use std::borrow::Cow;
+use std::collections::HashMap;
 use std::io::Cursor;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// Largest image file (in bytes) read from a URI; larger files are refused before reading.
@@ -50,9 +57,61 @@ pub fn blinn_phong_from_pbr(roughness: f32, metallic: f32) -> (f32, f32) {
     (shininess, specular)
 }
 
+/// The extension that scales `emissiveFactor` beyond 1.
+const EMISSIVE_STRENGTH: &str = "KHR_materials_emissive_strength";
+
+/// The `KHR_materials_emissive_strength` `emissiveStrength` of every material of glTF JSON
+/// `json` (already parsed by `gltf`), by material index; empty when the file does not mention
+/// the extension. A missing, non-numeric, negative or non-finite strength is 1 (with a warning
+/// for the last three).
+///
+/// The `gltf` crate drops material extensions unless its `KHR_materials_emissive_strength`
+/// feature is on, so they are read from the text: each level is parsed into a map of raw
+/// (unparsed) values, so the rest of the document is only scanned, never built.
+pub(super) fn emissive_strengths(path: &Path, json: &[u8]) -> Vec<f32> {
+    use serde_json::value::RawValue;
+    type RawMap<'j> = HashMap<String, &'j RawValue>;
+    if !json.windows(EMISSIVE_STRENGTH.len()).any(|w| w == EMISSIVE_STRENGTH.as_bytes()) {
+        return Vec::new();
+    }
+    let materials = serde_json::from_slice::<RawMap<'_>>(json).ok().and_then(|top| {
+        let list = top.get("materials")?;
+        serde_json::from_str::<Vec<&RawValue>>(list.get()).ok()
+    });
+    let Some(materials) = materials else {
+        tracing::warn!(file = %path.display(), "could not read {EMISSIVE_STRENGTH}, ignored");
+        return Vec::new();
+    };
+    let strength = |(index, m): (usize, &&RawValue)| -> f32 {
+        let ext = serde_json::from_str::<RawMap<'_>>(m.get()).ok().and_then(|m| {
+            let exts = serde_json::from_str::<RawMap<'_>>(m.get("extensions")?.get()).ok()?;
+            Some(serde_json::from_str::<serde_json::Map<String, Value>>(exts.get(EMISSIVE_STRENGTH)?.get()))
+        });
+        let value = match ext {
+            None => return 1.0,
+            Some(Ok(ext)) => match ext.get("emissiveStrength") {
+                None => return 1.0,
+                Some(v) => v.as_f64().map(|v| v as f32),
+            },
+            Some(Err(_)) => None,
+        };
+        match value {
+            Some(v) if v.is_finite() && v >= 0.0 => v,
+            _ => {
+                tracing::warn!(
+                    file = %path.display(), material = index,
+                    "{EMISSIVE_STRENGTH}: emissiveStrength is not a finite non-negative number, using 1"
+                );
+                1.0
+            }
+        }
+    };
+    materials.iter().enumerate().map(strength).collect()
+}
+
 impl<'a> Ctx<'a> {
-    /// Converts material `index`: base colour, metallic and roughness factors and their
-    /// textures.
+    /// Converts material `index`: base colour, metallic-roughness, normal, occlusion and
+    /// emissive factors and textures, `doubleSided` and `alphaMode`.
     pub(super) fn material(&mut self, index: usize) -> Result<MaterialData, SceneError> {
         let root = self.root;
         let m = &root.materials[index]; // the caller checked the index
@@ -64,24 +123,52 @@ impl<'a> Ctx<'a> {
         }
         let base = base.clamp(Vec4::ZERO, Vec4::splat(f32::MAX));
         let texture = match &pbr.base_color_texture {
-            Some(info) => Some(self.texture(index, "baseColorTexture", info, true)?),
+            Some(info) => {
+                Some(self.texture(index, "baseColorTexture", info.index.value(), info.tex_coord, true)?)
+            }
             None => None,
         };
         let metallic_roughness_texture = match &pbr.metallic_roughness_texture {
-            Some(info) => Some(self.texture(index, "metallicRoughnessTexture", info, false)?),
+            Some(info) => {
+                let (i, uv) = (info.index.value(), info.tex_coord);
+                Some(self.texture(index, "metallicRoughnessTexture", i, uv, false)?)
+            }
             None => None,
         };
-        let factor = |v: f32, name: &str, default: f32| {
-            if v.is_finite() {
-                v.clamp(0.0, 1.0)
-            } else {
-                tracing::warn!(file = %self.path.display(), material = index, "non-finite {name}, using {default}");
-                default
+        let (normal_texture, normal_scale) = match &m.normal_texture {
+            Some(info) => {
+                let t = self.texture(index, "normalTexture", info.index.value(), info.tex_coord, false)?;
+                (Some(t), self.finite(info.scale, index, "normalTexture.scale", 1.0))
             }
+            None => (None, 1.0),
         };
+        let (occlusion_texture, occlusion_strength) = match &m.occlusion_texture {
+            Some(info) => {
+                let t = self.texture(index, "occlusionTexture", info.index.value(), info.tex_coord, false)?;
+                let strength = self.finite(info.strength.0, index, "occlusionTexture.strength", 1.0);
+                (Some(t), strength.clamp(0.0, 1.0))
+            }
+            None => (None, 1.0),
+        };
+        let emissive_texture = match &m.emissive_texture {
+            Some(info) => {
+                Some(self.texture(index, "emissiveTexture", info.index.value(), info.tex_coord, true)?)
+            }
+            None => None,
+        };
+        let mut emissive = Vec3::from_array(m.emissive_factor.0);
+        if !emissive.is_finite() {
+            tracing::warn!(file = %self.path.display(), material = index, "non-finite emissiveFactor, using black");
+            emissive = Vec3::ZERO;
+        }
+        let strength = self.emissive_strengths.get(index).copied().unwrap_or(1.0);
+        // Clamped after the product, which may overflow to infinity.
+        let emissive = (emissive.max(Vec3::ZERO) * strength).min(Vec3::splat(f32::MAX));
+        let factor = |v: f32, name: &str, default: f32| self.finite(v, index, name, default).clamp(0.0, 1.0);
         let metallic = factor(pbr.metallic_factor.0, "metallicFactor", 1.0);
         let roughness = factor(pbr.roughness_factor.0, "roughnessFactor", 1.0);
         let (shininess, specular) = blinn_phong_from_pbr(roughness, metallic);
+        let alpha_mode = self.alpha_mode(index);
         Ok(MaterialData {
             label: m.name.clone().unwrap_or_else(|| format!("material {index}")),
             base_color: base,
@@ -92,31 +179,76 @@ impl<'a> Ctx<'a> {
             shading: None,
             shininess,
             specular,
+            normal_texture,
+            normal_scale,
+            occlusion_texture,
+            occlusion_strength,
+            emissive,
+            emissive_texture,
+            double_sided: m.double_sided,
+            alpha_mode,
         })
     }
 
-    /// The image of texture `info` of material `material` (`slot` names the material's
-    /// property in errors), as sRGB colour or as linear data.
+    /// `value`, or `default` with a warning when it is not finite (`name` is the property).
+    fn finite(&self, value: f32, material: usize, name: &str, default: f32) -> f32 {
+        if value.is_finite() {
+            value
+        } else {
+            tracing::warn!(file = %self.path.display(), material, "non-finite {name}, using {default}");
+            default
+        }
+    }
+
+    /// The `alphaMode` (and `alphaCutoff`) of material `index`. `BLEND` is kept but drawn
+    /// opaque for now, which is logged once per file.
+    fn alpha_mode(&mut self, index: usize) -> AlphaMode {
+        let m = &self.root.materials[index];
+        match m.alpha_mode {
+            Checked::Valid(gltf::json::material::AlphaMode::Opaque) => AlphaMode::Opaque,
+            Checked::Valid(gltf::json::material::AlphaMode::Mask) => {
+                let cutoff = m.alpha_cutoff.map_or(AlphaMode::DEFAULT_CUTOFF, |c| c.0);
+                let cutoff = self.finite(cutoff, index, "alphaCutoff", AlphaMode::DEFAULT_CUTOFF);
+                AlphaMode::Mask(cutoff.max(0.0))
+            }
+            Checked::Valid(gltf::json::material::AlphaMode::Blend) => {
+                if !std::mem::replace(&mut self.warned_blend, true) {
+                    tracing::warn!(
+                        file = %self.path.display(), material = index,
+                        "alphaMode BLEND is drawn opaque for now (no transparent pass yet)"
+                    );
+                }
+                AlphaMode::Blend
+            }
+            Checked::Invalid => {
+                tracing::warn!(file = %self.path.display(), material = index, "unknown alphaMode, using OPAQUE");
+                AlphaMode::Opaque
+            }
+        }
+    }
+
+    /// The image of texture `texture` used by material `material` through `TEXCOORD_<tex_coord>`
+    /// (`slot` names the material's property in errors), as sRGB colour or as linear data.
     fn texture(
         &mut self,
         material: usize,
         slot: &str,
-        info: &gltf::json::texture::Info,
+        texture: usize,
+        tex_coord: u32,
         srgb: bool,
     ) -> Result<Arc<TextureData>, SceneError> {
         let root = self.root;
-        if info.tex_coord != 0 {
+        if tex_coord != 0 {
             tracing::warn!(
                 file = %self.path.display(),
                 material,
-                "{slot} uses TEXCOORD_{}, only TEXCOORD_0 is loaded",
-                info.tex_coord
+                "{slot} uses TEXCOORD_{tex_coord}, only TEXCOORD_0 is loaded",
             );
         }
         let what = format!("material {material} {slot}");
-        let tex = self.lookup(&root.textures, info.index.value(), &what, "texture")?;
+        let tex = self.lookup(&root.textures, texture, &what, "texture")?;
         let image = tex.source.value();
-        let what = format!("texture {}", info.index.value());
+        let what = format!("texture {texture}");
         self.lookup(&root.images, image, &what, "image")?;
         let data = self.image(image)?;
         if srgb {

@@ -179,7 +179,10 @@ impl Ctx<'_> {
                 );
                 continue;
             }
-            let Some(mesh_index) = self.primitive_mesh(mesh, p)? else { continue };
+            // A normal map needs a tangent frame: generated when the file gives none.
+            let normal_mapped = (prim.material.and_then(|m| root.materials.get(m.value())))
+                .is_some_and(|m| m.normal_texture.is_some());
+            let Some(mesh_index) = self.primitive_mesh(mesh, p, normal_mapped)? else { continue };
             let material = self.material_index(mesh, p, prim.material.map(|m| m.value()))?;
             self.scene.instances.push(SceneInstance { mesh: mesh_index, material, transform: world });
         }
@@ -190,7 +193,17 @@ impl Ctx<'_> {
     /// `None` for primitives without positions or without triangles. The accessors' types and
     /// counts are checked, and the vertices and indices counted against
     /// `LoadOptions::max_vertices` and `LoadOptions::max_indices`, before any is read.
-    fn primitive_mesh(&mut self, mesh: usize, p: usize) -> Result<Option<usize>, SceneError> {
+    ///
+    /// Tangents come from `TANGENT`; without it, when the primitive is `normal_mapped` and
+    /// has `TEXCOORD_0`, they are generated with MikkTSpace, as the glTF specification asks
+    /// (once per mesh, also when the mesh was first converted for a primitive without a
+    /// normal map).
+    fn primitive_mesh(
+        &mut self,
+        mesh: usize,
+        p: usize,
+        normal_mapped: bool,
+    ) -> Result<Option<usize>, SceneError> {
         let root = self.root;
         let prim = &root.meshes[mesh].primitives[p];
         let what = format!("mesh {mesh} primitive {p}");
@@ -203,9 +216,17 @@ impl Ctx<'_> {
             Some(pos),
             attr(Semantic::Normals),
             attr(Semantic::TexCoords(0)),
+            attr(Semantic::Tangents),
             prim.indices.map(|i| i.value()),
         ];
+        let generate_tangents = normal_mapped && key[2].is_some() && key[3].is_none();
         if let Some(&index) = self.meshes.get(&key) {
+            if let Some(i) = index
+                && generate_tangents
+                && self.generated_tangents.insert(i)
+            {
+                Arc::make_mut(&mut self.scene.meshes[i]).generate_tangents();
+            }
             return Ok(index);
         }
         let bad = |problem: String| SceneError::BadPrimitive {
@@ -218,7 +239,8 @@ impl Ctx<'_> {
         let pos_layout = self.vec3_layout(pos, &what, "POSITION")?;
         let normal_layout = key[1].map(|a| self.vec3_layout(a, &what, "NORMAL")).transpose()?;
         let uv_layout = key[2].map(|a| self.uv_layout(a, &what)).transpose()?;
-        let index_layout = key[3].map(|a| self.index_layout(a, &what)).transpose()?;
+        let tangent_layout = key[3].map(|a| self.tangent_layout(a, &what)).transpose()?;
+        let index_layout = key[4].map(|a| self.index_layout(a, &what)).transpose()?;
         let vertices = pos_layout.count;
         if let Some(n) = normal_layout
             && n.count != vertices
@@ -229,6 +251,11 @@ impl Ctx<'_> {
             && u.count != vertices
         {
             return Err(bad(format!("{} TEXCOORD_0 values for {vertices} positions", u.count)));
+        }
+        if let Some(t) = tangent_layout
+            && t.count != vertices
+        {
+            return Err(bad(format!("{} tangents for {vertices} positions", t.count)));
         }
         let indices = index_layout.map_or(vertices, |l| l.count);
         let options = self.options;
@@ -256,7 +283,11 @@ impl Ctx<'_> {
             (Some(a), Some(l)) => Some(self.read_uv(a, l)?),
             _ => None,
         };
-        let indices = match (key[3], index_layout) {
+        let tangents = match (key[3], tangent_layout) {
+            (Some(a), Some(l)) => Some(self.read_vec4(a, l)?),
+            _ => None,
+        };
+        let indices = match (key[4], index_layout) {
             (Some(a), Some(l)) => Some(self.read_indices(a, l)?),
             _ => None,
         };
@@ -267,6 +298,10 @@ impl Ctx<'_> {
         if let Some(u) = uvs.as_mut().filter(|u| u.iter().any(|v| !v.is_finite())) {
             tracing::warn!(file = %self.path.display(), mesh, primitive = p, "non-finite TEXCOORD_0 replaced");
             u.iter_mut().filter(|v| !v.is_finite()).for_each(|v| *v = glam::Vec2::ZERO);
+        }
+        if tangents.as_ref().is_some_and(|t| t.iter().any(|v| !v.is_finite())) {
+            // `MeshData::set_tangents` turns them into "no tangent frame".
+            tracing::warn!(file = %self.path.display(), mesh, primitive = p, "non-finite tangents replaced");
         }
         let count = indices.as_ref().map_or(positions.len(), Vec::len);
         if count == 0 {
@@ -279,10 +314,18 @@ impl Ctx<'_> {
             Some(name) => format!("{name}/{p}"),
             None => format!("{} mesh {mesh}/{p}", self.file_name()),
         };
-        let data = MeshData::from_attributes(label, &positions, normals.as_deref(), uvs.as_deref(), indices)
-            .map_err(|source| SceneError::Mesh { path: self.path.to_owned(), mesh, primitive: p, source })?;
+        let mesh_err = |source| SceneError::Mesh { path: self.path.to_owned(), mesh, primitive: p, source };
+        let mut data =
+            MeshData::from_attributes(label, &positions, normals.as_deref(), uvs.as_deref(), indices)
+                .map_err(mesh_err)?;
+        let index = self.scene.meshes.len();
+        if let Some(t) = &tangents {
+            data.set_tangents(t);
+        } else if generate_tangents {
+            data.generate_tangents();
+            self.generated_tangents.insert(index);
+        }
         self.scene.meshes.push(Arc::new(data));
-        let index = self.scene.meshes.len() - 1;
         self.meshes.insert(key, Some(index));
         Ok(Some(index))
     }
