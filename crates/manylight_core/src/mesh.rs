@@ -280,7 +280,8 @@ mod tests {
     }
 
     /// A quad in the xy plane with u along +x and v along -y (glTF's uv origin is top-left):
-    /// MikkTSpace gives tangent +x; mirrored uvs (u along -x) flip it and the handedness.
+    /// MikkTSpace gives tangent +x and a handedness with `w * cross(n, t)` along +v (-y);
+    /// mirrored uvs (u along -x) flip the tangent and the handedness.
     #[test]
     fn generated_tangents_follow_u_and_flip_when_mirrored() {
         let positions = [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
@@ -290,7 +291,7 @@ mod tests {
         m.generate_tangents();
         for v in &m.vertices {
             let t = Vec4::from(v.tangent);
-            assert!((t - Vec4::new(1.0, 0.0, 0.0, 1.0)).abs().max_element() < 1e-5, "{t}");
+            assert!((t - Vec4::new(1.0, 0.0, 0.0, -1.0)).abs().max_element() < 1e-5, "{t}");
         }
         let mirrored = uvs.map(|uv| Vec2::new(1.0 - uv.x, uv.y));
         let mut m =
@@ -298,7 +299,7 @@ mod tests {
         m.generate_tangents();
         for v in &m.vertices {
             let t = Vec4::from(v.tangent);
-            assert!((t - Vec4::new(-1.0, 0.0, 0.0, -1.0)).abs().max_element() < 1e-5, "{t}");
+            assert!((t - Vec4::new(-1.0, 0.0, 0.0, 1.0)).abs().max_element() < 1e-5, "{t}");
         }
     }
 
