@@ -1,5 +1,6 @@
 //! Every debug view renders its data on the default scene and replaces tone mapping; the views
-//! of geometry (albedo, normal, depth, cluster x/y/z) match stored references (FLIP); the views
+//! of geometry and material (albedo, normal, metallic, roughness, emissive, occlusion, depth,
+//! cluster x/y/z) match stored references (FLIP); the views
 //! of cluster contents (light count, overflow) show, pixel by pixel, what the CPU reference
 //! assignment says of the pixel's cluster; and the view follows the `DebugView` resource when a
 //! system changes it.

@@ -14,9 +14,6 @@ struct SurfaceVertexOut {
     // World tangent (xyz, transformed like positions) and the bitangent's handedness in world
     // space (w: the vertex's times the sign of the instance's determinant; 0 without tangent).
     @location(3) world_tangent: vec4<f32>,
-    // +1, or -1 for a mirrored instance (negative determinant), whose triangles wind the other
-    // way on screen.
-    @location(4) @interpolate(flat) mirror: f32,
 };
 
 // True in the pipelines of alpha-masked materials (Rust: `SurfaceVariant::alpha_mask`).
@@ -25,6 +22,7 @@ override ALPHA_MASK: bool = false;
 fn surface_vertex(v: VertexIn, inst: GpuInstance, clip_from_world: mat4x4<f32>, camera: vec3<f32>) -> SurfaceVertexOut {
     let world = inst.world_from_local * vec4<f32>(v.position, 1.0);
     let m = mat3x3<f32>(inst.world_from_local[0].xyz, inst.world_from_local[1].xyz, inst.world_from_local[2].xyz);
+    // A mirrored instance (negative determinant) flips the bitangent's handedness too.
     let mirror = select(1.0, -1.0, determinant(m) < 0.0);
     var out: SurfaceVertexOut;
     out.clip_position = clip_from_world * world;
@@ -32,7 +30,6 @@ fn surface_vertex(v: VertexIn, inst: GpuInstance, clip_from_world: mat4x4<f32>, 
     out.world_normal = (inst.normal_from_local * vec4<f32>(v.normal, 0.0)).xyz;
     out.uv = v.uv;
     out.world_tangent = vec4<f32>(m * v.tangent.xyz, v.tangent.w * mirror);
-    out.mirror = mirror;
     return out;
 }
 
@@ -50,14 +47,16 @@ fn surface_metal_rough(m: GpuMaterial, t: texture_2d<f32>, smp: sampler, uv: vec
 }
 
 // The shading normal of a fragment: the interpolated normal, turned to the side the camera
-// sees (the back faces of single-sided materials are culled before they get here), then
+// sees (the back faces of single-sided materials are culled before they get here; a mirrored
+// instance's pipeline takes clockwise triangles as front, so `front_facing` is the face's own
+// side whatever the instance's handedness), then
 // perturbed by the tangent-space normal map `texel` (0..1 per channel) when the material has
 // one and the vertex a tangent frame (glTF: bitangent = w * cross(normal, tangent), the map's
 // +y along it). On a back face the whole frame turns, as MikkTSpace bakers expect.
 fn surface_normal(m: GpuMaterial, texel: vec3<f32>, in: SurfaceVertexOut, front_facing: bool) -> vec3<f32> {
     let len = length(in.world_normal);
     let n0 = select(vec3<f32>(0.0, 1.0, 0.0), in.world_normal / len, len > 1e-8);
-    let side = select(-1.0, 1.0, front_facing == (in.mirror > 0.0));
+    let side = select(-1.0, 1.0, front_facing);
     let n = n0 * side;
     let t = in.world_tangent.xyz * side;
     let b = cross(n0, in.world_tangent.xyz) * (in.world_tangent.w * side);

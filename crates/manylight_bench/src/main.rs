@@ -294,8 +294,8 @@ struct ClusterArgs {
     /// octa16 or octa8. The full G-buffer stores normals unencoded.
     #[arg(long, default_value = "octa16", value_parser = parse_normal_codec)]
     normal_codec: NormalCodec,
-    /// Debug view: none, albedo, normal, depth, light-count, slice-x, slice-y, slice-z or
-    /// overflow (replaces tone mapping).
+    /// Debug view: none, albedo, normal, metallic, roughness, emissive, occlusion, depth,
+    /// light-count, slice-x, slice-y, slice-z or overflow (replaces tone mapping).
     #[arg(long, default_value = "none", value_parser = parse_debug_view)]
     debug_view: DebugViewMode,
 }

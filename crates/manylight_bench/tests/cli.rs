@@ -207,7 +207,7 @@ fn bench_writes_a_csv_row_per_configuration() {
     );
     assert!(lines[0].starts_with("adapter,scene,pipeline,gbuffer,"), "{}", lines[0]);
     assert!(lines[1..].iter().all(|l| l.contains(",\"default\",")), "{text}");
-    assert!(lines.iter().any(|l| l.contains(",clustered-deferred,compact,20,32,")), "{text}");
+    assert!(lines.iter().any(|l| l.contains(",clustered-deferred,compact,28,32,")), "{text}");
     let header: Vec<&str> = lines[0].split(',').collect();
     let column =
         |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no column {name}"));

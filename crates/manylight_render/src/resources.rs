@@ -51,15 +51,19 @@ pub struct GpuMaterialBinding {
     last_used: u64,
 }
 
-/// How a draw is rasterised beyond what its pass decides: back faces culled (single-sided
-/// materials, the front face following the instance's handedness) and alpha masking. Each
-/// variant the frame draws is a pipeline of every mesh pass, so opaque surfaces keep shaders
-/// without `discard` (early depth testing on real GPUs) and no material branch reaches a
-/// shader (lavapipe compiles a shader again per draw where it can fold a uniform branch).
+/// How a draw is rasterised beyond what its pass decides: which winding faces front (the
+/// instance's handedness: a mirrored transform winds its triangles the other way on screen, so
+/// `front_facing` in the shaders always means the face's own front), back faces culled
+/// (single-sided materials) and alpha masking. Each variant the frame draws is a pipeline of
+/// every mesh pass, so opaque surfaces keep shaders without `discard` (early depth testing on
+/// real GPUs) and no material branch reaches a shader (lavapipe compiles a shader again per
+/// draw where it can fold a uniform branch).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct SurfaceVariant {
-    /// Cull back faces, with this winding facing front; `None` draws both sides.
-    pub cull_back: Option<wgpu::FrontFace>,
+    /// The winding that faces front.
+    pub front_face: wgpu::FrontFace,
+    /// Cull back faces; otherwise both sides are drawn.
+    pub cull_back: bool,
     /// Discard fragments whose alpha is below the material's cutoff (`ALPHA_MASK` in
     /// `shaders/common/surface.wgsl`).
     pub alpha_mask: bool,
@@ -67,20 +71,20 @@ pub struct SurfaceVariant {
 
 impl SurfaceVariant {
     /// The variant of `material` drawn with a transform whose determinant is negative when
-    /// `mirrored` (its triangles wind the other way on screen).
+    /// `mirrored`.
     pub fn of(material: &MaterialData, mirrored: bool) -> SurfaceVariant {
-        let front = if mirrored { wgpu::FrontFace::Cw } else { wgpu::FrontFace::Ccw };
         SurfaceVariant {
-            cull_back: (!material.double_sided).then_some(front),
+            front_face: if mirrored { wgpu::FrontFace::Cw } else { wgpu::FrontFace::Ccw },
+            cull_back: !material.double_sided,
             alpha_mask: material.alpha_mode.cutoff().is_some(),
         }
     }
 
-    /// Rasteriser state: triangle lists, culling as the variant says.
+    /// Rasteriser state: triangle lists, winding and culling as the variant says.
     pub fn primitive(self) -> wgpu::PrimitiveState {
         wgpu::PrimitiveState {
-            front_face: self.cull_back.unwrap_or_default(),
-            cull_mode: self.cull_back.map(|_| wgpu::Face::Back),
+            front_face: self.front_face,
+            cull_mode: self.cull_back.then_some(wgpu::Face::Back),
             ..Default::default()
         }
     }

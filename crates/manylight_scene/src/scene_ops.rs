@@ -48,8 +48,8 @@ impl Scene {
         out
     }
 
-    /// The scene's first camera, or else one that frames [`Scene::bounds`] from a 3/4 view
-    /// (above, front-right) for a viewport of aspect ratio `aspect`.
+    /// The scene's first camera, or else one that frames [`Scene::bounds`] from the front
+    /// (looking down -Z, as glTF viewers show a model) for a viewport of aspect ratio `aspect`.
     pub fn camera_or_fit(&self, aspect: f32) -> SceneCamera {
         if let Some(c) = self.cameras.first() {
             return *c;
@@ -66,7 +66,8 @@ impl Scene {
         let half_x = ((fov_y * 0.5).tan() * aspect).atan();
         let half = (fov_y * 0.5).min(half_x);
         let distance = radius / half.sin();
-        let dir = Vec3::new(1.0, 0.7, 1.0).normalize();
+        // From the front, as glTF viewers frame a model: +Z is the asset's front.
+        let dir = Vec3::Z;
         let eye = center + dir * distance;
         let transform = camera_looking_at(eye, center);
         SceneCamera {
