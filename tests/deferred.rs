@@ -103,8 +103,13 @@ fn hard_light_scene(aspect: f32) -> Scene {
     let far = cam.projection.far;
     scene.cameras = vec![cam];
     let warm = Vec3::new(1.0, 0.8, 0.6);
-    let light =
-        |position: Vec3, radius: f32, intensity: f32| SceneLight { position, color: warm, intensity, radius };
+    let light = |position: Vec3, radius: f32, intensity: f32| SceneLight {
+        position,
+        color: warm,
+        intensity,
+        radius,
+        spot: None,
+    };
     let half_width = (cam.projection.fov_y * 0.5).tan() * aspect;
     scene.lights.extend([
         light(eye, 4.0, 2.0),                                              // camera inside
@@ -154,8 +159,13 @@ fn nonfinite_hdr_pixels_are_counted() {
     let forward = -cam.transform.z_axis.truncate().normalize();
     // Valid (finite, so not dropped as invalid), but its radiance overflows f32 in the shading
     // sum near the light. (1e30 is not enough on lavapipe: it clamps f16 writes to 65504.)
-    let light =
-        SceneLight { position: eye + forward * 2.0, color: Vec3::ONE, intensity: f32::MAX, radius: 50.0 };
+    let light = SceneLight {
+        position: eye + forward * 2.0,
+        color: Vec3::ONE,
+        intensity: f32::MAX,
+        radius: 50.0,
+        spot: None,
+    };
     scene.lights.push(light);
     for pipeline in [PipelineKind::NaiveForward, PipelineKind::ClusteredDeferred] {
         let frame =
@@ -211,7 +221,13 @@ fn light_volumes_plan_only_what_they_need() {
     use manylight::app::render_world::plan_passes;
     use manylight::app::scene::scene_snapshot;
     use manylight::render::{ExtractedPointLight, FrameSettings};
-    let light = ExtractedPointLight { position: Vec3::ZERO, color: Vec3::ONE, intensity: 1.0, radius: 2.0 };
+    let light = ExtractedPointLight {
+        position: Vec3::ZERO,
+        color: Vec3::ONE,
+        intensity: 1.0,
+        radius: 2.0,
+        spot: None,
+    };
     let settings = FrameSettings {
         render: RenderSettings { pipeline: PipelineKind::LightVolumes, ..Default::default() },
         ..FrameSettings::default()

@@ -100,6 +100,7 @@ fn box_scene(sx: f32, double_sided: bool) -> Scene {
             color: Vec3::ONE,
             intensity: 8.0,
             radius: 20.0,
+            spot: None,
         }],
         cameras: vec![SceneCamera {
             transform: camera_looking_at(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO),

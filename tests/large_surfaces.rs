@@ -159,6 +159,7 @@ fn lights() -> Vec<SceneLight> {
         color,
         intensity: 3.0,
         radius: 5.0,
+        spot: None,
     };
     vec![
         light(-1.5, 0.5, 1.0, Vec3::new(1.0, 0.8, 0.6)),

@@ -93,6 +93,7 @@ fn orthographic_gpu_lists_equal_the_cpu_reference() {
             color: Vec3::ONE,
             intensity: 1.0,
             radius,
+            spot: None,
         });
     }
     for cull in [CullTest::Aabb, CullTest::Planes, CullTest::Both] {

@@ -1,5 +1,5 @@
 //! The metallic-roughness model on the GPU against its CPU twin: a grid of spheres of known
-//! metallic and roughness under point lights, rendered by naive forward and by a CPU ray
+//! metallic and roughness under point lights and a spot light, rendered by naive forward and by a CPU ray
 //! caster that shades with `manylight_core::brdf` and tone-maps with
 //! `manylight_core::tonemap`; then every other pipeline and G-buffer layout against naive
 //! forward on the same spheres.
@@ -12,7 +12,7 @@ use manylight::app::RenderSettings;
 use manylight::app::prelude::GBufferLayout;
 use manylight::core::brdf::{PointLightSample, SurfaceParams, shade_point_light};
 use manylight::core::tonemap::tonemap_to_srgb8;
-use manylight::core::{MaterialData, Projection, ShadingModel};
+use manylight::core::{MaterialData, Projection, ShadingModel, SpotCone};
 use manylight::prelude::*;
 use manylight::scene::shapes::uv_sphere;
 use manylight::scene::{SceneCamera, SceneInstance, SceneLight, camera_looking_at};
@@ -39,18 +39,32 @@ fn centre(row: usize, column: usize) -> Vec3 {
 
 fn lights() -> Vec<SceneLight> {
     vec![
-        SceneLight { position: Vec3::new(2.5, 2.0, 3.5), color: Vec3::ONE, intensity: 30.0, radius: 40.0 },
+        SceneLight {
+            position: Vec3::new(2.5, 2.0, 3.5),
+            color: Vec3::ONE,
+            intensity: 30.0,
+            radius: 40.0,
+            spot: None,
+        },
         SceneLight {
             position: Vec3::new(-3.0, 1.0, 3.0),
             color: Vec3::new(1.0, 0.7, 0.4),
             intensity: 15.0,
             radius: 40.0,
+            spot: None,
         },
+        // A spot from below and to the left, its cone's edge falling across the middle of
+        // the grid, so both the full-strength core and the falloff show.
         SceneLight {
-            position: Vec3::new(0.5, -2.5, 2.0),
+            position: Vec3::new(-1.0, -2.5, 2.0),
             color: Vec3::new(0.4, 0.6, 1.0),
-            intensity: 12.0,
+            intensity: 40.0,
             radius: 40.0,
+            spot: Some(SpotCone {
+                direction: (Vec3::new(-1.0, 0.0, 0.0) - Vec3::new(-1.0, -2.5, 2.0)).normalize(),
+                inner_angle: 0.25,
+                outer_angle: 0.45,
+            }),
         },
     ]
 }
@@ -95,7 +109,7 @@ fn settings(pipeline: PipelineKind) -> RenderSettings {
 }
 
 /// The spheres ray-cast at each pixel centre and shaded by the CPU twin.
-fn cpu_twin() -> RgbaImage {
+fn cpu_twin(scene_lights: &[SceneLight]) -> RgbaImage {
     let aspect = SIZE.x as f32 / SIZE.y as f32;
     let clip_from_world = Projection::perspective(FOV_Y, 0.1, 100.0).matrix(aspect)
         * camera_looking_at(EYE, Vec3::ZERO).inverse();
@@ -104,9 +118,12 @@ fn cpu_twin() -> RgbaImage {
         let p = world_from_clip * ndc.extend(1.0);
         p.truncate() / p.w
     };
-    let lights: Vec<PointLightSample> = lights()
+    let lights: Vec<PointLightSample> = scene_lights
         .iter()
-        .map(|l| PointLightSample { position: l.position, radius: l.radius, color: l.color * l.intensity })
+        .map(|l| match &l.spot {
+            Some(cone) => PointLightSample::spot(l.position, l.radius, l.color * l.intensity, cone),
+            None => PointLightSample::point(l.position, l.radius, l.color * l.intensity),
+        })
         .collect();
     RgbaImage::from_fn(SIZE.x, SIZE.y, |x, y| {
         let ndc = Vec3::new(
@@ -162,7 +179,11 @@ fn cpu_twin() -> RgbaImage {
 fn pbr_spheres_match_the_cpu_twin() {
     let _gpu = gpu();
     let frame = render_scene(spheres(), SIZE, 0, settings(PipelineKind::NaiveForward));
-    let twin = cpu_twin();
+    let twin = cpu_twin(&lights());
+    // The spot's cone shows: the same light shining in every direction gives another image.
+    let unbounded: Vec<SceneLight> = lights().into_iter().map(|l| SceneLight { spot: None, ..l }).collect();
+    let cone = support::flip(&twin, &cpu_twin(&unbounded));
+    assert!(cone.mean > 0.01, "the spot light's cone changes little: {cone:?}");
     let _ = frame.image.save(support::output_dir().join("pbr_spheres.png"));
     let stats = assert_similar("pbr_spheres_cpu_twin", &twin, &frame.image, TWIN);
     eprintln!("pbr spheres against the CPU twin: {stats:?}");

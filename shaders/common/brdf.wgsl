@@ -29,7 +29,7 @@ fn with_material_slots(s: SurfaceParams, slots: vec2<f32>) -> SurfaceParams {
     return out;
 }
 
-// Radiance a point light adds at `position` seen from `view_dir` (unit, towards the eye).
+// Radiance a point or spot light adds at `position` seen from `view_dir` (unit, towards the eye).
 fn shade_point_light(s: SurfaceParams, position: vec3<f32>, view_dir: vec3<f32>, light: GpuPointLight) -> vec3<f32> {
     let to_light = light.position_radius.xyz - position;
     let distance = length(to_light);
@@ -38,15 +38,17 @@ fn shade_point_light(s: SurfaceParams, position: vec3<f32>, view_dir: vec3<f32>,
         return vec3<f32>(0.0);
     }
     let l = to_light / max(distance, 1e-6);
+    let cone = spot_attenuation(dot(light.spot.xyz, -l), light.spot.w, light.color.a);
+    let lit = att * cone;
     let n_dot_l = max(dot(s.normal, l), 0.0);
     if s.model == SHADING_TOON {
-        return toon_point_light(s, n_dot_l, view_dir, l) * light.color.rgb * att;
+        return toon_point_light(s, n_dot_l, view_dir, l) * light.color.rgb * lit;
     }
     if s.model == SHADING_PBR {
         if n_dot_l <= 0.0 {
             return vec3<f32>(0.0);
         }
-        return pbr_point_light(s, n_dot_l, view_dir, l) * light.color.rgb * att;
+        return pbr_point_light(s, n_dot_l, view_dir, l) * light.color.rgb * lit;
     }
     var result = s.albedo * n_dot_l;
     if s.model == SHADING_BLINN_PHONG && n_dot_l > 0.0 {
@@ -54,7 +56,7 @@ fn shade_point_light(s: SurfaceParams, position: vec3<f32>, view_dir: vec3<f32>,
         let n_dot_h = max(dot(s.normal, h), 0.0);
         result += vec3<f32>(s.specular * pow(n_dot_h, s.shininess) * n_dot_l);
     }
-    return result * light.color.rgb * att;
+    return result * light.color.rgb * lit;
 }
 
 // Toon (cel) shading of one light: the diffuse term in TOON_BANDS flat bands (the light's

@@ -1,11 +1,20 @@
-// Point lights (Rust: `GpuPointLight`) and the attenuation shared with
+// Point and spot lights (Rust: `GpuPointLight`) and the attenuation shared with
 // crates/manylight_core/src/attenuation.rs: saturate(1 - (d/r)^4)^2 / (d^2 + 1), exactly 0 at r.
 struct GpuPointLight {
     // xyz: world position, w: radius
     position_radius: vec4<f32>,
-    // rgb: colour * intensity (linear), a: unused
+    // rgb: colour * intensity (linear), a: the spot falloff's offset (1 for a point light)
     color: vec4<f32>,
+    // xyz: a spot light's unit direction (0 for a point light), w: the falloff's scale (0)
+    spot: vec4<f32>,
 };
+
+// A spot light's angular falloff (crates/manylight_core/src/spot.rs): saturate(cos * scale +
+// offset)^2; 1 for a point light's (scale 0, offset 1).
+fn spot_attenuation(cos_angle: f32, scale: f32, offset: f32) -> f32 {
+    let t = saturate(cos_angle * scale + offset);
+    return t * t;
+}
 
 fn attenuation(distance: f32, radius: f32) -> f32 {
     if !(radius > 0.0) || distance >= radius {

@@ -255,6 +255,40 @@ impl Default for PointLight {
     }
 }
 
+/// A light shining in a cone down the entity's local -Z (its [`GlobalTransform`]'s forward), in
+/// Bevy's words: full strength within `inner_angle` of the axis, fading to exactly zero at
+/// `outer_angle` (glTF `KHR_lights_punctual` spot lights). The cluster build culls it with the
+/// sphere around its cone, smaller than a point light's of the same `range`.
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+#[require(Transform, Visibility)]
+pub struct SpotLight {
+    /// Linear RGB colour.
+    pub color: Vec3,
+    /// Multiplier of `color`.
+    pub intensity: f32,
+    /// Distance at which the contribution reaches exactly zero.
+    pub range: f32,
+    /// Radius of the emitter (not used by the shading, as for [`PointLight`]).
+    pub radius: f32,
+    /// Angle from the axis, in radians, within which the light is at full strength.
+    pub inner_angle: f32,
+    /// Angle from the axis, in radians, at which the light reaches zero (at most π/2).
+    pub outer_angle: f32,
+}
+
+impl Default for SpotLight {
+    fn default() -> Self {
+        Self {
+            color: Vec3::ONE,
+            intensity: 10.0,
+            range: 10.0,
+            radius: 0.0,
+            inner_angle: 0.0,
+            outer_angle: std::f32::consts::FRAC_PI_4,
+        }
+    }
+}
+
 /// The geometry drawn at the entity's [`GlobalTransform`] (shared; uploaded once per `Arc`).
 #[derive(Component, Clone, Debug)]
 #[require(Transform, Visibility)]

@@ -4,14 +4,14 @@
 use crate::backend::{RenderBackend, record_results};
 use crate::components::{
     Bloom, Camera, Camera3d, CameraDebugView, GlobalTransform, InheritedVisibility, LightAnimation, Material,
-    Mesh3d, MotionBlur, PointLight, Projection, RenderTarget, Transform,
+    Mesh3d, MotionBlur, PointLight, Projection, RenderTarget, SpotLight, Transform,
 };
 use crate::resources::{DebugView, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize};
 use bevy_app::AppExit;
 use bevy_ecs::prelude::*;
 use bevy_time::Time;
 use glam::Mat4;
-use manylight_core::MaterialData;
+use manylight_core::{MaterialData, SpotCone};
 use manylight_render::{
     ExtractedCamera, ExtractedInstance, ExtractedPointLight, ExtractedView, FrameSnapshot, ViewRect,
     ViewTarget,
@@ -48,8 +48,12 @@ pub type MeshItem = (
     Option<&'static InheritedVisibility>,
 );
 
-/// What extract reads of a light entity (hidden ones are skipped).
-pub type LightItem = (&'static GlobalTransform, &'static PointLight, Option<&'static InheritedVisibility>);
+/// What extract reads of a light entity, point or spot (hidden ones are skipped).
+pub type LightItem = (
+    &'static GlobalTransform,
+    AnyOf<(&'static PointLight, &'static SpotLight)>,
+    Option<&'static InheritedVisibility>,
+);
 
 /// Whether an entity's computed visibility lets it render (none computed yet: visible).
 fn shown(visibility: Option<&InheritedVisibility>) -> bool {
@@ -122,11 +126,18 @@ pub fn build_snapshot(
     let lights = lights
         .iter()
         .filter(|(.., visibility)| shown(*visibility))
-        .map(|(t, l, _)| ExtractedPointLight {
-            position: t.translation(),
-            color: l.color,
-            intensity: l.intensity,
-            radius: l.range,
+        .filter_map(|(t, (point, spot), _)| {
+            // A point light wins over a spot light on the same entity.
+            let (color, intensity, range, spot) = match (point, spot) {
+                (Some(l), _) => (l.color, l.intensity, l.range, None),
+                (None, Some(l)) => {
+                    let direction = t.forward().into();
+                    let cone = SpotCone { direction, inner_angle: l.inner_angle, outer_angle: l.outer_angle };
+                    (l.color, l.intensity, l.range, Some(cone))
+                }
+                (None, None) => return None,
+            };
+            Some(ExtractedPointLight { position: t.translation(), color, intensity, radius: range, spot })
         })
         .collect();
     let snapshot = FrameSnapshot {

@@ -29,7 +29,7 @@ pub use backend::RenderFailed;
 pub use components::{
     Bloom, Camera, Camera3d, CameraDebugView, GlobalTransform, InheritedVisibility, LightAnimation, Material,
     Mesh3d, MotionBlur, OrthographicProjection, PerspectiveProjection, PointLight, Projection, RenderImage,
-    RenderTarget, Transform, Viewport, Visibility,
+    RenderTarget, SpotLight, Transform, Viewport, Visibility,
 };
 pub use plugin::{HEADLESS_TIME_STEP, HeadlessConfig, ManyLightPlugin, ManyLightSet, OutputMode};
 pub use resources::{
@@ -48,7 +48,7 @@ pub mod prelude {
     pub use crate::components::{
         Bloom, Camera, Camera3d, CameraDebugView, GlobalTransform, InheritedVisibility, LightAnimation,
         Material, Mesh3d, MotionBlur, OrthographicProjection, PerspectiveProjection, PointLight, Projection,
-        RenderImage, RenderTarget, Transform, Viewport, Visibility,
+        RenderImage, RenderTarget, SpotLight, Transform, Viewport, Visibility,
     };
     pub use crate::plugin::{ManyLightPlugin, ManyLightSet};
     pub use crate::resources::{

@@ -1,11 +1,12 @@
 //! Turning a [`Scene`] (loaded glTF or the embedded default) into entities.
 
 use crate::components::{
-    Camera3d, LightAnimation, Material, Mesh3d, PointLight, Projection, Transform, Visibility,
+    Camera3d, LightAnimation, Material, Mesh3d, PointLight, Projection, SpotLight, Transform, Visibility,
     transform_from_matrix,
 };
 use bevy_ecs::name::Name;
 use bevy_ecs::prelude::*;
+use glam::{Quat, Vec3};
 use manylight_core::Aabb;
 use manylight_render::{
     ExtractedCamera, ExtractedInstance, ExtractedPointLight, ExtractedView, FrameSettings, FrameSnapshot,
@@ -52,7 +53,7 @@ pub fn spawn_scene(commands: &mut Commands, scene: &Scene, spawn_camera: bool, a
         }
         for &l in &node.lights {
             if let Some(light) = scene.lights.get(l) {
-                commands.spawn((Transform::IDENTITY, point_light(light), ChildOf(entity)));
+                spawn_light(commands, light, Transform::IDENTITY, true, entity);
                 placed_lights[l] = true;
             }
         }
@@ -72,7 +73,7 @@ pub fn spawn_scene(commands: &mut Commands, scene: &Scene, spawn_camera: bool, a
         }
     }
     for (light, _) in scene.lights.iter().zip(&placed_lights).filter(|(_, placed)| !**placed) {
-        commands.spawn((Transform::from_translation(light.position), point_light(light), ChildOf(root)));
+        spawn_light(commands, light, Transform::from_translation(light.position), false, root);
     }
     if spawn_camera && !camera_placed {
         let cam = scene.camera_or_fit(aspect);
@@ -105,9 +106,31 @@ fn spawn_instance(
     true
 }
 
-/// The component of a scene light (its range is the scene light's radius).
-fn point_light(light: &SceneLight) -> PointLight {
-    PointLight { color: light.color, intensity: light.intensity, range: light.radius, radius: 0.0 }
+/// Spawns scene light `light` under `parent`: a [`PointLight`], or a [`SpotLight`] turned so
+/// that its -Z is the cone's direction. `local` places it relative to the parent; a light that
+/// hangs from a glTF node (`on_node`) already points down that node's -Z.
+fn spawn_light(commands: &mut Commands, light: &SceneLight, local: Transform, on_node: bool, parent: Entity) {
+    let (color, intensity, range) = (light.color, light.intensity, light.radius);
+    match &light.spot {
+        None => {
+            commands.spawn((local, PointLight { color, intensity, range, radius: 0.0 }, ChildOf(parent)));
+        }
+        Some(cone) => {
+            let mut transform = local;
+            if !on_node {
+                transform.rotation = Quat::from_rotation_arc(Vec3::NEG_Z, cone.sanitized().direction);
+            }
+            let spot = SpotLight {
+                color,
+                intensity,
+                range,
+                radius: 0.0,
+                inner_angle: cone.inner_angle,
+                outer_angle: cone.outer_angle,
+            };
+            commands.spawn((transform, spot, ChildOf(parent)));
+        }
+    }
 }
 
 /// Marks the entity of node `.0` of `Scene::nodes` (spawned by [`spawn_scene`]).
@@ -136,7 +159,13 @@ pub fn spawn_light_rig(commands: &mut Commands, count: usize, bounds: Aabb, seed
 
 /// A scene light as the render side sees it.
 pub fn extracted_light(l: &SceneLight) -> ExtractedPointLight {
-    ExtractedPointLight { position: l.position, color: l.color, intensity: l.intensity, radius: l.radius }
+    ExtractedPointLight {
+        position: l.position,
+        color: l.color,
+        intensity: l.intensity,
+        radius: l.radius,
+        spot: l.spot,
+    }
 }
 
 /// The snapshot of `scene` seen through its camera (or one framing it) at `size`, lit by

@@ -10,14 +10,17 @@
 //! F = f0 + (1 - f0) (1 - v.h)^5
 //! D = a^2 / (pi ((n.h)^2 (a^2 - 1) + 1)^2)
 //! V = 1 / ((n.l + sqrt(a^2 + (1 - a^2)(n.l)^2)) (n.v + sqrt(a^2 + (1 - a^2)(n.v)^2)))
-//! radiance = ((1 - F) c_diff / pi + F D V) * light * attenuation * n.l
+//! radiance = ((1 - F) c_diff / pi + F D V) * light * attenuation * cone * n.l
 //! ```
 //!
 //! The other models are this renderer's own: Lambert (`albedo * n.l`, no `1/pi`), Blinn-Phong
-//! (Lambert plus `specular * (n.h)^shininess * n.l`) and toon.
+//! (Lambert plus `specular * (n.h)^shininess * n.l`) and toon. Every model multiplies by the
+//! distance attenuation and a spot light's angular falloff (`cone`, [`crate::spot`]; 1 for a
+//! point light).
 
 use crate::attenuation::attenuation;
 use crate::material::{ShadingModel, TOON_BANDS, TOON_RIM_STRENGTH};
+use crate::spot::spot_attenuation;
 use glam::Vec3;
 
 /// Smallest roughness the PBR model shades with: below it the GGX lobe of a point light is
@@ -57,6 +60,33 @@ pub struct PointLightSample {
     pub radius: f32,
     /// Linear colour times intensity.
     pub color: Vec3,
+    /// Unit direction of a spot light's axis (zero for a point light).
+    pub spot_direction: Vec3,
+    /// Scale of the angular falloff (`crate::spot::SpotCone::scale_offset`; 0 for a point light).
+    pub spot_scale: f32,
+    /// Offset of the angular falloff (1 for a point light).
+    pub spot_offset: f32,
+}
+
+impl PointLightSample {
+    /// A point light (no cone).
+    pub fn point(position: Vec3, radius: f32, color: Vec3) -> PointLightSample {
+        PointLightSample {
+            position,
+            radius,
+            color,
+            spot_direction: Vec3::ZERO,
+            spot_scale: 0.0,
+            spot_offset: 1.0,
+        }
+    }
+
+    /// A spot light with `cone`.
+    pub fn spot(position: Vec3, radius: f32, color: Vec3, cone: &crate::spot::SpotCone) -> PointLightSample {
+        let (spot_scale, spot_offset) = cone.scale_offset();
+        let spot_direction = cone.sanitized().direction;
+        PointLightSample { position, radius, color, spot_direction, spot_scale, spot_offset }
+    }
 }
 
 /// Radiance that `light` adds at `position` seen from `view_dir` (unit, towards the eye).
@@ -73,14 +103,16 @@ pub fn shade_point_light(
         return Vec3::ZERO;
     }
     let l = to_light / distance.max(1e-6);
+    let cone = spot_attenuation(light.spot_direction.dot(-l), light.spot_scale, light.spot_offset);
+    let lit = att * cone;
     let n_dot_l = s.normal.dot(l).max(0.0);
     match s.model {
-        ShadingModel::Toon => toon_point_light(s, n_dot_l, view_dir, l) * light.color * att,
+        ShadingModel::Toon => toon_point_light(s, n_dot_l, view_dir, l) * light.color * lit,
         ShadingModel::Pbr => {
             if n_dot_l <= 0.0 {
                 return Vec3::ZERO;
             }
-            pbr_point_light(s, n_dot_l, view_dir, l) * light.color * att
+            pbr_point_light(s, n_dot_l, view_dir, l) * light.color * lit
         }
         ShadingModel::Lambert | ShadingModel::BlinnPhong => {
             let mut result = s.albedo * n_dot_l;
@@ -89,7 +121,7 @@ pub fn shade_point_light(
                 let n_dot_h = s.normal.dot(h).max(0.0);
                 result += Vec3::splat(s.specular * n_dot_h.powf(s.shininess) * n_dot_l);
             }
-            result * light.color * att
+            result * light.color * lit
         }
     }
 }
@@ -234,7 +266,7 @@ mod tests {
             let l = Vec3::new(lx, ly, lz).normalize_or(Vec3::Y);
             let v = Vec3::new(vx, vy, vz).normalize_or(Vec3::Y);
             let s = surface(metallic, roughness);
-            let light = PointLightSample { position: l * 2.0, radius: 10.0, color: Vec3::splat(100.0) };
+            let light = PointLightSample::point(l * 2.0, 10.0, Vec3::splat(100.0));
             let c = shade_point_light(&s, Vec3::ZERO, v, &light);
             prop_assert!(c.is_finite() && c.min_element() >= 0.0, "{c}");
         }

@@ -14,9 +14,11 @@ pub mod icosphere;
 pub mod image_metrics;
 pub mod material;
 pub mod mesh;
+pub mod spot;
 pub mod tonemap;
 
 pub use attenuation::{attenuation, radius_for_intensity};
 pub use camera::{Projection, ProjectionKind, linearize_depth_reverse_z};
 pub use material::{AlphaMode, MaterialData, ShadingModel, TextureData};
 pub use mesh::{Aabb, MeshData, MeshError, Vertex};
+pub use spot::SpotCone;

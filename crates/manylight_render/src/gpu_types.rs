@@ -111,14 +111,16 @@ pub struct ViewUniform {
     pub _pad: [u32; 2],
 }
 
-/// A point light as the shaders read it (`GpuPointLight` in `shaders/common/lights.wgsl`).
+/// A point or spot light as the shaders read it (`GpuPointLight` in `shaders/common/lights.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuPointLight {
     /// xyz: world position, w: radius.
     pub position_radius: [f32; 4],
-    /// rgb: colour * intensity, a: unused.
+    /// rgb: colour * intensity, a: the spot falloff's offset (1 for a point light).
     pub color: [f32; 4],
+    /// xyz: a spot light's unit direction (0 for a point light), w: the falloff's scale (0).
+    pub spot: [f32; 4],
 }
 
 /// Per-instance transforms (`GpuInstance` in `shaders/common/mesh.wgsl`).

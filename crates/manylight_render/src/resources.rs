@@ -144,7 +144,8 @@ pub struct SceneResources {
     /// Instances not drawn this frame because their transform collapses the mesh to a line or
     /// a point (a zero scale on two or three axes, on the mesh or a parent): they cover no pixel.
     pub collapsed_instances: u32,
-    /// (position, radius) of the uploaded lights, in light-buffer order.
+    /// (centre, radius) of the sphere bounding what each uploaded light can reach (a spot
+    /// light's is the smaller sphere around its cone), in light-buffer order.
     pub light_spheres: Vec<(glam::Vec3, f32)>,
     /// The tone map's count of non-finite HDR pixels.
     pub nonfinite: NonFiniteCounter,
@@ -265,7 +266,7 @@ impl SceneResources {
         });
         let storage_usage = wgpu::BufferUsages::STORAGE;
         // One placeholder light (every pipeline binds the buffer); it grows when lights appear.
-        let lights = GrowableBuffer::new(gpu, "point_lights", storage_usage, 32);
+        let lights = GrowableBuffer::new(gpu, "point_lights", storage_usage, 48);
         let instances = GrowableBuffer::new(gpu, "instances", storage_usage, 64 * 128);
         let view_bind_group =
             Self::make_view_bind_group(gpu, &view_layout, &view_buffer, &lights, &instances);
@@ -375,17 +376,28 @@ impl SceneResources {
             .lights
             .iter()
             .filter(|l| l.is_valid())
-            .map(|l| GpuPointLight {
-                position_radius: l.position.extend(l.radius).to_array(),
-                color: (l.color * l.intensity).extend(0.0).to_array(),
+            .map(|l| {
+                // A point light: no direction, falloff scale 0 and offset 1 (1 everywhere).
+                let (direction, scale, offset) = match &l.spot {
+                    Some(cone) => {
+                        let (scale, offset) = cone.scale_offset();
+                        (cone.sanitized().direction, scale, offset)
+                    }
+                    None => (glam::Vec3::ZERO, 0.0, 1.0),
+                };
+                GpuPointLight {
+                    position_radius: l.position.extend(l.radius).to_array(),
+                    color: (l.color * l.intensity).extend(offset).to_array(),
+                    spot: direction.extend(scale).to_array(),
+                }
             })
             .collect();
         self.invalid_lights = (snapshot.lights.len() - gpu_lights.len()) as u32;
         self.light_spheres =
-            snapshot.lights.iter().filter(|l| l.is_valid()).map(|l| (l.position, l.radius)).collect();
+            snapshot.lights.iter().filter(|l| l.is_valid()).map(|l| l.bounding_sphere()).collect();
         self.light_count = gpu_lights.len() as u32;
         let light_bytes: &[u8] =
-            if gpu_lights.is_empty() { &[0u8; 32] } else { bytemuck::cast_slice(&gpu_lights) };
+            if gpu_lights.is_empty() { &[0u8; 48] } else { bytemuck::cast_slice(&gpu_lights) };
         self.lights.write(gpu, light_bytes)?;
         self.light_upload_bytes = light_bytes.len() as u64;
 

@@ -4,7 +4,7 @@
 use glam::{Mat4, UVec2, Vec3};
 use manylight_core::cluster::{CullTest, GridConfig};
 use manylight_core::codec::NormalCodec;
-use manylight_core::{MaterialData, MeshData, Projection, ShadingModel};
+use manylight_core::{MaterialData, MeshData, Projection, ShadingModel, SpotCone};
 use std::sync::Arc;
 
 pub use crate::settings::{BloomChain, BloomSettings, MotionBlurSettings};
@@ -426,9 +426,21 @@ pub struct ExtractedPointLight {
     pub intensity: f32,
     /// Radius of influence (contribution is exactly 0 at and beyond it).
     pub radius: f32,
+    /// The cone of a spot light (`None`: a point light, lighting every direction).
+    pub spot: Option<SpotCone>,
 }
 
 impl ExtractedPointLight {
+    /// The sphere that holds every point the light can reach: the light's own sphere, or the
+    /// smaller one around a spot light's cone ([`SpotCone::bounding_sphere`]). The cluster
+    /// build culls with it.
+    pub fn bounding_sphere(&self) -> (Vec3, f32) {
+        match &self.spot {
+            Some(cone) => cone.bounding_sphere(self.position, self.radius),
+            None => (self.position, self.radius),
+        }
+    }
+
     /// True when every parameter is finite, the radius and intensity are not negative, and the
     /// emitted colour (`color × intensity`) does not overflow to infinity.
     pub fn is_valid(&self) -> bool {

@@ -100,6 +100,7 @@ fn shared_structs_match_rust() {
         &[
             ("position_radius", offset_of!(GpuPointLight, position_radius)),
             ("color", offset_of!(GpuPointLight, color)),
+            ("spot", offset_of!(GpuPointLight, spot)),
         ],
     );
     offsets(

@@ -182,6 +182,7 @@ pub fn default_scene() -> Scene {
             color: Vec3::new(1.0, 0.78, 0.5),
             intensity: 80.0,
             radius: 15.0,
+            spot: None,
         });
     }
 

@@ -88,6 +88,8 @@ pub struct SceneLight {
     pub intensity: f32,
     /// Distance at which the light's contribution reaches exactly zero.
     pub radius: f32,
+    /// The cone of a spot light (`None`: a point light).
+    pub spot: Option<manylight_core::SpotCone>,
 }
 
 /// A camera placement.

@@ -92,6 +92,7 @@ impl AnimatedLight {
             color: self.color_at(t),
             intensity: self.intensity,
             radius: self.radius,
+            spot: None,
         }
     }
 }
@@ -215,6 +216,7 @@ pub fn sphere_shell_lights(count: usize, shell_radius: f32, light_range: f32, se
                 color: hsv(rng.f32(), rng.range(0.7, 1.0)),
                 intensity: intensity_for_radius(range),
                 radius: range,
+                spot: None,
             }
         })
         .collect()

@@ -73,6 +73,7 @@ const EXPECTED: &[(&str, &str, &str)] = &[
     ("negative_light.gltf", "BadLight", "intensity -5"),
     ("negative_light_color.gltf", "BadLight", "color"),
     ("zero_light_range.gltf", "BadLight", "range"),
+    ("spot_inner_wider_than_outer.gltf", "BadLight", "inner 0.8 and outer 0.5"),
     ("bad_camera.gltf", "BadCamera", "yfov"),
     ("missing_image.gltf", "ReferencedFile", "missing.png"),
     ("unsupported_image.gltf", "UnsupportedImage", "image/gif"),

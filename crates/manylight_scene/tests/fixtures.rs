@@ -73,8 +73,15 @@ fn hierarchy_lights_and_cameras_without_a_scene_list() {
     assert!(world.abs_diff_eq(expected, 1e-6), "{world:?}");
     // The non-indexed triangle got sequential indices.
     assert_eq!(s.meshes[s.instances[0].mesh].indices, vec![0, 1, 2]);
-    // The point light sits at node 2's world position; the spot light is skipped.
-    assert_eq!(s.lights.len(), 1);
+    // The point light sits at node 2's world position; the spot light at node 3's (the
+    // origin), pointing down its -Z with the specification's default cone (0 to pi/4).
+    assert_eq!(s.lights.len(), 2);
+    let spot = s.lights[1];
+    assert_eq!(spot.position, Vec3::ZERO);
+    assert_eq!(spot.intensity, 10.0);
+    let cone = spot.spot.expect("a spot light");
+    assert_eq!(cone.direction, Vec3::NEG_Z);
+    assert_eq!((cone.inner_angle, cone.outer_angle), (0.0, std::f32::consts::FRAC_PI_4));
     let l = s.lights[0];
     assert!((l.position - Vec3::new(10.0, 0.0, 10.0)).length() < 1e-5, "{:?}", l.position);
     assert_eq!(l.intensity, 4.0);

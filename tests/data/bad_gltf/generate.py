@@ -135,6 +135,10 @@ def main():
     write_json("negative_light.gltf", light_doc({"type": "point", "intensity": -5.0}))
     write_json("negative_light_color.gltf", light_doc({"type": "point", "color": [1, -1, 0]}))
     write_json("zero_light_range.gltf", light_doc({"type": "point", "range": 0}))
+    write_json(
+        "spot_inner_wider_than_outer.gltf",
+        light_doc({"type": "spot", "intensity": 5, "spot": {"innerConeAngle": 0.8, "outerConeAngle": 0.5}}),
+    )
 
     d = base_doc()
     d["cameras"] = [{"type": "perspective", "perspective": {"yfov": 0, "znear": 0.1}}]

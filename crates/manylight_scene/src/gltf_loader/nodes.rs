@@ -7,7 +7,8 @@ use gltf::json::camera::Type as CameraType;
 use gltf::json::extensions::scene::khr_lights_punctual::Type as LightType;
 use gltf::json::mesh::{Mode, Semantic};
 use gltf::json::validation::Checked;
-use manylight_core::{MeshData, Projection, radius_for_intensity};
+use manylight_core::{MeshData, Projection, SpotCone, radius_for_intensity};
+use std::f32::consts::FRAC_PI_2;
 use std::sync::Arc;
 
 impl Ctx<'_> {
@@ -359,21 +360,41 @@ impl Ctx<'_> {
         Ok(i)
     }
 
-    /// Adds `KHR_lights_punctual` light `light` at the node's world position (point lights only).
+    /// Adds `KHR_lights_punctual` light `light` at the node's world position: point and spot
+    /// lights (a spot points down the node's -Z); directional lights are skipped with a warning.
     fn add_light(&mut self, node: usize, light: usize, world: Mat4) -> Result<(), SceneError> {
         let lights = (self.root.extensions.as_ref())
             .and_then(|e| e.khr_lights_punctual.as_ref())
             .map_or(&[][..], |k| &k.lights[..]);
         let l = self.lookup(lights, light, &format!("node {node}"), "light")?;
         let bad = |problem: String| SceneError::BadLight { path: self.path.to_owned(), light, problem };
-        match l.type_ {
-            Checked::Valid(LightType::Point) => {}
+        let spot = match l.type_ {
+            Checked::Valid(LightType::Point) => None,
+            Checked::Valid(LightType::Spot) => {
+                let cone = l.spot.as_ref().ok_or_else(|| bad("a spot light needs `spot`".into()))?;
+                let (inner, outer) = (cone.inner_cone_angle, cone.outer_cone_angle);
+                if !(inner.is_finite()
+                    && outer.is_finite()
+                    && 0.0 <= inner
+                    && inner < outer
+                    && outer <= FRAC_PI_2)
+                {
+                    return Err(bad(format!(
+                        "spot cone angles inner {inner} and outer {outer} must satisfy 0 <= inner < outer <= pi/2"
+                    )));
+                }
+                // glTF spots point down the node's local -Z.
+                let direction = world.transform_vector3(Vec3::NEG_Z).try_normalize().ok_or_else(|| {
+                    bad(format!("node {node}'s transform collapses the spot light's direction"))
+                })?;
+                Some(SpotCone { direction, inner_angle: inner, outer_angle: outer })
+            }
             Checked::Valid(other) => {
                 tracing::warn!(file = %self.path.display(), light, "{other:?} lights are not supported, skipped");
                 return Ok(());
             }
             Checked::Invalid => return Err(bad("invalid light type".into())),
-        }
+        };
         let color = Vec3::from_array(l.color);
         if !color.is_finite() || color.min_element() < 0.0 {
             return Err(bad(format!("color {:?} must be finite and non-negative", l.color)));
@@ -391,6 +412,7 @@ impl Ctx<'_> {
             color,
             intensity: l.intensity,
             radius,
+            spot,
         });
         Ok(())
     }

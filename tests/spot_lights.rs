@@ -1,0 +1,103 @@
+//! Spot lights in every pipeline: the same image as naive forward, which evaluates every light
+//! at every pixel, so a cone culled too tightly anywhere would show. The CPU twin of the cone's
+//! falloff is checked in `tests/pbr.rs`, the lists in `tests/clusters.rs`.
+
+mod support;
+
+use manylight::app::RenderSettings;
+use manylight::app::prelude::GBufferLayout;
+use manylight::core::SpotCone;
+use manylight::prelude::*;
+use manylight::scene::light_rig;
+use support::{STRICT, assert_similar, flip, gpu, render_scene};
+
+const SIZE: UVec2 = UVec2::new(160, 96);
+
+/// The default scene lit by rig lights turned into spot lights of every width, pointing every
+/// which way (some at the camera, some away; one cone is a hemisphere, one a hair).
+fn spot_scene(count: usize) -> Scene {
+    let mut scene = default_scene();
+    for (i, anim) in light_rig(count, scene.bounds(), 7).iter().enumerate() {
+        let a = i as f32 * 2.399;
+        let outer = [0.05, 0.35, 0.7, 1.2, std::f32::consts::FRAC_PI_2][i % 5];
+        let mut light = anim.at(0.0);
+        light.intensity *= 3.0;
+        light.spot = Some(SpotCone {
+            direction: Vec3::new(a.cos(), (i % 5) as f32 / 2.0 - 1.5, a.sin()),
+            inner_angle: if i % 4 == 0 { outer } else { outer * 0.6 },
+            outer_angle: outer,
+        });
+        scene.lights.push(light);
+    }
+    scene
+}
+
+fn settings(pipeline: PipelineKind) -> RenderSettings {
+    RenderSettings { pipeline, ..RenderSettings::default() }
+}
+
+#[test]
+fn spot_lights_give_the_naive_image_in_every_pipeline() {
+    let _gpu = gpu();
+    let naive = render_scene(spot_scene(120), SIZE, 0, settings(PipelineKind::NaiveForward));
+    // The cones show: the same lights as point lights light another image.
+    let mut points = spot_scene(120);
+    points.lights.iter_mut().for_each(|l| l.spot = None);
+    let as_points = render_scene(points, SIZE, 0, settings(PipelineKind::NaiveForward));
+    assert!(flip(&naive.image, &as_points.image).mean > 0.02, "the cones change little");
+    let mut variants: Vec<(String, RenderSettings)> = PipelineKind::ALL
+        .into_iter()
+        .filter(|p| *p != PipelineKind::NaiveForward)
+        .map(|p| (format!("spot_{}", p.name()), settings(p)))
+        .collect();
+    variants.push((
+        "spot_clustered_deferred_packed".into(),
+        RenderSettings { gbuffer: GBufferLayout::Packed, ..settings(PipelineKind::ClusteredDeferred) },
+    ));
+    for (name, s) in variants {
+        let frame = render_scene(spot_scene(120), SIZE, 0, s);
+        let stats = assert_similar(&name, &naive.image, &frame.image, STRICT);
+        eprintln!("{name}: {stats:?}");
+    }
+}
+
+/// A spot light placed through the ECS (`SpotLight`, pointing down its entity's -Z) lights
+/// only what lies in its cone.
+#[test]
+fn a_spot_light_component_lights_only_its_cone() {
+    let _gpu = gpu();
+    let render =
+        |light: Option<SpotLight>| {
+            manylight::app::headless::render_headless(SIZE, 1, move |app| {
+                app.insert_resource(RenderSettings { ambient: 0.0, ..RenderSettings::default() })
+                    .add_systems(Startup, move |mut commands: Commands| {
+                        let mut scene = default_scene();
+                        scene.lights.clear();
+                        spawn_scene(&mut commands, &scene, true, SIZE.x as f32 / SIZE.y as f32);
+                        if let Some(light) = light {
+                            // Above the floor of the nave, pointing straight down.
+                            let at = Transform::from_xyz(-12.0, 5.0, 0.0).looking_to(Vec3::NEG_Y, Vec3::X);
+                            commands.spawn((at, light));
+                        }
+                    });
+            })
+            .expect("renders")
+            .image
+        };
+    let dark = render(None);
+    let lit = render(Some(SpotLight {
+        intensity: 200.0,
+        range: 30.0,
+        inner_angle: 0.3,
+        outer_angle: 0.5,
+        ..SpotLight::default()
+    }));
+    let changed: Vec<(u32, u32)> = lit
+        .enumerate_pixels()
+        .filter(|(x, y, p)| *p != dark.get_pixel(*x, *y))
+        .map(|(x, y, _)| (x, y))
+        .collect();
+    let total = (SIZE.x * SIZE.y) as usize;
+    // A pool of light on the floor: some pixels, far from all of them.
+    assert!(changed.len() > 50 && changed.len() < total / 4, "{} of {total} pixels lit", changed.len());
+}
