@@ -319,8 +319,7 @@ fn gpu_lists_are_exact_past_the_workgroups_per_dimension_limit() {
     assert_same_lists("256×256×2 grid, workgroup size 1", &gpu, &cpu);
 }
 
-/// 4 194 304 lights (this device's binding limit on lavapipe) that each cover every one of
-/// 32 × 32 tiles make 2³² light–tile pairs, one more than the build's u32 sums hold. A wrapped
+/// 2 097 152 lights that each cover every one of 64 × 32 tiles make 2³² light–tile pairs, one more than the build's u32 sums hold. A wrapped
 /// sum would be 0 and pass every capacity check with empty lists; the saturating sums refuse
 /// the frame instead, naming the limit.
 #[test]
@@ -329,8 +328,10 @@ fn more_pairs_than_32_bits_hold_are_refused_not_wrapped() {
     let mut r = HeadlessRenderer::new().expect("adapter");
     let scene = default_scene();
     let mut settings = clustered(CullTest::Aabb, ZSlicing::Exponential, None);
-    settings.clusters.grid.dims = Some(glam::UVec3::new(32, 32, 1));
-    let count = 1usize << 22;
+    // 2^21 lights (48 bytes each: 96 MiB, under the 128 MiB a storage binding may hold)
+    // times 2^11 tiles.
+    settings.clusters.grid.dims = Some(glam::UVec3::new(64, 32, 1));
+    let count = 1usize << 21;
     let center = scene.bounds().center();
     let lights = vec![light(center, 1e6); count];
     let snapshot = scene_snapshot(&scene, UVec2::new(64, 64), lights, settings);

@@ -22,7 +22,7 @@ fn cornell() -> Scene {
 fn tolerance(gbuffer: GBufferLayout, codec: NormalCodec) -> Tolerance {
     match (gbuffer, codec) {
         // 8-bit sRGB albedo: FLIP mean ≈ 0.010 against naive.
-        (GBufferLayout::Compact, _) => Tolerance { mean: 0.015, p99: 0.05 },
+        (GBufferLayout::Compact, _) => support::COMPACT,
         // xyz rebuilds z >= 0 in view space: normals turned away from the camera (grazing
         // surfaces at the image border) come back mirrored: p99 ≈ 0.05.
         (GBufferLayout::Packed, NormalCodec::Xyz) => Tolerance { mean: 0.005, p99: 0.08 },

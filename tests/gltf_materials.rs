@@ -8,7 +8,6 @@ mod support;
 
 use glam::{Mat4, Vec4};
 use manylight::app::RenderSettings;
-use manylight::app::prelude::GBufferLayout;
 use manylight::core::{MaterialData, Projection};
 use manylight::prelude::*;
 use manylight::scene::shapes::cuboid;
@@ -58,17 +57,7 @@ fn every_pipeline_matches_naive_forward_on_gltf_materials() {
     for (name, rel) in [ASSETS[0], ASSETS[3]] {
         let scene = load(rel);
         let naive = render_scene(scene.clone(), SIZE, LIGHTS, settings(PipelineKind::NaiveForward));
-        let mut variants: Vec<(String, RenderSettings)> = PipelineKind::ALL
-            .into_iter()
-            .filter(|p| *p != PipelineKind::NaiveForward)
-            .map(|p| (format!("{name}_{}", p.name()), settings(p)))
-            .collect();
-        for layout in [GBufferLayout::Packed, GBufferLayout::Compact] {
-            variants.push((
-                format!("{name}_clustered_deferred_{}", layout.name()),
-                RenderSettings { gbuffer: layout, ..settings(PipelineKind::ClusteredDeferred) },
-            ));
-        }
+        let variants = support::pipelines_besides_naive(name, settings);
         for (variant, s) in variants {
             let frame = render_scene(scene.clone(), SIZE, LIGHTS, s);
             let stats = assert_similar(&variant, &naive.image, &frame.image, STRICT);

@@ -87,7 +87,7 @@ fn tiled_and_clustered_pipelines_match_naive_forward() {
         let tol = if settings.gbuffer == GBufferLayout::Compact
             && settings.pipeline == PipelineKind::ClusteredDeferred
         {
-            support::Tolerance { mean: 0.015, p99: 0.05 }
+            support::COMPACT
         } else {
             STRICT
         };

@@ -308,7 +308,7 @@ fn configurations() -> Vec<(String, RenderSettings)> {
 fn tolerance(settings: &RenderSettings) -> Tolerance {
     let deferred = matches!(settings.pipeline, PipelineKind::ClusteredDeferred | PipelineKind::LightVolumes);
     match (deferred, settings.gbuffer, settings.normal_codec) {
-        (true, GBufferLayout::Compact, _) => Tolerance { mean: 0.015, p99: 0.05 },
+        (true, GBufferLayout::Compact, _) => support::COMPACT,
         (true, GBufferLayout::Packed, NormalCodec::Xyz) => Tolerance { mean: 0.005, p99: 0.08 },
         _ => STRICT,
     }

@@ -12,7 +12,7 @@ use manylight::core::cluster::{CullTest, GridConfig, ZSlicing, assign_lights};
 use manylight::prelude::*;
 use manylight::render::{ClusterSettings, FrameSettings};
 use manylight::scene::SceneCamera;
-use support::{STRICT, Tolerance, assert_similar, gpu, render_scene as render};
+use support::{STRICT, assert_similar, gpu, render_scene as render};
 
 const SIZE: UVec2 = UVec2::new(192, 128);
 
@@ -60,8 +60,7 @@ fn an_orthographic_view_matches_naive_forward_in_every_pipeline() {
         let settings = RenderSettings { gbuffer, normal_codec, ..with(pipeline) };
         let frame = render(scene(orthographic()), SIZE, 128, settings);
         // Compact stores albedo in 8-bit sRGB (docs/accuracy.md).
-        let tol =
-            if gbuffer == GBufferLayout::Compact { Tolerance { mean: 0.015, p99: 0.05 } } else { STRICT };
+        let tol = if gbuffer == GBufferLayout::Compact { support::COMPACT } else { STRICT };
         let s = assert_similar(&name, &naive.image, &frame.image, tol);
         eprintln!("{name} vs naive: FLIP mean {:.5}, p99 {:.5}", s.mean, s.p99);
         if pipeline.uses_clusters() {

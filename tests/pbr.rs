@@ -9,7 +9,6 @@ mod support;
 use glam::{Mat4, Vec3};
 use image::RgbaImage;
 use manylight::app::RenderSettings;
-use manylight::app::prelude::GBufferLayout;
 use manylight::core::brdf::{PointLightSample, SurfaceParams, shade_point_light};
 use manylight::core::tonemap::tonemap_to_srgb8;
 use manylight::core::{MaterialData, Projection, ShadingModel, SpotCone};
@@ -209,17 +208,7 @@ fn pbr_spheres_match_the_cpu_twin() {
 fn every_pipeline_matches_naive_forward_with_pbr() {
     let _gpu = gpu();
     let naive = render_scene(spheres(), SIZE, 0, settings(PipelineKind::NaiveForward));
-    let mut variants: Vec<(String, RenderSettings)> = PipelineKind::ALL
-        .into_iter()
-        .filter(|p| *p != PipelineKind::NaiveForward)
-        .map(|p| (format!("pbr_{}", p.name()), settings(p)))
-        .collect();
-    for layout in [GBufferLayout::Packed, GBufferLayout::Compact] {
-        variants.push((
-            format!("pbr_clustered_deferred_{}", layout.name()),
-            RenderSettings { gbuffer: layout, ..settings(PipelineKind::ClusteredDeferred) },
-        ));
-    }
+    let variants = support::pipelines_besides_naive("pbr", settings);
     for (name, s) in variants {
         let frame = render_scene(spheres(), SIZE, 0, s);
         let stats = assert_similar(&name, &naive.image, &frame.image, STRICT);

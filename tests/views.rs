@@ -101,9 +101,11 @@ fn split_screen_cameras_render_their_own_views() {
         "the two views see the lights differently"
     );
     assert_eq!(report.light_uploads, 1, "lights are uploaded once for both views");
-    // The scene's own lights and the 48 spawned here, 32 bytes each, once.
+    // The scene's own lights and the 48 spawned here, 48 bytes each, once.
     assert!(report.light_count > 48, "{}", report.light_count);
-    assert_eq!(report.light_upload_bytes, u64::from(report.light_count) * 32);
+    let light_bytes = std::mem::size_of::<manylight::render::gpu_types::GpuPointLight>() as u64;
+    assert_eq!(light_bytes, 48);
+    assert_eq!(report.light_upload_bytes, u64::from(report.light_count) * light_bytes);
     assert_eq!(report.passes.len(), a.passes.len() + b.passes.len());
 }
 

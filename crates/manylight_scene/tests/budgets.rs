@@ -9,12 +9,14 @@
 
 #[path = "support/counting_alloc.rs"]
 mod counting_alloc;
+#[path = "support/sandbox.rs"]
+mod sandbox;
 
 use manylight_scene::{LoadOptions, Scene, SceneError, load_gltf};
+use sandbox::Sandbox;
 use serde_json::{Value, json};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Duration;
 
 #[global_allocator]
@@ -72,36 +74,6 @@ fn load(path: &Path, options: LoadOptions) -> Outcome {
         .unwrap_or_else(|| panic!("loading {} took over {LOAD_TIMEOUT:?}", path.display()));
     eprintln!("{}: peak {:.1} MiB, {elapsed:?}", path.display(), peak as f64 / MIB as f64);
     Outcome { result, peak, elapsed }
-}
-
-/// A fresh temporary folder, removed on drop.
-struct Sandbox(PathBuf);
-
-impl Sandbox {
-    fn new(name: &str) -> Self {
-        static NEXT: AtomicUsize = AtomicUsize::new(0);
-        let n = NEXT.fetch_add(1, Ordering::Relaxed);
-        let dir = std::env::temp_dir().join(format!("manylight_budgets_{}_{n}_{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("create sandbox");
-        Self(dir)
-    }
-
-    fn write(&self, name: &str, bytes: &[u8]) -> PathBuf {
-        let path = self.0.join(name);
-        std::fs::write(&path, bytes).expect("write");
-        path
-    }
-
-    fn write_json(&self, name: &str, root: &Value) -> PathBuf {
-        self.write(name, serde_json::to_string(root).expect("serialize").as_bytes())
-    }
-}
-
-impl Drop for Sandbox {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
 }
 
 /// A `data:` URI of `bytes`.
@@ -514,14 +486,14 @@ fn oversized_or_special_scene_files_are_refused_before_reading() {
     let _serial = serial();
     let sandbox = Sandbox::new("top_level");
     // Sparse files: they take no disk space, but reading them would take gigabytes.
-    let big = sandbox.0.join("big.gltf");
+    let big = sandbox.path("big.gltf");
     std::fs::File::create(&big).expect("create").set_len(2 << 30).expect("set_len");
     let out = load(&big, LoadOptions::default());
     assert!(out.peak < MIB, "peak {}", out.peak);
     let message = out.over_budget(&big, "max_json_bytes");
     assert!(message.contains("the file needs 2147483648 bytes, over the limit of 67108864"), "{message}");
 
-    let glb = sandbox.0.join("big.glb");
+    let glb = sandbox.path("big.glb");
     {
         use std::io::Write as _;
         let mut f = std::fs::File::create(&glb).expect("create");
@@ -558,7 +530,7 @@ fn devices_and_fifos_are_refused_without_reading() {
         assert!(err.to_string().contains("/dev/zero"), "{err}");
     }
     let sandbox = Sandbox::new("fifo");
-    let fifo = sandbox.0.join("pipe.gltf");
+    let fifo = sandbox.path("pipe.gltf");
     let made = std::process::Command::new("mkfifo").arg(&fifo).status().is_ok_and(|s| s.success());
     if made && cfg!(target_os = "linux") {
         let err = load(&fifo, LoadOptions::default()).result.expect_err("a FIFO is refused");
