@@ -18,6 +18,7 @@ fn fs_main(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> @
     let cluster = cluster_index(cluster_params, in.clip_position.xy, p.view_depth);
     let range = cluster_ranges[cluster];
     var color = surface_base_radiance(s.albedo, view.params.w, m.occlusion, m.emissive);
+    color += shade_directional_lights(view, s, view_dir);
     for (var i = 0u; i < range.y; i++) {
         color += shade_point_light(s, p.world_position, view_dir, lights[cluster_indices[range.x + i]]);
     }

@@ -10,6 +10,7 @@ fn fs_main(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> @
     alpha_test(m.base_color);
     let view_dir = direction_to_eye(view, p.world_position);
     var color = surface_base_radiance(s.albedo, view.params.w, m.occlusion, m.emissive);
+    color += shade_directional_lights(view, s, view_dir);
     // Four lights per iteration, added in order: lavapipe stops an invocation after 65 535 loop
     // iterations, which would drop every light past the 65 535th of the reference.
     let n = view.light_count;

@@ -1,5 +1,6 @@
 // Deferred light volumes. After the G-buffer pass, one render pass into HDR:
 // 1. a full-screen triangle writes the clear colour behind the geometry and the ambient term
+//    (with emission and the directional lights)
 //    on it (fs_ambient_*);
 // 2. every light is drawn as an instanced sphere proxy (vs_volume: an icosphere that contains
 //    the light's sphere) whose pixels add that one light (fs_volume_*, additive blending).
@@ -44,8 +45,11 @@ fn vs_volume(@location(0) position: vec3<f32>, @builtin(instance_index) light_in
     return out;
 }
 
+// What reaches the pixel whatever the point lights: ambient, emission and the directional
+// lights (which no volume bounds).
 fn ambient(g: GSurface) -> vec4<f32> {
-    return vec4<f32>(gbuffer_base_radiance(g), 1.0);
+    let view_dir = direction_to_eye(view, g.world_position);
+    return vec4<f32>(gbuffer_base_radiance(g) + shade_directional_lights(view, g.params, view_dir), 1.0);
 }
 
 fn one_light(g: GSurface, light_index: u32) -> vec4<f32> {

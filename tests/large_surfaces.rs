@@ -192,7 +192,7 @@ fn floor_scene_at(mesh: MeshData, far: f32, transform: Mat4) -> Scene {
         instances: vec![SceneInstance { mesh: 0, material: 0, transform }],
         lights: lights(),
         cameras: vec![camera(far)],
-        nodes: Vec::new(),
+        ..Scene::default()
     }
 }
 

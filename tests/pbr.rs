@@ -1,5 +1,5 @@
 //! The metallic-roughness model on the GPU against its CPU twin: a grid of spheres of known
-//! metallic and roughness under point lights and a spot light, rendered by naive forward and by a CPU ray
+//! metallic and roughness under point lights, a spot light and a directional light, rendered by naive forward and by a CPU ray
 //! caster that shades with `manylight_core::brdf` and tone-maps with
 //! `manylight_core::tonemap`; then every other pipeline and G-buffer layout against naive
 //! forward on the same spheres.
@@ -9,12 +9,12 @@ mod support;
 use glam::{Mat4, Vec3};
 use image::RgbaImage;
 use manylight::app::RenderSettings;
-use manylight::core::brdf::{PointLightSample, SurfaceParams, shade_point_light};
+use manylight::core::brdf::{PointLightSample, SurfaceParams, shade_incoming, shade_point_light};
 use manylight::core::tonemap::tonemap_to_srgb8;
 use manylight::core::{MaterialData, Projection, ShadingModel, SpotCone};
 use manylight::prelude::*;
 use manylight::scene::shapes::uv_sphere;
-use manylight::scene::{SceneCamera, SceneInstance, SceneLight, camera_looking_at};
+use manylight::scene::{SceneCamera, SceneDirectionalLight, SceneInstance, SceneLight, camera_looking_at};
 use std::sync::Arc;
 use support::{STRICT, Tolerance, assert_similar, gpu, render_scene};
 
@@ -68,6 +68,15 @@ fn lights() -> Vec<SceneLight> {
     ]
 }
 
+/// A directional light from the upper right, behind the camera.
+fn sun() -> SceneDirectionalLight {
+    SceneDirectionalLight {
+        direction: Vec3::new(-0.4, -0.6, -1.0).normalize(),
+        color: Vec3::new(1.0, 0.95, 0.85),
+        illuminance: 1.5,
+    }
+}
+
 /// Ten spheres: metals on the top row, dielectrics below, roughness rising to the right.
 fn spheres() -> Scene {
     let mut scene = Scene { name: "pbr spheres".into(), ..Scene::default() };
@@ -89,6 +98,7 @@ fn spheres() -> Scene {
         }
     }
     scene.lights = lights();
+    scene.directional_lights = vec![sun()];
     scene.cameras.push(SceneCamera {
         transform: camera_looking_at(EYE, Vec3::ZERO),
         projection: Projection::perspective(FOV_Y, 0.1, 100.0),
@@ -161,6 +171,8 @@ fn cpu_twin(scene_lights: &[SceneLight]) -> RgbaImage {
                 };
                 let view_dir = (EYE - p).normalize();
                 let mut c = BASE_COLOR * AMBIENT;
+                let sun = sun();
+                c += shade_incoming(&s, -sun.direction, view_dir, sun.color * sun.illuminance);
                 for l in &lights {
                     c += shade_point_light(&s, p, view_dir, l);
                 }

@@ -1,4 +1,4 @@
-//! Spot lights in every pipeline: the same image as naive forward, which evaluates every light
+//! Spot and directional lights. Spot lights in every pipeline: the same image as naive forward, which evaluates every light
 //! at every pixel, so a cone culled too tightly anywhere would show. The CPU twin of the cone's
 //! falloff is checked in `tests/pbr.rs`, the lists in `tests/clusters.rs`.
 
@@ -92,4 +92,40 @@ fn a_spot_light_component_lights_only_its_cone() {
     let total = (SIZE.x * SIZE.y) as usize;
     // A pool of light on the floor: some pixels, far from all of them.
     assert!(changed.len() > 50 && changed.len() < total / 4, "{} of {total} pixels lit", changed.len());
+}
+
+/// A `DirectionalLight` lights every surface facing it, whatever the distance; past
+/// `MAX_DIRECTIONAL_LIGHTS` the extra ones are not drawn, and the report counts them.
+#[test]
+fn directional_lights_light_everything_and_extra_ones_are_counted() {
+    use manylight::render::gpu_types::MAX_DIRECTIONAL_LIGHTS;
+    let _gpu = gpu();
+    let render =
+        |count: u32| {
+            manylight::app::headless::render_headless(SIZE, 1, move |app| {
+                app.insert_resource(RenderSettings { ambient: 0.0, ..RenderSettings::default() })
+                    .add_systems(Startup, move |mut commands: Commands| {
+                        let mut scene = default_scene();
+                        scene.lights.clear();
+                        spawn_scene(&mut commands, &scene, true, SIZE.x as f32 / SIZE.y as f32);
+                        for _ in 0..count {
+                            // Straight down onto the floor of the nave.
+                            let down = Transform::default().looking_to(Vec3::NEG_Y, Vec3::X);
+                            commands.spawn((down, DirectionalLight { illuminance: 0.4, ..default() }));
+                        }
+                    });
+            })
+            .expect("renders")
+        };
+    let dark = render(0);
+    let one = render(1);
+    let lit = one.image.pixels().zip(dark.image.pixels()).filter(|(a, b)| a != b).count();
+    let total = (SIZE.x * SIZE.y) as usize;
+    assert!(lit > total / 4, "{lit} of {total} pixels lit by a directional light");
+    let report = one.stats.last.as_ref().expect("report");
+    assert_eq!((report.directional_lights, report.dropped_directional_lights), (1, 0));
+    let many = render(MAX_DIRECTIONAL_LIGHTS + 3);
+    let report = many.stats.last.as_ref().expect("report");
+    assert_eq!((report.directional_lights, report.dropped_directional_lights), (MAX_DIRECTIONAL_LIGHTS, 3));
+    assert!(flip(&one.image, &many.image).mean > 0.01, "eight lights are brighter than one");
 }

@@ -1,5 +1,6 @@
 // Shading models (ids: SHADING_* constants, generated from Rust `ShadingModel::gpu_id`).
 //!include common/lights.wgsl
+//!include common/view.wgsl
 // Rust twin: `manylight_core::brdf` (same operations, same order).
 struct SurfaceParams {
     albedo: vec3<f32>,
@@ -39,16 +40,21 @@ fn shade_point_light(s: SurfaceParams, position: vec3<f32>, view_dir: vec3<f32>,
     }
     let l = to_light / max(distance, 1e-6);
     let cone = spot_attenuation(dot(light.spot.xyz, -l), light.spot.w, light.color.a);
-    let lit = att * cone;
+    return shade_incoming(s, l, view_dir, light.color.rgb * (att * cone));
+}
+
+// Radiance that light arriving from unit direction `l` (towards the light) with `radiance`
+// (colour x intensity x falloff; a directional light's illuminance) adds, seen from `view_dir`.
+fn shade_incoming(s: SurfaceParams, l: vec3<f32>, view_dir: vec3<f32>, radiance: vec3<f32>) -> vec3<f32> {
     let n_dot_l = max(dot(s.normal, l), 0.0);
     if s.model == SHADING_TOON {
-        return toon_point_light(s, n_dot_l, view_dir, l) * light.color.rgb * lit;
+        return toon_point_light(s, n_dot_l, view_dir, l) * radiance;
     }
     if s.model == SHADING_PBR {
         if n_dot_l <= 0.0 {
             return vec3<f32>(0.0);
         }
-        return pbr_point_light(s, n_dot_l, view_dir, l) * light.color.rgb * lit;
+        return pbr_point_light(s, n_dot_l, view_dir, l) * radiance;
     }
     var result = s.albedo * n_dot_l;
     if s.model == SHADING_BLINN_PHONG && n_dot_l > 0.0 {
@@ -56,7 +62,18 @@ fn shade_point_light(s: SurfaceParams, position: vec3<f32>, view_dir: vec3<f32>,
         let n_dot_h = max(dot(s.normal, h), 0.0);
         result += vec3<f32>(s.specular * pow(n_dot_h, s.shininess) * n_dot_l);
     }
-    return result * light.color.rgb * lit;
+    return result * radiance;
+}
+
+// Radiance the view's directional lights add (`ViewUniform::directional`, at most
+// MAX_DIRECTIONAL_LIGHTS, not clustered: each reaches every pixel).
+fn shade_directional_lights(v: ViewUniform, s: SurfaceParams, view_dir: vec3<f32>) -> vec3<f32> {
+    var color = vec3<f32>(0.0);
+    for (var i = 0u; i < min(v.directional_count, MAX_DIRECTIONAL_LIGHTS); i++) {
+        let light = v.directional[i];
+        color += shade_incoming(s, -light.direction.xyz, view_dir, light.color.rgb);
+    }
+    return color;
 }
 
 // Toon (cel) shading of one light: the diffuse term in TOON_BANDS flat bands (the light's

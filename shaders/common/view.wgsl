@@ -1,3 +1,12 @@
+// A directional light (Rust: `GpuDirectionalLight`): light travelling along `direction`
+// everywhere, not clustered.
+struct GpuDirectionalLight {
+    // xyz: unit direction the light travels (from the light into the scene), w: unused
+    direction: vec4<f32>,
+    // rgb: colour x illuminance (linear), a: unused
+    color: vec4<f32>,
+};
+
 // Per-view constants (Rust: `ViewUniform` in crates/manylight_render/src/gpu_types.rs).
 struct ViewUniform {
     clip_from_world: mat4x4<f32>,
@@ -13,8 +22,9 @@ struct ViewUniform {
     params: vec4<f32>,
     light_count: u32,
     shading_model: u32,
+    directional_count: u32,
     _pad0: u32,
-    _pad1: u32,
+    directional: array<GpuDirectionalLight, MAX_DIRECTIONAL_LIGHTS>,
 };
 
 // True for an orthographic projection: its matrix has w = 1 for every point (a perspective

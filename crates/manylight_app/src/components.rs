@@ -289,6 +289,25 @@ impl Default for SpotLight {
     }
 }
 
+/// A light travelling down the entity's local -Z everywhere (the sun), in Bevy's words:
+/// `illuminance` (lux for glTF's directional lights) times `color`. Not clustered: every pixel
+/// evaluates every directional light, up to `MAX_DIRECTIONAL_LIGHTS` (8) per frame; more are
+/// dropped and counted (`FrameReport::dropped_directional_lights`).
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+#[require(Transform, Visibility)]
+pub struct DirectionalLight {
+    /// Linear RGB colour.
+    pub color: Vec3,
+    /// Illuminance, multiplying `color`.
+    pub illuminance: f32,
+}
+
+impl Default for DirectionalLight {
+    fn default() -> Self {
+        Self { color: Vec3::ONE, illuminance: 1.0 }
+    }
+}
+
 /// The geometry drawn at the entity's [`GlobalTransform`] (shared; uploaded once per `Arc`).
 #[derive(Component, Clone, Debug)]
 #[require(Transform, Visibility)]

@@ -3,8 +3,8 @@
 
 use crate::backend::{RenderBackend, record_results};
 use crate::components::{
-    Bloom, Camera, Camera3d, CameraDebugView, GlobalTransform, InheritedVisibility, LightAnimation, Material,
-    Mesh3d, MotionBlur, PointLight, Projection, RenderTarget, SpotLight, Transform,
+    Bloom, Camera, Camera3d, CameraDebugView, DirectionalLight, GlobalTransform, InheritedVisibility,
+    LightAnimation, Material, Mesh3d, MotionBlur, PointLight, Projection, RenderTarget, SpotLight, Transform,
 };
 use crate::resources::{DebugView, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize};
 use bevy_app::AppExit;
@@ -13,8 +13,8 @@ use bevy_time::Time;
 use glam::Mat4;
 use manylight_core::{MaterialData, SpotCone};
 use manylight_render::{
-    ExtractedCamera, ExtractedInstance, ExtractedPointLight, ExtractedView, FrameSnapshot, ViewRect,
-    ViewTarget,
+    ExtractedCamera, ExtractedDirectionalLight, ExtractedInstance, ExtractedPointLight, ExtractedView,
+    FrameSnapshot, ViewRect, ViewTarget,
 };
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -48,10 +48,10 @@ pub type MeshItem = (
     Option<&'static InheritedVisibility>,
 );
 
-/// What extract reads of a light entity, point or spot (hidden ones are skipped).
+/// What extract reads of a light entity, point, spot or directional (hidden ones are skipped).
 pub type LightItem = (
     &'static GlobalTransform,
-    AnyOf<(&'static PointLight, &'static SpotLight)>,
+    AnyOf<(&'static PointLight, &'static SpotLight, &'static DirectionalLight)>,
     Option<&'static InheritedVisibility>,
 );
 
@@ -123,29 +123,47 @@ pub fn build_snapshot(
             world_from_local: t.to_matrix(),
         })
         .collect();
-    let lights = lights
-        .iter()
-        .filter(|(.., visibility)| shown(*visibility))
-        .filter_map(|(t, (point, spot), _)| {
-            // A point light wins over a spot light on the same entity.
-            let (color, intensity, range, spot) = match (point, spot) {
-                (Some(l), _) => (l.color, l.intensity, l.range, None),
-                (None, Some(l)) => {
-                    let direction = t.forward().into();
-                    let cone = SpotCone { direction, inner_angle: l.inner_angle, outer_angle: l.outer_angle };
-                    (l.color, l.intensity, l.range, Some(cone))
-                }
-                (None, None) => return None,
-            };
-            Some(ExtractedPointLight { position: t.translation(), color, intensity, radius: range, spot })
-        })
-        .collect();
+    let mut point_lights = Vec::new();
+    let mut directional_lights = Vec::new();
+    for (t, (point, spot, directional), visibility) in lights {
+        if !shown(visibility) {
+            continue;
+        }
+        // One light per entity: a point light wins over a spot light, which wins over a
+        // directional one.
+        let (color, intensity, range, cone) = match (point, spot, directional) {
+            (Some(l), ..) => (l.color, l.intensity, l.range, None),
+            (None, Some(l), _) => {
+                let direction = t.forward().into();
+                let cone = SpotCone { direction, inner_angle: l.inner_angle, outer_angle: l.outer_angle };
+                (l.color, l.intensity, l.range, Some(cone))
+            }
+            (None, None, Some(l)) => {
+                let direction = t.forward().into();
+                directional_lights.push(ExtractedDirectionalLight {
+                    direction,
+                    color: l.color,
+                    illuminance: l.illuminance,
+                });
+                continue;
+            }
+            (None, None, None) => continue,
+        };
+        point_lights.push(ExtractedPointLight {
+            position: t.translation(),
+            color,
+            intensity,
+            radius: range,
+            spot: cone,
+        });
+    }
     let snapshot = FrameSnapshot {
         frame_index: state.frame_index,
         viewport,
         views,
         instances,
-        lights,
+        lights: point_lights,
+        directional_lights,
         settings: crate::resources::frame_settings(settings, debug),
     };
     state.frame_index += 1;

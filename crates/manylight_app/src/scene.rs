@@ -1,15 +1,16 @@
 //! Turning a [`Scene`] (loaded glTF or the embedded default) into entities.
 
 use crate::components::{
-    Camera3d, LightAnimation, Material, Mesh3d, PointLight, Projection, SpotLight, Transform, Visibility,
-    transform_from_matrix,
+    Camera3d, DirectionalLight, LightAnimation, Material, Mesh3d, PointLight, Projection, SpotLight,
+    Transform, Visibility, transform_from_matrix,
 };
 use bevy_ecs::name::Name;
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
 use manylight_core::Aabb;
 use manylight_render::{
-    ExtractedCamera, ExtractedInstance, ExtractedPointLight, ExtractedView, FrameSettings, FrameSnapshot,
+    ExtractedCamera, ExtractedDirectionalLight, ExtractedInstance, ExtractedPointLight, ExtractedView,
+    FrameSettings, FrameSnapshot,
 };
 use manylight_scene::light_rig;
 use manylight_scene::{Scene, SceneLight};
@@ -74,6 +75,12 @@ pub fn spawn_scene(commands: &mut Commands, scene: &Scene, spawn_camera: bool, a
     }
     for (light, _) in scene.lights.iter().zip(&placed_lights).filter(|(_, placed)| !**placed) {
         spawn_light(commands, light, Transform::from_translation(light.position), false, root);
+    }
+    for l in &scene.directional_lights {
+        let rotation =
+            Quat::from_rotation_arc(Vec3::NEG_Z, l.direction.try_normalize().unwrap_or(Vec3::NEG_Z));
+        let light = DirectionalLight { color: l.color, illuminance: l.illuminance };
+        commands.spawn((Transform::from_rotation(rotation), light, ChildOf(root)));
     }
     if spawn_camera && !camera_placed {
         let cam = scene.camera_or_fit(aspect);
@@ -178,7 +185,17 @@ pub fn scene_snapshot(
     frame_index: u64,
 ) -> FrameSnapshot {
     let cam = scene.camera_or_fit(size.x as f32 / size.y.max(1) as f32);
+    let directional_lights = scene
+        .directional_lights
+        .iter()
+        .map(|l| ExtractedDirectionalLight {
+            direction: l.direction,
+            color: l.color,
+            illuminance: l.illuminance,
+        })
+        .collect();
     FrameSnapshot {
+        directional_lights,
         frame_index,
         viewport: size,
         views: vec![ExtractedView::main(ExtractedCamera {

@@ -104,15 +104,21 @@ pub fn shade_point_light(
     }
     let l = to_light / distance.max(1e-6);
     let cone = spot_attenuation(light.spot_direction.dot(-l), light.spot_scale, light.spot_offset);
-    let lit = att * cone;
+    shade_incoming(s, l, view_dir, light.color * (att * cone))
+}
+
+/// Radiance that light arriving from unit direction `l` (towards the light) with `radiance`
+/// (colour × intensity × falloff; for a directional light its illuminance) adds, seen from
+/// `view_dir`.
+pub fn shade_incoming(s: &SurfaceParams, l: Vec3, view_dir: Vec3, radiance: Vec3) -> Vec3 {
     let n_dot_l = s.normal.dot(l).max(0.0);
     match s.model {
-        ShadingModel::Toon => toon_point_light(s, n_dot_l, view_dir, l) * light.color * lit,
+        ShadingModel::Toon => toon_point_light(s, n_dot_l, view_dir, l) * radiance,
         ShadingModel::Pbr => {
             if n_dot_l <= 0.0 {
                 return Vec3::ZERO;
             }
-            pbr_point_light(s, n_dot_l, view_dir, l) * light.color * lit
+            pbr_point_light(s, n_dot_l, view_dir, l) * radiance
         }
         ShadingModel::Lambert | ShadingModel::BlinnPhong => {
             let mut result = s.albedo * n_dot_l;
@@ -121,7 +127,7 @@ pub fn shade_point_light(
                 let n_dot_h = s.normal.dot(h).max(0.0);
                 result += Vec3::splat(s.specular * n_dot_h.powf(s.shininess) * n_dot_l);
             }
-            result * light.color * lit
+            result * radiance
         }
     }
 }

@@ -49,6 +49,7 @@ pub fn shared_u32_constants() -> Vec<(&'static str, u32)> {
     use crate::snapshot::DebugViewMode as DebugView;
     use manylight_core::cluster::ZSlicing;
     vec![
+        ("MAX_DIRECTIONAL_LIGHTS", MAX_DIRECTIONAL_LIGHTS),
         ("SHADING_LAMBERT", ShadingModel::Lambert.gpu_id()),
         ("SHADING_BLINN_PHONG", ShadingModel::BlinnPhong.gpu_id()),
         ("SHADING_TOON", ShadingModel::Toon.gpu_id()),
@@ -107,8 +108,27 @@ pub struct ViewUniform {
     pub light_count: u32,
     /// Global shading model id.
     pub shading_model: u32,
+    /// Directional lights in `directional` (at most [`MAX_DIRECTIONAL_LIGHTS`]).
+    pub directional_count: u32,
     /// Padding to 16 bytes.
-    pub _pad: [u32; 2],
+    pub _pad: u32,
+    /// The frame's directional lights, each reaching every pixel (not clustered).
+    pub directional: [GpuDirectionalLight; MAX_DIRECTIONAL_LIGHTS as usize],
+}
+
+/// Directional lights a view carries (in its uniform; more are dropped and counted in
+/// `FrameReport::dropped_directional_lights`).
+pub const MAX_DIRECTIONAL_LIGHTS: u32 = 8;
+
+/// A directional light as the shaders read it (`GpuDirectionalLight` in
+/// `shaders/common/view.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuDirectionalLight {
+    /// xyz: unit direction the light travels, w: unused.
+    pub direction: [f32; 4],
+    /// rgb: colour × illuminance, a: unused.
+    pub color: [f32; 4],
 }
 
 /// A point or spot light as the shaders read it (`GpuPointLight` in `shaders/common/lights.wgsl`).

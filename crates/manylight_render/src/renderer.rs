@@ -336,6 +336,8 @@ impl Renderer {
             frame_cpu_ms: frame_start.elapsed().as_secs_f64() * 1e3,
             light_count: self.scene.light_count,
             invalid_lights: self.scene.invalid_lights,
+            directional_lights: self.scene.directional_count,
+            dropped_directional_lights: self.scene.dropped_directional_lights,
             invalid_cameras: 0,
             sanitized_cameras: 0,
             nonfinite_pixels: None,

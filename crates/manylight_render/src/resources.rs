@@ -5,7 +5,10 @@
 //! buffers every frame, grown when the counts outgrow them.
 
 use crate::context::{GpuContext, RenderError};
-use crate::gpu_types::{GpuInstance, GpuMaterial, GpuPointLight, SHADING_GLOBAL, ViewUniform};
+use crate::gpu_types::{
+    GpuDirectionalLight, GpuInstance, GpuMaterial, GpuPointLight, MAX_DIRECTIONAL_LIGHTS, SHADING_GLOBAL,
+    ViewUniform,
+};
 use crate::pool::GrowableBuffer;
 use crate::snapshot::{FrameSnapshot, RenderView, aspect};
 use glam::{Mat4, Vec4};
@@ -135,6 +138,12 @@ pub struct SceneResources {
     pub view: ViewUniform,
     /// Lights uploaded this frame.
     pub light_count: u32,
+    /// This frame's directional lights as every view's uniform carries them.
+    pub directional: [GpuDirectionalLight; MAX_DIRECTIONAL_LIGHTS as usize],
+    /// Directional lights in `directional`.
+    pub directional_count: u32,
+    /// Valid directional lights past [`MAX_DIRECTIONAL_LIGHTS`], not drawn.
+    pub dropped_directional_lights: u32,
     /// Bytes written to the light buffer this frame (once per frame, whatever the views).
     pub light_upload_bytes: u64,
     /// Lights dropped for invalid parameters this frame.
@@ -295,6 +304,9 @@ impl SceneResources {
             variants: Vec::new(),
             view: ViewUniform::zeroed_default(),
             light_count: 0,
+            directional: [GpuDirectionalLight::default(); MAX_DIRECTIONAL_LIGHTS as usize],
+            directional_count: 0,
+            dropped_directional_lights: 0,
             light_upload_bytes: 0,
             invalid_lights: 0,
             invalid_instances: 0,
@@ -354,7 +366,9 @@ impl SceneResources {
                     params: Vec4::new(p.near, p.near_over_far(), settings.exposure, settings.ambient),
                     light_count: self.light_count,
                     shading_model: settings.shading.gpu_id(),
-                    _pad: [0; 2],
+                    directional_count: self.directional_count,
+                    _pad: 0,
+                    directional: self.directional,
                 }
             }
             None => ViewUniform {
@@ -393,6 +407,29 @@ impl SceneResources {
             })
             .collect();
         self.invalid_lights = (snapshot.lights.len() - gpu_lights.len()) as u32;
+        // Directional lights: the first MAX_DIRECTIONAL_LIGHTS valid ones, in the view uniform.
+        let valid = snapshot.directional_lights.iter().filter(|l| l.is_valid());
+        let (mut count, mut valid_count) = (0usize, 0u32);
+        for l in valid {
+            valid_count += 1;
+            if let Some(slot) = self.directional.get_mut(count) {
+                let direction = l.direction.normalize();
+                *slot = GpuDirectionalLight {
+                    direction: direction.extend(0.0).to_array(),
+                    color: (l.color * l.illuminance).extend(0.0).to_array(),
+                };
+                count += 1;
+            }
+        }
+        self.invalid_lights += snapshot.directional_lights.len() as u32 - valid_count;
+        self.directional_count = count as u32;
+        self.dropped_directional_lights = valid_count - count as u32;
+        if self.dropped_directional_lights > 0 {
+            tracing::warn!(
+                "{} directional lights past the first {MAX_DIRECTIONAL_LIGHTS} are not drawn",
+                self.dropped_directional_lights
+            );
+        }
         self.light_spheres =
             snapshot.lights.iter().filter(|l| l.is_valid()).map(|l| l.bounding_sphere()).collect();
         self.light_count = gpu_lights.len() as u32;
@@ -642,7 +679,9 @@ impl ViewUniform {
             params: Vec4::new(0.1, 1000.0, 1.0, 0.0),
             light_count: 0,
             shading_model: 0,
-            _pad: [0; 2],
+            directional_count: 0,
+            _pad: 0,
+            directional: [GpuDirectionalLight::default(); MAX_DIRECTIONAL_LIGHTS as usize],
         }
     }
 }

@@ -563,10 +563,38 @@ pub struct FrameSnapshot {
     pub views: Vec<ExtractedView>,
     /// Drawn objects.
     pub instances: Vec<ExtractedInstance>,
-    /// Point lights.
+    /// Point and spot lights.
     pub lights: Vec<ExtractedPointLight>,
+    /// Directional lights (not clustered; at most `MAX_DIRECTIONAL_LIGHTS` are drawn, the rest
+    /// dropped and counted).
+    pub directional_lights: Vec<ExtractedDirectionalLight>,
     /// Settings.
     pub settings: FrameSettings,
+}
+
+/// A directional light as extracted for rendering: light travelling along `direction`
+/// everywhere (the sun).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ExtractedDirectionalLight {
+    /// Unit direction the light travels, from the light into the scene.
+    pub direction: Vec3,
+    /// Linear RGB colour.
+    pub color: Vec3,
+    /// Illuminance (lux in glTF), multiplying `color`.
+    pub illuminance: f32,
+}
+
+impl ExtractedDirectionalLight {
+    /// True when every parameter is finite, the direction is not zero, the illuminance is not
+    /// negative and `color × illuminance` does not overflow.
+    pub fn is_valid(&self) -> bool {
+        self.direction.is_finite()
+            && self.direction.length_squared() > 0.0
+            && self.color.is_finite()
+            && self.illuminance.is_finite()
+            && self.illuminance >= 0.0
+            && (self.color * self.illuminance).is_finite()
+    }
 }
 
 impl FrameSnapshot {

@@ -35,8 +35,13 @@ pub struct FrameReport {
     pub frame_gpu_ms: Option<f64>,
     /// Lights rendered.
     pub light_count: u32,
-    /// Lights dropped because a parameter was NaN, infinite or negative.
+    /// Lights dropped because a parameter was NaN, infinite or negative (directional ones
+    /// included).
     pub invalid_lights: u32,
+    /// Directional lights drawn (at most `MAX_DIRECTIONAL_LIGHTS`).
+    pub directional_lights: u32,
+    /// Valid directional lights past `MAX_DIRECTIONAL_LIGHTS`, not drawn.
+    pub dropped_directional_lights: u32,
     /// Cameras refused because their transform was not finite or not invertible (the frame
     /// rendered nothing).
     pub invalid_cameras: u32,

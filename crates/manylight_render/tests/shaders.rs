@@ -1,7 +1,9 @@
 //! Every WGSL file parses and validates with naga, and the structs shared with Rust have the
 //! same size and field offsets on both sides. No GPU needed.
 
-use manylight_render::gpu_types::{GpuClusterCounters, GpuInstance, GpuMaterial, GpuPointLight, ViewUniform};
+use manylight_render::gpu_types::{
+    GpuClusterCounters, GpuDirectionalLight, GpuInstance, GpuMaterial, GpuPointLight, ViewUniform,
+};
 use manylight_render::shaders::{SOURCES, compose};
 use std::mem::{offset_of, size_of};
 
@@ -91,6 +93,17 @@ fn shared_structs_match_rust() {
             ("params", offset_of!(ViewUniform, params)),
             ("light_count", offset_of!(ViewUniform, light_count)),
             ("shading_model", offset_of!(ViewUniform, shading_model)),
+            ("directional_count", offset_of!(ViewUniform, directional_count)),
+            ("directional", offset_of!(ViewUniform, directional)),
+        ],
+    );
+    offsets(
+        &forward,
+        "GpuDirectionalLight",
+        size_of::<GpuDirectionalLight>(),
+        &[
+            ("direction", offset_of!(GpuDirectionalLight, direction)),
+            ("color", offset_of!(GpuDirectionalLight, color)),
         ],
     );
     offsets(

@@ -38,8 +38,10 @@ pub struct Scene {
     pub materials: Vec<Arc<MaterialData>>,
     /// Drawn objects.
     pub instances: Vec<SceneInstance>,
-    /// Point lights that come with the scene.
+    /// Point and spot lights that come with the scene.
     pub lights: Vec<SceneLight>,
+    /// Directional lights that come with the scene (glTF `directional`).
+    pub directional_lights: Vec<SceneDirectionalLight>,
     /// Cameras that come with the scene (glTF cameras); may be empty.
     pub cameras: Vec<SceneCamera>,
     /// The node tree the instances, lights and cameras hang from (glTF nodes), parents before
@@ -90,6 +92,19 @@ pub struct SceneLight {
     pub radius: f32,
     /// The cone of a spot light (`None`: a point light).
     pub spot: Option<manylight_core::SpotCone>,
+}
+
+/// A light travelling along one direction everywhere (the sun): not clustered, it reaches
+/// every pixel.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneDirectionalLight {
+    /// Unit direction the light travels, in world space (a glTF directional light shines down
+    /// its node's local -Z).
+    pub direction: Vec3,
+    /// Linear RGB colour.
+    pub color: Vec3,
+    /// Illuminance (lux in glTF), multiplying `color`.
+    pub illuminance: f32,
 }
 
 /// A camera placement.

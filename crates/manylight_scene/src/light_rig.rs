@@ -247,6 +247,7 @@ pub fn sphere_shell_scene() -> Scene {
             },
         ],
         lights: Vec::new(),
+        directional_lights: Vec::new(),
         cameras: vec![SceneCamera {
             transform: Mat4::IDENTITY,
             projection: Projection::perspective(45f32.to_radians(), 0.1, 1000.0),

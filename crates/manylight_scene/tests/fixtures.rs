@@ -82,6 +82,11 @@ fn hierarchy_lights_and_cameras_without_a_scene_list() {
     let cone = spot.spot.expect("a spot light");
     assert_eq!(cone.direction, Vec3::NEG_Z);
     assert_eq!((cone.inner_angle, cone.outer_angle), (0.0, std::f32::consts::FRAC_PI_4));
+    // The directional light hangs from node 0 (no rotation): it shines down -Z.
+    assert_eq!(s.directional_lights.len(), 1);
+    let sun = s.directional_lights[0];
+    assert_eq!(sun.direction, Vec3::NEG_Z);
+    assert_eq!((sun.color, sun.illuminance), (Vec3::new(1.0, 0.9, 0.8), 3.0));
     let l = s.lights[0];
     assert!((l.position - Vec3::new(10.0, 0.0, 10.0)).length() < 1e-5, "{:?}", l.position);
     assert_eq!(l.intensity, 4.0);

@@ -1,7 +1,7 @@
 //! The node tree of a glTF scene: transforms, mesh instances, point lights and cameras.
 
 use super::{Ctx, over_budget};
-use crate::{SceneCamera, SceneError, SceneInstance, SceneLight, SceneNode};
+use crate::{SceneCamera, SceneDirectionalLight, SceneError, SceneInstance, SceneLight, SceneNode};
 use glam::{Mat4, Quat, Vec3};
 use gltf::json::camera::Type as CameraType;
 use gltf::json::extensions::scene::khr_lights_punctual::Type as LightType;
@@ -360,8 +360,8 @@ impl Ctx<'_> {
         Ok(i)
     }
 
-    /// Adds `KHR_lights_punctual` light `light` at the node's world position: point and spot
-    /// lights (a spot points down the node's -Z); directional lights are skipped with a warning.
+    /// Adds `KHR_lights_punctual` light `light` at the node's world position: point, spot and
+    /// directional lights (spot and directional ones shine down the node's -Z).
     fn add_light(&mut self, node: usize, light: usize, world: Mat4) -> Result<(), SceneError> {
         let lights = (self.root.extensions.as_ref())
             .and_then(|e| e.khr_lights_punctual.as_ref())
@@ -389,8 +389,26 @@ impl Ctx<'_> {
                 })?;
                 Some(SpotCone { direction, inner_angle: inner, outer_angle: outer })
             }
-            Checked::Valid(other) => {
-                tracing::warn!(file = %self.path.display(), light, "{other:?} lights are not supported, skipped");
+            Checked::Valid(LightType::Directional) => {
+                let color = Vec3::from_array(l.color);
+                if !color.is_finite()
+                    || color.min_element() < 0.0
+                    || !l.intensity.is_finite()
+                    || l.intensity < 0.0
+                {
+                    return Err(bad(format!(
+                        "color {:?} and intensity {} must be finite and non-negative",
+                        l.color, l.intensity
+                    )));
+                }
+                let direction = world.transform_vector3(Vec3::NEG_Z).try_normalize().ok_or_else(|| {
+                    bad(format!("node {node}'s transform collapses the directional light's direction"))
+                })?;
+                self.scene.directional_lights.push(SceneDirectionalLight {
+                    direction,
+                    color,
+                    illuminance: l.intensity,
+                });
                 return Ok(());
             }
             Checked::Invalid => return Err(bad("invalid light type".into())),
