@@ -1,4 +1,5 @@
-//! The smallest manylight app: the plugin, a scene, a few lights and a system that moves one.
+//! The smallest manylight app: the plugin, a scene, point, spot and directional lights and a
+//! system that moves one.
 //!
 //! `cargo run --example add_as_plugin` opens a window (Esc closes it);
 //! `cargo run --example add_as_plugin -- --headless out.png` renders one frame to a PNG.
@@ -21,6 +22,16 @@ fn setup(mut commands: Commands) {
     let green =
         PointLight { color: Vec3::new(0.2, 1.0, 0.3), intensity: 60.0, range: 6.0, ..PointLight::default() };
     commands.spawn((Transform::from_xyz(-6.0, 1.5, 0.0), green, Orbiting));
+    // A spot light over the nave, pointing down its -Z (here: straight down).
+    commands.spawn((
+        Transform::from_xyz(-2.0, 5.0, 0.0).looking_to(Vec3::NEG_Y, Vec3::X),
+        SpotLight { intensity: 300.0, range: 12.0, inner_angle: 0.25, outer_angle: 0.4, ..default() },
+    ));
+    // Dim moonlight from above and to the side, reaching every surface that faces it.
+    commands.spawn((
+        Transform::default().looking_to(Vec3::new(0.3, -1.0, 0.4), Vec3::Y),
+        DirectionalLight { color: Vec3::new(0.6, 0.7, 1.0), illuminance: 0.15 },
+    ));
 }
 
 fn orbit(time: Res<Time>, mut lights: Query<&mut Transform, With<Orbiting>>) {

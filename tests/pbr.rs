@@ -9,7 +9,7 @@ mod support;
 use glam::{Mat4, Vec3};
 use image::RgbaImage;
 use manylight::app::RenderSettings;
-use manylight::core::brdf::{PointLightSample, SurfaceParams, shade_incoming, shade_point_light};
+use manylight::core::brdf::{PointLightSample, SurfaceParams, shade_directional_light, shade_point_light};
 use manylight::core::tonemap::tonemap_to_srgb8;
 use manylight::core::{MaterialData, Projection, ShadingModel, SpotCone};
 use manylight::prelude::*;
@@ -172,7 +172,7 @@ fn cpu_twin(scene_lights: &[SceneLight]) -> RgbaImage {
                 let view_dir = (EYE - p).normalize();
                 let mut c = BASE_COLOR * AMBIENT;
                 let sun = sun();
-                c += shade_incoming(&s, -sun.direction, view_dir, sun.color * sun.illuminance);
+                c += shade_directional_light(&s, sun.direction, view_dir, sun.color * sun.illuminance);
                 for l in &lights {
                     c += shade_point_light(&s, p, view_dir, l);
                 }

@@ -40,21 +40,23 @@ fn shade_point_light(s: SurfaceParams, position: vec3<f32>, view_dir: vec3<f32>,
     }
     let l = to_light / max(distance, 1e-6);
     let cone = spot_attenuation(dot(light.spot.xyz, -l), light.spot.w, light.color.a);
-    return shade_incoming(s, l, view_dir, light.color.rgb * (att * cone));
+    return reflected(s, l, view_dir) * light.color.rgb * (att * cone);
 }
 
-// Radiance that light arriving from unit direction `l` (towards the light) with `radiance`
-// (colour x intensity x falloff; a directional light's illuminance) adds, seen from `view_dir`.
-fn shade_incoming(s: SurfaceParams, l: vec3<f32>, view_dir: vec3<f32>, radiance: vec3<f32>) -> vec3<f32> {
+// What a surface reflects towards `view_dir` of unit light arriving from unit direction `l`
+// (towards the light): the model's BRDF times n.l. Point, spot and directional lights multiply
+// it by their colour and falloff (in that order: a huge colour overflows to infinity there,
+// and the tone map counts it).
+fn reflected(s: SurfaceParams, l: vec3<f32>, view_dir: vec3<f32>) -> vec3<f32> {
     let n_dot_l = max(dot(s.normal, l), 0.0);
     if s.model == SHADING_TOON {
-        return toon_point_light(s, n_dot_l, view_dir, l) * radiance;
+        return toon_point_light(s, n_dot_l, view_dir, l);
     }
     if s.model == SHADING_PBR {
         if n_dot_l <= 0.0 {
             return vec3<f32>(0.0);
         }
-        return pbr_point_light(s, n_dot_l, view_dir, l) * radiance;
+        return pbr_point_light(s, n_dot_l, view_dir, l);
     }
     var result = s.albedo * n_dot_l;
     if s.model == SHADING_BLINN_PHONG && n_dot_l > 0.0 {
@@ -62,7 +64,7 @@ fn shade_incoming(s: SurfaceParams, l: vec3<f32>, view_dir: vec3<f32>, radiance:
         let n_dot_h = max(dot(s.normal, h), 0.0);
         result += vec3<f32>(s.specular * pow(n_dot_h, s.shininess) * n_dot_l);
     }
-    return result * radiance;
+    return result;
 }
 
 // Radiance the view's directional lights add (`ViewUniform::directional`, at most
@@ -71,7 +73,7 @@ fn shade_directional_lights(v: ViewUniform, s: SurfaceParams, view_dir: vec3<f32
     var color = vec3<f32>(0.0);
     for (var i = 0u; i < min(v.directional_count, MAX_DIRECTIONAL_LIGHTS); i++) {
         let light = v.directional[i];
-        color += shade_incoming(s, -light.direction.xyz, view_dir, light.color.rgb);
+        color += reflected(s, -light.direction.xyz, view_dir) * light.color.rgb;
     }
     return color;
 }

@@ -104,21 +104,21 @@ pub fn shade_point_light(
     }
     let l = to_light / distance.max(1e-6);
     let cone = spot_attenuation(light.spot_direction.dot(-l), light.spot_scale, light.spot_offset);
-    shade_incoming(s, l, view_dir, light.color * (att * cone))
+    reflected(s, l, view_dir) * light.color * (att * cone)
 }
 
-/// Radiance that light arriving from unit direction `l` (towards the light) with `radiance`
-/// (colour × intensity × falloff; for a directional light its illuminance) adds, seen from
-/// `view_dir`.
-pub fn shade_incoming(s: &SurfaceParams, l: Vec3, view_dir: Vec3, radiance: Vec3) -> Vec3 {
+/// What a surface reflects towards `view_dir` of unit light arriving from unit direction `l`
+/// (towards the light): the model's BRDF times n.l (WGSL: `reflected`). Point, spot and
+/// directional lights multiply it by their colour, then their falloff.
+pub fn reflected(s: &SurfaceParams, l: Vec3, view_dir: Vec3) -> Vec3 {
     let n_dot_l = s.normal.dot(l).max(0.0);
     match s.model {
-        ShadingModel::Toon => toon_point_light(s, n_dot_l, view_dir, l) * radiance,
+        ShadingModel::Toon => toon_point_light(s, n_dot_l, view_dir, l),
         ShadingModel::Pbr => {
             if n_dot_l <= 0.0 {
                 return Vec3::ZERO;
             }
-            pbr_point_light(s, n_dot_l, view_dir, l) * radiance
+            pbr_point_light(s, n_dot_l, view_dir, l)
         }
         ShadingModel::Lambert | ShadingModel::BlinnPhong => {
             let mut result = s.albedo * n_dot_l;
@@ -127,9 +127,15 @@ pub fn shade_incoming(s: &SurfaceParams, l: Vec3, view_dir: Vec3, radiance: Vec3
                 let n_dot_h = s.normal.dot(h).max(0.0);
                 result += Vec3::splat(s.specular * n_dot_h.powf(s.shininess) * n_dot_l);
             }
-            result * radiance
+            result
         }
     }
+}
+
+/// Radiance a directional light of `radiance` (colour × illuminance) travelling along unit
+/// `direction` adds, seen from `view_dir` (WGSL: the loop of `shade_directional_lights`).
+pub fn shade_directional_light(s: &SurfaceParams, direction: Vec3, view_dir: Vec3, radiance: Vec3) -> Vec3 {
+    reflected(s, -direction, view_dir) * radiance
 }
 
 /// Toon shading of one light (WGSL: `toon_point_light`).
