@@ -54,6 +54,9 @@ pub struct GpuMaterialBinding {
     last_used: u64,
 }
 
+/// The light buffer's content when there is no light (every pipeline binds the buffer).
+const PLACEHOLDER_LIGHT: &[u8] = &[0; std::mem::size_of::<GpuPointLight>()];
+
 /// How a draw is rasterised beyond what its pass decides: which winding faces front (the
 /// instance's handedness: a mirrored transform winds its triangles the other way on screen, so
 /// `front_facing` in the shaders always means the face's own front), back faces culled
@@ -275,7 +278,8 @@ impl SceneResources {
         });
         let storage_usage = wgpu::BufferUsages::STORAGE;
         // One placeholder light (every pipeline binds the buffer); it grows when lights appear.
-        let lights = GrowableBuffer::new(gpu, "point_lights", storage_usage, 48);
+        let light_bytes = std::mem::size_of::<GpuPointLight>() as u64;
+        let lights = GrowableBuffer::new(gpu, "point_lights", storage_usage, light_bytes);
         let instances = GrowableBuffer::new(gpu, "instances", storage_usage, 64 * 128);
         let view_bind_group =
             Self::make_view_bind_group(gpu, &view_layout, &view_buffer, &lights, &instances);
@@ -434,7 +438,7 @@ impl SceneResources {
             snapshot.lights.iter().filter(|l| l.is_valid()).map(|l| l.bounding_sphere()).collect();
         self.light_count = gpu_lights.len() as u32;
         let light_bytes: &[u8] =
-            if gpu_lights.is_empty() { &[0u8; 48] } else { bytemuck::cast_slice(&gpu_lights) };
+            if gpu_lights.is_empty() { PLACEHOLDER_LIGHT } else { bytemuck::cast_slice(&gpu_lights) };
         self.lights.write(gpu, light_bytes)?;
         self.light_upload_bytes = light_bytes.len() as u64;
 
