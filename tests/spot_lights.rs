@@ -53,29 +53,40 @@ fn spot_lights_give_the_naive_image_in_every_pipeline() {
     }
 }
 
+/// The default scene without its lights and ambient, plus what `spawn` adds, rendered once.
+fn render_unlit_hall_with(
+    spawn: impl Fn(&mut Commands) + Clone + Send + Sync + 'static,
+) -> manylight::app::headless::HeadlessFrame {
+    manylight::app::headless::render_headless(SIZE, 1, move |app| {
+        let spawn = spawn.clone();
+        app.insert_resource(RenderSettings { ambient: 0.0, ..RenderSettings::default() }).add_systems(
+            Startup,
+            move |mut commands: Commands| {
+                let mut scene = default_scene();
+                scene.lights.clear();
+                spawn_scene(&mut commands, &scene, true, SIZE.x as f32 / SIZE.y as f32);
+                spawn(&mut commands);
+            },
+        );
+    })
+    .expect("renders")
+}
+
 /// A spot light placed through the ECS (`SpotLight`, pointing down its entity's -Z) lights
 /// only what lies in its cone.
 #[test]
 fn a_spot_light_component_lights_only_its_cone() {
     let _gpu = gpu();
-    let render =
-        |light: Option<SpotLight>| {
-            manylight::app::headless::render_headless(SIZE, 1, move |app| {
-                app.insert_resource(RenderSettings { ambient: 0.0, ..RenderSettings::default() })
-                    .add_systems(Startup, move |mut commands: Commands| {
-                        let mut scene = default_scene();
-                        scene.lights.clear();
-                        spawn_scene(&mut commands, &scene, true, SIZE.x as f32 / SIZE.y as f32);
-                        if let Some(light) = light {
-                            // Above the floor of the nave, pointing straight down.
-                            let at = Transform::from_xyz(-12.0, 5.0, 0.0).looking_to(Vec3::NEG_Y, Vec3::X);
-                            commands.spawn((at, light));
-                        }
-                    });
-            })
-            .expect("renders")
-            .image
-        };
+    let render = |light: Option<SpotLight>| {
+        render_unlit_hall_with(move |commands: &mut Commands| {
+            if let Some(light) = light {
+                // Above the floor of the nave, pointing straight down.
+                let at = Transform::from_xyz(-12.0, 5.0, 0.0).looking_to(Vec3::NEG_Y, Vec3::X);
+                commands.spawn((at, light));
+            }
+        })
+        .image
+    };
     let dark = render(None);
     let lit = render(Some(SpotLight {
         intensity: 200.0,
@@ -100,23 +111,15 @@ fn a_spot_light_component_lights_only_its_cone() {
 fn directional_lights_light_everything_and_extra_ones_are_counted() {
     use manylight::render::gpu_types::MAX_DIRECTIONAL_LIGHTS;
     let _gpu = gpu();
-    let render =
-        |count: u32| {
-            manylight::app::headless::render_headless(SIZE, 1, move |app| {
-                app.insert_resource(RenderSettings { ambient: 0.0, ..RenderSettings::default() })
-                    .add_systems(Startup, move |mut commands: Commands| {
-                        let mut scene = default_scene();
-                        scene.lights.clear();
-                        spawn_scene(&mut commands, &scene, true, SIZE.x as f32 / SIZE.y as f32);
-                        for _ in 0..count {
-                            // Straight down onto the floor of the nave.
-                            let down = Transform::default().looking_to(Vec3::NEG_Y, Vec3::X);
-                            commands.spawn((down, DirectionalLight { illuminance: 0.4, ..default() }));
-                        }
-                    });
-            })
-            .expect("renders")
-        };
+    let render = |count: u32| {
+        render_unlit_hall_with(move |commands: &mut Commands| {
+            for _ in 0..count {
+                // Straight down onto the floor of the nave.
+                let down = Transform::default().looking_to(Vec3::NEG_Y, Vec3::X);
+                commands.spawn((down, DirectionalLight { illuminance: 0.4, ..default() }));
+            }
+        })
+    };
     let dark = render(0);
     let one = render(1);
     let lit = one.image.pixels().zip(dark.image.pixels()).filter(|(a, b)| a != b).count();
