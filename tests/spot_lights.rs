@@ -132,3 +132,43 @@ fn directional_lights_light_everything_and_extra_ones_are_counted() {
     assert_eq!((report.directional_lights, report.dropped_directional_lights), (MAX_DIRECTIONAL_LIGHTS, 3));
     assert!(flip(&one.image, &many.image).mean > 0.01, "eight lights are brighter than one");
 }
+
+/// Spot lights on hard cases render the naive image in every pipeline, with no non-finite
+/// pixel: the apex at the camera, a huge and a zero range, zero and right-angle cones, equal
+/// inner and outer angles, and bad input the renderer must make usable (a zero direction, NaN
+/// and infinite angles).
+#[test]
+fn spot_lights_on_hard_cases_stay_finite_and_exact() {
+    let _gpu = gpu();
+    let scene = || {
+        let mut scene = default_scene();
+        let eye = scene.cameras[0].transform.w_axis.truncate();
+        let forward = -scene.cameras[0].transform.z_axis.truncate().normalize();
+        let cone = |direction: Vec3, inner: f32, outer: f32| {
+            Some(SpotCone { direction, inner_angle: inner, outer_angle: outer })
+        };
+        let spot = |position: Vec3, radius: f32, spot| manylight::scene::SceneLight {
+            position,
+            color: Vec3::new(1.0, 0.8, 0.6),
+            intensity: 20.0,
+            radius,
+            spot,
+        };
+        scene.lights.extend([
+            spot(eye, 40.0, cone(forward, 0.2, 0.4)),
+            spot(eye + forward * 3.0, 1e6, cone(Vec3::NEG_Y, 0.3, 0.5)),
+            spot(eye + forward * 5.0, 0.0, cone(forward, 0.1, 0.2)),
+            spot(eye + forward * 6.0, 10.0, cone(Vec3::NEG_Y, 0.0, 0.0)),
+            spot(eye + forward * 7.0, 10.0, cone(Vec3::X, 1.0, std::f32::consts::FRAC_PI_2)),
+            spot(eye + forward * 8.0, 10.0, cone(Vec3::NEG_Y, 0.6, 0.6)),
+            spot(eye + forward * 9.0, 10.0, cone(Vec3::ZERO, f32::NAN, f32::INFINITY)),
+        ]);
+        scene
+    };
+    let naive = render_scene(scene(), SIZE, 0, settings(PipelineKind::NaiveForward));
+    for (name, s) in support::pipelines_besides_naive("spot_hard", settings) {
+        let frame = render_scene(scene(), SIZE, 0, s);
+        let tolerance = if name.ends_with("compact") { COMPACT } else { STRICT };
+        assert_similar(&name, &naive.image, &frame.image, tolerance);
+    }
+}
