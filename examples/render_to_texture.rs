@@ -89,7 +89,7 @@ fn show_on_screen(
     });
     for mut material in &mut screens {
         let mut m = (*material.0).clone();
-        m.base_color_texture = Some(texture.clone());
+        m.base_color_texture = Some(texture.clone().into());
         material.0 = Arc::new(m);
     }
 }

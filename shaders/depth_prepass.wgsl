@@ -5,5 +5,6 @@
 
 @fragment
 fn fs_mask(in: SurfaceVertexOut) {
-    alpha_test(surface_albedo(material, base_color_texture, base_color_sampler, in.uv));
+    let uv = texture_uv(material, TEXTURE_SLOT_BASE_COLOR, in.uv);
+    alpha_test(surface_albedo(material, base_color_texture, base_color_sampler, uv));
 }

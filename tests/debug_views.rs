@@ -49,7 +49,7 @@ fn scene() -> Scene {
         if i == 0 {
             m.emissive = Vec3::new(1.0, 0.5, 0.2);
         } else {
-            m.occlusion_texture = Some(occlusion.clone());
+            m.occlusion_texture = Some(occlusion.clone().into());
         }
     }
     scene

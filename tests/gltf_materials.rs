@@ -1,5 +1,6 @@
 //! glTF materials as their authors made them: normal maps (tangents from the file, generated
-//! with MikkTSpace, and mirrored), occlusion, emission, alpha masks and single-sided culling.
+//! with MikkTSpace, and mirrored), occlusion, emission, alpha masks, single-sided culling,
+//! per-texture samplers, texture transforms and the second uv set.
 //! Khronos sample assets rendered by naive forward match stored references; every other
 //! pipeline and G-buffer layout matches naive forward on them; and culling follows each
 //! instance's handedness.
@@ -20,7 +21,7 @@ const SIZE: UVec2 = UVec2::new(160, 160);
 const LIGHTS: usize = 48;
 
 /// (reference name, asset): each exercises a material feature.
-const ASSETS: [(&str, &str); 4] = [
+const ASSETS: [(&str, &str); 7] = [
     // Normal, occlusion and emissive maps, tangents generated with MikkTSpace.
     ("damaged_helmet", "DamagedHelmet/DamagedHelmet.glb"),
     // Tangents from the file, with mirrored uvs.
@@ -29,6 +30,12 @@ const ASSETS: [(&str, &str); 4] = [
     ("normal_tangent", "NormalTangentTest/NormalTangentTest.gltf"),
     // Alpha masks with several cutoffs (its blended materials are drawn opaque for now).
     ("alpha_blend_mode", "AlphaBlendModeTest/AlphaBlendModeTest.gltf"),
+    // Per-texture samplers: repeat, mirrored repeat and clamp on each axis.
+    ("texture_settings", "TextureSettingsTest/TextureSettingsTest.gltf"),
+    // Where uv (0, 0) lies on the image and which way v runs.
+    ("texture_coordinate", "TextureCoordinateTest/TextureCoordinateTest.gltf"),
+    // sRGB decoding of PNGs with and without gamma and ICC chunks: all alike.
+    ("texture_encoding", "TextureEncodingTest/TextureEncodingTest.gltf"),
 ];
 
 fn settings(pipeline: PipelineKind) -> RenderSettings {
@@ -139,4 +146,110 @@ fn single_sided_faces_seen_from_behind_are_not_drawn() {
     let drawn = double.pixels().filter(|p| **p != background).count();
     assert!(drawn == double.pixels().len(), "{drawn} of {} pixels drawn from inside", double.pixels().len());
     assert!(flip(&single, &double).mean > 0.05);
+}
+
+/// A 2 × 2 quad in the xy plane facing +z, every vertex's two uv sets from `uv0` and `uv1`
+/// of its corner (u along +x, v along -y in `[0, 1]`).
+fn uv_quad(uv0: impl Fn(Vec2) -> Vec2, uv1: impl Fn(Vec2) -> Vec2) -> manylight::core::MeshData {
+    let corners = [Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, 0.0)];
+    let positions: Vec<Vec3> =
+        corners.iter().map(|c| Vec3::new(c.x * 2.0 - 1.0, 1.0 - c.y * 2.0, 0.0)).collect();
+    let normals = [Vec3::Z; 4];
+    let uvs: Vec<Vec2> = corners.iter().map(|&c| uv0(c)).collect();
+    let mut mesh = manylight::core::MeshData::from_attributes(
+        "uv quad",
+        &positions,
+        Some(&normals),
+        Some(&uvs),
+        Some(vec![0, 1, 2, 0, 2, 3]),
+    )
+    .expect("valid quad");
+    mesh.set_uv1(&corners.map(uv1));
+    mesh
+}
+
+/// A 16 × 16 texture with no symmetry: red along x, green along y, a blue diagonal stripe.
+fn asymmetric_texture() -> Arc<manylight::core::TextureData> {
+    let mut rgba8 = Vec::new();
+    for y in 0..16u8 {
+        for x in 0..16u8 {
+            let stripe = if (x + 2 * y) % 7 == 0 { 255 } else { 0 };
+            rgba8.extend_from_slice(&[x * 16, y * 16, stripe, 255]);
+        }
+    }
+    Arc::new(manylight::core::TextureData {
+        label: "asymmetric".into(),
+        width: 16,
+        height: 16,
+        rgba8,
+        srgb: true,
+    })
+}
+
+/// `KHR_texture_transform` and `TEXCOORD_1`: a quad whose base colour and emissive textures
+/// transform their uvs (each its own way) looks like the same quad with those transforms
+/// applied to its vertices' uvs beforehand, whichever uv set the textures read; and unlike the
+/// quad sampled without them.
+#[test]
+fn texture_transforms_and_the_second_uv_set_match_pre_transformed_uvs() {
+    use manylight::core::{MaterialTexture, UvChannel};
+    let _gpu = gpu();
+    let base = MaterialTexture::gltf_uv_transform(Vec2::new(0.25, 0.5), 0.7, Vec2::new(1.5, -0.8));
+    let emissive = MaterialTexture::gltf_uv_transform(Vec2::new(0.1, 0.3), -1.2, Vec2::new(0.6, 2.0));
+    let image = asymmetric_texture();
+    let texture = |channel, transform| MaterialTexture {
+        uv_channel: channel,
+        uv_transform: transform,
+        ..MaterialTexture::new(image.clone())
+    };
+    let scene = |mesh: manylight::core::MeshData, base_texture, emissive_texture| {
+        let material = MaterialData {
+            label: "transformed".into(),
+            base_color_texture: Some(base_texture),
+            emissive: Vec3::splat(0.5),
+            emissive_texture: Some(emissive_texture),
+            ..MaterialData::default()
+        };
+        Scene {
+            name: "uv quad".into(),
+            meshes: vec![Arc::new(mesh)],
+            materials: vec![Arc::new(material)],
+            instances: vec![SceneInstance { mesh: 0, material: 0, transform: Mat4::IDENTITY }],
+            cameras: vec![SceneCamera {
+                transform: camera_looking_at(Vec3::new(0.3, -0.2, 2.5), Vec3::ZERO),
+                projection: Projection::perspective(0.9, 0.1, 20.0),
+            }],
+            ..Scene::default()
+        }
+    };
+    let id = glam::Affine2::IDENTITY;
+    let (apply_base, apply_emissive) = (|uv| base.transform_point2(uv), |uv| emissive.transform_point2(uv));
+    let size = UVec2::new(96, 96);
+    for pipeline in [PipelineKind::NaiveForward, PipelineKind::ClusteredDeferred] {
+        let render =
+            |s: Scene| render_scene(s, size, 0, RenderSettings { ambient: 0.5, ..settings(pipeline) }).image;
+        // The transforms baked into the vertices: base colour from uv0, emissive from uv1.
+        let baked = render(scene(
+            uv_quad(apply_base, apply_emissive),
+            texture(UvChannel::Uv0, id),
+            texture(UvChannel::Uv1, id),
+        ));
+        let on_uv0 = render(scene(
+            uv_quad(|c| c, |_| Vec2::ZERO),
+            texture(UvChannel::Uv0, base),
+            texture(UvChannel::Uv0, emissive),
+        ));
+        let on_uv1 = render(scene(
+            uv_quad(|_| Vec2::ZERO, |c| c),
+            texture(UvChannel::Uv1, base),
+            texture(UvChannel::Uv1, emissive),
+        ));
+        let plain =
+            render(scene(uv_quad(|c| c, |c| c), texture(UvChannel::Uv0, id), texture(UvChannel::Uv0, id)));
+        let name = format!("texture_transform_{}", pipeline.name());
+        assert_similar(&format!("{name}_uv0"), &baked, &on_uv0, STRICT);
+        assert_similar(&format!("{name}_uv1"), &baked, &on_uv1, STRICT);
+        let untransformed = flip(&baked, &plain).mean;
+        assert!(untransformed > 0.05, "{name}: the transforms change little ({untransformed})");
+    }
 }

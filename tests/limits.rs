@@ -111,7 +111,7 @@ fn a_texture_larger_than_the_device_allows_is_refused_naming_the_limit() {
                 Transform::IDENTITY,
                 Mesh3d(Arc::new(quad_in_front(4))),
                 Material(Arc::new(MaterialData {
-                    base_color_texture: Some(texture.clone()),
+                    base_color_texture: Some(texture.clone().into()),
                     ..Default::default()
                 })),
             ));

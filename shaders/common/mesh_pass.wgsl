@@ -21,6 +21,11 @@
 @group(1) @binding(5) var occlusion_texture: texture_2d<f32>;
 // emitted colour (sRGB)
 @group(1) @binding(6) var emissive_texture: texture_2d<f32>;
+// each texture's own sampler (glTF wrap and filter modes)
+@group(1) @binding(7) var metallic_roughness_sampler: sampler;
+@group(1) @binding(8) var normal_sampler: sampler;
+@group(1) @binding(9) var occlusion_sampler: sampler;
+@group(1) @binding(10) var emissive_sampler: sampler;
 
 // Everything a shading pass needs of the material at a fragment.
 struct MaterialSample {
@@ -35,16 +40,21 @@ struct MaterialSample {
 // behind a branch) and builds the surface: normal map, occlusion, emissive, and the normal
 // turned towards the viewer on the back faces of double-sided materials.
 fn sample_material(in: SurfaceVertexOut, front_facing: bool) -> MaterialSample {
-    let smp = base_color_sampler;
     var out: MaterialSample;
-    out.base_color = surface_albedo(material, base_color_texture, smp, in.uv);
-    let metal_rough = surface_metal_rough(material, metallic_roughness_texture, smp, in.uv);
-    let normal_texel = textureSample(normal_texture, smp, in.uv);
+    let base_uv = texture_uv(material, TEXTURE_SLOT_BASE_COLOR, in.uv);
+    out.base_color = surface_albedo(material, base_color_texture, base_color_sampler, base_uv);
+    let metal_rough_uv = texture_uv(material, TEXTURE_SLOT_METALLIC_ROUGHNESS, in.uv);
+    let metal_rough =
+        surface_metal_rough(material, metallic_roughness_texture, metallic_roughness_sampler, metal_rough_uv);
+    let normal_uv = texture_uv(material, TEXTURE_SLOT_NORMAL, in.uv);
+    let normal_texel = textureSample(normal_texture, normal_sampler, normal_uv);
     let n = surface_normal(material, normal_texel.xyz, in, front_facing);
     out.params = surface_params(material, view.shading_model, out.base_color.rgb, metal_rough, n);
-    let occlusion_texel = textureSample(occlusion_texture, smp, in.uv).r;
+    let occlusion_uv = texture_uv(material, TEXTURE_SLOT_OCCLUSION, in.uv);
+    let occlusion_texel = textureSample(occlusion_texture, occlusion_sampler, occlusion_uv).r;
     out.occlusion = surface_occlusion(material, occlusion_texel);
-    let emissive_texel = textureSample(emissive_texture, smp, in.uv).rgb;
+    let emissive_uv = texture_uv(material, TEXTURE_SLOT_EMISSIVE, in.uv);
+    let emissive_texel = textureSample(emissive_texture, emissive_sampler, emissive_uv).rgb;
     out.emissive = material.emissive * select(vec3<f32>(1.0), emissive_texel, material.has_emissive_texture != 0u);
     return out;
 }

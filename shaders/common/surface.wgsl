@@ -10,7 +10,8 @@ struct SurfaceVertexOut {
     // camera are small, whatever the distance from the world origin).
     @location(0) camera_offset: vec3<f32>,
     @location(1) world_normal: vec3<f32>,
-    @location(2) uv: vec2<f32>,
+    // xy: TEXCOORD_0, zw: TEXCOORD_1 (`texture_uv` picks and transforms a texture's).
+    @location(2) uv: vec4<f32>,
     // World tangent (xyz, transformed like positions) and the bitangent's handedness in world
     // space (w: the vertex's times the sign of the instance's determinant; 0 without tangent).
     @location(3) world_tangent: vec4<f32>,
@@ -28,7 +29,7 @@ fn surface_vertex(v: VertexIn, inst: GpuInstance, clip_from_world: mat4x4<f32>, 
     out.clip_position = clip_from_world * world;
     out.camera_offset = world.xyz - camera;
     out.world_normal = (inst.normal_from_local * vec4<f32>(v.normal, 0.0)).xyz;
-    out.uv = v.uv;
+    out.uv = vec4<f32>(v.uv, v.uv1);
     out.world_tangent = vec4<f32>(m * v.tangent.xyz, v.tangent.w * mirror);
     return out;
 }

@@ -19,6 +19,9 @@ pub mod tonemap;
 
 pub use attenuation::{attenuation, radius_for_intensity};
 pub use camera::{Projection, ProjectionKind, linearize_depth_reverse_z};
-pub use material::{AlphaMode, MaterialData, ShadingModel, TextureData};
+pub use material::{
+    AlphaMode, ImageAddressMode, ImageFilterMode, MaterialData, MaterialTexture, ShadingModel, TextureData,
+    TextureSampler, UvChannel,
+};
 pub use mesh::{Aabb, MeshData, MeshError, Vertex};
 pub use spot::SpotCone;

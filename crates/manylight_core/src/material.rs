@@ -1,6 +1,6 @@
 //! Materials and textures as plain data (what the GPU side uploads once, shared as `Arc`s).
 
-use glam::{Vec3, Vec4};
+use glam::{Affine2, Vec2, Vec3, Vec4};
 use std::sync::Arc;
 
 /// How a surface responds to light. Selected per material or globally in the render settings.
@@ -70,6 +70,133 @@ pub struct TextureData {
     pub srgb: bool,
 }
 
+/// How a texture repeats outside `[0, 1]` (Bevy's `ImageAddressMode`, glTF `wrapS`/`wrapT`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum ImageAddressMode {
+    /// The texture tiles.
+    #[default]
+    Repeat,
+    /// The texture tiles, every other copy mirrored.
+    MirrorRepeat,
+    /// The edge texels extend forever.
+    ClampToEdge,
+}
+
+/// How texels are filtered (Bevy's `ImageFilterMode`, glTF `magFilter`/`minFilter`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum ImageFilterMode {
+    /// The nearest texel (or mip level).
+    Nearest,
+    /// Linear interpolation between texels (or mip levels).
+    #[default]
+    Linear,
+}
+
+/// How a material samples one of its textures (glTF `sampler`).
+///
+/// The default is what glTF leaves to the implementation: repeat, trilinear, and anisotropic
+/// filtering where the adapter has it (only when every filter is linear).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct TextureSampler {
+    /// Along u.
+    pub address_mode_u: ImageAddressMode,
+    /// Along v.
+    pub address_mode_v: ImageAddressMode,
+    /// When a texel covers more than a pixel.
+    pub mag_filter: ImageFilterMode,
+    /// When a pixel covers more than a texel.
+    pub min_filter: ImageFilterMode,
+    /// Between mip levels; `None` samples the full-size level only (glTF `NEAREST` and
+    /// `LINEAR` minification filters).
+    pub mipmap_filter: Option<ImageFilterMode>,
+}
+
+impl Default for TextureSampler {
+    fn default() -> Self {
+        TextureSampler {
+            address_mode_u: ImageAddressMode::Repeat,
+            address_mode_v: ImageAddressMode::Repeat,
+            mag_filter: ImageFilterMode::Linear,
+            min_filter: ImageFilterMode::Linear,
+            mipmap_filter: Some(ImageFilterMode::Linear),
+        }
+    }
+}
+
+impl TextureSampler {
+    /// True when the sampler may filter anisotropically: every filter linear, mipmaps on.
+    pub fn allows_anisotropy(&self) -> bool {
+        self.mag_filter == ImageFilterMode::Linear
+            && self.min_filter == ImageFilterMode::Linear
+            && self.mipmap_filter == Some(ImageFilterMode::Linear)
+    }
+}
+
+/// Which texture coordinate set of the mesh a texture reads (Bevy's `UvChannel`, glTF
+/// `texCoord`): [`Vertex::uv`](crate::Vertex::uv) or [`Vertex::uv1`](crate::Vertex::uv1).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum UvChannel {
+    /// `TEXCOORD_0`.
+    #[default]
+    Uv0,
+    /// `TEXCOORD_1`.
+    Uv1,
+}
+
+/// A material's texture: the image, how it is sampled, which uv set it reads and how those
+/// uvs are transformed first (`KHR_texture_transform`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialTexture {
+    /// The pixels (shared between materials).
+    pub image: Arc<TextureData>,
+    /// Wrap and filter modes.
+    pub sampler: TextureSampler,
+    /// The uv set.
+    pub uv_channel: UvChannel,
+    /// Applied to the uvs before sampling: `uv' = uv_transform * uv` (identity by default).
+    pub uv_transform: Affine2,
+}
+
+impl MaterialTexture {
+    /// `image` with the default sampler, `TEXCOORD_0` and no transform.
+    pub fn new(image: Arc<TextureData>) -> MaterialTexture {
+        MaterialTexture {
+            image,
+            sampler: TextureSampler::default(),
+            uv_channel: UvChannel::Uv0,
+            uv_transform: Affine2::IDENTITY,
+        }
+    }
+
+    /// The transform of glTF's `KHR_texture_transform`: scale, then rotate by `rotation`
+    /// radians counter-clockwise in texture space (v points down), then offset.
+    pub fn gltf_uv_transform(offset: Vec2, rotation: f32, scale: Vec2) -> Affine2 {
+        // glam's angle turns +x towards +y; with v down that is clockwise on the image.
+        Affine2::from_scale_angle_translation(scale, -rotation, offset)
+    }
+
+    /// The uv the texture is sampled at for a vertex's two uv sets.
+    pub fn sample_uv(&self, uv0: Vec2, uv1: Vec2) -> Vec2 {
+        let uv = match self.uv_channel {
+            UvChannel::Uv0 => uv0,
+            UvChannel::Uv1 => uv1,
+        };
+        self.uv_transform.transform_point2(uv)
+    }
+}
+
+impl From<Arc<TextureData>> for MaterialTexture {
+    fn from(image: Arc<TextureData>) -> MaterialTexture {
+        MaterialTexture::new(image)
+    }
+}
+
+impl From<TextureData> for MaterialTexture {
+    fn from(image: TextureData) -> MaterialTexture {
+        MaterialTexture::new(Arc::new(image))
+    }
+}
+
 /// How a material's alpha is used (glTF `alphaMode`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum AlphaMode {
@@ -107,14 +234,14 @@ pub struct MaterialData {
     /// Linear RGBA multiplier of the base colour texture.
     pub base_color: Vec4,
     /// Optional sRGB base colour texture.
-    pub base_color_texture: Option<Arc<TextureData>>,
+    pub base_color_texture: Option<MaterialTexture>,
     /// PBR metalness factor (0 dielectric .. 1 metal).
     pub metallic: f32,
     /// PBR perceptual roughness factor (0 mirror .. 1 rough).
     pub roughness: f32,
     /// Optional linear metallic-roughness texture (glTF: blue = metalness, green =
     /// roughness), multiplied with the factors.
-    pub metallic_roughness_texture: Option<Arc<TextureData>>,
+    pub metallic_roughness_texture: Option<MaterialTexture>,
     /// Per-material shading model; `None` uses the global one from the render settings.
     pub shading: Option<ShadingModel>,
     /// Blinn-Phong exponent (the Blinn-Phong and toon models).
@@ -123,19 +250,19 @@ pub struct MaterialData {
     pub specular: f32,
     /// Optional linear tangent-space normal map (glTF: rgb = xyz * 0.5 + 0.5, +y up in
     /// texture space); the mesh's tangents (`Vertex::tangent`) give its frame.
-    pub normal_texture: Option<Arc<TextureData>>,
+    pub normal_texture: Option<MaterialTexture>,
     /// Scale of the normal map's x and y (glTF `normalTexture.scale`).
     pub normal_scale: f32,
     /// Optional linear ambient-occlusion texture (red channel). Occlusion darkens only the
     /// ambient term, never a point light's contribution (glTF: it applies to indirect light).
-    pub occlusion_texture: Option<Arc<TextureData>>,
+    pub occlusion_texture: Option<MaterialTexture>,
     /// How much of the occlusion applies: `1 + strength * (texel - 1)` (0 = none, 1 = full).
     pub occlusion_strength: f32,
     /// Linear emitted radiance, added whatever the lights (glTF `emissiveFactor` times
     /// `KHR_materials_emissive_strength`).
     pub emissive: Vec3,
     /// Optional sRGB emissive texture, multiplied with `emissive`.
-    pub emissive_texture: Option<Arc<TextureData>>,
+    pub emissive_texture: Option<MaterialTexture>,
     /// Drawn from both sides, the normal flipped on back faces; single-sided materials are not
     /// drawn where their back faces the camera (glTF `doubleSided`).
     pub double_sided: bool,
@@ -170,7 +297,7 @@ impl Default for MaterialData {
 
 impl MaterialData {
     /// Every texture the material samples.
-    pub fn textures(&self) -> impl Iterator<Item = &Arc<TextureData>> {
+    pub fn textures(&self) -> impl Iterator<Item = &MaterialTexture> {
         [
             &self.base_color_texture,
             &self.metallic_roughness_texture,

@@ -18,6 +18,9 @@ pub struct Vertex {
     /// `bitangent = w * cross(normal, tangent)`), as glTF's `TANGENT`. All zero when the mesh
     /// has none: normal maps then leave the normal as it is.
     pub tangent: [f32; 4],
+    /// Second texture coordinate (glTF `TEXCOORD_1`), for textures whose
+    /// [`UvChannel`](crate::UvChannel) is `Uv1`; zero when the mesh has none.
+    pub uv1: [f32; 2],
 }
 
 /// A mesh whose data is not usable.
@@ -36,7 +39,7 @@ pub enum MeshError {
     /// The index count is not a multiple of three.
     #[error("index count {0} is not a multiple of 3")]
     NotTriangles(usize),
-    /// A position, normal or uv is NaN or infinite.
+    /// A position, normal or uv (either set) is NaN or infinite.
     #[error("vertex {0} has a non-finite attribute")]
     NonFinite(usize),
 }
@@ -130,6 +133,7 @@ impl MeshData {
                     normal: normals.and_then(|n| n.get(i)).map_or([0.0; 3], |n| n.to_array()),
                     uv: uvs.and_then(|u| u.get(i)).map_or([0.0; 2], |u| u.to_array()),
                     tangent: [0.0; 4],
+                    uv1: [0.0; 2],
                 })
                 .collect(),
             indices,
@@ -153,14 +157,20 @@ impl MeshData {
         {
             return Err(MeshError::IndexOutOfRange { index, at, vertices: self.vertices.len() });
         }
-        if let Some(i) = self
-            .vertices
-            .iter()
-            .position(|v| !v.position.iter().chain(&v.normal).chain(&v.uv).all(|x| x.is_finite()))
-        {
+        if let Some(i) = self.vertices.iter().position(|v| {
+            !v.position.iter().chain(&v.normal).chain(&v.uv).chain(&v.uv1).all(|x| x.is_finite())
+        }) {
             return Err(MeshError::NonFinite(i));
         }
         Ok(())
+    }
+
+    /// Sets the second texture coordinate of every vertex (`uv1[i]` for vertex `i`; vertices
+    /// past its end get zero).
+    pub fn set_uv1(&mut self, uv1: &[Vec2]) {
+        for (i, v) in self.vertices.iter_mut().enumerate() {
+            v.uv1 = uv1.get(i).map_or([0.0; 2], |u| u.to_array());
+        }
     }
 
     /// Replaces the normals by area-weighted smooth normals of the triangles.

@@ -5,7 +5,7 @@
 //! file is their single source.
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Mat4, Vec2, Vec3, Vec4};
 use manylight_core::ShadingModel;
 use manylight_core::codec::NormalCodec;
 
@@ -50,6 +50,12 @@ pub fn shared_u32_constants() -> Vec<(&'static str, u32)> {
     use manylight_core::cluster::ZSlicing;
     vec![
         ("MAX_DIRECTIONAL_LIGHTS", MAX_DIRECTIONAL_LIGHTS),
+        ("MATERIAL_TEXTURE_SLOTS", MATERIAL_TEXTURE_SLOTS),
+        ("TEXTURE_SLOT_BASE_COLOR", TEXTURE_SLOT_BASE_COLOR),
+        ("TEXTURE_SLOT_METALLIC_ROUGHNESS", TEXTURE_SLOT_METALLIC_ROUGHNESS),
+        ("TEXTURE_SLOT_NORMAL", TEXTURE_SLOT_NORMAL),
+        ("TEXTURE_SLOT_OCCLUSION", TEXTURE_SLOT_OCCLUSION),
+        ("TEXTURE_SLOT_EMISSIVE", TEXTURE_SLOT_EMISSIVE),
         ("SHADING_LAMBERT", ShadingModel::Lambert.gpu_id()),
         ("SHADING_BLINN_PHONG", ShadingModel::BlinnPhong.gpu_id()),
         ("SHADING_TOON", ShadingModel::Toon.gpu_id()),
@@ -235,6 +241,54 @@ pub struct GpuMaterial {
     pub has_emissive_texture: u32,
     /// Alpha below which the alpha-mask pipelines discard a fragment.
     pub alpha_cutoff: f32,
+    /// How each texture slot (`TEXTURE_SLOT_*`) reads its uvs.
+    pub texture_uv: [GpuTextureUv; MATERIAL_TEXTURE_SLOTS as usize],
+}
+
+/// Material texture slots, in [`GpuMaterial::texture_uv`] and `material.texture_uv` order.
+pub const MATERIAL_TEXTURE_SLOTS: u32 = 5;
+/// See [`MATERIAL_TEXTURE_SLOTS`].
+pub const TEXTURE_SLOT_BASE_COLOR: u32 = 0;
+/// See [`MATERIAL_TEXTURE_SLOTS`].
+pub const TEXTURE_SLOT_METALLIC_ROUGHNESS: u32 = 1;
+/// See [`MATERIAL_TEXTURE_SLOTS`].
+pub const TEXTURE_SLOT_NORMAL: u32 = 2;
+/// See [`MATERIAL_TEXTURE_SLOTS`].
+pub const TEXTURE_SLOT_OCCLUSION: u32 = 3;
+/// See [`MATERIAL_TEXTURE_SLOTS`].
+pub const TEXTURE_SLOT_EMISSIVE: u32 = 4;
+
+/// Which uv set a material texture reads and its uv transform (`GpuTextureUv` in
+/// `shaders/common/mesh.wgsl`): `uv' = (dot(row0.xyz, (uv, 1)), dot(row1.xyz, (uv, 1)))`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct GpuTextureUv {
+    /// First row of the affine transform (xyz); w is 1 to read `TEXCOORD_1`, else 0.
+    pub row0: Vec4,
+    /// Second row of the affine transform (xyz); w unused.
+    pub row1: Vec4,
+}
+
+impl GpuTextureUv {
+    /// `TEXCOORD_0`, untransformed (also for empty slots).
+    pub const IDENTITY: GpuTextureUv = GpuTextureUv { row0: Vec4::X, row1: Vec4::Y };
+
+    /// The slot of `texture` (identity when there is none).
+    pub fn of(texture: Option<&manylight_core::MaterialTexture>) -> GpuTextureUv {
+        let Some(t) = texture else { return GpuTextureUv::IDENTITY };
+        let m = t.uv_transform;
+        let finite = m.matrix2.is_finite() && m.translation.is_finite();
+        let (c0, c1, c2) = if finite {
+            (m.matrix2.x_axis, m.matrix2.y_axis, m.translation)
+        } else {
+            (Vec2::X, Vec2::Y, Vec2::ZERO)
+        };
+        let channel = match t.uv_channel {
+            manylight_core::UvChannel::Uv0 => 0.0,
+            manylight_core::UvChannel::Uv1 => 1.0,
+        };
+        GpuTextureUv { row0: Vec4::new(c0.x, c1.x, c2.x, channel), row1: Vec4::new(c0.y, c1.y, c2.y, 0.0) }
+    }
 }
 
 /// Constants emitted into WGSL as `const NAME: f32 = VALUE;` (printed so they round-trip).

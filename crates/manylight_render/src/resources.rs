@@ -6,13 +6,15 @@
 
 use crate::context::{GpuContext, RenderError};
 use crate::gpu_types::{
-    GpuDirectionalLight, GpuInstance, GpuMaterial, GpuPointLight, MAX_DIRECTIONAL_LIGHTS, SHADING_GLOBAL,
-    ViewUniform,
+    GpuDirectionalLight, GpuInstance, GpuMaterial, GpuPointLight, GpuTextureUv, MAX_DIRECTIONAL_LIGHTS,
+    SHADING_GLOBAL, ViewUniform,
 };
 use crate::pool::GrowableBuffer;
 use crate::snapshot::{FrameSnapshot, RenderView, aspect};
 use glam::{Mat4, Vec4};
-use manylight_core::{MaterialData, MeshData, TextureData, Vertex};
+use manylight_core::{
+    ImageAddressMode, ImageFilterMode, MaterialData, MeshData, TextureData, TextureSampler, Vertex,
+};
 use std::collections::HashMap;
 use std::sync::Arc;
 
@@ -122,7 +124,7 @@ pub struct Draw {
 pub struct SceneResources {
     /// Layout of group 0: view uniform, lights, instances.
     pub view_layout: wgpu::BindGroupLayout,
-    /// Layout of group 1: material uniform, sampler and the material's five textures.
+    /// Layout of group 1: material uniform, the material's five textures and their samplers.
     pub material_layout: wgpu::BindGroupLayout,
     /// Group 0 for this frame.
     pub view_bind_group: wgpu::BindGroup,
@@ -165,7 +167,10 @@ pub struct SceneResources {
     materials: HashMap<usize, GpuMaterialBinding>,
     textures: HashMap<usize, CachedTexture>,
     white: wgpu::TextureView,
-    sampler: wgpu::Sampler,
+    samplers: HashMap<TextureSampler, wgpu::Sampler>,
+    /// `anisotropy_clamp` of samplers that filter linearly everywhere (1 where the adapter
+    /// cannot filter anisotropically).
+    anisotropy: u16,
     frame: u64,
     bound_generations: (u64, u64),
     max_texture_size: u32,
@@ -241,6 +246,12 @@ impl SceneResources {
             },
             count: None,
         };
+        let material_sampler = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+            count: None,
+        };
         let material_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("material_layout"),
             entries: &[
@@ -256,18 +267,18 @@ impl SceneResources {
                 },
                 // base colour
                 material_texture(1),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
+                material_sampler(2),
                 // metallic-roughness
                 material_texture(3),
                 // normal map, occlusion, emissive
                 material_texture(4),
                 material_texture(5),
                 material_texture(6),
+                // the samplers of metallic-roughness, normal map, occlusion and emissive
+                material_sampler(7),
+                material_sampler(8),
+                material_sampler(9),
+                material_sampler(10),
             ],
         });
         let view_buffer = gpu.create_buffer(&wgpu::BufferDescriptor {
@@ -287,16 +298,11 @@ impl SceneResources {
             gpu,
             &TextureData { label: "white".into(), width: 1, height: 1, rgba8: vec![255; 4], srgb: true },
         );
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("material_sampler"),
-            address_mode_u: wgpu::AddressMode::Repeat,
-            address_mode_v: wgpu::AddressMode::Repeat,
-            address_mode_w: wgpu::AddressMode::Repeat,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            mipmap_filter: wgpu::MipmapFilterMode::Linear,
-            ..Default::default()
-        });
+        let anisotropic = gpu
+            .adapter
+            .get_downlevel_capabilities()
+            .flags
+            .contains(wgpu::DownlevelFlags::ANISOTROPIC_FILTERING);
         SceneResources {
             view_layout,
             material_layout,
@@ -321,7 +327,8 @@ impl SceneResources {
             materials: HashMap::new(),
             textures: HashMap::new(),
             white,
-            sampler,
+            samplers: HashMap::new(),
+            anisotropy: if anisotropic { MAX_ANISOTROPY } else { 1 },
             frame: 0,
             bound_generations: (0, 0),
             max_texture_size: gpu.max_texture_size(),
@@ -552,17 +559,26 @@ impl SceneResources {
         if let Some(m) = self.materials.get_mut(&k) {
             m.last_used = frame;
             for t in material.textures() {
-                if let Some(t) = self.textures.get_mut(&key(t)) {
+                if let Some(t) = self.textures.get_mut(&key(&t.image)) {
                     t.last_used = frame;
                 }
             }
             return Ok((k, m.order));
         }
-        let base_view = self.texture_view(gpu, material.base_color_texture.as_ref())?;
-        let metal_rough_view = self.texture_view(gpu, material.metallic_roughness_texture.as_ref())?;
-        let normal_view = self.texture_view(gpu, material.normal_texture.as_ref())?;
-        let occlusion_view = self.texture_view(gpu, material.occlusion_texture.as_ref())?;
-        let emissive_view = self.texture_view(gpu, material.emissive_texture.as_ref())?;
+        // In TEXTURE_SLOT_* order.
+        let slots = [
+            material.base_color_texture.as_ref(),
+            material.metallic_roughness_texture.as_ref(),
+            material.normal_texture.as_ref(),
+            material.occlusion_texture.as_ref(),
+            material.emissive_texture.as_ref(),
+        ];
+        let mut views = Vec::with_capacity(slots.len());
+        let mut samplers = Vec::with_capacity(slots.len());
+        for slot in slots {
+            views.push(self.texture_view(gpu, slot.map(|t| &t.image))?);
+            samplers.push(self.sampler(gpu, slot.map_or(TextureSampler::default(), |t| t.sampler)));
+        }
         let finite_or = |v: f32, default: f32| if v.is_finite() { v } else { default };
         let uniform = GpuMaterial {
             base_color: material.base_color,
@@ -584,6 +600,7 @@ impl SceneResources {
             has_occlusion_texture: material.occlusion_texture.is_some() as u32,
             has_emissive_texture: material.emissive_texture.is_some() as u32,
             alpha_cutoff: material.alpha_mode.cutoff().unwrap_or(0.0),
+            texture_uv: slots.map(GpuTextureUv::of),
         };
         let buffer = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some(&material.label),
@@ -595,24 +612,17 @@ impl SceneResources {
             layout: &self.material_layout,
             entries: &[
                 wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&base_view) },
-                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.sampler) },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::TextureView(&metal_rough_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: wgpu::BindingResource::TextureView(&normal_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: wgpu::BindingResource::TextureView(&occlusion_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: wgpu::BindingResource::TextureView(&emissive_view),
-                },
+                // Textures at 1, 3, 4, 5, 6; the base colour's sampler at 2, the others' at 7..10.
+                view_entry(1, &views[0]),
+                sampler_entry(2, &samplers[0]),
+                view_entry(3, &views[1]),
+                view_entry(4, &views[2]),
+                view_entry(5, &views[3]),
+                view_entry(6, &views[4]),
+                sampler_entry(7, &samplers[1]),
+                sampler_entry(8, &samplers[2]),
+                sampler_entry(9, &samplers[3]),
+                sampler_entry(10, &samplers[4]),
             ],
         });
         self.uploads += 1;
@@ -620,6 +630,43 @@ impl SceneResources {
         self.materials
             .insert(k, GpuMaterialBinding { _source: material.clone(), bind_group, order, last_used: frame });
         Ok((k, order))
+    }
+
+    /// The sampler for `s`, created on first use (a handful per scene: glTF files name few
+    /// distinct samplers).
+    fn sampler(&mut self, gpu: &GpuContext, s: TextureSampler) -> wgpu::Sampler {
+        let anisotropy = if s.allows_anisotropy() { self.anisotropy } else { 1 };
+        self.samplers
+            .entry(s)
+            .or_insert_with(|| {
+                let address = |m: ImageAddressMode| match m {
+                    ImageAddressMode::Repeat => wgpu::AddressMode::Repeat,
+                    ImageAddressMode::MirrorRepeat => wgpu::AddressMode::MirrorRepeat,
+                    ImageAddressMode::ClampToEdge => wgpu::AddressMode::ClampToEdge,
+                };
+                let filter = |f: ImageFilterMode| match f {
+                    ImageFilterMode::Nearest => wgpu::FilterMode::Nearest,
+                    ImageFilterMode::Linear => wgpu::FilterMode::Linear,
+                };
+                let mipmap_filter = match s.mipmap_filter {
+                    Some(ImageFilterMode::Linear) => wgpu::MipmapFilterMode::Linear,
+                    _ => wgpu::MipmapFilterMode::Nearest,
+                };
+                gpu.device.create_sampler(&wgpu::SamplerDescriptor {
+                    label: Some("material_sampler"),
+                    address_mode_u: address(s.address_mode_u),
+                    address_mode_v: address(s.address_mode_v),
+                    address_mode_w: wgpu::AddressMode::Repeat,
+                    mag_filter: filter(s.mag_filter),
+                    min_filter: filter(s.min_filter),
+                    mipmap_filter,
+                    // Without mipmaps only the full-size level is sampled.
+                    lod_max_clamp: if s.mipmap_filter.is_some() { 32.0 } else { 0.0 },
+                    anisotropy_clamp: anisotropy,
+                    ..Default::default()
+                })
+            })
+            .clone()
     }
 
     /// The view of `texture`, uploaded on first use (white when there is none); refused,
@@ -662,6 +709,17 @@ impl SceneResources {
     pub fn resident_counts(&self) -> (usize, usize, usize) {
         (self.meshes.len(), self.materials.len(), self.textures.len())
     }
+}
+
+/// Largest anisotropy of material samplers (where the adapter filters anisotropically).
+pub const MAX_ANISOTROPY: u16 = 16;
+
+fn view_entry(binding: u32, view: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(view) }
+}
+
+fn sampler_entry(binding: u32, sampler: &wgpu::Sampler) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::Sampler(sampler) }
 }
 
 fn viewport_vec(size: glam::UVec2) -> Vec4 {

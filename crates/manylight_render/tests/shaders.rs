@@ -2,7 +2,8 @@
 //! same size and field offsets on both sides. No GPU needed.
 
 use manylight_render::gpu_types::{
-    GpuClusterCounters, GpuDirectionalLight, GpuInstance, GpuMaterial, GpuPointLight, ViewUniform,
+    GpuClusterCounters, GpuDirectionalLight, GpuInstance, GpuMaterial, GpuPointLight, GpuTextureUv,
+    ViewUniform,
 };
 use manylight_render::shaders::{SOURCES, compose};
 use std::mem::{offset_of, size_of};
@@ -145,7 +146,14 @@ fn shared_structs_match_rust() {
             ("has_occlusion_texture", offset_of!(GpuMaterial, has_occlusion_texture)),
             ("has_emissive_texture", offset_of!(GpuMaterial, has_emissive_texture)),
             ("alpha_cutoff", offset_of!(GpuMaterial, alpha_cutoff)),
+            ("texture_uv", offset_of!(GpuMaterial, texture_uv)),
         ],
+    );
+    offsets(
+        &forward,
+        "GpuTextureUv",
+        size_of::<GpuTextureUv>(),
+        &[("row0", offset_of!(GpuTextureUv, row0)), ("row1", offset_of!(GpuTextureUv, row1))],
     );
     offsets(
         &validate("cluster_build.wgsl"),

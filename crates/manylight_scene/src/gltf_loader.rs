@@ -93,8 +93,8 @@ pub struct LoadOptions {
     /// read. Default 256 MiB.
     pub max_accessor_bytes: u64,
     /// Most vertices of all meshes together; each distinct combination of POSITION, NORMAL,
-    /// TEXCOORD_0, TANGENT and index accessors becomes one mesh, and its POSITION `count` is
-    /// checked before any attribute is read. A vertex takes 48 bytes once loaded. Default
+    /// TEXCOORD_0, TEXCOORD_1, TANGENT and index accessors becomes one mesh, and its POSITION
+    /// `count` is checked before any attribute is read. A vertex takes 56 bytes once loaded. Default
     /// 16 000 000.
     pub max_vertices: u64,
     /// Most indices of all meshes together (an unindexed primitive counts one per vertex);
@@ -165,7 +165,8 @@ const UNSUPPORTED_REQUIRED: &[&str] = &[
 ];
 
 /// Extensions the loader implements, so requiring them needs no warning.
-const SUPPORTED_REQUIRED: &[&str] = &["KHR_lights_punctual", "KHR_mesh_quantization"];
+const SUPPORTED_REQUIRED: &[&str] =
+    &["KHR_lights_punctual", "KHR_mesh_quantization", "KHR_texture_transform"];
 
 /// Loads a `.gltf` or `.glb` file into a [`Scene`].
 ///
@@ -374,7 +375,7 @@ fn load_inner(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
     // A UTF-8 byte-order mark is not valid JSON but harmless; accept it.
     let json_bytes = json_bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(json_bytes);
     let root = normalize::parse_root(path, json_bytes)?;
-    let emissive_strengths = materials::emissive_strengths(path, json_bytes);
+    let material_extensions = materials::material_extensions(path, json_bytes);
     for ext in &root.extensions_required {
         if UNSUPPORTED_REQUIRED.contains(&ext.as_str()) {
             return Err(SceneError::UnsupportedExtension { path: path.to_owned(), extension: ext.clone() });
@@ -397,7 +398,7 @@ fn load_inner(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
         meshes: HashMap::new(),
         generated_tangents: HashSet::new(),
         materials: HashMap::new(),
-        emissive_strengths,
+        material_extensions,
         warned_blend: false,
         used: Used::default(),
         scene: Scene {
@@ -441,16 +442,17 @@ struct Ctx<'a> {
     /// Images read as linear data (metallic-roughness, normal and occlusion maps), by image
     /// index.
     linear: HashMap<usize, Arc<TextureData>>,
-    /// Scene mesh index by (POSITION, NORMAL, TEXCOORD_0, TANGENT, indices) accessors
+    /// Scene mesh index by (POSITION, NORMAL, TEXCOORD_0, TANGENT, indices, TEXCOORD_1) accessors
     /// (`None`: the primitive has no triangles and is skipped).
-    meshes: HashMap<[Option<usize>; 5], Option<usize>>,
+    meshes: HashMap<[Option<usize>; 6], Option<usize>>,
     /// Scene meshes whose tangents were generated (MikkTSpace), so a mesh shared by many
     /// normal-mapped primitives is processed once.
     generated_tangents: HashSet<usize>,
     /// Scene material index by glTF material index (`None`: the default material).
     materials: HashMap<Option<usize>, usize>,
-    /// `KHR_materials_emissive_strength` by glTF material index (missing: 1).
-    emissive_strengths: Vec<f32>,
+    /// `KHR_materials_emissive_strength` and `KHR_texture_transform` by glTF material index
+    /// (empty when the file uses neither).
+    material_extensions: Vec<materials::MaterialExtensions>,
     /// Whether the "BLEND is drawn opaque" warning was logged for this file.
     warned_blend: bool,
     /// Budget use so far.

@@ -106,6 +106,13 @@ impl Scene {
                 return Err(invalid(format!("material {i} has non-finite or negative parameters")));
             }
             for t in m.textures() {
+                if !(t.uv_transform.matrix2.is_finite() && t.uv_transform.translation.is_finite()) {
+                    return Err(invalid(format!(
+                        "material {i} texture `{}` has a non-finite uv transform",
+                        t.image.label
+                    )));
+                }
+                let t = &t.image;
                 let expected = t.width as u64 * t.height as u64 * 4;
                 if t.width == 0 || t.height == 0 || t.rgba8.len() as u64 != expected {
                     return Err(invalid(format!(

@@ -20,6 +20,7 @@ impl Builder {
             normal: n.to_array(),
             uv: uv.to_array(),
             tangent: [0.0; 4],
+            uv1: [0.0; 2],
         });
         (self.vertices.len() - 1) as u32
     }

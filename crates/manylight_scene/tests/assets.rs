@@ -62,7 +62,7 @@ fn virtual_city_has_many_instances_and_shares_textures() {
     let mut textures: Vec<*const manylight_core::TextureData> = s
         .materials
         .iter()
-        .filter_map(|m| m.base_color_texture.as_ref().map(std::sync::Arc::as_ptr))
+        .filter_map(|m| m.base_color_texture.as_ref().map(|t| &t.image).map(std::sync::Arc::as_ptr))
         .collect();
     textures.sort();
     textures.dedup();
@@ -125,12 +125,12 @@ fn damaged_helmet_has_normal_occlusion_and_emissive_maps_and_generated_tangents(
     assert_eq!(s.materials.len(), 1);
     let m = &s.materials[0];
     assert_eq!(m.label, "Material_MR");
-    let normal = m.normal_texture.as_ref().expect("normal texture");
-    let occlusion = m.occlusion_texture.as_ref().expect("occlusion texture");
-    let emissive = m.emissive_texture.as_ref().expect("emissive texture");
+    let normal = m.normal_texture.as_ref().map(|t| &t.image).expect("normal texture");
+    let occlusion = m.occlusion_texture.as_ref().map(|t| &t.image).expect("occlusion texture");
+    let emissive = m.emissive_texture.as_ref().map(|t| &t.image).expect("emissive texture");
     assert!(!normal.srgb && !occlusion.srgb && emissive.srgb);
-    assert!(m.base_color_texture.as_ref().is_some_and(|t| t.srgb));
-    assert!(m.metallic_roughness_texture.as_ref().is_some_and(|t| !t.srgb));
+    assert!(m.base_color_texture.as_ref().map(|t| &t.image).is_some_and(|t| t.srgb));
+    assert!(m.metallic_roughness_texture.as_ref().map(|t| &t.image).is_some_and(|t| !t.srgb));
     assert_eq!(m.textures().count(), 5);
     assert_eq!(m.emissive, glam::Vec3::ONE);
     assert_eq!((m.normal_scale, m.occlusion_strength), (1.0, 1.0));
@@ -155,10 +155,10 @@ fn normal_tangent_tests_have_normal_maps_and_tangents() {
         let s = load(file);
         s.validate().unwrap_or_else(|e| panic!("{file}: {e}"));
         let m = &s.materials[0];
-        assert!(m.normal_texture.as_ref().is_some_and(|t| !t.srgb), "{file}");
+        assert!(m.normal_texture.as_ref().map(|t| &t.image).is_some_and(|t| !t.srgb), "{file}");
         // Occlusion and metallic-roughness share one image: one linear copy.
-        let occlusion = m.occlusion_texture.as_ref().expect("occlusion texture");
-        let mr = m.metallic_roughness_texture.as_ref().expect("metallic-roughness texture");
+        let occlusion = m.occlusion_texture.as_ref().map(|t| &t.image).expect("occlusion texture");
+        let mr = m.metallic_roughness_texture.as_ref().map(|t| &t.image).expect("metallic-roughness texture");
         assert!(std::sync::Arc::ptr_eq(occlusion, mr), "{file}");
         assert!(m.double_sided, "{file}");
         for mesh in &s.meshes {

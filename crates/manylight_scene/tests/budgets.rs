@@ -275,7 +275,7 @@ fn many_images_doc(images: Vec<Value>, buffers: Value, views: Value) -> Value {
 /// Distinct base-colour textures of a scene (by pointer).
 fn distinct_textures(scene: &Scene) -> usize {
     let mut ptrs: Vec<*const manylight_core::TextureData> = (scene.materials.iter())
-        .filter_map(|m| m.base_color_texture.as_ref().map(std::sync::Arc::as_ptr))
+        .filter_map(|m| m.base_color_texture.as_ref().map(|t| &t.image).map(std::sync::Arc::as_ptr))
         .collect();
     ptrs.sort();
     ptrs.dedup();

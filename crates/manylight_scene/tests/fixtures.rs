@@ -31,7 +31,7 @@ fn a_16_bit_png_texture_is_converted_to_8_bit_srgb() {
     // roughness 0.5: 2 / 0.0625 - 2 = 30; metallic 0: specular 0.04.
     assert!((m.shininess - 30.0).abs() < 1e-3, "{}", m.shininess);
     assert!((m.specular - 0.04).abs() < 1e-6);
-    let t = m.base_color_texture.as_ref().expect("texture");
+    let t = m.base_color_texture.as_ref().map(|t| &t.image).expect("texture");
     assert!(t.srgb);
     assert_eq!((t.width, t.height), (4, 4));
     assert_eq!(t.rgba8.len(), 4 * 4 * 4);
@@ -42,7 +42,7 @@ fn a_16_bit_png_texture_is_converted_to_8_bit_srgb() {
 #[test]
 fn a_glb_with_an_embedded_png_loads() {
     let s = load_gltf(&fixture("triangle.glb"), &LoadOptions::default()).expect("loads");
-    let t = s.materials[0].base_color_texture.as_ref().expect("texture");
+    let t = s.materials[0].base_color_texture.as_ref().map(|t| &t.image).expect("texture");
     assert_eq!((t.width, t.height), (2, 2));
     assert_eq!(&t.rgba8[..4], &[0, 255, 0, 255]);
     s.validate().expect("valid");
@@ -178,7 +178,7 @@ fn extras_of_any_type_are_accepted_on_every_object() {
     assert_eq!((s.instances.len(), s.lights.len(), s.cameras.len()), (1, 1, 1));
     assert_eq!(s.lights[0].intensity, 2.0);
     assert_eq!(s.cameras[0].projection.far, 50.0);
-    let t = s.materials[0].base_color_texture.as_ref().expect("texture");
+    let t = s.materials[0].base_color_texture.as_ref().map(|t| &t.image).expect("texture");
     assert_eq!(&t.rgba8[..4], &[0, 0, 255, 255]);
 }
 
@@ -201,7 +201,7 @@ fn data_uris_without_base64_are_percent_decoded() {
     assert_eq!(s.meshes[0].indices, vec![0, 1, 2]);
     let found: Vec<[f32; 3]> = s.meshes[0].vertices.iter().map(|v| v.position).collect();
     assert_near(&found, &TRIANGLE, "positions");
-    let t = s.materials[0].base_color_texture.as_ref().expect("texture");
+    let t = s.materials[0].base_color_texture.as_ref().map(|t| &t.image).expect("texture");
     assert_eq!((t.width, t.height, &t.rgba8[..]), (1, 1, &[255, 0, 0, 255][..]));
 }
 

@@ -895,7 +895,7 @@ fn check_scene(scene: &Scene, o: &LoadOptions) -> Result<(), String> {
     let vertices: usize = scene.meshes.iter().map(|m| m.vertices.len()).sum();
     let indices: usize = scene.meshes.iter().map(|m| m.indices.len()).sum();
     let mut textures: Vec<&std::sync::Arc<manylight_core::TextureData>> =
-        scene.materials.iter().filter_map(|m| m.base_color_texture.as_ref()).collect();
+        scene.materials.iter().filter_map(|m| m.base_color_texture.as_ref().map(|t| &t.image)).collect();
     textures.sort_by_key(|t| std::sync::Arc::as_ptr(t));
     textures.dedup_by_key(|t| std::sync::Arc::as_ptr(t));
     let image_bytes: usize = textures.iter().map(|t| t.rgba8.len()).sum();

@@ -151,10 +151,10 @@ fn texture_slots_alpha_modes_and_factors_are_read() {
     assert!(m.double_sided);
     assert_eq!(m.alpha_mode, AlphaMode::Mask(0.3));
     assert_eq!((m.normal_scale, m.occlusion_strength), (0.5, 0.25));
-    let normal = m.normal_texture.as_ref().expect("normal texture");
-    let occlusion = m.occlusion_texture.as_ref().expect("occlusion texture");
-    let emissive = m.emissive_texture.as_ref().expect("emissive texture");
-    let mr = m.metallic_roughness_texture.as_ref().expect("metallic-roughness texture");
+    let normal = m.normal_texture.as_ref().map(|t| &t.image).expect("normal texture");
+    let occlusion = m.occlusion_texture.as_ref().map(|t| &t.image).expect("occlusion texture");
+    let emissive = m.emissive_texture.as_ref().map(|t| &t.image).expect("emissive texture");
+    let mr = m.metallic_roughness_texture.as_ref().map(|t| &t.image).expect("metallic-roughness texture");
     assert!(!normal.srgb && !occlusion.srgb && !mr.srgb && emissive.srgb);
     // One image: one linear copy shared by the data slots, the decode itself for colour.
     assert!(std::sync::Arc::ptr_eq(normal, occlusion) && std::sync::Arc::ptr_eq(normal, mr));
@@ -221,4 +221,88 @@ fn a_tangent_accessor_of_the_wrong_type_or_count_is_refused() {
     let message = e.to_string();
     assert!(message.contains(&path.display().to_string()), "does not name the file: {message}");
     assert!(message.contains("2 tangents for 3 positions"), "{message}");
+}
+
+#[test]
+fn samplers_texture_transforms_and_the_second_uv_set_are_read() {
+    use manylight_core::{ImageAddressMode as Address, ImageFilterMode as Filter, TextureSampler, UvChannel};
+    let sandbox = Sandbox::new("samplers");
+    let t = "KHR_texture_transform";
+    let quarter = std::f32::consts::FRAC_PI_2;
+    let materials = vec![json!({
+        "name": "transformed",
+        "pbrMetallicRoughness": {
+            // The specification's example: the lower left quadrant, turned a quarter.
+            "baseColorTexture": { "index": 1,
+                "extensions": { t: { "offset": [0, 1], "rotation": quarter, "scale": [0.5, 0.5] } } },
+            "metallicRoughnessTexture": { "index": 0, "texCoord": 1 }
+        },
+        // The extension's texCoord (an integer written as 0.0) wins over the slot's.
+        "normalTexture": { "index": 2, "texCoord": 1, "extensions": { t: { "texCoord": 0.0, "scale": [2, 3] } } },
+        // Unusable values: the default transform.
+        "occlusionTexture": { "index": 0, "extensions": { t: { "offset": ["x", 1], "rotation": "no" } } },
+        // A third uv set is not loaded: TEXCOORD_0.
+        "emissiveTexture": { "index": 0, "texCoord": 2 }
+    })];
+    let meshes =
+        vec![mesh(json!({ "TEXCOORD_0": 2, "TEXCOORD_1": 2 }), 0), mesh(json!({ "TEXCOORD_0": 2 }), 0)];
+    let mut doc = triangle_doc(meshes, materials, &[t]);
+    doc["textures"] = json!([{ "source": 0 }, { "source": 0, "sampler": 0 }, { "source": 0, "sampler": 1 }]);
+    doc["samplers"] = json!([
+        { "magFilter": 9728, "minFilter": 9728, "wrapS": 33071, "wrapT": 33648 },
+        { "minFilter": 9985, "wrapS": 33648 }
+    ]);
+    let path = sandbox.write_json("samplers.gltf", &doc);
+    let s = load_ok(&path);
+    let m = material(&s, "transformed");
+    let base = m.base_color_texture.as_ref().expect("base colour");
+    assert_eq!(
+        base.sampler,
+        TextureSampler {
+            address_mode_u: Address::ClampToEdge,
+            address_mode_v: Address::MirrorRepeat,
+            mag_filter: Filter::Nearest,
+            min_filter: Filter::Nearest,
+            mipmap_filter: None,
+        }
+    );
+    assert!(!base.sampler.allows_anisotropy());
+    let uv = |u: f32, v: f32| base.sample_uv(glam::Vec2::new(u, v), glam::Vec2::ZERO);
+    for ((u, v), expected) in [((0.0, 0.0), (0.0, 1.0)), ((1.0, 0.0), (0.0, 0.5)), ((1.0, 1.0), (0.5, 0.5))] {
+        assert!(uv(u, v).distance(glam::Vec2::new(expected.0, expected.1)) < 1e-6, "{u},{v}: {}", uv(u, v));
+    }
+    let mr = m.metallic_roughness_texture.as_ref().expect("metallic-roughness");
+    assert_eq!((mr.uv_channel, mr.sampler), (UvChannel::Uv1, TextureSampler::default()));
+    assert!(mr.sampler.allows_anisotropy());
+    assert_eq!(mr.uv_transform, glam::Affine2::IDENTITY);
+    let normal = m.normal_texture.as_ref().expect("normal");
+    assert_eq!(normal.uv_channel, UvChannel::Uv0);
+    assert_eq!(normal.sample_uv(glam::Vec2::ONE, glam::Vec2::ZERO), glam::Vec2::new(2.0, 3.0));
+    assert_eq!(
+        (normal.sampler.address_mode_u, normal.sampler.address_mode_v),
+        (Address::MirrorRepeat, Address::Repeat)
+    );
+    assert_eq!(
+        (normal.sampler.mag_filter, normal.sampler.min_filter, normal.sampler.mipmap_filter),
+        (Filter::Linear, Filter::Linear, Some(Filter::Nearest))
+    );
+    let occlusion = m.occlusion_texture.as_ref().expect("occlusion");
+    assert_eq!(occlusion.uv_transform, glam::Affine2::IDENTITY);
+    assert_eq!(m.emissive_texture.as_ref().expect("emissive").uv_channel, UvChannel::Uv0);
+    // TEXCOORD_1 is read into `uv1`; a mesh without it has zeros there.
+    let with = &s.meshes[s.instances[0].mesh];
+    assert!(with.vertices.iter().all(|v| v.uv1 == v.uv) && with.vertices.iter().any(|v| v.uv1 != [0.0; 2]));
+    let without = &s.meshes[s.instances[1].mesh];
+    assert!(without.vertices.iter().all(|v| v.uv1 == [0.0; 2]));
+}
+
+#[test]
+fn a_second_uv_set_of_the_wrong_type_is_refused_naming_it() {
+    let sandbox = Sandbox::new("uv1_type");
+    let meshes = vec![mesh(json!({ "TEXCOORD_0": 2, "TEXCOORD_1": 3 }), 0)];
+    let path = sandbox.write_json("uv1.gltf", &triangle_doc(meshes, vec![json!({ "name": "m" })], &[]));
+    let err = load_gltf(&path, &LoadOptions::default()).expect_err("VEC4 TEXCOORD_1");
+    assert!(matches!(err, SceneError::AccessorType { .. }), "{err:?}");
+    let message = err.to_string();
+    assert!(message.contains("uv1.gltf") && message.contains("TEXCOORD_1"), "{message}");
 }

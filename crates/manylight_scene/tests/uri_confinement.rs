@@ -173,7 +173,11 @@ fn assert_refused(sandbox: &Sandbox, slot: Slot, uri: &str, want: &str, fragment
                 Slot::Buffer => format!("vertex positions {:?}", positions(&scene)),
                 Slot::Image => format!(
                     "texture {:?}",
-                    scene.materials.iter().find_map(|m| m.base_color_texture.as_ref().map(|t| &t.label))
+                    scene.materials.iter().find_map(|m| m
+                        .base_color_texture
+                        .as_ref()
+                        .map(|t| &t.image)
+                        .map(|t| &t.label))
                 ),
             };
             panic!("{slot:?} uri `{uri}` loaded ({leaked}) but must be refused");
@@ -339,7 +343,8 @@ fn a_relative_uri_in_a_subfolder_loads() {
         let path = s.write_gltf(&gltf_json(buffer, Some(image)));
         let scene = load(&path).unwrap_or_else(|e| panic!("buffer `{buffer}`, image `{image}`: {e}"));
         assert_eq!(positions(&scene), GOOD_POSITIONS, "buffer `{buffer}`");
-        let texture = scene.materials[0].base_color_texture.as_ref().expect("texture loaded");
+        let texture =
+            scene.materials[0].base_color_texture.as_ref().map(|t| &t.image).expect("texture loaded");
         assert_eq!((texture.width, texture.height), (4, 4), "image `{image}`");
     }
 }

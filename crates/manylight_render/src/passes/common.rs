@@ -231,8 +231,9 @@ pub fn draw_fullscreen(
 
 /// The vertex buffer layout of [`Vertex`].
 pub fn vertex_layout() -> wgpu::VertexBufferLayout<'static> {
-    const ATTRIBUTES: [wgpu::VertexAttribute; 4] =
-        wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Float32x4];
+    const ATTRIBUTES: [wgpu::VertexAttribute; 5] = wgpu::vertex_attr_array![
+        0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Float32x4, 4 => Float32x2
+    ];
     wgpu::VertexBufferLayout {
         array_stride: std::mem::size_of::<Vertex>() as u64,
         step_mode: wgpu::VertexStepMode::Vertex,
@@ -246,7 +247,7 @@ mod tests {
     use std::mem::offset_of;
 
     /// The vertex buffer layout reads each attribute where `Vertex` stores it
-    /// (`VertexIn` in `shaders/common/mesh.wgsl`: locations 0..3 in field order).
+    /// (`VertexIn` in `shaders/common/mesh.wgsl`: locations 0..4 in field order).
     #[test]
     fn vertex_attributes_match_the_rust_vertex() {
         let layout = vertex_layout();
@@ -255,6 +256,7 @@ mod tests {
             offset_of!(Vertex, normal),
             offset_of!(Vertex, uv),
             offset_of!(Vertex, tangent),
+            offset_of!(Vertex, uv1),
         ];
         assert_eq!(layout.attributes.len(), expected.len());
         for (attribute, (location, offset)) in layout.attributes.iter().zip(expected.into_iter().enumerate())

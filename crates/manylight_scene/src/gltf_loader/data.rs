@@ -362,7 +362,7 @@ impl Ctx<'_> {
     /// Checks that accessor `index` is a texture-coordinate accessor: `VEC2` of `FLOAT` or
     /// normalized unsigned bytes or shorts, or with `KHR_mesh_quantization` any 8- or 16-bit
     /// integer.
-    pub(super) fn uv_layout(&self, index: usize, what: &str) -> Result<Layout, SceneError> {
+    pub(super) fn uv_layout(&self, index: usize, what: &str, name: &str) -> Result<Layout, SceneError> {
         use ComponentType::{F32, I8, I16, U8, U16};
         let (accept, expected): (&dyn Fn(Type, ComponentType, bool) -> bool, _) = if self.quantized() {
             (
@@ -375,7 +375,7 @@ impl Ctx<'_> {
                 "VEC2 of FLOAT, normalized UNSIGNED_BYTE or normalized UNSIGNED_SHORT",
             )
         };
-        self.layout(index, what, "TEXCOORD_0", accept, expected)
+        self.layout(index, what, name, accept, expected)
     }
 
     /// Reads a texture-coordinate accessor checked by [`Ctx::uv_layout`], dequantised to `f32`.

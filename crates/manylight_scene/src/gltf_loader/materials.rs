@@ -13,10 +13,13 @@
 use super::uri::{UriSource, is_data_uri, resolve_uri, split_data_uri};
 use super::{Ctx, MAX_DOWNSCALED_SOURCE, OversizedTextures, over_budget};
 use crate::SceneError;
-use glam::{Vec3, Vec4};
+use glam::{Affine2, Vec2, Vec3, Vec4};
 use gltf::json::validation::Checked;
 use image::{ImageDecoder, ImageFormat, ImageReader, Limits};
-use manylight_core::{AlphaMode, MaterialData, TextureData};
+use manylight_core::{
+    AlphaMode, ImageAddressMode, ImageFilterMode, MaterialData, MaterialTexture, TextureData, TextureSampler,
+    UvChannel,
+};
 use serde_json::Value;
 use std::borrow::Cow;
 use std::collections::HashMap;
@@ -59,54 +62,132 @@ pub fn blinn_phong_from_pbr(roughness: f32, metallic: f32) -> (f32, f32) {
 
 /// The extension that scales `emissiveFactor` beyond 1.
 const EMISSIVE_STRENGTH: &str = "KHR_materials_emissive_strength";
+/// The extension that offsets, rotates and scales a texture's uvs.
+const TEXTURE_TRANSFORM: &str = "KHR_texture_transform";
 
-/// The `KHR_materials_emissive_strength` `emissiveStrength` of every material of glTF JSON
-/// `json` (already parsed by `gltf`), by material index; empty when the file does not mention
-/// the extension. A missing, non-numeric, negative or non-finite strength is 1 (with a warning
-/// for the last three).
+/// A material's texture slots in `MaterialData` order: the property's path from the material.
+const TEXTURE_SLOTS: [&[&str]; 5] = [
+    &["pbrMetallicRoughness", "baseColorTexture"],
+    &["pbrMetallicRoughness", "metallicRoughnessTexture"],
+    &["normalTexture"],
+    &["occlusionTexture"],
+    &["emissiveTexture"],
+];
+
+/// A `KHR_texture_transform` object of a texture slot.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct TextureTransformExt {
+    /// The uv transform (identity when a value was unusable, with a warning).
+    pub transform: Affine2,
+    /// Its `texCoord`, which overrides the slot's.
+    pub tex_coord: Option<u32>,
+}
+
+/// The material extensions that the `gltf` crate drops, of one material.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct MaterialExtensions {
+    /// `KHR_materials_emissive_strength` `emissiveStrength` (1 when absent).
+    pub emissive_strength: f32,
+    /// `KHR_texture_transform` of each slot, in [`TEXTURE_SLOTS`] order.
+    pub texture_transforms: [Option<TextureTransformExt>; 5],
+}
+
+impl Default for MaterialExtensions {
+    fn default() -> Self {
+        MaterialExtensions { emissive_strength: 1.0, texture_transforms: [None; 5] }
+    }
+}
+
+/// The `KHR_materials_emissive_strength` and `KHR_texture_transform` values of every
+/// material of glTF JSON `json` (already parsed by `gltf`), by material index; empty when the
+/// file mentions neither extension. Unusable values fall back to the defaults (strength 1,
+/// identity transform) with a warning.
 ///
-/// The `gltf` crate drops material extensions unless its `KHR_materials_emissive_strength`
-/// feature is on, so they are read from the text: each level is parsed into a map of raw
-/// (unparsed) values, so the rest of the document is only scanned, never built.
-pub(super) fn emissive_strengths(path: &Path, json: &[u8]) -> Vec<f32> {
+/// The `gltf` crate drops these extensions unless its matching features are on, so they are
+/// read from the text: the top level is parsed into a map of raw (unparsed) values, so the rest
+/// of the document is only scanned, and only the `materials` array is built.
+pub(super) fn material_extensions(path: &Path, json: &[u8]) -> Vec<MaterialExtensions> {
     use serde_json::value::RawValue;
-    type RawMap<'j> = HashMap<String, &'j RawValue>;
-    if !json.windows(EMISSIVE_STRENGTH.len()).any(|w| w == EMISSIVE_STRENGTH.as_bytes()) {
+    let mentions = |name: &str| json.windows(name.len()).any(|w| w == name.as_bytes());
+    if !mentions(EMISSIVE_STRENGTH) && !mentions(TEXTURE_TRANSFORM) {
         return Vec::new();
     }
-    let materials = serde_json::from_slice::<RawMap<'_>>(json).ok().and_then(|top| {
+    let materials = serde_json::from_slice::<HashMap<String, &RawValue>>(json).ok().and_then(|top| {
         let list = top.get("materials")?;
-        serde_json::from_str::<Vec<&RawValue>>(list.get()).ok()
+        serde_json::from_str::<Vec<Value>>(list.get()).ok()
     });
     let Some(materials) = materials else {
-        tracing::warn!(file = %path.display(), "could not read {EMISSIVE_STRENGTH}, ignored");
+        tracing::warn!(file = %path.display(), "could not read the materials' extensions, ignored");
         return Vec::new();
     };
-    let strength = |(index, m): (usize, &&RawValue)| -> f32 {
-        let ext = serde_json::from_str::<RawMap<'_>>(m.get()).ok().and_then(|m| {
-            let exts = serde_json::from_str::<RawMap<'_>>(m.get("extensions")?.get()).ok()?;
-            Some(serde_json::from_str::<serde_json::Map<String, Value>>(exts.get(EMISSIVE_STRENGTH)?.get()))
-        });
-        let value = match ext {
-            None => return 1.0,
-            Some(Ok(ext)) => match ext.get("emissiveStrength") {
-                None => return 1.0,
-                Some(v) => v.as_f64().map(|v| v as f32),
-            },
-            Some(Err(_)) => None,
-        };
-        match value {
-            Some(v) if v.is_finite() && v >= 0.0 => v,
-            _ => {
-                tracing::warn!(
+    let read = |(index, m): (usize, &Value)| {
+        let mut out = MaterialExtensions::default();
+        if let Some(ext) = m.get("extensions").and_then(|e| e.get(EMISSIVE_STRENGTH)) {
+            match ext.get("emissiveStrength").map(Value::as_f64) {
+                None => {}
+                Some(Some(v)) if v.is_finite() && v >= 0.0 && (v as f32).is_finite() => {
+                    out.emissive_strength = v as f32
+                }
+                Some(_) => tracing::warn!(
                     file = %path.display(), material = index,
                     "{EMISSIVE_STRENGTH}: emissiveStrength is not a finite non-negative number, using 1"
-                );
-                1.0
+                ),
             }
         }
+        for (slot, names) in TEXTURE_SLOTS.iter().enumerate() {
+            let info = names.iter().try_fold(m, |v, name| v.get(name));
+            let ext = info.and_then(|i| i.get("extensions")).and_then(|e| e.get(TEXTURE_TRANSFORM));
+            if let Some(ext) = ext {
+                let property = names.join(".");
+                out.texture_transforms[slot] = Some(texture_transform(path, index, &property, ext));
+            }
+        }
+        out
     };
-    materials.iter().enumerate().map(strength).collect()
+    materials.iter().enumerate().map(read).collect()
+}
+
+/// Reads a `KHR_texture_transform` object of property `property` of material `material`.
+fn texture_transform(path: &Path, material: usize, property: &str, ext: &Value) -> TextureTransformExt {
+    let warn = |what: &str| {
+        tracing::warn!(
+            file = %path.display(), material,
+            "{property} {TEXTURE_TRANSFORM}: {what}, using the default"
+        );
+    };
+    let number = |v: &Value| v.as_f64().map(|x| x as f32).filter(|x| x.is_finite());
+    let pair = |name: &str, default: Vec2| match ext.get(name) {
+        None => default,
+        Some(v) => match v.as_array().map(|a| a.iter().map(number).collect::<Vec<_>>()).as_deref() {
+            Some([Some(x), Some(y)]) => Vec2::new(*x, *y),
+            _ => {
+                warn(&format!("{name} is not two finite numbers"));
+                default
+            }
+        },
+    };
+    let offset = pair("offset", Vec2::ZERO);
+    let scale = pair("scale", Vec2::ONE);
+    let rotation = match ext.get("rotation") {
+        None => 0.0,
+        Some(v) => number(v).unwrap_or_else(|| {
+            warn("rotation is not a finite number");
+            0.0
+        }),
+    };
+    let tex_coord = match ext.get("texCoord") {
+        None => None,
+        // Integers may be written as `1.0`.
+        Some(v) => match v.as_f64().filter(|x| x.fract() == 0.0 && *x >= 0.0 && *x <= u32::MAX as f64) {
+            Some(x) => Some(x as u32),
+            None => {
+                warn("texCoord is not a non-negative integer");
+                None
+            }
+        },
+    };
+    let transform = MaterialTexture::gltf_uv_transform(offset, rotation, scale);
+    TextureTransformExt { transform, tex_coord }
 }
 
 impl<'a> Ctx<'a> {
@@ -122,38 +203,32 @@ impl<'a> Ctx<'a> {
             base = Vec4::ONE;
         }
         let base = base.clamp(Vec4::ZERO, Vec4::splat(f32::MAX));
+        // Slots in the order of `TEXTURE_SLOTS`.
         let texture = match &pbr.base_color_texture {
-            Some(info) => {
-                Some(self.texture(index, "baseColorTexture", info.index.value(), info.tex_coord, true)?)
-            }
+            Some(info) => Some(self.material_texture(index, 0, info.index.value(), info.tex_coord, true)?),
             None => None,
         };
         let metallic_roughness_texture = match &pbr.metallic_roughness_texture {
-            Some(info) => {
-                let (i, uv) = (info.index.value(), info.tex_coord);
-                Some(self.texture(index, "metallicRoughnessTexture", i, uv, false)?)
-            }
+            Some(info) => Some(self.material_texture(index, 1, info.index.value(), info.tex_coord, false)?),
             None => None,
         };
         let (normal_texture, normal_scale) = match &m.normal_texture {
             Some(info) => {
-                let t = self.texture(index, "normalTexture", info.index.value(), info.tex_coord, false)?;
+                let t = self.material_texture(index, 2, info.index.value(), info.tex_coord, false)?;
                 (Some(t), self.finite(info.scale, index, "normalTexture.scale", 1.0))
             }
             None => (None, 1.0),
         };
         let (occlusion_texture, occlusion_strength) = match &m.occlusion_texture {
             Some(info) => {
-                let t = self.texture(index, "occlusionTexture", info.index.value(), info.tex_coord, false)?;
+                let t = self.material_texture(index, 3, info.index.value(), info.tex_coord, false)?;
                 let strength = self.finite(info.strength.0, index, "occlusionTexture.strength", 1.0);
                 (Some(t), strength.clamp(0.0, 1.0))
             }
             None => (None, 1.0),
         };
         let emissive_texture = match &m.emissive_texture {
-            Some(info) => {
-                Some(self.texture(index, "emissiveTexture", info.index.value(), info.tex_coord, true)?)
-            }
+            Some(info) => Some(self.material_texture(index, 4, info.index.value(), info.tex_coord, true)?),
             None => None,
         };
         let mut emissive = Vec3::from_array(m.emissive_factor.0);
@@ -161,7 +236,7 @@ impl<'a> Ctx<'a> {
             tracing::warn!(file = %self.path.display(), material = index, "non-finite emissiveFactor, using black");
             emissive = Vec3::ZERO;
         }
-        let strength = self.emissive_strengths.get(index).copied().unwrap_or(1.0);
+        let strength = self.material_extensions.get(index).map_or(1.0, |e| e.emissive_strength);
         // Clamped after the product, which may overflow to infinity.
         let emissive = (emissive.max(Vec3::ZERO) * strength).min(Vec3::splat(f32::MAX));
         let factor = |v: f32, name: &str, default: f32| self.finite(v, index, name, default).clamp(0.0, 1.0);
@@ -227,29 +302,106 @@ impl<'a> Ctx<'a> {
         }
     }
 
-    /// The image of texture `texture` used by material `material` through `TEXCOORD_<tex_coord>`
-    /// (`slot` names the material's property in errors), as sRGB colour or as linear data.
-    fn texture(
+    /// Texture `texture` of slot `slot` (in `TEXTURE_SLOTS` order) of material `material`,
+    /// read through `TEXCOORD_<tex_coord>` unless its `KHR_texture_transform` names another
+    /// set: the image as sRGB colour or as linear data, its sampler, uv set and uv transform.
+    fn material_texture(
         &mut self,
         material: usize,
-        slot: &str,
+        slot: usize,
         texture: usize,
         tex_coord: u32,
         srgb: bool,
-    ) -> Result<Arc<TextureData>, SceneError> {
+    ) -> Result<MaterialTexture, SceneError> {
         let root = self.root;
-        if tex_coord != 0 {
-            tracing::warn!(
-                file = %self.path.display(),
-                material,
-                "{slot} uses TEXCOORD_{tex_coord}, only TEXCOORD_0 is loaded",
-            );
-        }
-        let what = format!("material {material} {slot}");
+        let property = TEXTURE_SLOTS[slot].last().copied().unwrap_or_default();
+        let what = format!("material {material} {property}");
         let tex = self.lookup(&root.textures, texture, &what, "texture")?;
-        let image = tex.source.value();
+        let sampler = match tex.sampler {
+            Some(s) => {
+                let what = format!("texture {texture}");
+                let s = self.lookup(&root.samplers, s.value(), &what, "sampler")?;
+                self.sampler(s, texture)
+            }
+            None => TextureSampler::default(),
+        };
+        let ext = self.material_extensions.get(material).and_then(|e| e.texture_transforms[slot]);
+        let uv_channel = match ext.and_then(|e| e.tex_coord).unwrap_or(tex_coord) {
+            0 => UvChannel::Uv0,
+            1 => UvChannel::Uv1,
+            n => {
+                tracing::warn!(
+                    file = %self.path.display(), material,
+                    "{property} uses TEXCOORD_{n}; only TEXCOORD_0 and TEXCOORD_1 are loaded, using TEXCOORD_0",
+                );
+                UvChannel::Uv0
+            }
+        };
+        let image = self.texture_image(tex.source.value(), texture, srgb)?;
+        let uv_transform = ext.map_or(Affine2::IDENTITY, |e| e.transform);
+        Ok(MaterialTexture { image, sampler, uv_channel, uv_transform })
+    }
+
+    /// The wrap and filter modes of glTF sampler `s` (of texture `texture`); unknown values
+    /// (already refused by the parser unless lenient) fall back to the defaults.
+    fn sampler(&self, s: &gltf::json::texture::Sampler, texture: usize) -> TextureSampler {
+        use gltf::json::texture::{MagFilter, MinFilter, WrappingMode};
+        let warn = |what: &str| {
+            tracing::warn!(file = %self.path.display(), texture, "sampler has an unknown {what}, using the default");
+        };
+        let address = |mode: &Checked<WrappingMode>, what: &str| match mode {
+            Checked::Valid(WrappingMode::Repeat) => ImageAddressMode::Repeat,
+            Checked::Valid(WrappingMode::MirroredRepeat) => ImageAddressMode::MirrorRepeat,
+            Checked::Valid(WrappingMode::ClampToEdge) => ImageAddressMode::ClampToEdge,
+            Checked::Invalid => {
+                warn(what);
+                ImageAddressMode::Repeat
+            }
+        };
+        let (nearest, linear) = (ImageFilterMode::Nearest, ImageFilterMode::Linear);
+        let mag_filter = match s.mag_filter {
+            None => linear,
+            Some(Checked::Valid(MagFilter::Nearest)) => nearest,
+            Some(Checked::Valid(MagFilter::Linear)) => linear,
+            Some(Checked::Invalid) => {
+                warn("magFilter");
+                linear
+            }
+        };
+        let (min_filter, mipmap_filter) = match s.min_filter {
+            None => (linear, Some(linear)),
+            Some(Checked::Valid(f)) => match f {
+                MinFilter::Nearest => (nearest, None),
+                MinFilter::Linear => (linear, None),
+                MinFilter::NearestMipmapNearest => (nearest, Some(nearest)),
+                MinFilter::LinearMipmapNearest => (linear, Some(nearest)),
+                MinFilter::NearestMipmapLinear => (nearest, Some(linear)),
+                MinFilter::LinearMipmapLinear => (linear, Some(linear)),
+            },
+            Some(Checked::Invalid) => {
+                warn("minFilter");
+                (linear, Some(linear))
+            }
+        };
+        TextureSampler {
+            address_mode_u: address(&s.wrap_s, "wrapS"),
+            address_mode_v: address(&s.wrap_t, "wrapT"),
+            mag_filter,
+            min_filter,
+            mipmap_filter,
+        }
+    }
+
+    /// The pixels of image `image` (the source of texture `texture`), as sRGB colour or as
+    /// linear data.
+    fn texture_image(
+        &mut self,
+        image: usize,
+        texture: usize,
+        srgb: bool,
+    ) -> Result<Arc<TextureData>, SceneError> {
         let what = format!("texture {texture}");
-        self.lookup(&root.images, image, &what, "image")?;
+        self.lookup(&self.root.images, image, &what, "image")?;
         let data = self.image(image)?;
         if srgb {
             return Ok(data);

@@ -219,6 +219,7 @@ impl Ctx<'_> {
             attr(Semantic::TexCoords(0)),
             attr(Semantic::Tangents),
             prim.indices.map(|i| i.value()),
+            attr(Semantic::TexCoords(1)),
         ];
         let generate_tangents = normal_mapped && key[2].is_some() && key[3].is_none();
         if let Some(&index) = self.meshes.get(&key) {
@@ -239,7 +240,8 @@ impl Ctx<'_> {
         // Types and counts first, then the budgets, and only then read anything.
         let pos_layout = self.vec3_layout(pos, &what, "POSITION")?;
         let normal_layout = key[1].map(|a| self.vec3_layout(a, &what, "NORMAL")).transpose()?;
-        let uv_layout = key[2].map(|a| self.uv_layout(a, &what)).transpose()?;
+        let uv_layout = key[2].map(|a| self.uv_layout(a, &what, "TEXCOORD_0")).transpose()?;
+        let uv1_layout = key[5].map(|a| self.uv_layout(a, &what, "TEXCOORD_1")).transpose()?;
         let tangent_layout = key[3].map(|a| self.tangent_layout(a, &what)).transpose()?;
         let index_layout = key[4].map(|a| self.index_layout(a, &what)).transpose()?;
         let vertices = pos_layout.count;
@@ -252,6 +254,11 @@ impl Ctx<'_> {
             && u.count != vertices
         {
             return Err(bad(format!("{} TEXCOORD_0 values for {vertices} positions", u.count)));
+        }
+        if let Some(u) = uv1_layout
+            && u.count != vertices
+        {
+            return Err(bad(format!("{} TEXCOORD_1 values for {vertices} positions", u.count)));
         }
         if let Some(t) = tangent_layout
             && t.count != vertices
@@ -284,6 +291,10 @@ impl Ctx<'_> {
             (Some(a), Some(l)) => Some(self.read_uv(a, l)?),
             _ => None,
         };
+        let mut uv1 = match (key[5], uv1_layout) {
+            (Some(a), Some(l)) => Some(self.read_uv(a, l)?),
+            _ => None,
+        };
         let tangents = match (key[3], tangent_layout) {
             (Some(a), Some(l)) => Some(self.read_vec4(a, l)?),
             _ => None,
@@ -298,6 +309,10 @@ impl Ctx<'_> {
         }
         if let Some(u) = uvs.as_mut().filter(|u| u.iter().any(|v| !v.is_finite())) {
             tracing::warn!(file = %self.path.display(), mesh, primitive = p, "non-finite TEXCOORD_0 replaced");
+            u.iter_mut().filter(|v| !v.is_finite()).for_each(|v| *v = glam::Vec2::ZERO);
+        }
+        if let Some(u) = uv1.as_mut().filter(|u| u.iter().any(|v| !v.is_finite())) {
+            tracing::warn!(file = %self.path.display(), mesh, primitive = p, "non-finite TEXCOORD_1 replaced");
             u.iter_mut().filter(|v| !v.is_finite()).for_each(|v| *v = glam::Vec2::ZERO);
         }
         if tangents.as_ref().is_some_and(|t| t.iter().any(|v| !v.is_finite())) {
@@ -320,6 +335,9 @@ impl Ctx<'_> {
             MeshData::from_attributes(label, &positions, normals.as_deref(), uvs.as_deref(), indices)
                 .map_err(mesh_err)?;
         let index = self.scene.meshes.len();
+        if let Some(u) = &uv1 {
+            data.set_uv1(u);
+        }
         if let Some(t) = &tangents {
             data.set_tangents(t);
         } else if generate_tangents {
