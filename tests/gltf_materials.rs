@@ -21,14 +21,14 @@ const SIZE: UVec2 = UVec2::new(160, 160);
 const LIGHTS: usize = 48;
 
 /// (reference name, asset): each exercises a material feature.
-const ASSETS: [(&str, &str); 7] = [
+const ASSETS: [(&str, &str); 9] = [
     // Normal, occlusion and emissive maps, tangents generated with MikkTSpace.
     ("damaged_helmet", "DamagedHelmet/DamagedHelmet.glb"),
     // Tangents from the file, with mirrored uvs.
     ("normal_tangent_mirror", "NormalTangentMirrorTest/NormalTangentMirrorTest.gltf"),
     // Tangents generated, normal maps against the geometry they were baked from.
     ("normal_tangent", "NormalTangentTest/NormalTangentTest.gltf"),
-    // Alpha masks with several cutoffs (its blended materials are drawn opaque for now).
+    // Alpha masks with several cutoffs, and a blended material.
     ("alpha_blend_mode", "AlphaBlendModeTest/AlphaBlendModeTest.gltf"),
     // Per-texture samplers: repeat, mirrored repeat and clamp on each axis.
     ("texture_settings", "TextureSettingsTest/TextureSettingsTest.gltf"),
@@ -36,6 +36,10 @@ const ASSETS: [(&str, &str); 7] = [
     ("texture_coordinate", "TextureCoordinateTest/TextureCoordinateTest.gltf"),
     // sRGB decoding of PNGs with and without gamma and ICC chunks: all alike.
     ("texture_encoding", "TextureEncodingTest/TextureEncodingTest.gltf"),
+    // Metallic and roughness factors from mirror to rough, metal to plastic.
+    ("metal_rough_spheres", "MetalRoughSpheresNoTextures/MetalRoughSpheresNoTextures.gltf"),
+    // Range-less point lights of the file (cut off by the loader), emissive and normal maps.
+    ("lights_punctual_lamp", "LightsPunctualLamp/LightsPunctualLamp.gltf"),
 ];
 
 fn settings(pipeline: PipelineKind) -> RenderSettings {
@@ -252,4 +256,79 @@ fn texture_transforms_and_the_second_uv_set_match_pre_transformed_uvs() {
         let untransformed = flip(&baked, &plain).mean;
         assert!(untransformed > 0.05, "{name}: the transforms change little ({untransformed})");
     }
+}
+
+/// An unlit quad at depth `z` (facing +z, 2 × 2, centred on the axis) emitting `emissive`,
+/// blended with alpha `alpha` when below 1.
+fn emitting_quad(z: f32, emissive: Vec3, alpha: f32) -> (MaterialData, Mat4) {
+    let material = MaterialData {
+        label: format!("quad at {z}"),
+        base_color: Vec4::new(0.0, 0.0, 0.0, alpha),
+        emissive,
+        alpha_mode: if alpha < 1.0 {
+            manylight::core::AlphaMode::Blend
+        } else {
+            manylight::core::AlphaMode::Opaque
+        },
+        ..MaterialData::default()
+    };
+    (material, Mat4::from_translation(Vec3::new(0.0, 0.0, z)))
+}
+
+/// Blended surfaces are drawn farthest first whatever their order in the scene, over the
+/// opaque ones and behind nearer opaque ones: half-transparent red in front of half-transparent
+/// blue in front of grey shows 0.5 red + 0.25 blue + 0.25 grey in the middle (the reverse
+/// order would show more blue than red), in every pipeline.
+#[test]
+fn blended_surfaces_are_drawn_back_to_front_over_the_opaque_ones() {
+    let _gpu = gpu();
+    let quads = [
+        emitting_quad(0.5, Vec3::new(1.0, 0.0, 0.0), 0.5),
+        emitting_quad(0.0, Vec3::new(0.0, 0.0, 1.0), 0.5),
+        emitting_quad(-0.5, Vec3::splat(0.2), 1.0),
+    ];
+    let scene = |order: [usize; 3]| Scene {
+        name: "blended quads".into(),
+        meshes: vec![Arc::new(uv_quad(|c| c, |c| c))],
+        materials: order.iter().map(|&i| Arc::new(quads[i].0.clone())).collect(),
+        instances: (0..3)
+            .map(|k| SceneInstance { mesh: 0, material: k, transform: quads[order[k]].1 })
+            .collect(),
+        cameras: vec![SceneCamera {
+            transform: camera_looking_at(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO),
+            projection: Projection::perspective(0.5, 0.1, 20.0),
+        }],
+        ..Scene::default()
+    };
+    let size = UVec2::new(48, 48);
+    let centre = |image: &image::RgbaImage| *image.get_pixel(size.x / 2, size.y / 2);
+    let render = |order, pipeline| {
+        render_scene(scene(order), size, 1, RenderSettings { ambient: 0.0, ..settings(pipeline) }).image
+    };
+    let reference = render([0, 1, 2], PipelineKind::NaiveForward);
+    let [r, _, b, _] = centre(&reference).0;
+    assert!(r > b + 20, "red over blue: {:?}", centre(&reference));
+    for pipeline in PipelineKind::ALL {
+        for order in [[0, 1, 2], [2, 1, 0], [1, 2, 0]] {
+            let image = render(order, pipeline);
+            assert_similar(
+                &format!("blended_quads_{}_{order:?}", pipeline.name()),
+                &reference,
+                &image,
+                STRICT,
+            );
+        }
+    }
+    // The opaque quad in front hides the blended ones.
+    let mut hidden = scene([0, 1, 2]);
+    hidden.instances[2].transform = Mat4::from_translation(Vec3::new(0.0, 0.0, 1.0));
+    let image = render_scene(
+        hidden,
+        size,
+        0,
+        RenderSettings { ambient: 0.0, ..settings(PipelineKind::NaiveForward) },
+    )
+    .image;
+    let [r, g, b, _] = centre(&image).0;
+    assert!(r == g && g == b, "grey in front: {:?}", centre(&image));
 }

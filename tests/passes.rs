@@ -398,3 +398,37 @@ fn the_graph_is_compiled_when_the_plan_changes_not_every_frame() {
     renderer.render(snapshot(bloom), false).expect("renders");
     assert_eq!(compilations(&renderer), first + 1, "both plans are kept");
 }
+
+/// Blended materials add the transparent pass after shading, in every pipeline (lit through
+/// the cluster lists where the view built them); without one there is none, and a debug view
+/// that replaces shading draws none either.
+#[test]
+fn the_transparent_pass_runs_only_for_blended_materials() {
+    let blended = |pipeline, lights, debug| {
+        let p = Point { lights, bloom: false, motion_blur: false, deferred: false, debug };
+        let mut s = snapshot(p);
+        s.settings.pipeline = pipeline;
+        if !debug {
+            s.settings.debug_view = DebugViewMode::None;
+        }
+        let material = std::sync::Arc::make_mut(&mut s.instances[0].material);
+        material.alpha_mode = manylight::core::AlphaMode::Blend;
+        plan_passes(s).expect("plan")
+    };
+    use PipelineKind::*;
+    assert_eq!(
+        blended(ClusteredForward, true, false),
+        ["depth_prepass", "cluster_build", "clustered_forward", "transparent", "tonemap"]
+    );
+    assert_eq!(
+        blended(ClusteredDeferred, true, false),
+        ["cluster_build", "gbuffer", "deferred_lighting", "transparent", "tonemap"]
+    );
+    assert_eq!(blended(NaiveForward, true, false), ["forward", "transparent", "tonemap"]);
+    assert_eq!(blended(LightVolumes, true, false), ["gbuffer", "light_volumes", "transparent", "tonemap"]);
+    assert_eq!(blended(ClusteredDeferred, false, false), ["forward", "transparent", "tonemap"]);
+    assert!(!blended(ClusteredForward, true, true).contains(&"transparent"));
+    for p in matrix() {
+        assert!(!plan_passes(snapshot(p)).expect("plan").contains(&"transparent"), "{p:?}");
+    }
+}

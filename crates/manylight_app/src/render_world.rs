@@ -36,19 +36,33 @@ pub struct RenderSchedule;
 #[derive(Resource, Default)]
 pub struct CurrentSnapshot(pub FrameSnapshot);
 
-/// The view being rendered (its camera, image size and settings), and whether the frame has
-/// lights to shade it with.
+/// The view being rendered (its camera, image size and settings), whether the frame has
+/// lights to shade it with, and whether it draws blended materials.
 #[derive(Resource, Clone, Copy, Debug)]
-pub struct CurrentView(pub RenderView, pub bool);
+pub struct CurrentView(pub RenderView, pub bool, pub bool);
 
 impl CurrentView {
     /// View `index` of `snapshot`.
     pub fn of(snapshot: &FrameSnapshot, index: usize) -> CurrentView {
-        CurrentView(snapshot.render_view(index), snapshot.has_lights())
+        CurrentView(snapshot.render_view(index), snapshot.has_lights(), snapshot.has_blended())
     }
 
     fn has_lights(&self) -> bool {
         self.1
+    }
+
+    fn has_blended(&self) -> bool {
+        self.2
+    }
+
+    /// The plan's inputs for this view.
+    fn plan_inputs(&self, accumulation: wgpu::TextureFormat) -> PlanInputs<'_> {
+        PlanInputs {
+            view: &self.0,
+            has_lights: self.has_lights(),
+            has_blended: self.has_blended(),
+            accumulation,
+        }
     }
 }
 
@@ -597,11 +611,7 @@ pub fn plan_passes(snapshot: FrameSnapshot) -> Result<Vec<&'static str>, RenderE
 /// The passes the plan runs for view `index` of `snapshot`, in order.
 pub fn plan_view_passes(snapshot: &FrameSnapshot, index: usize) -> Result<Vec<&'static str>, RenderError> {
     let view = CurrentView::of(snapshot, index);
-    let inputs = PlanInputs {
-        view: &view.0,
-        has_lights: view.1,
-        accumulation: manylight_render::resources::HDR_FORMAT,
-    };
+    let inputs = view.plan_inputs(manylight_render::resources::HDR_FORMAT);
     let mut graph = RenderGraph::new();
     FramePlanner::default().plan_into(&inputs, &mut graph);
     graph.pass_names()
@@ -625,7 +635,7 @@ fn plan_graph(
     mut graph: ResMut<FrameGraph>,
 ) {
     let accumulation = LightVolumesPass::accumulation_format(&renderer.0.gpu.device);
-    let inputs = PlanInputs { view: &view.0, has_lights: view.has_lights(), accumulation };
+    let inputs = view.plan_inputs(accumulation);
     planner.0.plan_into(&inputs, &mut graph.0);
 }
 

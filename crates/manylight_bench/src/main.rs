@@ -54,8 +54,12 @@ enum Command {
     /// Sweep pipelines × light counts at one size and write the timings as CSV.
     Bench(BenchArgs),
     /// What accuracy costs in time: every pipeline and G-buffer layout against the naive
-    /// reference (FLIP) and its frame time, in one run, as a markdown table.
+    /// reference (FLIP) and its frame time, in one run, as a markdown table; then what cutting
+    /// off lights without a range costs against their unbounded sum.
     Report(ReportArgs),
+    /// Only the last table of `report`: lights without a range cut off at several fractions of
+    /// their intensity (clustered forward) against their unbounded sum (naive forward).
+    RangelessLights(ReportArgs),
     /// What bloom and motion blur cost per frame: the same frame without post stages, with
     /// each bloom chain, with motion blur and with both, in one run, as a markdown table.
     Post(ReportArgs),
@@ -531,12 +535,25 @@ fn write_plots(dir: &std::path::Path, name: &str, csv: &str) -> Result<()> {
     Ok(())
 }
 
-fn report_cmd(args: ReportArgs) -> Result<()> {
-    let scene = load_scene(&args.scene, &LoadOptions::default())?;
-    let base = manylight_render::FrameSettings {
+/// The settings `report` and `rangeless-lights` start from.
+fn report_base(args: &ReportArgs) -> manylight_render::FrameSettings {
+    manylight_render::FrameSettings {
         render: manylight_render::RenderSettings { clusters: args.clusters.settings(), ..Default::default() },
         ..Default::default()
-    };
+    }
+}
+
+fn rangeless_lights_cmd(args: ReportArgs) -> Result<()> {
+    let scene = load_scene(&args.scene, &LoadOptions::default())?;
+    let mut renderer = manylight_app::render_world::HeadlessRenderer::new()?;
+    let (lights, size, frames) = (args.lights, args.size, args.frames.max(1));
+    print!("{}", report::rangeless_lights(&mut renderer, &scene, lights, size, frames, report_base(&args))?);
+    Ok(())
+}
+
+fn report_cmd(args: ReportArgs) -> Result<()> {
+    let scene = load_scene(&args.scene, &LoadOptions::default())?;
+    let base = report_base(&args);
     let name = scene_name(&args.scene);
     let report = report::run(&scene, &name, args.lights, args.size, args.frames.max(1), base)?;
     print!("{}", report.markdown);
@@ -640,6 +657,7 @@ fn main() -> ExitCode {
         Command::Check { path } => check(path),
         Command::Bench(args) => bench_cmd(args),
         Command::Report(args) => report_cmd(args),
+        Command::RangelessLights(args) => rangeless_lights_cmd(args),
         Command::Post(args) => post_cmd(args),
         Command::Views(args) => views_cmd(args),
         Command::Plot { csv, out } => plot_cmd(csv, out),

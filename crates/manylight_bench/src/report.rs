@@ -8,13 +8,14 @@ use crate::progress::Progress;
 use anyhow::Result;
 use glam::UVec2;
 use manylight_app::render_world::HeadlessRenderer;
+use manylight_core::attenuation::RANGELESS_LIGHT_CUTOFF;
 use manylight_core::cluster::CullTest;
 use manylight_core::codec::NormalCodec;
 use manylight_core::image_metrics::flip_compare;
 use manylight_render::{
     ClusterSettings, FrameReport, FrameSettings, GBufferLayout, PipelineKind, RenderSettings,
 };
-use manylight_scene::{Scene, light_rig};
+use manylight_scene::{AnimatedLight, Scene, light_rig};
 use std::fmt::Write as _;
 use std::time::Instant;
 
@@ -29,10 +30,22 @@ fn measure(
     frames: u32,
 ) -> Result<(f64, FrameReport, image::RgbaImage)> {
     let rig = light_rig(lights, scene.bounds(), 1);
+    measure_rig(renderer, scene, &rig, size, settings, frames)
+}
+
+/// [`measure`] with the rig given.
+fn measure_rig(
+    renderer: &mut HeadlessRenderer,
+    scene: &Scene,
+    rig: &[AnimatedLight],
+    size: UVec2,
+    settings: FrameSettings,
+    frames: u32,
+) -> Result<(f64, FrameReport, image::RgbaImage)> {
     let mut times = Vec::new();
     let mut last = None;
     for f in 0..=frames {
-        let snap = snapshot(scene, &rig, 0.0, size, settings, f as u64);
+        let snap = snapshot(scene, rig, 0.0, size, settings, f as u64);
         let start = Instant::now();
         let (report, image) = renderer.render(snap, f == frames)?;
         if f > 0 {
@@ -177,7 +190,78 @@ pub fn run(
         "{lights} lights (+ the scene's own), {}x{}, {scene_name}, {adapter}; median of {frames} frames",
         size.x, size.y
     );
-    Ok(Report { markdown: markdown(&rows, &context), csv: csv(&rows, scene_name, size, &adapter)? })
+    let mut markdown = markdown(&rows, &context);
+    markdown.push('\n');
+    markdown.push_str(&rangeless_lights(&mut renderer, scene, lights, size, frames, base)?);
+    Ok(Report { markdown, csv: csv(&rows, scene_name, size, &adapter)? })
+}
+
+/// Cut-off thresholds the "lights without a range" table compares, as fractions of a light's
+/// intensity (the loader's is [`RANGELESS_LIGHT_CUTOFF`]).
+pub const CUTOFFS: [f32; 5] = [0.1, 0.03, 0.01, RANGELESS_LIGHT_CUTOFF, 0.001];
+
+/// The range standing in for "unbounded": the falloff's window `(1 - (d/r)^4)^2` stays within
+/// 1e-7 of 1 for every distance under 50 (the scenes' size), so the sum equals the unbounded
+/// `1 / (d² + 1)` sum to f32 precision.
+pub const UNBOUNDED_RANGE: f32 = 1.0e4;
+
+/// What cutting lights without a range costs: the rig's lights as if they came without one,
+/// cut off at each of [`CUTOFFS`] (range `radius_for_intensity(intensity, cutoff)`) and
+/// shaded by clustered forward, against the unbounded sum (every light reaching every pixel,
+/// naive forward). A markdown table of FLIP error and frame time.
+pub fn rangeless_lights(
+    renderer: &mut HeadlessRenderer,
+    scene: &Scene,
+    lights: usize,
+    size: UVec2,
+    frames: u32,
+    base: FrameSettings,
+) -> Result<String> {
+    let rig = light_rig(lights, scene.bounds(), 1);
+    let with_range = |range: &dyn Fn(&AnimatedLight) -> f32| -> Vec<AnimatedLight> {
+        rig.iter().map(|l| AnimatedLight { radius: range(l), ..*l }).collect()
+    };
+    let with = |pipeline| FrameSettings { render: RenderSettings { pipeline, ..base.render }, ..base };
+    let mut progress = Progress::new(CUTOFFS.len() as u64 + 2, "cut-offs");
+    progress.set_message("unbounded, naive forward (reference)");
+    let unbounded = with_range(&|_| UNBOUNDED_RANGE);
+    let (naive_ms, _, reference) =
+        measure_rig(renderer, scene, &unbounded, size, with(PipelineKind::NaiveForward), frames)?;
+    progress.step(|| format!("unbounded, naive forward: {naive_ms:.0} ms"));
+    let mut out = format!(
+        "Lights without a range: the {lights} rig lights cut off where they fall to a fraction of \
+         their intensity, clustered forward, against their unbounded sum (naive forward, \
+         {naive_ms:.0} ms); the loader cuts at {RANGELESS_LIGHT_CUTOFF}.\n\n"
+    );
+    out.push_str("| cut off at | mean range | FLIP mean | FLIP p99 | frame ms | vs unbounded naive |\n");
+    out.push_str("|---|---:|---:|---:|---:|---:|\n");
+    let clustered = with(PipelineKind::ClusteredForward);
+    let mut rows: Vec<(String, Vec<AnimatedLight>)> = CUTOFFS
+        .iter()
+        .map(|&c| {
+            let lit =
+                with_range(&|l| manylight_core::radius_for_intensity(l.intensity * l.color.max_element(), c));
+            (format!("{c}"), lit)
+        })
+        .collect();
+    rows.push(("unbounded".into(), unbounded));
+    for (name, lit) in rows {
+        progress.set_message(format!("cut off at {name}"));
+        let (ms, _, image) = measure_rig(renderer, scene, &lit, size, clustered, frames)?;
+        let (flip, _) =
+            flip_compare(reference.dimensions(), reference.as_raw(), image.dimensions(), image.as_raw())?;
+        let mean_range = lit.iter().map(|l| f64::from(l.radius)).sum::<f64>() / lit.len().max(1) as f64;
+        let _ = writeln!(
+            out,
+            "| {name} | {mean_range:.1} | {:.5} | {:.5} | {ms:.0} | {:.2}× |",
+            flip.mean,
+            flip.p99,
+            naive_ms / ms
+        );
+        progress.step(|| format!("cut off at {name}: {ms:.0} ms, FLIP mean {:.5}", flip.mean));
+    }
+    progress.finish();
+    Ok(out)
 }
 
 fn passes(r: &FrameReport) -> String {

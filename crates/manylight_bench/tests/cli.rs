@@ -256,12 +256,19 @@ fn report_writes_csv_and_figures() {
         plots.to_str().expect("utf-8"),
     ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let markdown = String::from_utf8_lossy(&out.stdout);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let (markdown, rangeless) =
+        stdout.split_once("Lights without a range").expect("the range-less lights table");
     let text = std::fs::read_to_string(plots.join("report.csv")).expect("report.csv");
     let rows: Vec<&str> = text.lines().collect();
     // The markdown table and the CSV hold the same configurations.
     let table_rows = markdown.lines().filter(|l| l.starts_with("| ") && !l.starts_with("| pipeline")).count();
     assert_eq!(rows.len() - 1, table_rows, "{text}\n{markdown}");
+    // The range-less table: one row per cut-off and the unbounded one, which equals its reference.
+    let cut_rows: Vec<&str> =
+        rangeless.lines().filter(|l| l.starts_with("| ") && !l.starts_with("| cut")).collect();
+    assert_eq!(cut_rows.len(), 6, "{rangeless}");
+    assert!(cut_rows[5].starts_with("| unbounded | 10000.0 | 0.00000 | 0.00000 |"), "{rangeless}");
     assert!(rows[0].contains("flip_mean") && rows[0].contains("frame_ms_median"), "{}", rows[0]);
     assert!(rows[1].contains("naive forward (reference)"), "{}", rows[1]);
     assert_figures(&plots, &["report_accuracy_vs_time", "report_passes", "report_memory"]);

@@ -26,9 +26,16 @@ pub fn attenuation(distance: f32, radius: f32) -> f32 {
     window * window / (d * d + 1.0)
 }
 
+/// The fraction of its intensity (its brightest channel's) at which a light that comes without a
+/// range is cut off: glTF `KHR_lights_punctual` lights with `range` unset reach infinitely far,
+/// and get the range [`radius_for_intensity`]`(intensity, RANGELESS_LIGHT_CUTOFF)`.
+/// `manylight report` (its "lights without a range" table) measures what this cut-off costs in
+/// error and time against the unbounded sum.
+pub const RANGELESS_LIGHT_CUTOFF: f32 = 0.003;
+
 /// Radius at which a light of `intensity` falls below `threshold` under plain inverse-square
 /// falloff (used for lights that come without a range, e.g. glTF `KHR_lights_punctual` lights
-/// with `range` unset). Always finite and non-negative.
+/// with `range` unset: see [`RANGELESS_LIGHT_CUTOFF`]). Always finite and non-negative.
 pub fn radius_for_intensity(intensity: f32, threshold: f32) -> f32 {
     if !intensity.is_finite() || !threshold.is_finite() || intensity <= 0.0 || threshold <= 0.0 {
         return 0.0;

@@ -206,8 +206,9 @@ pub enum AlphaMode {
     /// Fragments whose alpha (base colour factor times texture) is below the cutoff are
     /// discarded; the rest are opaque.
     Mask(f32),
-    /// Alpha blends the surface over what lies behind it. Not drawn as a transparent pass yet:
-    /// such materials are drawn opaque (the loader warns).
+    /// Alpha blends the surface over what lies behind it ("over", not premultiplied): drawn by
+    /// the transparent pass after the opaque surfaces, farthest first (by the centre of each
+    /// instance's bounds), lit like forward shading, without writing depth.
     Blend,
 }
 

@@ -16,6 +16,8 @@ pub struct PlanInputs<'a> {
     pub view: &'a RenderView,
     /// The frame has a valid light (`FrameSnapshot::has_lights`).
     pub has_lights: bool,
+    /// The frame draws a blended material (`FrameSnapshot::has_blended`).
+    pub has_blended: bool,
     /// Where light volumes sum their lights (`LightVolumesPass::accumulation_format` of the
     /// device; `HDR_FORMAT` when planning without one).
     pub accumulation: wgpu::TextureFormat,

@@ -7,7 +7,7 @@ use crate::passes;
 use crate::plan::{PlanInputs, Planner};
 
 /// The stages, in order: each pass module's `plan` function.
-pub const STAGES: [(&str, Planner); 11] = [
+pub const STAGES: [(&str, Planner); 12] = [
     ("depth_prepass", passes::depth_prepass::plan),
     ("cluster_build", passes::cluster_build::plan),
     ("forward", passes::forward::plan),
@@ -15,6 +15,7 @@ pub const STAGES: [(&str, Planner); 11] = [
     ("gbuffer", passes::gbuffer::plan),
     ("deferred_lighting", passes::deferred_lighting::plan),
     ("light_volumes", passes::light_volumes::plan),
+    ("transparent", passes::transparent::plan),
     ("motion_blur", passes::motion_blur::plan),
     ("bloom", passes::bloom::plan),
     ("tonemap", passes::tonemap::plan),

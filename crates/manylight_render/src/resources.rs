@@ -37,6 +37,8 @@ pub struct GpuMesh {
     pub index_count: u32,
     /// Upload order (draws sort by it: the same scene draws in the same order on every run).
     pub order: u64,
+    /// Centre of the mesh's bounds (local space).
+    pub center: glam::Vec3,
     last_used: u64,
 }
 
@@ -75,6 +77,9 @@ pub struct SurfaceVariant {
     /// Discard fragments whose alpha is below the material's cutoff (`ALPHA_MASK` in
     /// `shaders/common/surface.wgsl`).
     pub alpha_mask: bool,
+    /// Blended over what is behind it (glTF `BLEND`): drawn only by the transparent pass, back
+    /// to front, never by the opaque passes.
+    pub blend: bool,
 }
 
 impl SurfaceVariant {
@@ -85,6 +90,7 @@ impl SurfaceVariant {
             front_face: if mirrored { wgpu::FrontFace::Cw } else { wgpu::FrontFace::Ccw },
             cull_back: !material.double_sided,
             alpha_mask: material.alpha_mode.cutoff().is_some(),
+            blend: material.alpha_mode == manylight_core::AlphaMode::Blend,
         }
     }
 
@@ -118,6 +124,8 @@ pub struct Draw {
     pub order: (u64, u64),
     /// Its pipeline variant.
     pub variant: SurfaceVariant,
+    /// World-space centre of the mesh's bounds (blended draws are sorted by its distance).
+    pub center: glam::Vec3,
 }
 
 /// Scene data on the GPU for the current frame.
@@ -139,6 +147,8 @@ pub struct SceneResources {
     /// The distinct variants of this frame's draws, in first-drawn order: the pipelines each
     /// mesh pass needs.
     pub variants: Vec<SurfaceVariant>,
+    /// The blended draws (indices into `draws`) of the current view, farthest first.
+    pub blended: Vec<usize>,
     /// The frame's view constants as uploaded.
     pub view: ViewUniform,
     /// Lights uploaded this frame.
@@ -312,6 +322,7 @@ impl SceneResources {
             instances,
             draws: Vec::new(),
             variants: Vec::new(),
+            blended: Vec::new(),
             view: ViewUniform::zeroed_default(),
             light_count: 0,
             directional: [GpuDirectionalLight::default(); MAX_DIRECTIONAL_LIGHTS as usize],
@@ -389,6 +400,15 @@ impl SceneResources {
             },
         };
         gpu.queue.write_buffer(&self.view_buffer, 0, bytemuck::bytes_of(&self.view));
+        // Blended draws, farthest first along the view direction (view-space z ascending).
+        let view_from_world = self.view.view_from_world;
+        let draws = &self.draws;
+        self.blended.clear();
+        self.blended.extend((0..draws.len()).filter(|&i| draws[i].variant.blend));
+        self.blended.sort_by(|&a, &b| {
+            let z = |i: usize| view_from_world.transform_point3(draws[i].center).z;
+            z(a).total_cmp(&z(b)).then(a.cmp(&b))
+        });
     }
 
     /// Uploads the frame's lights, instances and any new meshes/materials/textures, once per
@@ -466,12 +486,14 @@ impl SceneResources {
             if inst.mesh.indices.is_empty() {
                 continue;
             }
-            let (mesh, mesh_order) = self.mesh_entry(gpu, &inst.mesh)?;
+            let (mesh, mesh_order, local_center) = self.mesh_entry(gpu, &inst.mesh)?;
             let (material, material_order) = self.material_entry(gpu, &inst.material)?;
             let order = (material_order, mesh_order);
             let mirrored = glam::Mat3::from_mat4(inst.world_from_local).determinant() < 0.0;
             let variant = SurfaceVariant::of(&inst.material, mirrored);
-            self.draws.push(Draw { mesh, material, instance: instance_data.len() as u32, order, variant });
+            let center = inst.world_from_local.transform_point3(local_center);
+            let instance = instance_data.len() as u32;
+            self.draws.push(Draw { mesh, material, instance, order, variant, center });
             instance_data.push(gpu_instance);
         }
         self.draws.sort_by_key(|d| d.order);
@@ -507,7 +529,11 @@ impl SceneResources {
 
     /// The mesh's GPU buffers, uploaded on first use; refused, naming the limit, when a buffer
     /// would exceed the device's `max_buffer_size`.
-    fn mesh_entry(&mut self, gpu: &GpuContext, mesh: &Arc<MeshData>) -> Result<(usize, u64), RenderError> {
+    fn mesh_entry(
+        &mut self,
+        gpu: &GpuContext,
+        mesh: &Arc<MeshData>,
+    ) -> Result<(usize, u64, glam::Vec3), RenderError> {
         let k = key(mesh);
         let frame = self.frame;
         if !self.meshes.contains_key(&k) {
@@ -542,11 +568,16 @@ impl SceneResources {
                 }),
                 index_count: mesh.indices.len() as u32,
                 order: *uploads,
+                center: {
+                    let b = mesh.bounds();
+                    let c = (b.min + b.max) * 0.5;
+                    if c.is_finite() { c } else { glam::Vec3::ZERO }
+                },
                 last_used: frame,
             }
         });
         entry.last_used = frame;
-        Ok((k, entry.order))
+        Ok((k, entry.order, entry.center))
     }
 
     fn material_entry(

@@ -671,4 +671,10 @@ impl FrameSnapshot {
     pub fn has_lights(&self) -> bool {
         self.lights.iter().any(|l| l.is_valid())
     }
+
+    /// True when an instance's material is blended (`AlphaMode::Blend`): the frame needs the
+    /// transparent pass.
+    pub fn has_blended(&self) -> bool {
+        self.instances.iter().any(|i| i.material.alpha_mode == manylight_core::AlphaMode::Blend)
+    }
 }

@@ -399,7 +399,6 @@ fn load_inner(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
         generated_tangents: HashSet::new(),
         materials: HashMap::new(),
         material_extensions,
-        warned_blend: false,
         used: Used::default(),
         scene: Scene {
             name: path
@@ -453,8 +452,6 @@ struct Ctx<'a> {
     /// `KHR_materials_emissive_strength` and `KHR_texture_transform` by glTF material index
     /// (empty when the file uses neither).
     material_extensions: Vec<materials::MaterialExtensions>,
-    /// Whether the "BLEND is drawn opaque" warning was logged for this file.
-    warned_blend: bool,
     /// Budget use so far.
     used: Used,
     /// The scene being built.

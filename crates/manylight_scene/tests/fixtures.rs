@@ -91,7 +91,8 @@ fn hierarchy_lights_and_cameras_without_a_scene_list() {
     assert!((l.position - Vec3::new(10.0, 0.0, 10.0)).length() < 1e-5, "{:?}", l.position);
     assert_eq!(l.intensity, 4.0);
     assert_eq!(l.color, Vec3::new(1.0, 0.5, 0.25));
-    assert_eq!(l.radius, manylight_core::radius_for_intensity(4.0, 0.01));
+    let cutoff = manylight_core::attenuation::RANGELESS_LIGHT_CUTOFF;
+    assert_eq!(l.radius, manylight_core::radius_for_intensity(4.0, cutoff));
     // The camera: znear 0.05, no zfar (infinite), scale removed from the transform.
     assert_eq!(s.cameras.len(), 1);
     let c = s.cameras[0];

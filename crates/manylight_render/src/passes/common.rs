@@ -20,12 +20,13 @@ fn pipeline_layout(
     })
 }
 
-fn color_targets(formats: &[wgpu::TextureFormat]) -> Vec<Option<wgpu::ColorTargetState>> {
+fn color_targets(
+    formats: &[wgpu::TextureFormat],
+    blend: Option<wgpu::BlendState>,
+) -> Vec<Option<wgpu::ColorTargetState>> {
     formats
         .iter()
-        .map(|&format| {
-            Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })
-        })
+        .map(|&format| Some(wgpu::ColorTargetState { format, blend, write_mask: wgpu::ColorWrites::ALL }))
         .collect()
 }
 
@@ -68,7 +69,8 @@ pub fn mesh_pipeline_with_constants(
     let options = || wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
     let module = crate::shaders::create_module(device, d.shader)?;
     let layout = pipeline_layout(device, d.label, d.layouts);
-    let targets = color_targets(d.targets);
+    // Blended variants draw over the target by the fragment's alpha (glTF `BLEND`).
+    let targets = color_targets(d.targets, d.variant.blend.then_some(wgpu::BlendState::ALPHA_BLENDING));
     Ok(device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(d.label),
         layout: Some(&layout),

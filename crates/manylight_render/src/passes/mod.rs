@@ -19,6 +19,7 @@ pub mod light_volumes;
 pub mod motion_blur;
 pub mod scene_draw;
 pub mod tonemap;
+pub mod transparent;
 
 pub use bloom::{BloomBlurPass, BloomBrightPass, BloomCompositePass, BloomUpsamplePass};
 pub use cluster_build::ClusterBuildPass;
@@ -31,6 +32,7 @@ pub use gbuffer::GBufferPass;
 pub use light_volumes::LightVolumesPass;
 pub use motion_blur::MotionBlurPass;
 pub use tonemap::TonemapPass;
+pub use transparent::TransparentPass;
 
 /// Graph resource: the HDR scene colour.
 pub const HDR: crate::graph::ResourceName = "hdr";

@@ -17,14 +17,34 @@ pub trait ScenePipeline {
 /// A mesh pass's pipeline for each surface variant.
 pub type VariantPipelines<P> = Vec<(SurfaceVariant, Arc<P>)>;
 
-/// The pipelines of a mesh pass for every variant the frame draws (`SceneResources::variants`),
-/// each made by `create` on first use.
+/// The pipelines of an opaque mesh pass for every opaque variant the frame draws
+/// (`SceneResources::variants`), each made by `create` on first use. Blended variants get
+/// none, so the opaque passes skip their draws.
 pub fn variant_pipelines<K: PipelineKey>(
     ctx: &PassContext<'_>,
     key: impl Fn(SurfaceVariant) -> K,
     create: impl Fn(&K) -> Result<K::Pipeline, RenderError>,
 ) -> Result<VariantPipelines<K::Pipeline>, RenderError> {
-    ctx.scene.variants.iter().map(|&v| Ok((v, ctx.pipelines.get_or_create(key(v), &create)?))).collect()
+    pipelines_where(ctx, |v| !v.blend, key, create)
+}
+
+/// [`variant_pipelines`] for the blended variants only (the transparent pass).
+pub fn blended_variant_pipelines<K: PipelineKey>(
+    ctx: &PassContext<'_>,
+    key: impl Fn(SurfaceVariant) -> K,
+    create: impl Fn(&K) -> Result<K::Pipeline, RenderError>,
+) -> Result<VariantPipelines<K::Pipeline>, RenderError> {
+    pipelines_where(ctx, |v| v.blend, key, create)
+}
+
+fn pipelines_where<K: PipelineKey>(
+    ctx: &PassContext<'_>,
+    filter: impl Fn(&SurfaceVariant) -> bool,
+    key: impl Fn(SurfaceVariant) -> K,
+    create: impl Fn(&K) -> Result<K::Pipeline, RenderError>,
+) -> Result<VariantPipelines<K::Pipeline>, RenderError> {
+    let variants = ctx.scene.variants.iter().filter(|v| filter(v));
+    variants.map(|&v| Ok((v, ctx.pipelines.get_or_create(key(v), &create)?))).collect()
 }
 
 /// Records the graph pass as one timed wgpu render pass that draws every scene instance with
@@ -71,6 +91,20 @@ pub fn draw_scene<P: ScenePipeline>(
     pipelines: &[(SurfaceVariant, Arc<P>)],
     reverse: bool,
 ) {
+    if reverse {
+        draw_in_order(pass, scene, pipelines, scene.draws.iter().rev());
+    } else {
+        draw_in_order(pass, scene, pipelines, scene.draws.iter());
+    }
+}
+
+/// Issues `draws` in the order given, as [`draw_scene`] does.
+pub fn draw_in_order<'d, P: ScenePipeline>(
+    pass: &mut wgpu::RenderPass<'_>,
+    scene: &SceneResources,
+    pipelines: &[(SurfaceVariant, Arc<P>)],
+    draws: impl Iterator<Item = &'d crate::resources::Draw>,
+) {
     let (mut bound_material, mut bound_mesh) = (usize::MAX, usize::MAX);
     let mut bound_variant = None;
     let mut draw = |d: &crate::resources::Draw| {
@@ -95,9 +129,5 @@ pub fn draw_scene<P: ScenePipeline>(
         }
         pass.draw_indexed(0..mesh.index_count, 0, d.instance..d.instance + 1);
     };
-    if reverse {
-        scene.draws.iter().rev().for_each(&mut draw);
-    } else {
-        scene.draws.iter().for_each(&mut draw);
-    }
+    draws.for_each(&mut draw);
 }

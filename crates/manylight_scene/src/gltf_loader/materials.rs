@@ -275,9 +275,8 @@ impl<'a> Ctx<'a> {
         }
     }
 
-    /// The `alphaMode` (and `alphaCutoff`) of material `index`. `BLEND` is kept but drawn
-    /// opaque for now, which is logged once per file.
-    fn alpha_mode(&mut self, index: usize) -> AlphaMode {
+    /// The `alphaMode` (and `alphaCutoff`) of material `index`.
+    fn alpha_mode(&self, index: usize) -> AlphaMode {
         let m = &self.root.materials[index];
         match m.alpha_mode {
             Checked::Valid(gltf::json::material::AlphaMode::Opaque) => AlphaMode::Opaque,
@@ -286,15 +285,7 @@ impl<'a> Ctx<'a> {
                 let cutoff = self.finite(cutoff, index, "alphaCutoff", AlphaMode::DEFAULT_CUTOFF);
                 AlphaMode::Mask(cutoff.max(0.0))
             }
-            Checked::Valid(gltf::json::material::AlphaMode::Blend) => {
-                if !std::mem::replace(&mut self.warned_blend, true) {
-                    tracing::warn!(
-                        file = %self.path.display(), material = index,
-                        "alphaMode BLEND is drawn opaque for now (no transparent pass yet)"
-                    );
-                }
-                AlphaMode::Blend
-            }
+            Checked::Valid(gltf::json::material::AlphaMode::Blend) => AlphaMode::Blend,
             Checked::Invalid => {
                 tracing::warn!(file = %self.path.display(), material = index, "unknown alphaMode, using OPAQUE");
                 AlphaMode::Opaque

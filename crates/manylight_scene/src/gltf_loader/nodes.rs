@@ -7,6 +7,7 @@ use gltf::json::camera::Type as CameraType;
 use gltf::json::extensions::scene::khr_lights_punctual::Type as LightType;
 use gltf::json::mesh::{Mode, Semantic};
 use gltf::json::validation::Checked;
+use manylight_core::attenuation::RANGELESS_LIGHT_CUTOFF;
 use manylight_core::{MeshData, Projection, SpotCone, radius_for_intensity};
 use std::f32::consts::FRAC_PI_2;
 use std::sync::Arc;
@@ -441,7 +442,8 @@ impl Ctx<'_> {
         let radius = match l.range {
             Some(r) if r.is_finite() && r > 0.0 => r,
             Some(r) => return Err(bad(format!("range {r} must be finite and positive"))),
-            None => radius_for_intensity(l.intensity * color.max_element(), 0.01),
+            // Unbounded in glTF: cut where it falls to a fixed fraction of its intensity.
+            None => radius_for_intensity(l.intensity * color.max_element(), RANGELESS_LIGHT_CUTOFF),
         };
         self.scene.lights.push(SceneLight {
             position: world.transform_point3(Vec3::ZERO),

@@ -1,0 +1,61 @@
+// What the passes that shade meshes forward share (naive, tiled and clustered forward, and the
+// transparent pass): the fragment's surface with its ambient, emission and directional lights,
+// then the point and spot lights it sums, either every light or its cluster's list.
+//!include common/mesh_pass.wgsl
+//!include common/brdf.wgsl
+//!include common/clusters.wgsl
+
+// The cluster lists (group 2; Rust: `ClusterResources::shading_layout`), bound only by the
+// pipelines whose entry point calls `add_cluster_lights`.
+@group(2) @binding(0) var<uniform> cluster_params: ClusterParams;
+@group(2) @binding(1) var<storage, read> cluster_ranges: array<vec2<u32>>;
+@group(2) @binding(2) var<storage, read> cluster_indices: array<u32>;
+
+struct ForwardFragment {
+    p: SurfacePoint,
+    m: MaterialSample,
+    view_dir: vec3<f32>,
+    // the radiance so far: ambient (with occlusion), emission and the directional lights
+    color: vec3<f32>,
+};
+
+// Samples the material (discarding below an alpha mask's cutoff) and sums what every light
+// list starts from.
+fn forward_fragment(in: SurfaceVertexOut, front_facing: bool) -> ForwardFragment {
+    let p = surface_point(view, in.clip_position.xy, in.camera_offset);
+    let m = sample_material(in, front_facing);
+    alpha_test(m.base_color);
+    let view_dir = direction_to_eye(view, p.world_position);
+    var color = surface_base_radiance(m.params.albedo, view.params.w, m.occlusion, m.emissive);
+    color += shade_directional_lights(view, m.params, view_dir);
+    return ForwardFragment(p, m, view_dir, color);
+}
+
+// `f.color` plus every point and spot light, added in order.
+fn add_every_light(f: ForwardFragment) -> vec3<f32> {
+    var color = f.color;
+    // Four lights per iteration: lavapipe stops an invocation after 65 535 loop iterations,
+    // which would drop every light past the 65 535th of the reference.
+    let n = view.light_count;
+    var i = 0u;
+    for (; i + 4u <= n; i += 4u) {
+        color += shade_point_light(f.m.params, f.p.world_position, f.view_dir, lights[i]);
+        color += shade_point_light(f.m.params, f.p.world_position, f.view_dir, lights[i + 1u]);
+        color += shade_point_light(f.m.params, f.p.world_position, f.view_dir, lights[i + 2u]);
+        color += shade_point_light(f.m.params, f.p.world_position, f.view_dir, lights[i + 3u]);
+    }
+    for (; i < n; i++) {
+        color += shade_point_light(f.m.params, f.p.world_position, f.view_dir, lights[i]);
+    }
+    return color;
+}
+
+// `f.color` plus the lights of the cluster of the fragment at `frag` (pixel coordinates).
+fn add_cluster_lights(f: ForwardFragment, frag: vec2<f32>) -> vec3<f32> {
+    var color = f.color;
+    let range = cluster_ranges[cluster_index(cluster_params, frag, f.p.view_depth)];
+    for (var i = 0u; i < range.y; i++) {
+        color += shade_point_light(f.m.params, f.p.world_position, f.view_dir, lights[cluster_indices[range.x + i]]);
+    }
+    return color;
+}
