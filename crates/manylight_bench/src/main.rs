@@ -302,9 +302,21 @@ struct ClusterArgs {
     /// light-count, slice-x, slice-y, slice-z or overflow (replaces tone mapping).
     #[arg(long, default_value = "none", value_parser = parse_debug_view)]
     debug_view: DebugViewMode,
+    /// Anisotropic filtering of every texture: at most N samples per pixel footprint, 1 to 16
+    /// (1 = off). Costly on lavapipe (docs/benchmarks.md).
+    #[arg(long, default_value_t = manylight_core::material::MAX_ANISOTROPY,
+          value_parser = clap::value_parser!(u16).range(1..=16))]
+    anisotropy: u16,
 }
 
 impl ClusterArgs {
+    /// `spec` loaded (as [`load_scene`] does) with these options' texture filtering.
+    fn load(&self, spec: &str) -> Result<manylight_scene::Scene> {
+        let mut scene = load_scene(spec, &LoadOptions::default())?;
+        scene.set_anisotropy(self.anisotropy);
+        Ok(scene)
+    }
+
     fn settings(&self) -> ClusterSettings {
         ClusterSettings {
             grid: GridConfig { dims: self.grid, slicing: self.z_slicing, ..GridConfig::default() },
@@ -395,7 +407,7 @@ fn stats_json(stats: &FrameStats) -> serde_json::Value {
 }
 
 fn render(args: RenderArgs) -> Result<()> {
-    let mut scene = load_scene(&args.scene, &LoadOptions::default())?;
+    let mut scene = args.clusters.load(&args.scene)?;
     select_camera(&mut scene, &args.camera)?;
     // The sphere-shell preset is lit by its own lattice (`--lights`, default 100 000 of range
     // 0.3 just inside the radius-50 sphere), not by the animated rig.
@@ -544,7 +556,7 @@ fn report_base(args: &ReportArgs) -> manylight_render::FrameSettings {
 }
 
 fn rangeless_lights_cmd(args: ReportArgs) -> Result<()> {
-    let scene = load_scene(&args.scene, &LoadOptions::default())?;
+    let scene = args.clusters.load(&args.scene)?;
     let mut renderer = manylight_app::render_world::HeadlessRenderer::new()?;
     let (lights, size, frames) = (args.lights, args.size, args.frames.max(1));
     print!("{}", report::rangeless_lights(&mut renderer, &scene, lights, size, frames, report_base(&args))?);
@@ -552,7 +564,7 @@ fn rangeless_lights_cmd(args: ReportArgs) -> Result<()> {
 }
 
 fn report_cmd(args: ReportArgs) -> Result<()> {
-    let scene = load_scene(&args.scene, &LoadOptions::default())?;
+    let scene = args.clusters.load(&args.scene)?;
     let base = report_base(&args);
     let name = scene_name(&args.scene);
     let report = report::run(&scene, &name, args.lights, args.size, args.frames.max(1), base)?;
@@ -564,7 +576,7 @@ fn report_cmd(args: ReportArgs) -> Result<()> {
 }
 
 fn post_cmd(args: ReportArgs) -> Result<()> {
-    let scene = load_scene(&args.scene, &LoadOptions::default())?;
+    let scene = args.clusters.load(&args.scene)?;
     let base = manylight_render::FrameSettings {
         render: manylight_render::RenderSettings { clusters: args.clusters.settings(), ..Default::default() },
         ..Default::default()
@@ -579,7 +591,7 @@ fn post_cmd(args: ReportArgs) -> Result<()> {
 }
 
 fn views_cmd(args: ViewsArgs) -> Result<()> {
-    let scene = load_scene(&args.scene, &LoadOptions::default())?;
+    let scene = args.clusters.load(&args.scene)?;
     let base = manylight_render::FrameSettings {
         render: manylight_render::RenderSettings { clusters: args.clusters.settings(), ..Default::default() },
         ..Default::default()
@@ -607,7 +619,7 @@ fn codec_accuracy_cmd(samples: usize) -> Result<()> {
 }
 
 fn bench_cmd(args: BenchArgs) -> Result<()> {
-    let scene = load_scene(&args.scene, &LoadOptions::default())?;
+    let scene = args.clusters.load(&args.scene)?;
     let sweep = bench::Sweep {
         pipelines: args.pipelines,
         lights: args.lights,

@@ -178,9 +178,8 @@ pub struct SceneResources {
     textures: HashMap<usize, CachedTexture>,
     white: wgpu::TextureView,
     samplers: HashMap<TextureSampler, wgpu::Sampler>,
-    /// `anisotropy_clamp` of samplers that filter linearly everywhere (1 where the adapter
-    /// cannot filter anisotropically).
-    anisotropy: u16,
+    /// The adapter filters anisotropically (`DownlevelFlags::ANISOTROPIC_FILTERING`).
+    anisotropic: bool,
     frame: u64,
     bound_generations: (u64, u64),
     max_texture_size: u32,
@@ -339,7 +338,7 @@ impl SceneResources {
             textures: HashMap::new(),
             white,
             samplers: HashMap::new(),
-            anisotropy: if anisotropic { MAX_ANISOTROPY } else { 1 },
+            anisotropic,
             frame: 0,
             bound_generations: (0, 0),
             max_texture_size: gpu.max_texture_size(),
@@ -608,7 +607,7 @@ impl SceneResources {
         let mut samplers = Vec::with_capacity(slots.len());
         for slot in slots {
             views.push(self.texture_view(gpu, slot.map(|t| &t.image))?);
-            samplers.push(self.sampler(gpu, slot.map_or(TextureSampler::default(), |t| t.sampler)));
+            samplers.push(self.sampler(gpu, slot.map_or(UNUSED_SLOT_SAMPLER, |t| t.sampler)));
         }
         let finite_or = |v: f32, default: f32| if v.is_finite() { v } else { default };
         let uniform = GpuMaterial {
@@ -666,7 +665,11 @@ impl SceneResources {
     /// The sampler for `s`, created on first use (a handful per scene: glTF files name few
     /// distinct samplers).
     fn sampler(&mut self, gpu: &GpuContext, s: TextureSampler) -> wgpu::Sampler {
-        let anisotropy = if s.allows_anisotropy() { self.anisotropy } else { 1 };
+        let anisotropy = if s.allows_anisotropy() && self.anisotropic {
+            s.anisotropy_clamp.min(manylight_core::material::MAX_ANISOTROPY)
+        } else {
+            1
+        };
         self.samplers
             .entry(s)
             .or_insert_with(|| {
@@ -742,8 +745,16 @@ impl SceneResources {
     }
 }
 
-/// Largest anisotropy of material samplers (where the adapter filters anisotropically).
-pub const MAX_ANISOTROPY: u16 = 16;
+/// The sampler of an empty texture slot (its 1×1 white texture): the cheapest there is. On
+/// lavapipe an anisotropic sampler costs its full price even on a 1×1 texture.
+const UNUSED_SLOT_SAMPLER: TextureSampler = TextureSampler {
+    address_mode_u: ImageAddressMode::ClampToEdge,
+    address_mode_v: ImageAddressMode::ClampToEdge,
+    mag_filter: ImageFilterMode::Nearest,
+    min_filter: ImageFilterMode::Nearest,
+    mipmap_filter: None,
+    anisotropy_clamp: 1,
+};
 
 fn view_entry(binding: u32, view: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
     wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(view) }

@@ -80,6 +80,24 @@ impl Scene {
         }
     }
 
+    /// Sets the anisotropic filtering of every texture of every material (1 = off; see
+    /// [`TextureSampler::anisotropy_clamp`](manylight_core::TextureSampler::anisotropy_clamp)).
+    pub fn set_anisotropy(&mut self, clamp: u16) {
+        for material in &mut self.materials {
+            let m = std::sync::Arc::make_mut(material);
+            let slots = [
+                &mut m.base_color_texture,
+                &mut m.metallic_roughness_texture,
+                &mut m.normal_texture,
+                &mut m.occlusion_texture,
+                &mut m.emissive_texture,
+            ];
+            for t in slots.into_iter().flatten() {
+                t.sampler.anisotropy_clamp = clamp;
+            }
+        }
+    }
+
     /// Checks that every index is in range and every number is usable (finite transforms,
     /// non-negative light and emissive parameters, valid meshes with finite tangents, every
     /// texture with the right byte count).

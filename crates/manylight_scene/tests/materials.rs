@@ -264,6 +264,7 @@ fn samplers_texture_transforms_and_the_second_uv_set_are_read() {
             mag_filter: Filter::Nearest,
             min_filter: Filter::Nearest,
             mipmap_filter: None,
+            anisotropy_clamp: TextureSampler::default().anisotropy_clamp,
         }
     );
     assert!(!base.sampler.allows_anisotropy());

@@ -380,6 +380,7 @@ impl<'a> Ctx<'a> {
             mag_filter,
             min_filter,
             mipmap_filter,
+            anisotropy_clamp: TextureSampler::default().anisotropy_clamp,
         }
     }
 
