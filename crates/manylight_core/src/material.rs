@@ -322,3 +322,38 @@ impl MaterialData {
         .flatten()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The specification's example: offset (0, 1), a quarter turn and half scale take the
+    /// lower left quadrant of the image, turned clockwise.
+    #[test]
+    fn gltf_uv_transform_matches_the_specification_example() {
+        let t = MaterialTexture {
+            uv_transform: MaterialTexture::gltf_uv_transform(
+                Vec2::new(0.0, 1.0),
+                std::f32::consts::FRAC_PI_2,
+                Vec2::splat(0.5),
+            ),
+            ..MaterialTexture::new(Arc::new(TextureData {
+                label: "t".into(),
+                width: 1,
+                height: 1,
+                rgba8: vec![255; 4],
+                srgb: true,
+            }))
+        };
+        for (uv, expected) in [((0.0, 0.0), (0.0, 1.0)), ((1.0, 0.0), (0.0, 0.5)), ((1.0, 1.0), (0.5, 0.5))] {
+            let got = t.sample_uv(Vec2::new(uv.0, uv.1), Vec2::ZERO);
+            assert!(got.distance(Vec2::new(expected.0, expected.1)) < 1e-6, "{uv:?}: {got}");
+        }
+        // The second uv set, untransformed.
+        let uv1 = MaterialTexture { uv_channel: UvChannel::Uv1, ..t.clone() };
+        assert_eq!(uv1.sample_uv(Vec2::ZERO, Vec2::ZERO), Vec2::new(0.0, 1.0));
+        assert!(TextureSampler::default().allows_anisotropy());
+        let off = TextureSampler { anisotropy_clamp: 1, ..TextureSampler::default() };
+        assert!(!off.allows_anisotropy());
+    }
+}

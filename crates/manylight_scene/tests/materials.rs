@@ -247,6 +247,8 @@ fn samplers_texture_transforms_and_the_second_uv_set_are_read() {
     let meshes =
         vec![mesh(json!({ "TEXCOORD_0": 2, "TEXCOORD_1": 2 }), 0), mesh(json!({ "TEXCOORD_0": 2 }), 0)];
     let mut doc = triangle_doc(meshes, materials, &[t]);
+    // Required, the extension loads without a warning.
+    doc["extensionsRequired"] = json!([t]);
     doc["textures"] = json!([{ "source": 0 }, { "source": 0, "sampler": 0 }, { "source": 0, "sampler": 1 }]);
     doc["samplers"] = json!([
         { "magFilter": 9728, "minFilter": 9728, "wrapS": 33071, "wrapT": 33648 },
