@@ -309,17 +309,32 @@ impl Default for MaterialData {
 }
 
 impl MaterialData {
+    /// The five texture slots in shader order (`TEXTURE_SLOT_*`: base colour,
+    /// metallic-roughness, normal, occlusion, emissive).
+    pub fn texture_slots(&self) -> [Option<&MaterialTexture>; 5] {
+        [
+            self.base_color_texture.as_ref(),
+            self.metallic_roughness_texture.as_ref(),
+            self.normal_texture.as_ref(),
+            self.occlusion_texture.as_ref(),
+            self.emissive_texture.as_ref(),
+        ]
+    }
+
+    /// [`MaterialData::texture_slots`], mutable.
+    pub fn texture_slots_mut(&mut self) -> [Option<&mut MaterialTexture>; 5] {
+        [
+            self.base_color_texture.as_mut(),
+            self.metallic_roughness_texture.as_mut(),
+            self.normal_texture.as_mut(),
+            self.occlusion_texture.as_mut(),
+            self.emissive_texture.as_mut(),
+        ]
+    }
+
     /// Every texture the material samples.
     pub fn textures(&self) -> impl Iterator<Item = &MaterialTexture> {
-        [
-            &self.base_color_texture,
-            &self.metallic_roughness_texture,
-            &self.normal_texture,
-            &self.occlusion_texture,
-            &self.emissive_texture,
-        ]
-        .into_iter()
-        .flatten()
+        self.texture_slots().into_iter().flatten()
     }
 }
 

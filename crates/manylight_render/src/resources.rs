@@ -595,14 +595,7 @@ impl SceneResources {
             }
             return Ok((k, m.order));
         }
-        // In TEXTURE_SLOT_* order.
-        let slots = [
-            material.base_color_texture.as_ref(),
-            material.metallic_roughness_texture.as_ref(),
-            material.normal_texture.as_ref(),
-            material.occlusion_texture.as_ref(),
-            material.emissive_texture.as_ref(),
-        ];
+        let slots = material.texture_slots();
         let mut views = Vec::with_capacity(slots.len());
         let mut samplers = Vec::with_capacity(slots.len());
         for slot in slots {

@@ -84,15 +84,7 @@ impl Scene {
     /// [`TextureSampler::anisotropy_clamp`](manylight_core::TextureSampler::anisotropy_clamp)).
     pub fn set_anisotropy(&mut self, clamp: u16) {
         for material in &mut self.materials {
-            let m = std::sync::Arc::make_mut(material);
-            let slots = [
-                &mut m.base_color_texture,
-                &mut m.metallic_roughness_texture,
-                &mut m.normal_texture,
-                &mut m.occlusion_texture,
-                &mut m.emissive_texture,
-            ];
-            for t in slots.into_iter().flatten() {
+            for t in std::sync::Arc::make_mut(material).texture_slots_mut().into_iter().flatten() {
                 t.sampler.anisotropy_clamp = clamp;
             }
         }
