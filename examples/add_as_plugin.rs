@@ -16,16 +16,16 @@ fn setup(mut commands: Commands) {
     for (x, z, color) in [(-13.0, -2.5, Vec3::new(1.0, 0.1, 0.05)), (-9.0, 2.5, Vec3::new(0.1, 0.3, 1.0))] {
         commands.spawn((
             Transform::from_xyz(x, 1.0, z),
-            PointLight { color, intensity: 60.0, range: 6.0, ..PointLight::default() },
+            PointLight { color, intensity: 750.0, range: 6.0, ..PointLight::default() },
         ));
     }
     let green =
-        PointLight { color: Vec3::new(0.2, 1.0, 0.3), intensity: 60.0, range: 6.0, ..PointLight::default() };
+        PointLight { color: Vec3::new(0.2, 1.0, 0.3), intensity: 750.0, range: 6.0, ..PointLight::default() };
     commands.spawn((Transform::from_xyz(-6.0, 1.5, 0.0), green, Orbiting));
     // A spot light over the nave, pointing down its -Z (here: straight down).
     commands.spawn((
         Transform::from_xyz(-2.0, 5.0, 0.0).looking_to(Vec3::NEG_Y, Vec3::X),
-        SpotLight { intensity: 300.0, range: 12.0, inner_angle: 0.25, outer_angle: 0.4, ..default() },
+        SpotLight { intensity: 3800.0, range: 12.0, inner_angle: 0.25, outer_angle: 0.4, ..default() },
     ));
     // Dim moonlight from above and to the side, reaching every surface that faces it.
     commands.spawn((

@@ -26,7 +26,7 @@
 use anyhow::{Result, bail};
 use clap::Parser;
 use manylight::app::cli::{parse_pipeline, parse_size};
-use manylight::core::Aabb;
+use manylight::core::{Aabb, lumens_from_candela};
 use manylight::prelude::*;
 use manylight::scene::{AnimatedLight, light_rig, sphere_shell_lights};
 use std::path::PathBuf;
@@ -171,7 +171,12 @@ pub fn sync_light_count(
         commands.spawn_batch(lights.into_iter().map(move |l| {
             (
                 Transform::from_translation(l.position),
-                PointLight { color: l.color, intensity: l.intensity, range: l.radius * scale, radius: 0.0 },
+                PointLight {
+                    color: l.color,
+                    intensity: lumens_from_candela(l.intensity),
+                    range: l.radius * scale,
+                    radius: 0.0,
+                },
                 ShellLight { base_radius: l.radius },
             )
         }));
@@ -182,7 +187,7 @@ pub fn sync_light_count(
                 Transform::from_translation(a.position_at(0.0)),
                 PointLight {
                     color: a.color_at(0.0),
-                    intensity: a.intensity,
+                    intensity: lumens_from_candela(a.intensity),
                     range: a.radius * scale,
                     radius: 0.0,
                 },

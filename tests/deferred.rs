@@ -157,12 +157,14 @@ fn nonfinite_hdr_pixels_are_counted() {
     let cam = scene.camera_or_fit(aspect);
     let eye = cam.transform.w_axis.truncate();
     let forward = -cam.transform.z_axis.truncate().normalize();
-    // Valid (finite, so not dropped as invalid), but its radiance overflows f32 in the shading
-    // sum near the light. (1e30 is not enough on lavapipe: it clamps f16 writes to 65504.)
+    // Valid (finite, so not dropped as invalid, also in lumens on its way through the app's
+    // `PointLight`), but 10 cm above the floor its radiance overflows f32 in the shading sum.
+    // (1e30 is not enough on lavapipe: it clamps f16 writes to 65504.)
+    let on_floor = eye + forward * 5.0;
     let light = SceneLight {
-        position: eye + forward * 2.0,
-        color: Vec3::ONE,
-        intensity: f32::MAX,
+        position: Vec3::new(on_floor.x, 0.1, on_floor.z),
+        color: Vec3::splat(10.0),
+        intensity: f32::MAX / 16.0,
         radius: 50.0,
         spot: None,
     };

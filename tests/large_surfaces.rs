@@ -157,7 +157,7 @@ fn lights() -> Vec<SceneLight> {
     let light = |x: f32, y: f32, z: f32, color: Vec3| SceneLight {
         position: Vec3::new(x, y, z),
         color,
-        intensity: 3.0,
+        intensity: 0.3,
         radius: 5.0,
         spot: None,
     };
@@ -251,7 +251,8 @@ fn analytic_floor(extent: f64, far: f64, settings: &RenderSettings) -> image::Rg
                 }
                 let ratio2 = (d / r) * (d / r);
                 let window = (1.0 - ratio2 * ratio2).clamp(0.0, 1.0);
-                let att = window * window / (d * d + 1.0);
+                let min_d = f64::from(manylight::core::LIGHT_MIN_DISTANCE);
+                let att = window * window / (d * d).max(min_d * min_d);
                 let l = scale(to_light, 1.0 / d);
                 let n_dot_l = dot(n, l).max(0.0);
                 let mut spec = 0.0;

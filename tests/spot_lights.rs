@@ -89,7 +89,7 @@ fn a_spot_light_component_lights_only_its_cone() {
     };
     let dark = render(None);
     let lit = render(Some(SpotLight {
-        intensity: 200.0,
+        intensity: 2500.0,
         range: 30.0,
         inner_angle: 0.3,
         outer_angle: 0.5,

@@ -1,9 +1,10 @@
 // Point and spot lights (Rust: `GpuPointLight`) and the attenuation shared with
-// crates/manylight_core/src/attenuation.rs: saturate(1 - (d/r)^4)^2 / (d^2 + 1), exactly 0 at r.
+// crates/manylight_core/src/attenuation.rs: saturate(1 - (d/r)^4)^2 / max(d^2, LIGHT_MIN_DISTANCE^2),
+// exactly 0 at r; times a light's intensity (candela) it is the illuminance (lux) facing it.
 struct GpuPointLight {
     // xyz: world position, w: radius
     position_radius: vec4<f32>,
-    // rgb: colour * intensity (linear), a: the spot falloff's offset (1 for a point light)
+    // rgb: colour * intensity (linear, candela), a: the spot falloff's offset (1 for a point light)
     color: vec4<f32>,
     // xyz: a spot light's unit direction (0 for a point light), w: the falloff's scale (0)
     spot: vec4<f32>,
@@ -23,5 +24,5 @@ fn attenuation(distance: f32, radius: f32) -> f32 {
     let ratio = distance / radius;
     let ratio2 = ratio * ratio;
     let window = saturate(1.0 - ratio2 * ratio2);
-    return window * window / (distance * distance + 1.0);
+    return window * window / max(distance * distance, LIGHT_MIN_DISTANCE * LIGHT_MIN_DISTANCE);
 }

@@ -232,14 +232,18 @@ impl Projection {
     }
 }
 
-/// A point light at the entity's [`GlobalTransform`] translation, in Bevy's words: `range` is
-/// the cut-off distance, `radius` the size of the emitter.
+/// A point light at the entity's [`GlobalTransform`] translation, in Bevy's words and units:
+/// `intensity` is the luminous power in lumens (emitted evenly in every direction, so the
+/// shading uses `intensity / 4π` candela), `range` the cut-off distance, `radius` the size of
+/// the emitter. With a camera without [`Exposure`], a few hundred lumens light a room-sized
+/// scene (glTF's and the Khronos viewer's scale); Bevy's default of a million lumens wants
+/// [`Exposure::BLENDER`].
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
 #[require(Transform, Visibility)]
 pub struct PointLight {
     /// Linear RGB colour.
     pub color: Vec3,
-    /// Multiplier of `color`.
+    /// Luminous power in lumens (multiplies `color`).
     pub intensity: f32,
     /// Distance at which the contribution reaches exactly zero (the light's sphere of
     /// influence, which the cluster build culls with).
@@ -251,20 +255,22 @@ pub struct PointLight {
 
 impl Default for PointLight {
     fn default() -> Self {
-        Self { color: Vec3::ONE, intensity: 10.0, range: 10.0, radius: 0.0 }
+        Self { color: Vec3::ONE, intensity: 800.0, range: 10.0, radius: 0.0 }
     }
 }
 
 /// A light shining in a cone down the entity's local -Z (its [`GlobalTransform`]'s forward), in
 /// Bevy's words: full strength within `inner_angle` of the axis, fading to exactly zero at
 /// `outer_angle` (glTF `KHR_lights_punctual` spot lights). The cluster build culls it with the
-/// sphere around its cone, smaller than a point light's of the same `range`.
+/// sphere around its cone, smaller than a point light's of the same `range`. `intensity` is in
+/// lumens and converted to candela as Bevy does, as if the light shone in every direction
+/// (`intensity / 4π`): narrowing the cone does not brighten it.
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
 #[require(Transform, Visibility)]
 pub struct SpotLight {
     /// Linear RGB colour.
     pub color: Vec3,
-    /// Multiplier of `color`.
+    /// Luminous power in lumens (multiplies `color`).
     pub intensity: f32,
     /// Distance at which the contribution reaches exactly zero.
     pub range: f32,
@@ -280,7 +286,7 @@ impl Default for SpotLight {
     fn default() -> Self {
         Self {
             color: Vec3::ONE,
-            intensity: 10.0,
+            intensity: 800.0,
             range: 10.0,
             radius: 0.0,
             inner_angle: 0.0,
@@ -298,7 +304,7 @@ impl Default for SpotLight {
 pub struct DirectionalLight {
     /// Linear RGB colour.
     pub color: Vec3,
-    /// Illuminance, multiplying `color`.
+    /// Illuminance in lux, multiplying `color`.
     pub illuminance: f32,
 }
 
@@ -326,6 +332,11 @@ pub struct LightAnimation(pub manylight_scene::AnimatedLight);
 /// [`BloomSettings`](manylight_render::BloomSettings) itself, a component (no mirror to keep in
 /// step). A camera without it gets no bloom passes and no bloom textures.
 pub type Bloom = manylight_render::BloomSettings;
+
+/// The camera's exposure (EV100), Bevy's `Exposure`: the render crate's
+/// [`Exposure`](manylight_render::Exposure) itself, a component. A camera without it uses
+/// `RenderSettings::exposure` (a multiplier, 1 by default).
+pub type Exposure = manylight_render::Exposure;
 
 /// Camera-motion blur on the camera: the render crate's
 /// [`MotionBlurSettings`](manylight_render::MotionBlurSettings) itself, a component. A camera

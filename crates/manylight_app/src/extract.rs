@@ -3,15 +3,16 @@
 
 use crate::backend::{RenderBackend, record_results};
 use crate::components::{
-    Bloom, Camera, Camera3d, CameraDebugView, DirectionalLight, GlobalTransform, InheritedVisibility,
-    LightAnimation, Material, Mesh3d, MotionBlur, PointLight, Projection, RenderTarget, SpotLight, Transform,
+    Bloom, Camera, Camera3d, CameraDebugView, DirectionalLight, Exposure, GlobalTransform,
+    InheritedVisibility, LightAnimation, Material, Mesh3d, MotionBlur, PointLight, Projection, RenderTarget,
+    SpotLight, Transform,
 };
 use crate::resources::{DebugView, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize};
 use bevy_app::AppExit;
 use bevy_ecs::prelude::*;
 use bevy_time::Time;
 use glam::Mat4;
-use manylight_core::{MaterialData, SpotCone};
+use manylight_core::{MaterialData, SpotCone, candela_from_lumens};
 use manylight_render::{
     ExtractedCamera, ExtractedDirectionalLight, ExtractedInstance, ExtractedPointLight, ExtractedView,
     FrameSnapshot, ViewRect, ViewTarget,
@@ -38,6 +39,7 @@ pub type CameraItem = (
     Option<&'static Bloom>,
     Option<&'static MotionBlur>,
     Option<&'static CameraDebugView>,
+    Option<&'static Exposure>,
 );
 
 /// What extract reads of a mesh entity (hidden ones are skipped).
@@ -74,7 +76,7 @@ pub fn build_snapshot(
     let mut views: Vec<ExtractedView> = Vec::with_capacity(cameras.iter().len());
     // Last frame's cameras; the map is rebuilt from this frame's, so removed ones go.
     let prev_cameras = std::mem::take(&mut state.prev_cameras);
-    for (entity, t, projection, camera, bloom, motion_blur, debug) in cameras.iter() {
+    for (entity, t, projection, camera, bloom, motion_blur, debug, exposure) in cameras.iter() {
         let camera = camera.copied().unwrap_or_default();
         if !camera.is_active {
             continue;
@@ -97,6 +99,7 @@ pub fn build_snapshot(
                 prev_clip_from_world: None,
                 bloom: bloom.copied(),
                 motion_blur: motion_blur.copied(),
+                exposure: exposure.copied(),
             },
             target,
             rect,
@@ -130,8 +133,9 @@ pub fn build_snapshot(
             continue;
         }
         // One light per entity: a point light wins over a spot light, which wins over a
-        // directional one.
-        let (color, intensity, range, cone) = match (point, spot, directional) {
+        // directional one. Point and spot lights come in lumens (Bevy's unit) and render in
+        // candela.
+        let (color, lumens, range, cone) = match (point, spot, directional) {
             (Some(l), ..) => (l.color, l.intensity, l.range, None),
             (None, Some(l), _) => {
                 let direction = t.forward().into();
@@ -152,7 +156,7 @@ pub fn build_snapshot(
         point_lights.push(ExtractedPointLight {
             position: t.translation(),
             color,
-            intensity,
+            intensity: candela_from_lumens(lumens),
             radius: range,
             spot: cone,
         });

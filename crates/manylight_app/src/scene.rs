@@ -7,7 +7,7 @@ use crate::components::{
 use bevy_ecs::name::Name;
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
-use manylight_core::Aabb;
+use manylight_core::{Aabb, lumens_from_candela};
 use manylight_render::{
     ExtractedCamera, ExtractedDirectionalLight, ExtractedInstance, ExtractedPointLight, ExtractedView,
     FrameSettings, FrameSnapshot,
@@ -117,7 +117,8 @@ fn spawn_instance(
 /// that its -Z is the cone's direction. `local` places it relative to the parent; a light that
 /// hangs from a glTF node (`on_node`) already points down that node's -Z.
 fn spawn_light(commands: &mut Commands, light: &SceneLight, local: Transform, on_node: bool, parent: Entity) {
-    let (color, intensity, range) = (light.color, light.intensity, light.radius);
+    // Scene lights are in candela (glTF); the components in lumens (Bevy).
+    let (color, intensity, range) = (light.color, lumens_from_candela(light.intensity), light.radius);
     match &light.spot {
         None => {
             commands.spawn((local, PointLight { color, intensity, range, radius: 0.0 }, ChildOf(parent)));
@@ -155,7 +156,7 @@ pub fn spawn_light_rig(commands: &mut Commands, count: usize, bounds: Aabb, seed
             Transform::from_translation(anim.position_at(0.0)),
             PointLight {
                 color: anim.color_at(0.0),
-                intensity: anim.intensity,
+                intensity: lumens_from_candela(anim.intensity),
                 range: anim.radius,
                 radius: 0.0,
             },
@@ -204,6 +205,7 @@ pub fn scene_snapshot(
             prev_clip_from_world: None,
             bloom: None,
             motion_blur: None,
+            exposure: None,
         })],
         instances: scene
             .instances

@@ -203,11 +203,15 @@ struct RenderArgs {
     /// Shading model for materials without their own: pbr (default), lambert, blinn-phong or toon.
     #[arg(long, default_value = "pbr", value_parser = parse_shading)]
     shading: ShadingModel,
-    /// Animated lights added to the scene's own lights (default: 64 for a scene that has no
-    /// lights of its own, so it is not black; 0 otherwise). For `sphere-shell`: the lights of
-    /// its lattice instead (default 100 000).
+    /// Animated lights (inside the scene's bounds) added to the scene's own lights (default 0).
+    /// For `sphere-shell`: the lights of its lattice instead (default 100 000).
     #[arg(long)]
     lights: Option<usize>,
+    /// Static white lights on a dome around the scene, as a model viewer lights a model
+    /// (default: 32 for a scene that brings no lights of its own and no `--lights`, so it is
+    /// not black; 0 otherwise).
+    #[arg(long)]
+    studio_lights: Option<usize>,
     /// Image size, WxH.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     size: UVec2,
@@ -215,8 +219,13 @@ struct RenderArgs {
     #[arg(long, default_value_t = 1)]
     frames: u32,
     /// Exposure multiplier before tone mapping.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, conflicts_with = "ev100")]
     exposure: f32,
+    /// Photographic exposure value at ISO 100 instead of `--exposure` (multiplier
+    /// 1 / (1.2 · 2^EV100)): about 15 for sunlight, 7 for a lamp-lit room, with lights in
+    /// physical units.
+    #[arg(long, allow_hyphen_values = true)]
+    ev100: Option<f32>,
     /// Constant ambient light, as a fraction of albedo (default: 0.03, or 0.2 for a scene
     /// that brings no lights of its own, so its shapes read).
     #[arg(long)]
@@ -417,7 +426,10 @@ fn render(args: RenderArgs) -> Result<()> {
         scene.lights = manylight_scene::sphere_shell_lights(n, 50.0, 0.3, args.seed);
     }
     let unlit = scene.lights.is_empty();
-    let lights = if shell { 0 } else { args.lights.unwrap_or(if unlit { 64 } else { 0 }) };
+    let lights = if shell { 0 } else { args.lights.unwrap_or(0) };
+    let studio = args.studio_lights.unwrap_or(if unlit && args.lights.is_none() { 32 } else { 0 });
+    let studio = manylight_scene::studio_lights(studio, scene.bounds());
+    scene.lights.extend(studio);
     let ambient = args.ambient.unwrap_or(if unlit { 0.2 } else { RenderSettings::default().ambient });
     let culling = if args.culling_efficiency {
         let rig = manylight_scene::light_rig(lights, scene.bounds(), args.seed);
@@ -452,7 +464,7 @@ fn render(args: RenderArgs) -> Result<()> {
     let settings = RenderSettings {
         pipeline: args.pipeline,
         shading: args.shading,
-        exposure: args.exposure,
+        exposure: args.ev100.map_or(args.exposure, |ev100| manylight_app::Exposure { ev100 }.multiplier()),
         ambient,
         clusters: args.clusters.settings(),
         gbuffer: args.clusters.gbuffer,

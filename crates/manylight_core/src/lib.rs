@@ -17,7 +17,9 @@ pub mod mesh;
 pub mod spot;
 pub mod tonemap;
 
-pub use attenuation::{attenuation, radius_for_intensity};
+pub use attenuation::{
+    LIGHT_MIN_DISTANCE, attenuation, candela_from_lumens, lumens_from_candela, radius_for_intensity,
+};
 pub use camera::{Projection, ProjectionKind, linearize_depth_reverse_z};
 pub use material::{
     AlphaMode, ImageAddressMode, ImageFilterMode, MaterialData, MaterialTexture, ShadingModel, TextureData,

@@ -295,6 +295,7 @@ impl GpuTextureUv {
 pub fn shared_f32_constants() -> Vec<(&'static str, f32)> {
     vec![
         ("RADIUS_INFLATION", manylight_core::cluster::RADIUS_INFLATION),
+        ("LIGHT_MIN_DISTANCE", manylight_core::attenuation::LIGHT_MIN_DISTANCE),
         ("TILE_PREFILTER_INFLATION", manylight_core::cluster::TILE_PREFILTER_INFLATION),
         ("TOON_RIM_STRENGTH", manylight_core::material::TOON_RIM_STRENGTH),
         ("PBR_MIN_ROUGHNESS", manylight_core::brdf::PBR_MIN_ROUGHNESS),

@@ -384,7 +384,7 @@ impl SceneResources {
                     prev_clip_from_world: cam.prev_clip_from_world.unwrap_or(clip_from_world),
                     camera_position: cam.position().extend(1.0),
                     viewport: viewport_vec(size),
-                    params: Vec4::new(p.near, p.near_over_far(), settings.exposure, settings.ambient),
+                    params: Vec4::new(p.near, p.near_over_far(), view.exposure(), settings.ambient),
                     light_count: self.light_count,
                     shading_model: settings.shading.gpu_id(),
                     directional_count: self.directional_count,

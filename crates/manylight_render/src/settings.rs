@@ -32,7 +32,7 @@ impl BloomChain {
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "bevy", derive(bevy_ecs::component::Component))]
 pub struct BloomSettings {
-    /// HDR brightness (largest channel, before exposure) where bloom starts.
+    /// Brightness (largest channel, after the camera's exposure) where bloom starts.
     pub threshold: f32,
     /// Width of the soft knee below the threshold (0 = hard cut).
     pub knee: f32,
@@ -72,6 +72,51 @@ impl BloomSettings {
             intensity: finite_or(self.intensity, 0.0),
             ..*self
         }
+    }
+}
+
+/// A camera's exposure in photographic terms, Bevy's `Exposure`: `ev100` is the exposure value
+/// at ISO 100, and the HDR image is multiplied by `1 / (1.2 · 2^ev100)` before tone mapping
+/// (the saturation-based sensitivity). Use it with lights in physical units (candela, lux,
+/// lumens): a sunlit scene wants about [`Exposure::SUNLIGHT`], a lamp-lit room
+/// [`Exposure::INDOOR`]. With the `bevy` feature it is a component (the app's `Exposure`); a
+/// camera without it uses `RenderSettings::exposure` (a plain multiplier, 1 by default, which
+/// suits glTF sample scenes' light values as the Khronos viewer shows them).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_ecs::component::Component))]
+pub struct Exposure {
+    /// Exposure value at ISO 100 (larger: darker image).
+    pub ev100: f32,
+}
+
+impl Exposure {
+    /// Bright sunlight.
+    pub const SUNLIGHT: Exposure = Exposure { ev100: 15.0 };
+    /// An overcast day.
+    pub const OVERCAST: Exposure = Exposure { ev100: 12.0 };
+    /// A lamp-lit interior.
+    pub const INDOOR: Exposure = Exposure { ev100: 7.0 };
+    /// Blender's default camera (Bevy's default).
+    pub const BLENDER: Exposure = Exposure { ev100: 9.7 };
+
+    /// The exposure that multiplies the HDR image by `multiplier` (for `multiplier > 0`).
+    pub fn from_multiplier(multiplier: f32) -> Exposure {
+        Exposure { ev100: -(multiplier * 1.2).log2() }
+    }
+
+    /// The multiplier `1 / (1.2 · 2^ev100)`; 1 for a non-finite `ev100`, and always finite
+    /// (`ev100` is clamped to ±100).
+    pub fn multiplier(&self) -> f32 {
+        if !self.ev100.is_finite() {
+            return 1.0;
+        }
+        (-self.ev100.clamp(-100.0, 100.0)).exp2() / 1.2
+    }
+}
+
+impl Default for Exposure {
+    fn default() -> Self {
+        Exposure::BLENDER
     }
 }
 

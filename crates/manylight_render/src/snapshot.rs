@@ -7,7 +7,7 @@ use manylight_core::codec::NormalCodec;
 use manylight_core::{MaterialData, MeshData, Projection, ShadingModel, SpotCone};
 use std::sync::Arc;
 
-pub use crate::settings::{BloomChain, BloomSettings, MotionBlurSettings};
+pub use crate::settings::{BloomChain, BloomSettings, Exposure, MotionBlurSettings};
 
 /// Which many-light pipeline renders the frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -287,7 +287,7 @@ pub struct RenderSettings {
     pub pipeline: PipelineKind,
     /// The shading model for materials that do not choose one.
     pub shading: ShadingModel,
-    /// Multiplier applied before tone mapping.
+    /// Multiplier applied before tone mapping, for cameras without an [`Exposure`].
     pub exposure: f32,
     /// Constant ambient term (fraction of albedo).
     pub ambient: f32,
@@ -370,6 +370,8 @@ pub struct ExtractedCamera {
     pub bloom: Option<BloomSettings>,
     /// Camera-motion blur, when the camera has it.
     pub motion_blur: Option<MotionBlurSettings>,
+    /// The camera's exposure, when it has one (else `RenderSettings::exposure`).
+    pub exposure: Option<Exposure>,
 }
 
 impl ExtractedCamera {
@@ -422,7 +424,7 @@ pub struct ExtractedPointLight {
     pub position: Vec3,
     /// Linear RGB colour.
     pub color: Vec3,
-    /// Multiplier of `color`.
+    /// Luminous intensity in candela, multiplying `color`.
     pub intensity: f32,
     /// Radius of influence (contribution is exactly 0 at and beyond it).
     pub radius: f32,
@@ -539,6 +541,12 @@ pub struct RenderView {
 }
 
 impl RenderView {
+    /// What the HDR image is multiplied by before tone mapping: the camera's [`Exposure`], or
+    /// the settings' multiplier for a camera without one.
+    pub fn exposure(&self) -> f32 {
+        self.camera.and_then(|c| c.exposure).map_or(self.settings.render.exposure, |e| e.multiplier())
+    }
+
     /// True when the view needs the cluster build: a tiled/clustered pipeline with lights
     /// (`has_lights`) and no debug view, or a debug view that shows cluster data.
     pub fn needs_clusters(&self, has_lights: bool) -> bool {

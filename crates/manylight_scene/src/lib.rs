@@ -19,7 +19,7 @@ pub use gltf_loader::{
 };
 pub use light_rig::{
     AnimatedLight, RIG_RADIUS_K, SplitMix64, intensity_for_radius, light_rig, sphere_shell_lights,
-    sphere_shell_scene,
+    sphere_shell_scene, studio_lights,
 };
 pub use scene_ops::{camera_looking_at, load_scene};
 
@@ -86,7 +86,7 @@ pub struct SceneLight {
     pub position: Vec3,
     /// Linear RGB colour.
     pub color: Vec3,
-    /// Scalar multiplier of `color`.
+    /// Luminous intensity in candela (glTF `KHR_lights_punctual`'s unit), multiplying `color`.
     pub intensity: f32,
     /// Distance at which the light's contribution reaches exactly zero.
     pub radius: f32,

@@ -34,7 +34,7 @@ pub struct AnimatedLight {
     pub color: Vec3,
     /// Flicker angular speed in radians per second (hue drift is ten times slower).
     pub flicker_speed: f32,
-    /// Intensity multiplier of the colour.
+    /// Luminous intensity in candela (multiplies the colour).
     pub intensity: f32,
     /// Distance at which the light's contribution reaches zero.
     pub radius: f32,
@@ -137,13 +137,14 @@ fn hsv(h: f32, s: f32) -> Vec3 {
     }
 }
 
-/// Intensity for a light of radius `r`: `(0.36 r² + 1) / 3`.
+/// Intensity (candela) for a light of radius `r`: `0.12 r²`.
 ///
 /// A point sees about 4 lights (see [`RIG_RADIUS_K`]) at a typical distance of 0.6 r, where
-/// the windowed falloff is about `0.76 / (0.36 r² + 1)`; this intensity makes their sum about 1
-/// whatever the radius, so 16 big lights and 4096 small ones light a scene similarly.
+/// the windowed inverse-square falloff is about `0.76 / (0.36 r²)`; this intensity makes their
+/// sum about 1 lux whatever the radius, so 16 big lights and 4096 small ones light a scene
+/// similarly.
 pub fn intensity_for_radius(r: f32) -> f32 {
-    (0.36 * r * r + 1.0) / 3.0
+    0.12 * r * r
 }
 
 /// `count` animated lights placed deterministically (for `seed`) inside `bounds`.
@@ -222,6 +223,40 @@ pub fn sphere_shell_lights(count: usize, shell_radius: f32, light_range: f32, se
         .collect()
 }
 
+/// `count` static white point lights on a dome around `bounds`, as a model viewer lights a model
+/// that brings no lights of its own.
+///
+/// The lights lie on a Fibonacci (golden-angle) lattice on the sphere of radius `2ρ` about the
+/// centre of `bounds` (`ρ` = half its diagonal), each reaching `4ρ` (the whole model from any
+/// point of the dome), with `18 ρ² / count` candela each: a surface near the centre facing out
+/// then receives about 1 lux from the lights of its side (`count/4π` lights per steradian, each
+/// `I · 0.88 / (2ρ)²` with the window at half the range, integrated over the cosine). An empty
+/// or non-finite `bounds` is replaced by the cube [-1, 1]³.
+pub fn studio_lights(count: usize, bounds: Aabb) -> Vec<SceneLight> {
+    let usable =
+        !bounds.is_empty() && bounds.min.is_finite() && bounds.max.is_finite() && bounds.size().is_finite();
+    let bounds = if usable { bounds } else { Aabb { min: Vec3::splat(-1.0), max: Vec3::ONE } };
+    let rho = (bounds.size().length() * 0.5).max(1e-3);
+    let center = bounds.center();
+    let intensity = 18.0 * rho * rho / count.max(1) as f32;
+    let golden_angle = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    (0..count)
+        .map(|i| {
+            let y = 1.0 - 2.0 * (i as f64 + 0.5) / count as f64;
+            let ring = (1.0 - y * y).max(0.0).sqrt();
+            let theta = (golden_angle * i as f64).rem_euclid(TAU);
+            let dir = Vec3::new((theta.cos() * ring) as f32, y as f32, (theta.sin() * ring) as f32);
+            SceneLight {
+                position: center + dir * (2.0 * rho),
+                color: Vec3::ONE,
+                intensity,
+                radius: 4.0 * rho,
+                spot: None,
+            }
+        })
+        .collect()
+}
+
 /// The sphere-shell stress scene: an inward-facing white sphere of radius 50 (~2200
 /// triangles), a 5 × 5 × 5 box at (0, 50, 0), a camera at the origin (45° vertical fov,
 /// near 0.1, far 1000) and no lights (add [`sphere_shell_lights`]).
@@ -259,6 +294,29 @@ pub fn sphere_shell_scene() -> Scene {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn studio_lights_give_about_one_lux_facing_out() {
+        let bounds = Aabb { min: Vec3::new(-3.0, 0.0, -1.0), max: Vec3::new(5.0, 2.0, 1.0) };
+        let lights = studio_lights(64, bounds);
+        let rho = bounds.size().length() * 0.5;
+        for l in &lights {
+            assert!(((l.position - bounds.center()).length() - 2.0 * rho).abs() < 1e-3 * rho);
+            assert!(l.radius >= 3.0 * rho, "reaches the whole model");
+        }
+        // Illuminance at the centre on surfaces facing along each axis.
+        for n in [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z] {
+            let e: f32 = lights
+                .iter()
+                .map(|l| {
+                    let to = l.position - bounds.center();
+                    let cos = n.dot(to.normalize()).max(0.0);
+                    l.intensity * manylight_core::attenuation(to.length(), l.radius) * cos
+                })
+                .sum();
+            assert!((0.85..1.15).contains(&e), "{n}: {e} lux");
+        }
+    }
 
     #[test]
     fn hsv_is_in_unit_range_and_saturated() {

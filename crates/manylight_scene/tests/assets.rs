@@ -84,7 +84,7 @@ fn cornell_box_many_lights_has_64_small_lights() {
     assert_eq!(s.lights.len(), 64);
     for l in &s.lights {
         assert!((l.radius - 0.15).abs() < 1e-6, "{}", l.radius);
-        assert!((l.intensity - 0.02).abs() < 1e-6);
+        assert!((l.intensity - 0.0001).abs() < 1e-9);
     }
     assert_eq!(s.cameras.len(), 1);
     let single = load("CornellBox/CornellBox.gltf");

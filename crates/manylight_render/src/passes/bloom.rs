@@ -339,9 +339,12 @@ impl Pass for BloomCompositePass {
 /// Bright pass, blur chain and composite: needed when the camera has bloom and no debug view
 /// replaces the image.
 pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn Pass>>) {
-    if let Some(bloom) = p.view.camera.and_then(|c| c.bloom)
+    if let Some(mut bloom) = p.view.camera.and_then(|c| c.bloom)
         && p.shows_image()
     {
+        // The threshold is in exposed brightness: the bright pass reads the HDR image before
+        // the tone map multiplies it by the exposure.
+        bloom.threshold /= p.view.exposure().max(f32::MIN_POSITIVE);
         out.extend(bloom_passes(&bloom));
     }
 }
