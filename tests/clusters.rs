@@ -413,3 +413,85 @@ fn spot_rig(points: &[ExtractedPointLight]) -> Vec<ExtractedPointLight> {
         })
         .collect()
 }
+
+/// The oracle: exact per-pixel lists built on the CPU from a clustered frame's depth and lists.
+/// Shaded from them (no cluster build), the frame equals naive forward's (the same sum: only
+/// lights whose sphere does not hold the pixel are left out), its lists hold exactly the
+/// contributing pairs (culling ratio 1, nothing missing against every light) and are never
+/// longer than the clustered lists. On the rig and on the hard cases.
+#[test]
+fn exact_pixel_lists_shade_the_naive_image() {
+    use manylight::core::efficiency::{culling_efficiency, exact_pixel_lists, pixel_grid};
+    let _gpu = gpu();
+    let mut r = HeadlessRenderer::new().expect("adapter");
+    let scene = default_scene();
+    let size = UVec2::new(160, 96);
+    let cam = scene.camera_or_fit(size.x as f32 / size.y as f32);
+    let eye = cam.transform.w_axis.truncate();
+    let forward = -cam.transform.z_axis.truncate().normalize();
+    let mut hard = rig(&scene, 512, 4);
+    hard.extend([
+        light(eye, 2.0),                            // contains the camera
+        light(eye + forward * 0.1, 0.5),            // straddles the near plane
+        light(eye + forward * 5.0, 0.0),            // radius 0
+        light(eye + forward * 5.0, 1.0e4),          // covers the whole view
+        light(eye + forward * 199.0, 3.0),          // straddles the far plane
+        light(eye + forward * 3.0 + Vec3::Y, 1e-3), // tiny
+    ]);
+    let lit = |lights: &[ExtractedPointLight]| {
+        let mut lights = lights.to_vec();
+        for l in &mut lights {
+            l.intensity *= 0.2;
+        }
+        lights
+    };
+    for (what, lights) in [("rig", rig(&scene, 256, 9)), ("hard cases", lit(&hard))] {
+        let settings = clustered(CullTest::Both, ZSlicing::Exponential, None);
+        let snap = scene_snapshot(&scene, size, lights.clone(), settings);
+        let projection = snap.camera().expect("camera").projection;
+        r.render(snap.clone(), false).expect("renders");
+        let renderer = r.render_world.renderer();
+        let clusters = renderer.view_clusters(0).expect("clusters");
+        let assignment = clusters.read_assignment(&renderer.gpu).expect("lists");
+        let (_, _, depth) = renderer.read_depth().expect("readback").expect("depth");
+        let spheres = clusters.view_spheres.clone();
+        let lists = exact_pixel_lists(&clusters.grid, &projection, &assignment, &spheres, &depth);
+        assert!(lists.indices.len() < assignment.indices.len() * 64, "{what}: lists are per pixel");
+        let grid = pixel_grid(size, &projection);
+        let e = culling_efficiency(&grid, &projection, &lists, &spheres, &depth, 1);
+        assert_eq!(e.missed_pairs, 0, "{what}: the exact lists miss a contributing light: {e:?}");
+        assert_eq!(
+            e.evaluated_pairs, e.contributing_pairs,
+            "{what}: the exact lists hold a light that does not contribute"
+        );
+        let clustered = culling_efficiency(&clusters.grid, &projection, &assignment, &spheres, &depth, 0);
+        assert!(e.evaluated_pairs <= clustered.evaluated_pairs);
+
+        let oracle = FrameSnapshot { pixel_light_lists: Some(std::sync::Arc::new(lists)), ..snap.clone() };
+        let (report, image) = r.render(oracle, true).expect("renders from the lists");
+        let names: Vec<&str> = report.passes.iter().map(|p| p.name.as_str()).collect();
+        assert!(!names.contains(&"cluster_build") && names.contains(&"pixel_light_lists"), "{names:?}");
+        assert_eq!(report.nonfinite_pixels, Some(0));
+        let mut naive = snap;
+        naive.settings.render.pipeline = PipelineKind::NaiveForward;
+        let (_, expected) = r.render(naive, true).expect("naive renders");
+        let (image, expected) = (image.expect("image"), expected.expect("image"));
+        support::assert_similar(&format!("oracle, {what}"), &expected, &image, support::STRICT);
+    }
+
+    // Lists that do not fit the view are refused, not read out of bounds.
+    let snap = scene_snapshot(
+        &scene,
+        size,
+        rig(&scene, 16, 1),
+        clustered(CullTest::Both, ZSlicing::Exponential, None),
+    );
+    let wrong = ClusterAssignment {
+        ranges: vec![[0, 1]; 10],
+        indices: vec![0],
+        dropped_pairs: 0,
+        clusters_overflowed: 0,
+    };
+    let err = r.render(FrameSnapshot { pixel_light_lists: Some(std::sync::Arc::new(wrong)), ..snap }, false);
+    assert!(err.is_err(), "lists of 10 pixels for a 160×96 view must be refused");
+}

@@ -169,6 +169,7 @@ pub fn build_snapshot(
         lights: point_lights,
         directional_lights,
         settings: crate::resources::frame_settings(settings, debug),
+        pixel_light_lists: None,
     };
     state.frame_index += 1;
     snapshot

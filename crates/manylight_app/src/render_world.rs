@@ -39,12 +39,17 @@ pub struct CurrentSnapshot(pub FrameSnapshot);
 /// The view being rendered (its camera, image size and settings), whether the frame has
 /// lights to shade it with, and whether it draws blended materials.
 #[derive(Resource, Clone, Copy, Debug)]
-pub struct CurrentView(pub RenderView, pub bool, pub bool);
+pub struct CurrentView(pub RenderView, pub bool, pub bool, pub bool);
 
 impl CurrentView {
     /// View `index` of `snapshot`.
     pub fn of(snapshot: &FrameSnapshot, index: usize) -> CurrentView {
-        CurrentView(snapshot.render_view(index), snapshot.has_lights(), snapshot.has_blended())
+        CurrentView(
+            snapshot.render_view(index),
+            snapshot.has_lights(),
+            snapshot.has_blended(),
+            snapshot.pixel_light_lists.is_some(),
+        )
     }
 
     fn has_lights(&self) -> bool {
@@ -61,6 +66,7 @@ impl CurrentView {
             view: &self.0,
             has_lights: self.has_lights(),
             has_blended: self.has_blended(),
+            has_pixel_lists: self.3,
             accumulation,
         }
     }

@@ -220,5 +220,6 @@ pub fn scene_snapshot(
             .collect(),
         lights,
         settings,
+        pixel_light_lists: None,
     }
 }

@@ -1,7 +1,7 @@
 //! `manylight bench`: pipelines × light counts at one size, each frame rendered synchronously
 //! and timed end to end (prepare, record, submit, wait), written as CSV.
 
-use crate::direct::{measure_culling, snapshot};
+use crate::direct::{measure_culling, oracle_snapshot, snapshot};
 use crate::progress::Progress;
 use anyhow::{Context, Result};
 use glam::UVec2;
@@ -19,6 +19,23 @@ pub struct Row {
     frame_ms: Vec<f64>,
     last: FrameReport,
     culling: Option<f64>,
+    /// The oracle's row: the same frames shaded from exact per-pixel lists.
+    oracle: bool,
+}
+
+/// Passes that shade lights (a pipeline's lighting cost): `forward`, `clustered_forward`,
+/// `deferred_lighting`, `light_volumes`.
+pub const SHADING_PASSES: [&str; 4] = ["forward", "clustered_forward", "deferred_lighting", "light_volumes"];
+
+/// GPU milliseconds of `report`'s shading passes ([`SHADING_PASSES`]); `None` without timings.
+pub fn shading_ms(report: &FrameReport) -> Option<f64> {
+    let times: Vec<f64> = report
+        .passes
+        .iter()
+        .filter(|p| SHADING_PASSES.contains(&p.name.as_str()))
+        .filter_map(|p| p.gpu_ms)
+        .collect();
+    (!times.is_empty()).then(|| times.iter().sum())
 }
 
 /// The median of `v` (the upper one of an even count; NaN when empty).
@@ -52,6 +69,9 @@ pub struct Sweep {
     pub naive_max_lights: usize,
     /// Also measure the culling efficiency of the tiled/clustered pipelines.
     pub culling_efficiency: bool,
+    /// Also render each light count's frames with exact per-pixel light lists (the oracle) and
+    /// give every row its shading time against the oracle's.
+    pub oracle: bool,
     /// G-buffer layouts swept for the deferred pipeline.
     pub gbuffers: Vec<GBufferLayout>,
     /// Settings other than the pipeline.
@@ -77,7 +97,9 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
         })
         .filter(|&(p, _, n)| p != PipelineKind::NaiveForward || n <= sweep.naive_max_lights)
         .collect();
-    let mut progress = Progress::new(configs.len() as u64, "configurations");
+    let oracles: Vec<usize> =
+        if sweep.oracle { sweep.lights.iter().copied().filter(|&n| n > 0).collect() } else { Vec::new() };
+    let mut progress = Progress::new((configs.len() + oracles.len()) as u64, "configurations");
     let mut rows = Vec::new();
     for (pipeline, gbuffer, lights) in configs {
         let label = match gbuffer {
@@ -114,7 +136,44 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
         };
         let median_ms = median(&frame_ms);
         progress.step(|| format!("{label}: {median_ms:.1} ms"));
-        rows.push(Row { pipeline, gbuffer, lights, frame_ms, last: last.context("no frame")?, culling });
+        rows.push(Row {
+            pipeline,
+            gbuffer,
+            lights,
+            frame_ms,
+            last: last.context("no frame")?,
+            culling,
+            oracle: false,
+        });
+    }
+    for lights in oracles {
+        let label = format!("oracle (exact per-pixel lists), {lights} lights");
+        progress.set_message(label.clone());
+        let rig = light_rig(lights, scene.bounds(), 1);
+        let settings = FrameSettings {
+            render: RenderSettings { pipeline: PipelineKind::ClusteredForward, ..sweep.settings.render },
+            ..sweep.settings
+        };
+        let mut frame_ms = Vec::new();
+        let mut last = None;
+        let mut culling = None;
+        for f in 0..sweep.warmup + sweep.frames {
+            let snap = snapshot(scene, &rig, f as f32 / 60.0, sweep.size, settings, f as u64);
+            // The lists come from this frame's depth and are built before the timed frame.
+            let (snap, efficiency) = oracle_snapshot(&mut renderer, snap)?;
+            culling = Some(efficiency.ratio());
+            let start = Instant::now();
+            let (report, _) = renderer.render(snap, false)?;
+            let ms = start.elapsed().as_secs_f64() * 1e3;
+            if f >= sweep.warmup {
+                frame_ms.push(ms);
+            }
+            last = Some(report);
+        }
+        let median_ms = median(&frame_ms);
+        progress.step(|| format!("{label}: {median_ms:.1} ms"));
+        let (pipeline, gbuffer, last) = (PipelineKind::ClusteredForward, None, last.context("no frame")?);
+        rows.push(Row { pipeline, gbuffer, lights, frame_ms, last, culling, oracle: true });
     }
     progress.finish();
     Ok(csv(&rows, scene_name, sweep.size, &adapter))
@@ -166,7 +225,7 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
          frame_ms_mean,depth_prepass_gpu_ms,cluster_build_gpu_ms,cluster_build_gpu_trusted,\
          forward_gpu_ms,clustered_forward_gpu_ms,gbuffer_gpu_ms,deferred_lighting_gpu_ms,light_volumes_gpu_ms,tonemap_gpu_ms,clusters,non_empty_clusters,list_entries,\
          max_per_cluster,mean_per_non_empty,dropped_pairs,culling_ratio,transient_mib,cluster_buffer_mib,\
-         list_entry_bound,tile_entries,tile_entry_bound,list_bound_cpu_ms\n",
+         list_entry_bound,tile_entries,tile_entry_bound,list_bound_cpu_ms,shading_ms,shading_vs_oracle\n",
     );
     for r in rows {
         let c = r.last.clusters.as_ref();
@@ -177,10 +236,13 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
             .find(|p| p.name == "cluster_build")
             .map_or(String::new(), |p| p.gpu_trusted.to_string());
         let mean = r.frame_ms.iter().sum::<f64>() / r.frame_ms.len().max(1) as f64;
+        let shading = shading_ms(&r.last);
+        let oracle = rows.iter().find(|o| o.oracle && o.lights == r.lights).and_then(|o| shading_ms(&o.last));
+        let vs_oracle = shading.zip(oracle).filter(|&(_, o)| o > 0.0).map(|(s, o)| s / o);
         let _ = writeln!(
             out,
-            "\"{adapter}\",\"{scene}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{},{},{},{},{}",
-            r.pipeline.name(),
+            "\"{adapter}\",\"{scene}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{},{},{},{},{},{},{}",
+            if r.oracle { "oracle" } else { r.pipeline.name() },
             r.gbuffer.map_or("", |g| g.name()),
             r.gbuffer.map_or(String::new(), |g| g.bytes_per_pixel().to_string()),
             r.lights,
@@ -211,6 +273,8 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
             c.map_or(String::new(), |c| c.tile_entries.to_string()),
             c.map_or(String::new(), |c| c.tile_entry_bound.to_string()),
             c.map_or(String::new(), |c| format!("{:.3}", c.bound_cpu_ms)),
+            shading.map_or(String::new(), |x| format!("{x:.3}")),
+            vs_oracle.map_or(String::new(), |x| format!("{x:.3}")),
         );
     }
     out

@@ -6,9 +6,10 @@ use anyhow::{Context, Result};
 use glam::UVec2;
 use manylight_app::render_world::HeadlessRenderer;
 use manylight_app::scene::{extracted_light, scene_snapshot};
-use manylight_core::efficiency::{CullingEfficiency, culling_efficiency};
-use manylight_render::{FrameReport, FrameSettings, FrameSnapshot};
+use manylight_core::efficiency::{CullingEfficiency, culling_efficiency, exact_pixel_lists, pixel_grid};
+use manylight_render::{FrameReport, FrameSettings, FrameSnapshot, PipelineKind};
 use manylight_scene::{AnimatedLight, Scene};
+use std::sync::Arc;
 
 /// The snapshot of `scene` plus `rig` at animation time `t` (the camera is the scene's first,
 /// or one framing it).
@@ -41,6 +42,32 @@ pub fn measure_culling(
     let eff =
         culling_efficiency(&clusters.grid, &projection, &assignment, &clusters.view_spheres, &depth, 64);
     Ok((report, eff))
+}
+
+/// The oracle of `snapshot`'s frame: renders it with clustered forward (so the view has
+/// cluster lists and a depth buffer), builds exact per-pixel light lists from the read-back
+/// depth and lists (`exact_pixel_lists`), and returns the snapshot that shades from them, with
+/// the culling efficiency of the clustered frame's lists. Callers time only the frame they
+/// render from the returned snapshot: building the lists is not the oracle's cost.
+pub fn oracle_snapshot(
+    renderer: &mut HeadlessRenderer,
+    mut snapshot: FrameSnapshot,
+) -> Result<(FrameSnapshot, CullingEfficiency)> {
+    snapshot.settings.render.pipeline = PipelineKind::ClusteredForward;
+    snapshot.pixel_light_lists = None;
+    let projection = snapshot.camera().map(|c| c.projection).unwrap_or_default();
+    renderer.render(snapshot.clone(), false)?;
+    let r = renderer.render_world.renderer();
+    let clusters = r.view_clusters(0).context("the frame built no clusters (no lights)")?;
+    let assignment = clusters.read_assignment(&r.gpu)?;
+    let (_, _, depth) = r.read_depth()?.context("the frame has no depth buffer")?;
+    let spheres = &clusters.view_spheres;
+    let lists = exact_pixel_lists(&clusters.grid, &projection, &assignment, spheres, &depth);
+    // The oracle's own lists measured the same way: 1 by construction.
+    let grid = pixel_grid(clusters.grid.viewport, &projection);
+    let efficiency = culling_efficiency(&grid, &projection, &lists, spheres, &depth, 0);
+    snapshot.pixel_light_lists = Some(Arc::new(lists));
+    Ok((snapshot, efficiency))
 }
 
 /// One timed frame of an [`interleaved`] run: its wall-clock milliseconds and its report.

@@ -174,6 +174,11 @@ struct BenchArgs {
     /// Also measure each tiled/clustered configuration's culling efficiency.
     #[arg(long)]
     culling_efficiency: bool,
+    /// Also render each light count's frames with exact per-pixel light lists built on the CPU
+    /// from the read-back depth (not timed): the floor of culling. Every row gets its shading
+    /// time against the oracle's (`shading_vs_oracle`).
+    #[arg(long)]
+    oracle: bool,
     /// G-buffer layouts swept for clustered-deferred.
     #[arg(long, value_delimiter = ',', default_value = "full,compact", value_parser = parse_gbuffer)]
     gbuffers: Vec<GBufferLayout>,
@@ -640,6 +645,7 @@ fn bench_cmd(args: BenchArgs) -> Result<()> {
         frames: args.frames.max(1),
         naive_max_lights: args.naive_max_lights,
         culling_efficiency: args.culling_efficiency,
+        oracle: args.oracle,
         gbuffers: args.gbuffers,
         settings: manylight_render::FrameSettings {
             render: manylight_render::RenderSettings {

@@ -3,7 +3,8 @@
 //! in one run, and prints a markdown table of FLIP error against the reference, frame time and
 //! per-pass GPU time.
 
-use crate::direct::snapshot;
+use crate::bench::shading_ms;
+use crate::direct::{oracle_snapshot, snapshot};
 use crate::progress::Progress;
 use anyhow::Result;
 use glam::UVec2;
@@ -13,7 +14,7 @@ use manylight_core::cluster::CullTest;
 use manylight_core::codec::NormalCodec;
 use manylight_core::image_metrics::flip_compare;
 use manylight_render::{
-    ClusterSettings, FrameReport, FrameSettings, GBufferLayout, PipelineKind, RenderSettings,
+    ClusterSettings, FrameReport, FrameSettings, FrameSnapshot, GBufferLayout, PipelineKind, RenderSettings,
 };
 use manylight_scene::{AnimatedLight, Scene, light_rig};
 use std::fmt::Write as _;
@@ -42,10 +43,20 @@ fn measure_rig(
     settings: FrameSettings,
     frames: u32,
 ) -> Result<(f64, FrameReport, image::RgbaImage)> {
+    measure_snapshots(renderer, frames, |f| snapshot(scene, rig, 0.0, size, settings, f))
+}
+
+/// Renders `frames` timed frames of `snapshot(frame)` after one warm-up and returns the median
+/// frame time, the last report and the last image.
+fn measure_snapshots(
+    renderer: &mut HeadlessRenderer,
+    frames: u32,
+    snapshot: impl Fn(u64) -> FrameSnapshot,
+) -> Result<(f64, FrameReport, image::RgbaImage)> {
     let mut times = Vec::new();
     let mut last = None;
     for f in 0..=frames {
-        let snap = snapshot(scene, rig, 0.0, size, settings, f as u64);
+        let snap = snapshot(u64::from(f));
         let start = Instant::now();
         let (report, image) = renderer.render(snap, f == frames)?;
         if f > 0 {
@@ -154,7 +165,7 @@ pub fn run(
     let mut renderer = HeadlessRenderer::new()?;
     let adapter = renderer.render_world.gpu().info.name.clone();
     let configs = configurations(base);
-    let mut progress = Progress::new(configs.len() as u64 + 1, "configurations");
+    let mut progress = Progress::new(configs.len() as u64 + 2, "configurations");
     progress.set_message("naive forward (reference)");
     let naive = FrameSettings {
         render: RenderSettings { pipeline: PipelineKind::NaiveForward, ..base.render },
@@ -170,6 +181,29 @@ pub fn run(
         flip_mean: 0.0,
         flip_p99: 0.0,
     }];
+    // The oracle: the same frame shaded by clustered forward from exact per-pixel lists (built
+    // from a clustered frame's depth before the timed frames).
+    let oracle_name = "oracle (exact per-pixel lists)".to_string();
+    progress.set_message(oracle_name.clone());
+    let clustered = FrameSettings {
+        render: RenderSettings { pipeline: PipelineKind::ClusteredForward, ..base.render },
+        ..base
+    };
+    let rig = light_rig(lights, scene.bounds(), 1);
+    let (oracle, _) = oracle_snapshot(&mut renderer, snapshot(scene, &rig, 0.0, size, clustered, 0))?;
+    let (ms, report, image) =
+        measure_snapshots(&mut renderer, frames, |f| FrameSnapshot { frame_index: f, ..oracle.clone() })?;
+    let (flip, _) =
+        flip_compare(reference.dimensions(), reference.as_raw(), image.dimensions(), image.as_raw())?;
+    progress.step(|| format!("{oracle_name}: {ms:.0} ms, FLIP mean {:.5}", flip.mean));
+    rows.push(ReportRow {
+        name: oracle_name,
+        settings: Some(clustered),
+        frame_ms: ms,
+        report,
+        flip_mean: f64::from(flip.mean),
+        flip_p99: f64::from(flip.p99),
+    });
     for (name, settings) in configs {
         progress.set_message(name.clone());
         let (ms, report, image) = measure(&mut renderer, scene, lights, size, settings, frames)?;
@@ -202,7 +236,7 @@ pub const CUTOFFS: [f32; 5] = [0.1, 0.03, 0.01, RANGELESS_LIGHT_CUTOFF, 0.001];
 
 /// The range standing in for "unbounded": the falloff's window `(1 - (d/r)^4)^2` stays within
 /// 1e-7 of 1 for every distance under 50 (the scenes' size), so the sum equals the unbounded
-/// `1 / (d² + 1)` sum to f32 precision.
+/// inverse-square sum to f32 precision.
 pub const UNBOUNDED_RANGE: f32 = 1.0e4;
 
 /// What cutting lights without a range costs: the rig's lights as if they came without one,
@@ -276,14 +310,20 @@ fn passes(r: &FrameReport) -> String {
         .join(", ")
 }
 
+/// `row`'s shading GPU time over the oracle row's (`shading_ms`), when both have one.
+fn shading_vs_oracle(rows: &[ReportRow], row: &ReportRow) -> Option<f64> {
+    let oracle = rows.iter().find(|r| r.name.starts_with("oracle")).and_then(|r| shading_ms(&r.report))?;
+    shading_ms(&row.report).filter(|_| oracle > 0.0).map(|s| s / oracle)
+}
+
 fn markdown(rows: &[ReportRow], context: &str) -> String {
     let mut out = String::new();
     let _ = writeln!(out, "{context}\n");
     let _ = writeln!(
         out,
-        "| pipeline | G-buffer bytes/px | transient texture MiB | FLIP mean | FLIP p99 | dropped light-cluster pairs | frame ms | speed-up | passes (GPU ms; * = untrusted) |"
+        "| pipeline | G-buffer bytes/px | transient texture MiB | FLIP mean | FLIP p99 | dropped light-cluster pairs | frame ms | speed-up | shading vs oracle | passes (GPU ms; * = untrusted) |"
     );
-    let _ = writeln!(out, "|---|---:|---:|---:|---:|---:|---:|---:|---|");
+    let _ = writeln!(out, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---|");
     let naive_ms = rows.first().map_or(f64::NAN, |r| r.frame_ms);
     for r in rows {
         let bytes = match r.settings {
@@ -296,9 +336,10 @@ fn markdown(rows: &[ReportRow], context: &str) -> String {
         } else {
             (format!("{:.5}", r.flip_mean), format!("{:.5}", r.flip_p99))
         };
+        let vs_oracle = shading_vs_oracle(rows, r).map_or("–".to_string(), |x| format!("{x:.2}×"));
         let _ = writeln!(
             out,
-            "| {} | {bytes} | {:.1} | {mean} | {p99} | {dropped} | {:.0} | {:.1}× | {} |",
+            "| {} | {bytes} | {:.1} | {mean} | {p99} | {dropped} | {:.0} | {:.1}× | {vs_oracle} | {} |",
             r.name,
             crate::bench::mib(r.report.transient_bytes),
             r.frame_ms,
@@ -327,6 +368,8 @@ fn csv(rows: &[ReportRow], scene: &str, size: UVec2, adapter: &str) -> Result<St
         "dropped_pairs",
         "frame_ms_median",
         "speedup",
+        "shading_ms",
+        "shading_vs_oracle",
         "transient_mib",
         "cluster_buffer_mib",
         "untrusted_passes",
@@ -355,6 +398,8 @@ fn csv(rows: &[ReportRow], scene: &str, size: UVec2, adapter: &str) -> Result<St
             r.report.clusters.as_ref().map_or(0, |c| c.dropped_pairs).to_string(),
             format!("{:.3}", r.frame_ms),
             format!("{:.3}", naive_ms / r.frame_ms),
+            shading_ms(&r.report).map_or(String::new(), |x| format!("{x:.3}")),
+            shading_vs_oracle(rows, r).map_or(String::new(), |x| format!("{x:.3}")),
             format!("{:.3}", crate::bench::mib(r.report.transient_bytes)),
             r.report
                 .clusters

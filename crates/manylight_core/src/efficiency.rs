@@ -10,7 +10,7 @@
 //!    the list (must be zero for a conservative assignment).
 
 use crate::Projection;
-use crate::cluster::{ClusterAssignment, ClusterGrid, ViewSphere};
+use crate::cluster::{ClusterAssignment, ClusterGrid, GridConfig, ViewSphere, ZSlicing};
 use glam::{Vec2, Vec3};
 
 /// The result of [`culling_efficiency`].
@@ -36,6 +36,39 @@ impl CullingEfficiency {
     }
 }
 
+/// Calls `visit(pixel_index, view_position, cluster)` for every pixel covered by geometry (a
+/// depth above 0 in a reverse-Z buffer), in row-major order: the view-space position rebuilt
+/// from the pixel centre and its depth, and the cluster of `grid` it falls in.
+fn for_each_covered_pixel(
+    grid: &ClusterGrid,
+    projection: &Projection,
+    depth: &[f32],
+    mut visit: impl FnMut(usize, Vec3, u32),
+) {
+    let p = projection.sanitized();
+    let (w, h) = (grid.viewport.x.max(1), grid.viewport.y.max(1));
+    let aspect = w as f32 / h as f32;
+    for y in 0..h {
+        for x in 0..w {
+            let index = (y * w + x) as usize;
+            let z = depth.get(index).copied().unwrap_or(0.0);
+            if z <= 0.0 || !z.is_finite() {
+                continue;
+            }
+            let px = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+            let ndc = Vec2::new(px.x / w as f32 * 2.0 - 1.0, 1.0 - px.y / h as f32 * 2.0);
+            let q = p.view_position(ndc, z, aspect);
+            visit(index, q, grid.cluster_of(px, -q.z));
+        }
+    }
+}
+
+/// True when the view-space point `q` lies strictly inside light `s`'s sphere: the light's
+/// contribution there is not zero (its attenuation is zero at and beyond the radius).
+fn contributes(s: &ViewSphere, q: Vec3) -> bool {
+    s.is_valid() && s.center.distance_squared(q) < s.radius * s.radius
+}
+
 /// Measures the efficiency of `assignment` for a frame whose depth buffer (reverse-Z, row-major,
 /// `size.x * size.y` values, 0 = background) is `depth`. Every `sample_stride`-th covered
 /// pixel is also checked against all lights.
@@ -47,32 +80,114 @@ pub fn culling_efficiency(
     depth: &[f32],
     sample_stride: usize,
 ) -> CullingEfficiency {
-    let p = projection.sanitized();
-    let (w, h) = (grid.viewport.x.max(1), grid.viewport.y.max(1));
-    let aspect = w as f32 / h as f32;
-    let inside = |s: &ViewSphere, q: Vec3| s.is_valid() && s.center.distance_squared(q) < s.radius * s.radius;
     let mut out = CullingEfficiency::default();
-    for y in 0..h {
-        for x in 0..w {
-            let z = depth.get((y * w + x) as usize).copied().unwrap_or(0.0);
-            if z <= 0.0 || !z.is_finite() {
-                continue;
-            }
-            let px = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-            let ndc = Vec2::new(px.x / w as f32 * 2.0 - 1.0, 1.0 - px.y / h as f32 * 2.0);
-            let q = p.view_position(ndc, z, aspect);
-            let d = -q.z;
-            let list = assignment.lights_of(grid.cluster_of(px, d));
-            out.pixels += 1;
-            out.evaluated_pairs += list.len() as u64;
-            let hits = list.iter().filter(|&&l| lights.get(l as usize).is_some_and(|s| inside(s, q))).count();
-            out.contributing_pairs += hits as u64;
-            if sample_stride > 0 && (out.pixels as usize).is_multiple_of(sample_stride) {
-                out.sampled_pixels += 1;
-                let all = lights.iter().filter(|s| inside(s, q)).count();
-                out.missed_pairs += all.saturating_sub(hits) as u64;
-            }
+    for_each_covered_pixel(grid, projection, depth, |_, q, cluster| {
+        let list = assignment.lights_of(cluster);
+        out.pixels += 1;
+        out.evaluated_pairs += list.len() as u64;
+        let hits =
+            list.iter().filter(|&&l| lights.get(l as usize).is_some_and(|s| contributes(s, q))).count();
+        out.contributing_pairs += hits as u64;
+        if sample_stride > 0 && (out.pixels as usize).is_multiple_of(sample_stride) {
+            out.sampled_pixels += 1;
+            let all = lights.iter().filter(|s| contributes(s, q)).count();
+            out.missed_pairs += all.saturating_sub(hits) as u64;
         }
-    }
+    });
     out
+}
+
+/// The grid [`exact_pixel_lists`] are over: one-pixel tiles, one linear depth slice.
+pub fn pixel_grid(viewport: glam::UVec2, projection: &Projection) -> ClusterGrid {
+    let viewport = viewport.max(glam::UVec2::ONE);
+    let config =
+        GridConfig { dims: Some(viewport.extend(1)), slicing: ZSlicing::Linear, ..GridConfig::default() };
+    ClusterGrid::new(viewport, projection, &config)
+}
+
+/// The floor of light culling: exact per-pixel light lists for a frame whose depth buffer is
+/// `depth` (as for [`culling_efficiency`]), each holding only the lights that contribute at that
+/// pixel (the pixel's position strictly inside the light's sphere), in light order.
+///
+/// The result is an assignment over a grid of one-pixel tiles and one depth slice:
+/// `ranges[x + y * width]`, empty for background pixels. The candidates of each pixel are the
+/// lights of its cluster in `assignment` (a conservative assignment holds every contributing
+/// light, which [`culling_efficiency`]'s sampled check confirms), so building the lists costs a
+/// culling-efficiency pass, not pixels × lights.
+pub fn exact_pixel_lists(
+    grid: &ClusterGrid,
+    projection: &Projection,
+    assignment: &ClusterAssignment,
+    lights: &[ViewSphere],
+    depth: &[f32],
+) -> ClusterAssignment {
+    let pixels = grid.viewport.x.max(1) as usize * grid.viewport.y.max(1) as usize;
+    let mut ranges = vec![[0u32; 2]; pixels];
+    let mut indices: Vec<u32> = Vec::new();
+    for_each_covered_pixel(grid, projection, depth, |index, q, cluster| {
+        let offset = indices.len() as u32;
+        indices.extend(
+            assignment
+                .lights_of(cluster)
+                .iter()
+                .copied()
+                .filter(|&l| lights.get(l as usize).is_some_and(|s| contributes(s, q))),
+        );
+        ranges[index] = [offset, indices.len() as u32 - offset];
+    });
+    // Background pixels keep offset 0; give them the running offset so the offsets stay an
+    // exclusive prefix sum of the counts.
+    let mut running = 0u32;
+    for r in &mut ranges {
+        r[0] = running;
+        running += r[1];
+    }
+    ClusterAssignment { ranges, indices, dropped_pairs: 0, clusters_overflowed: 0 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cluster::{CullTest, assign_lights};
+    use glam::UVec2;
+
+    /// A wall 4 units away filling an 8×4 view; the left half lit by one light, a light behind
+    /// the camera and a radius-0 light lighting nothing.
+    #[test]
+    fn exact_lists_hold_exactly_the_contributing_lights() {
+        let size = UVec2::new(8, 4);
+        let projection = Projection::perspective(1.0, 0.1, 100.0);
+        let grid = ClusterGrid::new(
+            size,
+            &projection,
+            &GridConfig { tile_px: 4, z_slices: 4, ..GridConfig::default() },
+        );
+        // The reverse-Z depth the projection gives a point `d` units ahead.
+        let depth_of = |d: f32| projection.matrix(2.0).project_point3(glam::Vec3::new(0.0, 0.0, -d)).z;
+        let mut depth = vec![depth_of(4.0); 32];
+        depth[31] = 0.0; // one background pixel
+        let left = projection.view_position(glam::Vec2::new(-0.75, 0.0), depth_of(4.0), 2.0);
+        let lights = [
+            ViewSphere { center: left + glam::Vec3::new(0.0, 0.0, 0.5), radius: 1.0 },
+            ViewSphere { center: glam::Vec3::new(0.0, 0.0, 5.0), radius: 2.0 },
+            ViewSphere { center: left, radius: 0.0 },
+        ];
+        let assignment = assign_lights(&grid, &lights, CullTest::Both, None);
+        let lists = exact_pixel_lists(&grid, &projection, &assignment, &lights, &depth);
+        assert_eq!(lists.ranges.len(), 32);
+        let lit: Vec<u32> = (0..32).filter(|&p| lists.lights_of(p) == [0]).collect();
+        assert!(!lit.is_empty() && lit.iter().all(|&p| p % 8 < 4), "left pixels lit: {lit:?}");
+        assert!(lists.lights_of(31).is_empty(), "background");
+        // Offsets are the exclusive prefix sum of the counts.
+        let mut running = 0;
+        for r in &lists.ranges {
+            assert_eq!(r[0], running);
+            running += r[1];
+        }
+        assert_eq!(running as usize, lists.indices.len());
+        let pixels = pixel_grid(size, &projection);
+        let e = culling_efficiency(&pixels, &projection, &lists, &lights, &depth, 1);
+        assert_eq!((e.missed_pairs, e.evaluated_pairs), (0, e.contributing_pairs));
+        assert_eq!(e.pixels, 31);
+    }
 }

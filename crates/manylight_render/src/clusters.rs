@@ -387,6 +387,61 @@ impl ClusterResources {
         Ok(())
     }
 
+    /// Uploads per-pixel light lists made outside the renderer (`FrameSnapshot::pixel_light_lists`)
+    /// instead of preparing the build: the grid becomes one-pixel tiles with one depth slice
+    /// (`manylight_core::efficiency::pixel_grid`), `lists` its ranges and indices. Lists that do
+    /// not cover the view's pixels, or that index past the ranges or the lights, are refused.
+    pub fn prepare_pixel_lists(
+        &mut self,
+        gpu: &GpuContext,
+        view: &RenderView,
+        view_from_world: &Mat4,
+        lights: &[(glam::Vec3, f32)],
+        lists: &ClusterAssignment,
+    ) -> Result<(), RenderError> {
+        self.view_spheres = view_spheres(view_from_world, lights.iter().copied());
+        let reach = manylight_core::cluster::farthest_reach(self.view_spheres.iter().copied());
+        let projection = view.camera.map(|c| c.projection).unwrap_or_default().finite_for(reach);
+        self.grid = manylight_core::efficiency::pixel_grid(view.size, &projection);
+        let count = self.grid.cluster_count();
+        let bad =
+            |problem: String| RenderError::UnsupportedSettings(format!("per-pixel light lists: {problem}"));
+        if lists.ranges.len() != count as usize {
+            return Err(bad(format!("{} ranges for a view of {count} pixels", lists.ranges.len())));
+        }
+        let entries = lists.indices.len() as u64;
+        if let Some(r) = lists.ranges.iter().find(|r| u64::from(r[0]) + u64::from(r[1]) > entries) {
+            return Err(bad(format!("a range {r:?} reaches past the {entries} indices")));
+        }
+        if let Some(l) = lists.indices.iter().find(|&&l| l as usize >= lights.len()) {
+            return Err(bad(format!("light {l} of {} lights", lights.len())));
+        }
+        self.ranges.write(gpu, bytemuck::cast_slice(&lists.ranges))?;
+        if lists.indices.is_empty() {
+            self.indices.write(gpu, &[0u8; 4])?;
+        } else {
+            self.indices.write(gpu, bytemuck::cast_slice(&lists.indices))?;
+        }
+        self.bounds_estimate = ListBounds { cluster_pairs: entries, ..ListBounds::default() };
+        self.bound_cpu_ms = 0.0;
+        let (near, far) = (self.grid.near, self.grid.far);
+        self.params = GpuClusterParams {
+            dims: [self.grid.dims.x, self.grid.dims.y, self.grid.dims.z, count],
+            viewport: [view.size.x.max(1) as f32, view.size.y.max(1) as f32, near, far],
+            light_count: lights.len() as u32,
+            cap: CLUSTER_NO_CAP,
+            index_capacity: (self.indices.capacity() / 4).min(u32::MAX as u64) as u32,
+            slicing: self.grid.slicing.gpu_id(),
+            log_far_over_near: (far / near).ln(),
+            tile_chunks: 1,
+            ..self.params
+        };
+        gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
+        gpu.queue.write_buffer(&self.counters, 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
+        self.rebind_if_grown(gpu);
+        Ok(())
+    }
+
     /// The buffer the build writes its counters into (the renderer copies it into the frame's
     /// read-back slot after the view's passes).
     pub fn counters_buffer(&self) -> &wgpu::Buffer {

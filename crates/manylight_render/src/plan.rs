@@ -18,6 +18,9 @@ pub struct PlanInputs<'a> {
     pub has_lights: bool,
     /// The frame draws a blended material (`FrameSnapshot::has_blended`).
     pub has_blended: bool,
+    /// The frame brings its own per-pixel light lists (`FrameSnapshot::pixel_light_lists`):
+    /// no cluster build.
+    pub has_pixel_lists: bool,
     /// Where light volumes sum their lights (`LightVolumesPass::accumulation_format` of the
     /// device; `HDR_FORMAT` when planning without one).
     pub accumulation: wgpu::TextureFormat,

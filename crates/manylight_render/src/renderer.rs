@@ -42,6 +42,8 @@ pub struct Renderer {
     counts_at_begin: GpuCounts,
     cpu_adapter: bool,
     last_textures: HashMap<crate::graph::ResourceName, wgpu::TextureView>,
+    /// This frame's `FrameSnapshot::pixel_light_lists`.
+    pixel_light_lists: Option<std::sync::Arc<manylight_core::cluster::ClusterAssignment>>,
 }
 
 impl Renderer {
@@ -65,6 +67,7 @@ impl Renderer {
             counts_at_begin: gpu.counts(),
             cpu_adapter,
             last_textures: HashMap::new(),
+            pixel_light_lists: None,
             gpu,
         }
     }
@@ -93,6 +96,7 @@ impl Renderer {
         self.pool.begin_frame();
         self.bindings.begin_frame();
         self.scene.prepare(&self.gpu, snapshot)?;
+        self.pixel_light_lists = snapshot.pixel_light_lists.clone();
         // Views that went away free their cluster buffers.
         self.clusters.truncate(snapshot.views.len().max(1));
         Ok(())
@@ -110,7 +114,16 @@ impl Renderer {
             let gpu = &self.gpu;
             let clusters = self.clusters[view.index].get_or_insert_with(|| ClusterResources::new(gpu));
             let view_from_world = view.camera.map(|c| c.view_from_world()).unwrap_or_default();
-            clusters.prepare(gpu, view, &view_from_world, &self.scene.light_spheres)?;
+            match &self.pixel_light_lists {
+                Some(lists) => clusters.prepare_pixel_lists(
+                    gpu,
+                    view,
+                    &view_from_world,
+                    &self.scene.light_spheres,
+                    lists,
+                )?,
+                None => clusters.prepare(gpu, view, &view_from_world, &self.scene.light_spheres)?,
+            }
         }
         Ok(())
     }

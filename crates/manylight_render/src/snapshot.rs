@@ -578,6 +578,13 @@ pub struct FrameSnapshot {
     pub directional_lights: Vec<ExtractedDirectionalLight>,
     /// Settings.
     pub settings: FrameSettings,
+    /// Exact per-pixel light lists made outside the renderer (the oracle of `manylight bench
+    /// --oracle`, from `manylight_core::efficiency::exact_pixel_lists`): a view that shades
+    /// with clusters skips the cluster build and reads these instead, over a grid of one-pixel
+    /// tiles and one depth slice (`ranges[x + y * width]`, indices into
+    /// [`FrameSnapshot::lights`]). For a single view. `None` (the default): the cluster build
+    /// makes the lists.
+    pub pixel_light_lists: Option<Arc<manylight_core::cluster::ClusterAssignment>>,
 }
 
 /// A directional light as extracted for rendering: light travelling along `direction`

@@ -155,10 +155,41 @@ impl Pass for ClusterBuildPass {
     }
 }
 
-/// Needed when the view shades with clusters, or shows a view of cluster data.
+/// The per-pixel light lists a frame brings (`FrameSnapshot::pixel_light_lists`), uploaded
+/// with the view's constants (`ClusterResources::prepare_pixel_lists`). It records no GPU work:
+/// it stands in the graph for the cluster build the view skips, as the writer of the lists the
+/// shading passes read.
+pub struct PixelListsPass;
+
+/// Name of [`PixelListsPass`] in pass lists and reports.
+pub const PIXEL_LIGHT_LISTS: &str = "pixel_light_lists";
+
+impl Pass for PixelListsPass {
+    fn name(&self) -> &'static str {
+        PIXEL_LIGHT_LISTS
+    }
+    fn reads(&self) -> Vec<ResourceName> {
+        Vec::new()
+    }
+    fn writes(&self) -> Vec<ResourceName> {
+        vec![CLUSTERS]
+    }
+    fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
+        ctx.clusters
+            .map(|_| ())
+            .ok_or_else(|| RenderError::Graph("pixel_light_lists needs cluster resources".into()))
+    }
+}
+
+/// Needed when the view shades with clusters, or shows a view of cluster data: the build, or
+/// the lists the frame brings.
 pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
     if p.view.needs_clusters(p.has_lights) {
-        out.push(Box::new(ClusterBuildPass { workgroup_size: p.settings().clusters.workgroup_size }));
+        if p.has_pixel_lists {
+            out.push(Box::new(PixelListsPass));
+        } else {
+            out.push(Box::new(ClusterBuildPass { workgroup_size: p.settings().clusters.workgroup_size }));
+        }
     }
 }
 
