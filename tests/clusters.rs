@@ -416,7 +416,8 @@ fn spot_rig(points: &[ExtractedPointLight]) -> Vec<ExtractedPointLight> {
 
 /// The oracle: exact per-pixel lists built on the CPU from a clustered frame's depth and lists.
 /// Shaded from them (no cluster build), the frame equals naive forward's (the same sum: only
-/// lights whose sphere does not hold the pixel are left out), its lists hold exactly the
+/// lights whose sphere does not hold the pixel are left out), clustered deferred from them
+/// equals clustered deferred, its lists hold exactly the
 /// contributing pairs (culling ratio 1, nothing missing against every light) and are never
 /// longer than the clustered lists. On the rig and on the hard cases.
 #[test]
@@ -467,16 +468,29 @@ fn exact_pixel_lists_shade_the_naive_image() {
         let clustered = culling_efficiency(&clusters.grid, &projection, &assignment, &spheres, &depth, 0);
         assert!(e.evaluated_pairs <= clustered.evaluated_pairs);
 
-        let oracle = FrameSnapshot { pixel_light_lists: Some(std::sync::Arc::new(lists)), ..snap.clone() };
+        let oracle_lists = Some(std::sync::Arc::new(lists));
+        let oracle = FrameSnapshot { pixel_light_lists: oracle_lists.clone(), ..snap.clone() };
         let (report, image) = r.render(oracle, true).expect("renders from the lists");
         let names: Vec<&str> = report.passes.iter().map(|p| p.name.as_str()).collect();
         assert!(!names.contains(&"cluster_build") && names.contains(&"pixel_light_lists"), "{names:?}");
         assert_eq!(report.nonfinite_pixels, Some(0));
-        let mut naive = snap;
+        let mut naive = snap.clone();
         naive.settings.render.pipeline = PipelineKind::NaiveForward;
         let (_, expected) = r.render(naive, true).expect("naive renders");
         let (image, expected) = (image.expect("image"), expected.expect("image"));
         support::assert_similar(&format!("oracle, {what}"), &expected, &image, support::STRICT);
+
+        // The deferred oracle: clustered deferred's lighting pass reads the same lists and
+        // draws clustered deferred's image.
+        let mut deferred = snap;
+        deferred.settings.render.pipeline = PipelineKind::ClusteredDeferred;
+        let (_, expected) = r.render(deferred.clone(), true).expect("deferred renders");
+        let lists = FrameSnapshot { pixel_light_lists: oracle_lists.clone(), ..deferred };
+        let (report, image) = r.render(lists, true).expect("deferred renders from the lists");
+        assert!(report.passes.iter().any(|p| p.name == "deferred_lighting"));
+        assert!(!report.passes.iter().any(|p| p.name == "cluster_build"));
+        let (image, expected) = (image.expect("image"), expected.expect("image"));
+        support::assert_similar(&format!("deferred oracle, {what}"), &expected, &image, support::STRICT);
     }
 
     // Lists that do not fit the view are refused, not read out of bounds.

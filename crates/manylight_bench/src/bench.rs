@@ -19,8 +19,22 @@ pub struct Row {
     frame_ms: Vec<f64>,
     last: FrameReport,
     culling: Option<f64>,
-    /// The oracle's row: the same frames shaded from exact per-pixel lists.
+    /// An oracle's row: the same frames shaded from exact per-pixel lists, by clustered forward
+    /// (the forward oracle) or clustered deferred (the deferred oracle, per G-buffer layout).
     oracle: bool,
+}
+
+impl Row {
+    /// The oracle a row's shading is measured against: the forward oracle for the forward
+    /// pipelines, the deferred one of the same G-buffer layout for the deferred pipelines.
+    fn oracle_of<'a>(&self, rows: &'a [Row]) -> Option<&'a Row> {
+        rows.iter().find(|o| {
+            o.oracle
+                && o.lights == self.lights
+                && o.pipeline.is_deferred() == self.pipeline.is_deferred()
+                && o.gbuffer == self.gbuffer
+        })
+    }
 }
 
 /// Passes that shade lights (a pipeline's lighting cost): `forward`, `clustered_forward`,
@@ -97,8 +111,29 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
         })
         .filter(|&(p, _, n)| p != PipelineKind::NaiveForward || n <= sweep.naive_max_lights)
         .collect();
-    let oracles: Vec<usize> =
-        if sweep.oracle { sweep.lights.iter().copied().filter(|&n| n > 0).collect() } else { Vec::new() };
+    // One forward oracle per light count, and a deferred one per G-buffer layout when the
+    // sweep has deferred pipelines.
+    let deferred = sweep.pipelines.iter().any(|p| p.is_deferred());
+    let oracles: Vec<(PipelineKind, Option<GBufferLayout>, usize)> = if sweep.oracle {
+        let kinds: Vec<(PipelineKind, Option<GBufferLayout>)> =
+            std::iter::once((PipelineKind::ClusteredForward, None))
+                .chain(
+                    sweep
+                        .gbuffers
+                        .iter()
+                        .filter(|_| deferred)
+                        .map(|&g| (PipelineKind::ClusteredDeferred, Some(g))),
+                )
+                .collect();
+        sweep
+            .lights
+            .iter()
+            .filter(|&&n| n > 0)
+            .flat_map(|&n| kinds.iter().map(move |&(p, g)| (p, g, n)))
+            .collect()
+    } else {
+        Vec::new()
+    };
     let mut progress = Progress::new((configs.len() + oracles.len()) as u64, "configurations");
     let mut rows = Vec::new();
     for (pipeline, gbuffer, lights) in configs {
@@ -146,12 +181,19 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
             oracle: false,
         });
     }
-    for lights in oracles {
-        let label = format!("oracle (exact per-pixel lists), {lights} lights");
+    for (pipeline, gbuffer, lights) in oracles {
+        let label = match gbuffer {
+            Some(g) => format!("deferred oracle ({} G-buffer), {lights} lights", g.name()),
+            None => format!("forward oracle, {lights} lights"),
+        };
         progress.set_message(label.clone());
         let rig = light_rig(lights, scene.bounds(), 1);
         let settings = FrameSettings {
-            render: RenderSettings { pipeline: PipelineKind::ClusteredForward, ..sweep.settings.render },
+            render: RenderSettings {
+                pipeline,
+                gbuffer: gbuffer.unwrap_or(sweep.settings.gbuffer),
+                ..sweep.settings.render
+            },
             ..sweep.settings
         };
         let mut frame_ms = Vec::new();
@@ -172,7 +214,7 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
         }
         let median_ms = median(&frame_ms);
         progress.step(|| format!("{label}: {median_ms:.1} ms"));
-        let (pipeline, gbuffer, last) = (PipelineKind::ClusteredForward, None, last.context("no frame")?);
+        let last = last.context("no frame")?;
         rows.push(Row { pipeline, gbuffer, lights, frame_ms, last, culling, oracle: true });
     }
     progress.finish();
@@ -237,12 +279,16 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
             .map_or(String::new(), |p| p.gpu_trusted.to_string());
         let mean = r.frame_ms.iter().sum::<f64>() / r.frame_ms.len().max(1) as f64;
         let shading = shading_ms(&r.last);
-        let oracle = rows.iter().find(|o| o.oracle && o.lights == r.lights).and_then(|o| shading_ms(&o.last));
+        let oracle = r.oracle_of(rows).and_then(|o| shading_ms(&o.last));
         let vs_oracle = shading.zip(oracle).filter(|&(_, o)| o > 0.0).map(|(s, o)| s / o);
         let _ = writeln!(
             out,
             "\"{adapter}\",\"{scene}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{},{},{},{},{},{},{}",
-            if r.oracle { "oracle" } else { r.pipeline.name() },
+            match (r.oracle, r.pipeline.is_deferred()) {
+                (true, false) => "oracle-forward",
+                (true, true) => "oracle-deferred",
+                _ => r.pipeline.name(),
+            },
             r.gbuffer.map_or("", |g| g.name()),
             r.gbuffer.map_or(String::new(), |g| g.bytes_per_pixel().to_string()),
             r.lights,

@@ -44,16 +44,21 @@ pub fn measure_culling(
     Ok((report, eff))
 }
 
-/// The oracle of `snapshot`'s frame: renders it with clustered forward (so the view has
-/// cluster lists and a depth buffer), builds exact per-pixel light lists from the read-back
-/// depth and lists (`exact_pixel_lists`), and returns the snapshot that shades from them, with
-/// the culling efficiency of the clustered frame's lists. Callers time only the frame they
-/// render from the returned snapshot: building the lists is not the oracle's cost.
+/// The oracle of `snapshot`'s frame: renders it (so the view has cluster lists and a depth
+/// buffer), builds exact per-pixel light lists from the read-back depth and lists
+/// (`exact_pixel_lists`), and returns the snapshot that shades from them, with the culling
+/// efficiency of those lists (1: only contributing lights). Clustered deferred stays clustered
+/// deferred (the deferred oracle: its lighting pass reads the lists); every other pipeline
+/// becomes clustered forward (the forward oracle). Callers time only the frame they render from
+/// the returned snapshot: building the lists is not the oracle's cost.
 pub fn oracle_snapshot(
     renderer: &mut HeadlessRenderer,
     mut snapshot: FrameSnapshot,
 ) -> Result<(FrameSnapshot, CullingEfficiency)> {
-    snapshot.settings.render.pipeline = PipelineKind::ClusteredForward;
+    let render = &mut snapshot.settings.render;
+    if render.pipeline != PipelineKind::ClusteredDeferred {
+        render.pipeline = PipelineKind::ClusteredForward;
+    }
     snapshot.pixel_light_lists = None;
     let projection = snapshot.camera().map(|c| c.projection).unwrap_or_default();
     renderer.render(snapshot.clone(), false)?;

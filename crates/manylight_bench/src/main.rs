@@ -252,6 +252,11 @@ struct RenderArgs {
     /// with a non-zero contribution (CPU reference over the depth buffer read back).
     #[arg(long)]
     culling_efficiency: bool,
+    /// Also time the shading of the last frame against the oracle's: the same frame shaded by
+    /// clustered forward from exact per-pixel light lists built on the CPU (not timed) from
+    /// its depth.
+    #[arg(long)]
+    oracle: bool,
     #[command(flatten)]
     post: PostArgs,
 }
@@ -420,6 +425,30 @@ fn stats_json(stats: &FrameStats) -> serde_json::Value {
     })
 }
 
+/// Times `snapshot`'s shading passes against the oracle's (the same frame shaded from exact
+/// per-pixel lists): 3 frames of each, interleaved after a warm-up, medians. Prints and returns
+/// (pipeline ms, oracle ms).
+fn measure_oracle(snapshot: manylight_render::FrameSnapshot, pipeline: PipelineKind) -> Result<(f64, f64)> {
+    let mut renderer = manylight_app::render_world::HeadlessRenderer::new()?;
+    let (oracle, _) = direct::oracle_snapshot(&mut renderer, snapshot.clone())?;
+    let (mut ours, mut floor) = (Vec::new(), Vec::new());
+    for f in 0..=3 {
+        let (report, _) = renderer.render(snapshot.clone(), false)?;
+        let (oracle_report, _) = renderer.render(oracle.clone(), false)?;
+        if f > 0 {
+            ours.push(bench::shading_ms(&report).context("no GPU timings for the shading pass")?);
+            floor.push(bench::shading_ms(&oracle_report).context("no GPU timings for the oracle")?);
+        }
+    }
+    let (ours, floor) = (bench::median(&ours), bench::median(&floor));
+    println!(
+        "oracle: {} shades in {ours:.1} ms GPU, the oracle (exact per-pixel lists) in {floor:.1} ms: {:.2}x the floor (medians of 3)",
+        pipeline.name(),
+        ours / floor
+    );
+    Ok((ours, floor))
+}
+
 fn render(args: RenderArgs) -> Result<()> {
     let mut scene = args.clusters.load(&args.scene)?;
     select_camera(&mut scene, &args.camera)?;
@@ -436,7 +465,9 @@ fn render(args: RenderArgs) -> Result<()> {
     let studio = manylight_scene::studio_lights(studio, scene.bounds());
     scene.lights.extend(studio);
     let ambient = args.ambient.unwrap_or(if unlit { 0.2 } else { RenderSettings::default().ambient });
-    let culling = if args.culling_efficiency {
+    // The measured frame of `--culling-efficiency` and `--oracle`: the last frame's animation
+    // time, rendered straight from the scene (no app).
+    let measured = (args.culling_efficiency || args.oracle).then(|| {
         let rig = manylight_scene::light_rig(lights, scene.bounds(), args.seed);
         let t = args.frames.max(1).saturating_sub(1) as f32 / 60.0;
         let settings = manylight_render::FrameSettings {
@@ -450,21 +481,28 @@ fn render(args: RenderArgs) -> Result<()> {
             },
             ..Default::default()
         };
-        let snap = direct::snapshot(&scene, &rig, t, args.size, settings, 0);
-        let mut renderer = manylight_app::render_world::HeadlessRenderer::new()?;
-        let (_, eff) = direct::measure_culling(&mut renderer, snap)?;
-        println!(
-            "culling efficiency: {} light-pixel pairs evaluated, {} contributing: {:.3}x \
-             ({} sampled pixels, {} contributing pairs missing from the lists)",
-            eff.evaluated_pairs,
-            eff.contributing_pairs,
-            eff.ratio(),
-            eff.sampled_pixels,
-            eff.missed_pairs
-        );
-        Some(eff)
-    } else {
-        None
+        direct::snapshot(&scene, &rig, t, args.size, settings, 0)
+    });
+    let culling = match &measured {
+        Some(snap) if args.culling_efficiency => {
+            let mut renderer = manylight_app::render_world::HeadlessRenderer::new()?;
+            let (_, eff) = direct::measure_culling(&mut renderer, snap.clone())?;
+            println!(
+                "culling efficiency: {} light-pixel pairs evaluated, {} contributing: {:.3}x \
+                 ({} sampled pixels, {} contributing pairs missing from the lists)",
+                eff.evaluated_pairs,
+                eff.contributing_pairs,
+                eff.ratio(),
+                eff.sampled_pixels,
+                eff.missed_pairs
+            );
+            Some(eff)
+        }
+        _ => None,
+    };
+    let oracle = match measured {
+        Some(snap) if args.oracle => Some(measure_oracle(snap, args.pipeline)?),
+        _ => None,
     };
     let settings = RenderSettings {
         pipeline: args.pipeline,
@@ -489,6 +527,13 @@ fn render(args: RenderArgs) -> Result<()> {
     save_png(&image, &args.out).map_err(anyhow::Error::msg)?;
     if let Some(path) = &args.stats_json {
         let mut json = stats_json(&stats);
+        if let Some((ours, floor)) = oracle {
+            json["oracle"] = serde_json::json!({
+                "shading_ms": ours,
+                "oracle_shading_ms": floor,
+                "shading_vs_oracle": ours / floor,
+            });
+        }
         if let Some(e) = culling {
             json["culling_efficiency"] = serde_json::json!({
                 "pixels": e.pixels,

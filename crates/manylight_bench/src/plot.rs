@@ -237,9 +237,16 @@ pub fn accuracy_points(table: &Table) -> Vec<AccuracyPoint> {
         .collect()
 }
 
-/// Indices of the Pareto front (no other point is both faster and more accurate), fastest first.
+/// True for the oracle rows of `manylight report`: drawn as the floor, never on the front (their
+/// lists are built on the CPU outside the timed frame, so no renderer can choose them).
+pub fn is_oracle(point: &AccuracyPoint) -> bool {
+    point.label.starts_with("oracle")
+}
+
+/// Indices of the Pareto front (no other point is both faster and more accurate), fastest
+/// first; oracle rows ([`is_oracle`]) are left out.
 pub fn pareto_front(points: &[AccuracyPoint]) -> Vec<usize> {
-    let mut order: Vec<usize> = (0..points.len()).collect();
+    let mut order: Vec<usize> = (0..points.len()).filter(|&i| !is_oracle(&points[i])).collect();
     order.sort_by(|&a, &b| {
         points[a]
             .frame_ms
@@ -669,8 +676,10 @@ mod tests {
             p("fast exact", 170.0, 0.0001),
             p("faster", 160.0, 0.004),
             p("worse", 200.0, 0.01),
+            p("oracle, forward (exact per-pixel lists)", 150.0, 0.0),
         ];
-        // The reference is exact: nothing beats its error, so it ends the front.
+        // The reference is exact: nothing beats its error, so it ends the front; the oracle
+        // beats everything but is not a configuration, so it is not on the front.
         assert_eq!(pareto_front(&points), vec![2, 1, 0]);
     }
 

@@ -165,7 +165,7 @@ pub fn run(
     let mut renderer = HeadlessRenderer::new()?;
     let adapter = renderer.render_world.gpu().info.name.clone();
     let configs = configurations(base);
-    let mut progress = Progress::new(configs.len() as u64 + 2, "configurations");
+    let mut progress = Progress::new(configs.len() as u64 + 3, "configurations");
     progress.set_message("naive forward (reference)");
     let naive = FrameSettings {
         render: RenderSettings { pipeline: PipelineKind::NaiveForward, ..base.render },
@@ -181,29 +181,30 @@ pub fn run(
         flip_mean: 0.0,
         flip_p99: 0.0,
     }];
-    // The oracle: the same frame shaded by clustered forward from exact per-pixel lists (built
-    // from a clustered frame's depth before the timed frames).
-    let oracle_name = "oracle (exact per-pixel lists)".to_string();
-    progress.set_message(oracle_name.clone());
-    let clustered = FrameSettings {
-        render: RenderSettings { pipeline: PipelineKind::ClusteredForward, ..base.render },
-        ..base
-    };
+    // The oracles: the same frame shaded from exact per-pixel lists (built from a clustered
+    // frame's depth before the timed frames), by clustered forward and by clustered deferred
+    // with the base G-buffer layout.
     let rig = light_rig(lights, scene.bounds(), 1);
-    let (oracle, _) = oracle_snapshot(&mut renderer, snapshot(scene, &rig, 0.0, size, clustered, 0))?;
-    let (ms, report, image) =
-        measure_snapshots(&mut renderer, frames, |f| FrameSnapshot { frame_index: f, ..oracle.clone() })?;
-    let (flip, _) =
-        flip_compare(reference.dimensions(), reference.as_raw(), image.dimensions(), image.as_raw())?;
-    progress.step(|| format!("{oracle_name}: {ms:.0} ms, FLIP mean {:.5}", flip.mean));
-    rows.push(ReportRow {
-        name: oracle_name,
-        settings: Some(clustered),
-        frame_ms: ms,
-        report,
-        flip_mean: f64::from(flip.mean),
-        flip_p99: f64::from(flip.p99),
-    });
+    for (name, pipeline) in
+        [(FORWARD_ORACLE, PipelineKind::ClusteredForward), (DEFERRED_ORACLE, PipelineKind::ClusteredDeferred)]
+    {
+        progress.set_message(name.to_string());
+        let settings = FrameSettings { render: RenderSettings { pipeline, ..base.render }, ..base };
+        let (oracle, _) = oracle_snapshot(&mut renderer, snapshot(scene, &rig, 0.0, size, settings, 0))?;
+        let (ms, report, image) =
+            measure_snapshots(&mut renderer, frames, |f| FrameSnapshot { frame_index: f, ..oracle.clone() })?;
+        let (flip, _) =
+            flip_compare(reference.dimensions(), reference.as_raw(), image.dimensions(), image.as_raw())?;
+        progress.step(|| format!("{name}: {ms:.0} ms, FLIP mean {:.5}", flip.mean));
+        rows.push(ReportRow {
+            name: name.to_string(),
+            settings: Some(settings),
+            frame_ms: ms,
+            report,
+            flip_mean: f64::from(flip.mean),
+            flip_p99: f64::from(flip.p99),
+        });
+    }
     for (name, settings) in configs {
         progress.set_message(name.clone());
         let (ms, report, image) = measure(&mut renderer, scene, lights, size, settings, frames)?;
@@ -310,9 +311,17 @@ fn passes(r: &FrameReport) -> String {
         .join(", ")
 }
 
-/// `row`'s shading GPU time over the oracle row's (`shading_ms`), when both have one.
+/// Name of the report's row shaded by clustered forward from exact per-pixel lists.
+const FORWARD_ORACLE: &str = "oracle, forward (exact per-pixel lists)";
+/// Name of the report's row shaded by clustered deferred from exact per-pixel lists.
+const DEFERRED_ORACLE: &str = "oracle, deferred (exact per-pixel lists)";
+
+/// `row`'s shading GPU time (`shading_ms`) over its oracle's: the deferred oracle's (base
+/// G-buffer layout) for the deferred pipelines, the forward oracle's for the others.
 fn shading_vs_oracle(rows: &[ReportRow], row: &ReportRow) -> Option<f64> {
-    let oracle = rows.iter().find(|r| r.name.starts_with("oracle")).and_then(|r| shading_ms(&r.report))?;
+    let deferred = row.settings.is_some_and(|s| s.pipeline.is_deferred());
+    let name = if deferred { DEFERRED_ORACLE } else { FORWARD_ORACLE };
+    let oracle = rows.iter().find(|r| r.name == name).and_then(|r| shading_ms(&r.report))?;
     shading_ms(&row.report).filter(|_| oracle > 0.0).map(|s| s / oracle)
 }
 
