@@ -107,19 +107,17 @@ fn gpu_lists_equal_the_cpu_reference_on_ordinary_scenes() {
     assert_same_lists("forward+", &gpu, &cpu);
 }
 
-#[test]
-fn gpu_lists_equal_the_cpu_reference_on_hard_cases() {
-    let _gpu = gpu();
-    let mut r = HeadlessRenderer::new().expect("adapter");
-    let scene = default_scene();
-    let size = UVec2::new(160, 96);
+/// Lights that stress the assignment for the scene's camera at `size`: around and behind the
+/// camera, across the near and far planes, radius 0 (index 4), covering the view (index 5), on
+/// tile planes, tiny.
+fn hard_lights(scene: &Scene, size: UVec2) -> Vec<ExtractedPointLight> {
     let cam = scene.camera_or_fit(size.x as f32 / size.y as f32);
     let eye = cam.transform.w_axis.truncate();
     let forward = -cam.transform.z_axis.truncate().normalize();
     let right = cam.transform.x_axis.truncate().normalize();
     let up = cam.transform.y_axis.truncate().normalize();
     let at = |d: f32, x: f32, y: f32| eye + forward * d + right * x + up * y;
-    let hard = vec![
+    vec![
         light(eye, 2.0),                 // contains the camera
         light(eye - forward * 1.0, 1.5), // behind the camera, reaching forward
         light(eye - forward * 5.0, 1.0), // behind the camera, touching nothing
@@ -129,7 +127,19 @@ fn gpu_lists_equal_the_cpu_reference_on_hard_cases() {
         light(at(8.0, 0.0, 0.0), 0.25),  // on the central tile planes
         light(at(199.0, 0.0, 0.0), 3.0), // straddles the far plane
         light(at(3.0, 1.0, 0.5), 1e-3),  // tiny
-    ];
+    ]
+}
+
+#[test]
+fn gpu_lists_equal_the_cpu_reference_on_hard_cases() {
+    let _gpu = gpu();
+    let mut r = HeadlessRenderer::new().expect("adapter");
+    let scene = default_scene();
+    let size = UVec2::new(160, 96);
+    let cam = scene.camera_or_fit(size.x as f32 / size.y as f32);
+    let forward = -cam.transform.z_axis.truncate().normalize();
+    let at = |d: f32| cam.transform.w_axis.truncate() + forward * d;
+    let hard = hard_lights(&scene, size);
     for cull in CullTest::ALL {
         let snap = scene_snapshot(&scene, size, hard.clone(), clustered(cull, ZSlicing::Exponential, None));
         let (_, gpu, cpu) = gpu_and_cpu(&mut r, snap);
@@ -150,7 +160,7 @@ fn gpu_lists_equal_the_cpu_reference_on_hard_cases() {
     let mut lights = Vec::new();
     for k in 0..24 {
         let d = 1e-4 * (1e10f32).powf(k as f32 / 24.0);
-        lights.push(light(at(d.min(5e5), 0.0, 0.0), d.min(5e5) * 0.01));
+        lights.push(light(at(d.min(5e5)), d.min(5e5) * 0.01));
     }
     let snap = scene_snapshot(&scene, size, lights, clustered(CullTest::Planes, ZSlicing::Exponential, None));
     let (report, gpu, cpu) = gpu_and_cpu(&mut r, snap);
@@ -416,10 +426,10 @@ fn spot_rig(points: &[ExtractedPointLight]) -> Vec<ExtractedPointLight> {
 
 /// The oracle: exact per-pixel lists built on the CPU from a clustered frame's depth and lists.
 /// Shaded from them (no cluster build), the frame equals naive forward's (the same sum: only
-/// lights whose sphere does not hold the pixel are left out), clustered deferred from them
-/// equals clustered deferred, its lists hold exactly the
-/// contributing pairs (culling ratio 1, nothing missing against every light) and are never
-/// longer than the clustered lists. On the rig and on the hard cases.
+/// lights whose sphere does not hold the pixel are left out), and clustered deferred from them
+/// equals clustered deferred; the lists hold exactly the contributing pairs (culling ratio 1,
+/// nothing missing against every light) and never more than the clustered lists. On the rig,
+/// and on the hard cases among 512 rig lights.
 #[test]
 fn exact_pixel_lists_shade_the_naive_image() {
     use manylight::core::efficiency::{culling_efficiency, exact_pixel_lists, pixel_grid};
@@ -427,18 +437,8 @@ fn exact_pixel_lists_shade_the_naive_image() {
     let mut r = HeadlessRenderer::new().expect("adapter");
     let scene = default_scene();
     let size = UVec2::new(160, 96);
-    let cam = scene.camera_or_fit(size.x as f32 / size.y as f32);
-    let eye = cam.transform.w_axis.truncate();
-    let forward = -cam.transform.z_axis.truncate().normalize();
     let mut hard = rig(&scene, 512, 4);
-    hard.extend([
-        light(eye, 2.0),                            // contains the camera
-        light(eye + forward * 0.1, 0.5),            // straddles the near plane
-        light(eye + forward * 5.0, 0.0),            // radius 0
-        light(eye + forward * 5.0, 1.0e4),          // covers the whole view
-        light(eye + forward * 199.0, 3.0),          // straddles the far plane
-        light(eye + forward * 3.0 + Vec3::Y, 1e-3), // tiny
-    ]);
+    hard.extend(hard_lights(&scene, size));
     let lit = |lights: &[ExtractedPointLight]| {
         let mut lights = lights.to_vec();
         for l in &mut lights {

@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use glam::UVec2;
 use manylight_app::render_world::HeadlessRenderer;
 use manylight_render::{FrameReport, FrameSettings, GBufferLayout, PipelineKind, RenderSettings};
-use manylight_scene::{Scene, light_rig};
+use manylight_scene::{AnimatedLight, Scene, light_rig};
 use std::fmt::Write as _;
 use std::time::Instant;
 
@@ -151,18 +151,7 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
             },
             ..sweep.settings
         };
-        let mut frame_ms = Vec::new();
-        let mut last = None;
-        for f in 0..sweep.warmup + sweep.frames {
-            let snap = snapshot(scene, &rig, f as f32 / 60.0, sweep.size, settings, f as u64);
-            let start = Instant::now();
-            let (report, _) = renderer.render(snap, false)?;
-            let ms = start.elapsed().as_secs_f64() * 1e3;
-            if f >= sweep.warmup {
-                frame_ms.push(ms);
-            }
-            last = Some(report);
-        }
+        let (frame_ms, last, _) = timed_frames(&mut renderer, scene, &rig, sweep, settings, false)?;
         let culling = if sweep.culling_efficiency && pipeline.uses_clusters() && lights > 0 {
             let snap = snapshot(scene, &rig, 0.0, sweep.size, settings, 0);
             Some(measure_culling(&mut renderer, snap)?.1.ratio())
@@ -171,15 +160,7 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
         };
         let median_ms = median(&frame_ms);
         progress.step(|| format!("{label}: {median_ms:.1} ms"));
-        rows.push(Row {
-            pipeline,
-            gbuffer,
-            lights,
-            frame_ms,
-            last: last.context("no frame")?,
-            culling,
-            oracle: false,
-        });
+        rows.push(Row { pipeline, gbuffer, lights, frame_ms, last, culling, oracle: false });
     }
     for (pipeline, gbuffer, lights) in oracles {
         let label = match gbuffer {
@@ -196,29 +177,45 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
             },
             ..sweep.settings
         };
-        let mut frame_ms = Vec::new();
-        let mut last = None;
-        let mut culling = None;
-        for f in 0..sweep.warmup + sweep.frames {
-            let snap = snapshot(scene, &rig, f as f32 / 60.0, sweep.size, settings, f as u64);
-            // The lists come from this frame's depth and are built before the timed frame.
-            let (snap, efficiency) = oracle_snapshot(&mut renderer, snap)?;
-            culling = Some(efficiency.ratio());
-            let start = Instant::now();
-            let (report, _) = renderer.render(snap, false)?;
-            let ms = start.elapsed().as_secs_f64() * 1e3;
-            if f >= sweep.warmup {
-                frame_ms.push(ms);
-            }
-            last = Some(report);
-        }
+        let (frame_ms, last, culling) = timed_frames(&mut renderer, scene, &rig, sweep, settings, true)?;
         let median_ms = median(&frame_ms);
         progress.step(|| format!("{label}: {median_ms:.1} ms"));
-        let last = last.context("no frame")?;
         rows.push(Row { pipeline, gbuffer, lights, frame_ms, last, culling, oracle: true });
     }
     progress.finish();
     Ok(csv(&rows, scene_name, sweep.size, &adapter))
+}
+
+/// Renders `sweep.warmup + sweep.frames` frames of `rig` animated at 60 frames a second with
+/// `settings`; returns the timed frames' wall milliseconds and the last report. With `oracle`,
+/// each frame is shaded from exact per-pixel lists built (not timed) from a render of that same
+/// frame, and the lists' culling ratio comes back too.
+fn timed_frames(
+    renderer: &mut HeadlessRenderer,
+    scene: &Scene,
+    rig: &[AnimatedLight],
+    sweep: &Sweep,
+    settings: FrameSettings,
+    oracle: bool,
+) -> Result<(Vec<f64>, FrameReport, Option<f64>)> {
+    let mut frame_ms = Vec::new();
+    let mut last = None;
+    let mut culling = None;
+    for f in 0..sweep.warmup + sweep.frames {
+        let mut snap = snapshot(scene, rig, f as f32 / 60.0, sweep.size, settings, f as u64);
+        if oracle {
+            let (lists, efficiency) = oracle_snapshot(renderer, snap)?;
+            (snap, culling) = (lists, Some(efficiency.ratio()));
+        }
+        let start = Instant::now();
+        let (report, _) = renderer.render(snap, false)?;
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        if f >= sweep.warmup {
+            frame_ms.push(ms);
+        }
+        last = Some(report);
+    }
+    Ok((frame_ms, last.context("no frame")?, culling))
 }
 
 /// Every pass name of `reports` in an order that keeps each frame's order (a pass first seen

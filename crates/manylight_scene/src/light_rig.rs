@@ -193,6 +193,18 @@ pub fn light_rig(count: usize, bounds: Aabb, seed: u64) -> Vec<AnimatedLight> {
         .collect()
 }
 
+/// `count` unit directions spread evenly over the sphere: the Fibonacci (golden-angle) lattice,
+/// from +y down to -y.
+fn fibonacci_sphere(count: usize) -> impl Iterator<Item = Vec3> {
+    let golden_angle = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    (0..count).map(move |i| {
+        let y = 1.0 - 2.0 * (i as f64 + 0.5) / count as f64;
+        let ring = (1.0 - y * y).max(0.0).sqrt();
+        let theta = (golden_angle * i as f64).rem_euclid(TAU);
+        Vec3::new((theta.cos() * ring) as f32, y as f32, (theta.sin() * ring) as f32)
+    })
+}
+
 /// `count` static lights of range `light_range` on a Fibonacci (golden-angle) lattice just
 /// inside a sphere of radius `shell_radius` centred on the origin, with random hues.
 ///
@@ -204,21 +216,14 @@ pub fn sphere_shell_lights(count: usize, shell_radius: f32, light_range: f32, se
     let shell = if shell_radius.is_finite() { shell_radius.max(0.0) } else { 0.0 };
     let range = if light_range.is_finite() { light_range.max(0.0) } else { 0.0 };
     let r = shell - (0.8 * range).min(1.0).min(shell);
-    let golden_angle = std::f64::consts::PI * (3.0 - 5f64.sqrt());
     let mut rng = SplitMix64(seed ^ 0x7368_656c_6c5f_6c74);
-    (0..count)
-        .map(|i| {
-            let y = 1.0 - 2.0 * (i as f64 + 0.5) / count as f64;
-            let ring = (1.0 - y * y).max(0.0).sqrt();
-            let theta = (golden_angle * i as f64).rem_euclid(TAU);
-            let dir = Vec3::new((theta.cos() * ring) as f32, y as f32, (theta.sin() * ring) as f32);
-            SceneLight {
-                position: dir * r,
-                color: hsv(rng.f32(), rng.range(0.7, 1.0)),
-                intensity: intensity_for_radius(range),
-                radius: range,
-                spot: None,
-            }
+    fibonacci_sphere(count)
+        .map(|dir| SceneLight {
+            position: dir * r,
+            color: hsv(rng.f32(), rng.range(0.7, 1.0)),
+            intensity: intensity_for_radius(range),
+            radius: range,
+            spot: None,
         })
         .collect()
 }
@@ -239,20 +244,13 @@ pub fn studio_lights(count: usize, bounds: Aabb) -> Vec<SceneLight> {
     let rho = (bounds.size().length() * 0.5).max(1e-3);
     let center = bounds.center();
     let intensity = 18.0 * rho * rho / count.max(1) as f32;
-    let golden_angle = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-    (0..count)
-        .map(|i| {
-            let y = 1.0 - 2.0 * (i as f64 + 0.5) / count as f64;
-            let ring = (1.0 - y * y).max(0.0).sqrt();
-            let theta = (golden_angle * i as f64).rem_euclid(TAU);
-            let dir = Vec3::new((theta.cos() * ring) as f32, y as f32, (theta.sin() * ring) as f32);
-            SceneLight {
-                position: center + dir * (2.0 * rho),
-                color: Vec3::ONE,
-                intensity,
-                radius: 4.0 * rho,
-                spot: None,
-            }
+    fibonacci_sphere(count)
+        .map(|dir| SceneLight {
+            position: center + dir * (2.0 * rho),
+            color: Vec3::ONE,
+            intensity,
+            radius: 4.0 * rho,
+            spot: None,
         })
         .collect()
 }
