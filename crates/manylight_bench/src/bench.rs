@@ -136,10 +136,13 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
     };
     let mut progress = Progress::new((configs.len() + oracles.len()) as u64, "configurations");
     let mut rows = Vec::new();
-    for (pipeline, gbuffer, lights) in configs {
-        let label = match gbuffer {
-            Some(g) => format!("{} ({} G-buffer), {lights} lights", pipeline.name(), g.name()),
-            None => format!("{}, {lights} lights", pipeline.name()),
+    let runs = configs.into_iter().map(|c| (c, false)).chain(oracles.into_iter().map(|c| (c, true)));
+    for ((pipeline, gbuffer, lights), oracle) in runs {
+        let label = match (oracle, gbuffer) {
+            (true, Some(g)) => format!("deferred oracle ({} G-buffer), {lights} lights", g.name()),
+            (true, None) => format!("forward oracle, {lights} lights"),
+            (false, Some(g)) => format!("{} ({} G-buffer), {lights} lights", pipeline.name(), g.name()),
+            (false, None) => format!("{}, {lights} lights", pipeline.name()),
         };
         progress.set_message(label.clone());
         let rig = light_rig(lights, scene.bounds(), 1);
@@ -151,8 +154,11 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
             },
             ..sweep.settings
         };
-        let (frame_ms, last, _) = timed_frames(&mut renderer, scene, &rig, sweep, settings, false)?;
-        let culling = if sweep.culling_efficiency && pipeline.uses_clusters() && lights > 0 {
+        let (frame_ms, last, oracle_culling) =
+            timed_frames(&mut renderer, scene, &rig, sweep, settings, oracle)?;
+        let culling = if oracle {
+            oracle_culling
+        } else if sweep.culling_efficiency && pipeline.uses_clusters() && lights > 0 {
             let snap = snapshot(scene, &rig, 0.0, sweep.size, settings, 0);
             Some(measure_culling(&mut renderer, snap)?.1.ratio())
         } else {
@@ -160,27 +166,7 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
         };
         let median_ms = median(&frame_ms);
         progress.step(|| format!("{label}: {median_ms:.1} ms"));
-        rows.push(Row { pipeline, gbuffer, lights, frame_ms, last, culling, oracle: false });
-    }
-    for (pipeline, gbuffer, lights) in oracles {
-        let label = match gbuffer {
-            Some(g) => format!("deferred oracle ({} G-buffer), {lights} lights", g.name()),
-            None => format!("forward oracle, {lights} lights"),
-        };
-        progress.set_message(label.clone());
-        let rig = light_rig(lights, scene.bounds(), 1);
-        let settings = FrameSettings {
-            render: RenderSettings {
-                pipeline,
-                gbuffer: gbuffer.unwrap_or(sweep.settings.gbuffer),
-                ..sweep.settings.render
-            },
-            ..sweep.settings
-        };
-        let (frame_ms, last, culling) = timed_frames(&mut renderer, scene, &rig, sweep, settings, true)?;
-        let median_ms = median(&frame_ms);
-        progress.step(|| format!("{label}: {median_ms:.1} ms"));
-        rows.push(Row { pipeline, gbuffer, lights, frame_ms, last, culling, oracle: true });
+        rows.push(Row { pipeline, gbuffer, lights, frame_ms, last, culling, oracle });
     }
     progress.finish();
     Ok(csv(&rows, scene_name, sweep.size, &adapter))
