@@ -1,5 +1,6 @@
 //! Views a glTF/GLB file: its meshes and lights, seen through its first camera (or one that
-//! frames the whole scene), with an optional rig of animated lights.
+//! frames the whole scene), with an optional rig of animated lights. A file without lights is
+//! lit by a dome of studio lights around it, as a model viewer does.
 //!
 //! ```text
 //! cargo run --example gltf_viewer -- PATH [--lights N] [--fit] [--headless OUT.png]
@@ -15,16 +16,17 @@ use manylight::prelude::*;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-/// Lights added when the file brings none and `--lights` is not given.
-const DEFAULT_RIG: usize = 32;
+/// Studio lights (`manylight::scene::studio_lights`) around a file that brings no lights when
+/// `--lights` is not given.
+const STUDIO_LIGHTS: usize = 32;
 
 #[derive(Parser)]
 #[command(about = "View a glTF/GLB file with manylight")]
 struct Args {
     /// The .gltf or .glb file.
     path: PathBuf,
-    /// Animated lights added to the file's own lights (default: 0, or 32 when the file has
-    /// no lights).
+    /// Animated lights added to the file's own lights (default 0; a file without lights and
+    /// without this option gets 32 static studio lights around it instead).
     #[arg(long)]
     lights: Option<usize>,
     /// Frame the whole scene instead of looking through the file's first camera.
@@ -55,7 +57,11 @@ fn main() -> ExitCode {
     if args.fit {
         scene.cameras.clear();
     }
-    let lights = args.lights.unwrap_or(if scene.lights.is_empty() { DEFAULT_RIG } else { 0 });
+    if scene.lights.is_empty() && args.lights.is_none() {
+        let studio = manylight::scene::studio_lights(STUDIO_LIGHTS, scene.bounds());
+        scene.lights.extend(studio);
+    }
+    let lights = args.lights.unwrap_or(0);
     println!(
         "{}: {} meshes, {} instances, {} lights{}, {}",
         args.path.display(),
