@@ -28,7 +28,7 @@ use clap::Parser;
 use manylight::app::cli::{parse_pipeline, parse_size};
 use manylight::core::{Aabb, lumens_from_candela};
 use manylight::prelude::*;
-use manylight::scene::{AnimatedLight, light_rig, sphere_shell_lights};
+use manylight::scene::{AnimatedLight, SHELL_LIGHT_RANGE, SHELL_RADIUS, light_rig, sphere_shell_lights};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -37,10 +37,6 @@ use std::time::Instant;
 pub const DEFAULT_LIGHTS: u32 = 4096;
 /// Lights of the sphere-shell preset unless `--lights` says otherwise.
 pub const DEFAULT_SHELL_LIGHTS: u32 = 100_000;
-/// Radius of the sphere-shell preset's sphere (its lights sit just inside).
-pub const SHELL_RADIUS: f32 = 50.0;
-/// Range (radius) of each sphere-shell light.
-pub const SHELL_LIGHT_RANGE: f32 = 0.3;
 /// Radians the sphere-shell camera turns per frame about the z axis, then the x axis.
 pub const SHELL_TURN_PER_FRAME: f32 = 0.0025;
 

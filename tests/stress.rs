@@ -88,7 +88,10 @@ fn sphere_shell_preset_has_its_lattice_and_turns_the_camera() {
     let mut lights = world.query::<(&Transform, &PointLight)>();
     for (t, l) in lights.iter(world) {
         let r = t.translation.length();
-        assert!(r < stress::SHELL_RADIUS && r > stress::SHELL_RADIUS - 1.0, "light at radius {r}");
-        assert_eq!(l.radius, stress::SHELL_LIGHT_RANGE);
+        assert!(
+            r < manylight::scene::SHELL_RADIUS && r > manylight::scene::SHELL_RADIUS - 1.0,
+            "light at radius {r}"
+        );
+        assert_eq!(l.radius, manylight::scene::SHELL_LIGHT_RANGE);
     }
 }

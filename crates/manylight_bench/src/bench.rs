@@ -7,7 +7,9 @@ use anyhow::{Context, Result};
 use glam::UVec2;
 use manylight_app::render_world::HeadlessRenderer;
 use manylight_render::{FrameReport, FrameSettings, GBufferLayout, PipelineKind, RenderSettings};
-use manylight_scene::{AnimatedLight, Scene, light_rig};
+use manylight_scene::{
+    AnimatedLight, SHELL_LIGHT_RANGE, SHELL_RADIUS, Scene, light_rig, sphere_shell_lights,
+};
 use std::fmt::Write as _;
 use std::time::Instant;
 
@@ -86,6 +88,9 @@ pub struct Sweep {
     /// Also render each light count's frames with exact per-pixel light lists (the oracle) and
     /// give every row its shading time against the oracle's.
     pub oracle: bool,
+    /// The scene is the sphere-shell preset: light it with its lattice of static lights (as
+    /// `manylight render` and the stress example do) instead of the animated rig.
+    pub shell_lattice: bool,
     /// G-buffer layouts swept for the deferred pipeline.
     pub gbuffers: Vec<GBufferLayout>,
     /// Settings other than the pipeline.
@@ -145,7 +150,7 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
             (false, None) => format!("{}, {lights} lights", pipeline.name()),
         };
         progress.set_message(label.clone());
-        let rig = light_rig(lights, scene.bounds(), 1);
+        let (lit, rig) = lights_of(scene, sweep.shell_lattice, lights);
         let settings = FrameSettings {
             render: RenderSettings {
                 pipeline,
@@ -155,11 +160,11 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
             ..sweep.settings
         };
         let (frame_ms, last, oracle_culling) =
-            timed_frames(&mut renderer, scene, &rig, sweep, settings, oracle)?;
+            timed_frames(&mut renderer, &lit, &rig, sweep, settings, oracle)?;
         let culling = if oracle {
             oracle_culling
         } else if sweep.culling_efficiency && pipeline.uses_clusters() && lights > 0 {
-            let snap = snapshot(scene, &rig, 0.0, sweep.size, settings, 0);
+            let snap = snapshot(&lit, &rig, 0.0, sweep.size, settings, 0);
             Some(measure_culling(&mut renderer, snap)?.1.ratio())
         } else {
             None
@@ -170,6 +175,17 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
     }
     progress.finish();
     Ok(csv(&rows, scene_name, sweep.size, &adapter))
+}
+
+/// The scene lit by `count` lights: the sphere-shell preset (`shell_lattice`) gets its lattice of
+/// static lights, every other scene `count` animated rig lights over its own.
+fn lights_of(scene: &Scene, shell_lattice: bool, count: usize) -> (Scene, Vec<AnimatedLight>) {
+    if shell_lattice {
+        let lights = sphere_shell_lights(count, SHELL_RADIUS, SHELL_LIGHT_RANGE, 1);
+        (Scene { lights, ..scene.clone() }, Vec::new())
+    } else {
+        (scene.clone(), light_rig(count, scene.bounds(), 1))
+    }
 }
 
 /// Renders `sweep.warmup + sweep.frames` frames of `rig` animated at 60 frames a second with

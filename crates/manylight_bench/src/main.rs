@@ -457,7 +457,12 @@ fn render(args: RenderArgs) -> Result<()> {
     let shell = args.scene == "sphere-shell";
     if shell {
         let n = args.lights.unwrap_or(100_000);
-        scene.lights = manylight_scene::sphere_shell_lights(n, 50.0, 0.3, args.seed);
+        scene.lights = manylight_scene::sphere_shell_lights(
+            n,
+            manylight_scene::SHELL_RADIUS,
+            manylight_scene::SHELL_LIGHT_RANGE,
+            args.seed,
+        );
     }
     let unlit = scene.lights.is_empty();
     let lights = if shell { 0 } else { args.lights.unwrap_or(0) };
@@ -691,6 +696,7 @@ fn bench_cmd(args: BenchArgs) -> Result<()> {
         naive_max_lights: args.naive_max_lights,
         culling_efficiency: args.culling_efficiency,
         oracle: args.oracle,
+        shell_lattice: args.scene == "sphere-shell",
         gbuffers: args.gbuffers,
         settings: manylight_render::FrameSettings {
             render: manylight_render::RenderSettings {

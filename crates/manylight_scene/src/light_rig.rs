@@ -205,6 +205,12 @@ fn fibonacci_sphere(count: usize) -> impl Iterator<Item = Vec3> {
     })
 }
 
+/// Radius of the sphere-shell preset's sphere ([`sphere_shell_scene`]; its lights sit just
+/// inside).
+pub const SHELL_RADIUS: f32 = 50.0;
+/// Range of each light of the sphere-shell preset.
+pub const SHELL_LIGHT_RANGE: f32 = 0.3;
+
 /// `count` static lights of range `light_range` on a Fibonacci (golden-angle) lattice just
 /// inside a sphere of radius `shell_radius` centred on the origin, with random hues.
 ///
