@@ -15,6 +15,7 @@ use crate::pool::GrowableBuffer;
 use crate::readback::read_buffer;
 use crate::snapshot::RenderView;
 use glam::Mat4;
+use manylight_core::Projection;
 use manylight_core::cluster::{
     ClusterAssignment, ClusterGrid, CullTest, ListBounds, ViewSphere, list_bounds, view_spheres,
 };
@@ -281,14 +282,9 @@ impl ClusterResources {
         view_from_world: &Mat4,
         lights: &[(glam::Vec3, f32)],
     ) -> Result<(), RenderError> {
-        let queue = &gpu.queue;
         let settings = &view.settings.clusters;
         let grid_config = settings.grid_for(view.settings.pipeline);
-        self.view_spheres = view_spheres(view_from_world, lights.iter().copied());
-        // An infinite projection is sliced up to the farthest light's reach: nothing beyond it
-        // is lit, and every light lies inside the grid.
-        let reach = manylight_core::cluster::farthest_reach(self.view_spheres.iter().copied());
-        let projection = view.camera.map(|c| c.projection).unwrap_or_default().finite_for(reach);
+        let projection = self.place_lights(view, view_from_world, lights);
         self.grid = ClusterGrid::new(view.size, &projection, &grid_config);
         self.cull = settings.cull;
         let count = self.grid.cluster_count();
@@ -364,13 +360,42 @@ impl ClusterResources {
         let tiles = self.grid.dims.x as u64 * self.grid.dims.y as u64;
         let tile_chunks = (spheres.len() as u32).div_ceil(TILE_LIGHT_CHUNK).max(1);
         self.tile_ranges.reserve(gpu, tiles * tile_chunks as u64 * 8)?;
+        let cap = settings.cap.unwrap_or(CLUSTER_NO_CAP);
+        self.write_params(gpu, view, spheres.len() as u32, cap, tile_chunks);
+        Ok(())
+    }
+
+    /// Sets the lights' view-space spheres (`lights` in the order of the light buffer) and
+    /// returns the view's projection made finite: an infinite projection is sliced up to the
+    /// farthest light's reach, so nothing beyond it is lit and every light lies inside the grid.
+    fn place_lights(
+        &mut self,
+        view: &RenderView,
+        view_from_world: &Mat4,
+        lights: &[(glam::Vec3, f32)],
+    ) -> Projection {
+        self.view_spheres = view_spheres(view_from_world, lights.iter().copied());
+        let reach = manylight_core::cluster::farthest_reach(self.view_spheres.iter().copied());
+        view.camera.map(|c| c.projection).unwrap_or_default().finite_for(reach)
+    }
+
+    /// Fills the parameters from this frame's grid, culling test and list capacities, uploads
+    /// them, zeroes the counters and rebinds the buffers that grew.
+    fn write_params(
+        &mut self,
+        gpu: &GpuContext,
+        view: &RenderView,
+        light_count: u32,
+        cap: u32,
+        tile_chunks: u32,
+    ) {
         let (near, far) = (self.grid.near, self.grid.far);
         self.params = GpuClusterParams {
-            dims: [self.grid.dims.x, self.grid.dims.y, self.grid.dims.z, count],
+            dims: [self.grid.dims.x, self.grid.dims.y, self.grid.dims.z, self.grid.cluster_count()],
             viewport: [view.size.x.max(1) as f32, view.size.y.max(1) as f32, near, far],
-            light_count: spheres.len() as u32,
-            cap: settings.cap.unwrap_or(CLUSTER_NO_CAP),
-            cull_test: match settings.cull {
+            light_count,
+            cap,
+            cull_test: match self.cull {
                 CullTest::Aabb => CULL_AABB,
                 CullTest::Planes => CULL_PLANES,
                 CullTest::Both => CULL_BOTH,
@@ -381,10 +406,9 @@ impl ClusterResources {
             tile_index_capacity: (self.tile_indices.capacity() / 4).min(u32::MAX as u64) as u32,
             tile_chunks,
         };
-        queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
-        queue.write_buffer(&self.counters, 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
+        gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
+        gpu.queue.write_buffer(&self.counters, 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
         self.rebind_if_grown(gpu);
-        Ok(())
     }
 
     /// Uploads per-pixel light lists made outside the renderer (`FrameSnapshot::pixel_light_lists`)
@@ -399,10 +423,9 @@ impl ClusterResources {
         lights: &[(glam::Vec3, f32)],
         lists: &ClusterAssignment,
     ) -> Result<(), RenderError> {
-        self.view_spheres = view_spheres(view_from_world, lights.iter().copied());
-        let reach = manylight_core::cluster::farthest_reach(self.view_spheres.iter().copied());
-        let projection = view.camera.map(|c| c.projection).unwrap_or_default().finite_for(reach);
+        let projection = self.place_lights(view, view_from_world, lights);
         self.grid = manylight_core::efficiency::pixel_grid(view.size, &projection);
+        self.cull = view.settings.clusters.cull;
         let count = self.grid.cluster_count();
         let bad =
             |problem: String| RenderError::UnsupportedSettings(format!("per-pixel light lists: {problem}"));
@@ -424,21 +447,7 @@ impl ClusterResources {
         }
         self.bounds_estimate = ListBounds { cluster_pairs: entries, ..ListBounds::default() };
         self.bound_cpu_ms = 0.0;
-        let (near, far) = (self.grid.near, self.grid.far);
-        self.params = GpuClusterParams {
-            dims: [self.grid.dims.x, self.grid.dims.y, self.grid.dims.z, count],
-            viewport: [view.size.x.max(1) as f32, view.size.y.max(1) as f32, near, far],
-            light_count: lights.len() as u32,
-            cap: CLUSTER_NO_CAP,
-            index_capacity: (self.indices.capacity() / 4).min(u32::MAX as u64) as u32,
-            slicing: self.grid.slicing.gpu_id(),
-            log_far_over_near: (far / near).ln(),
-            tile_chunks: 1,
-            ..self.params
-        };
-        gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
-        gpu.queue.write_buffer(&self.counters, 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
-        self.rebind_if_grown(gpu);
+        self.write_params(gpu, view, lights.len() as u32, CLUSTER_NO_CAP, 1);
         Ok(())
     }
 
