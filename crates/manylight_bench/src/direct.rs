@@ -26,12 +26,18 @@ pub fn snapshot(
     scene_snapshot(scene, lights, size, settings, frame_index)
 }
 
-/// Renders `snapshot` and measures the culling efficiency of its cluster lists against its
-/// depth buffer (every 64th covered pixel is also checked against all lights).
-pub fn measure_culling(
-    renderer: &mut HeadlessRenderer,
-    snapshot: FrameSnapshot,
-) -> Result<(FrameReport, CullingEfficiency)> {
+/// What a rendered frame's light lists are measured from, read back from the GPU.
+struct FrameLists {
+    report: FrameReport,
+    projection: manylight_core::Projection,
+    grid: manylight_core::cluster::ClusterGrid,
+    assignment: manylight_core::cluster::ClusterAssignment,
+    spheres: Vec<manylight_core::cluster::ViewSphere>,
+    depth: Vec<f32>,
+}
+
+/// Renders `snapshot` and reads back view 0's cluster grid, lists, light spheres and depth.
+fn render_and_read_lists(renderer: &mut HeadlessRenderer, snapshot: FrameSnapshot) -> Result<FrameLists> {
     let projection = snapshot.camera().map(|c| c.projection).unwrap_or_default();
     let (report, _) = renderer.render(snapshot, false)?;
     let r = renderer.render_world.renderer();
@@ -39,9 +45,19 @@ pub fn measure_culling(
         r.view_clusters(0).context("the frame built no clusters (naive pipeline, or no lights)")?;
     let assignment = clusters.read_assignment(&r.gpu)?;
     let (_, _, depth) = r.read_depth()?.context("the frame has no depth buffer")?;
-    let eff =
-        culling_efficiency(&clusters.grid, &projection, &assignment, &clusters.view_spheres, &depth, 64);
-    Ok((report, eff))
+    let (grid, spheres) = (clusters.grid, clusters.view_spheres.clone());
+    Ok(FrameLists { report, projection, grid, assignment, spheres, depth })
+}
+
+/// Renders `snapshot` and measures the culling efficiency of its cluster lists against its
+/// depth buffer (every 64th covered pixel is also checked against all lights).
+pub fn measure_culling(
+    renderer: &mut HeadlessRenderer,
+    snapshot: FrameSnapshot,
+) -> Result<(FrameReport, CullingEfficiency)> {
+    let f = render_and_read_lists(renderer, snapshot)?;
+    let eff = culling_efficiency(&f.grid, &f.projection, &f.assignment, &f.spheres, &f.depth, 64);
+    Ok((f.report, eff))
 }
 
 /// The oracle of `snapshot`'s frame: renders it (so the view has cluster lists and a depth
@@ -60,17 +76,11 @@ pub fn oracle_snapshot(
         render.pipeline = PipelineKind::ClusteredForward;
     }
     snapshot.pixel_light_lists = None;
-    let projection = snapshot.camera().map(|c| c.projection).unwrap_or_default();
-    renderer.render(snapshot.clone(), false)?;
-    let r = renderer.render_world.renderer();
-    let clusters = r.view_clusters(0).context("the frame built no clusters (no lights)")?;
-    let assignment = clusters.read_assignment(&r.gpu)?;
-    let (_, _, depth) = r.read_depth()?.context("the frame has no depth buffer")?;
-    let spheres = &clusters.view_spheres;
-    let lists = exact_pixel_lists(&clusters.grid, &projection, &assignment, spheres, &depth);
+    let f = render_and_read_lists(renderer, snapshot.clone())?;
+    let lists = exact_pixel_lists(&f.grid, &f.projection, &f.assignment, &f.spheres, &f.depth);
     // The oracle's own lists measured the same way: 1 by construction.
-    let grid = pixel_grid(clusters.grid.viewport, &projection);
-    let efficiency = culling_efficiency(&grid, &projection, &lists, spheres, &depth, 0);
+    let grid = pixel_grid(f.grid.viewport, &f.projection);
+    let efficiency = culling_efficiency(&grid, &f.projection, &lists, &f.spheres, &f.depth, 0);
     snapshot.pixel_light_lists = Some(Arc::new(lists));
     Ok((snapshot, efficiency))
 }

@@ -431,16 +431,14 @@ fn stats_json(stats: &FrameStats) -> serde_json::Value {
 fn measure_oracle(snapshot: manylight_render::FrameSnapshot, pipeline: PipelineKind) -> Result<(f64, f64)> {
     let mut renderer = manylight_app::render_world::HeadlessRenderer::new()?;
     let (oracle, _) = direct::oracle_snapshot(&mut renderer, snapshot.clone())?;
-    let (mut ours, mut floor) = (Vec::new(), Vec::new());
-    for f in 0..=3 {
-        let (report, _) = renderer.render(snapshot.clone(), false)?;
-        let (oracle_report, _) = renderer.render(oracle.clone(), false)?;
-        if f > 0 {
-            ours.push(bench::shading_ms(&report).context("no GPU timings for the shading pass")?);
-            floor.push(bench::shading_ms(&oracle_report).context("no GPU timings for the oracle")?);
-        }
-    }
-    let (ours, floor) = (bench::median(&ours), bench::median(&floor));
+    let names = [pipeline.name().to_string(), "oracle".to_string()];
+    let snapshots = [snapshot, oracle];
+    let (_, timed) = direct::interleaved(&names, 3, "frames", |i, _| snapshots[i].clone())?;
+    let shading = |frames: &[direct::TimedFrame], what: &str| -> Result<f64> {
+        let ms = frames.iter().map(|f| bench::shading_ms(&f.report)).collect::<Option<Vec<f64>>>();
+        Ok(bench::median(&ms.with_context(|| format!("no GPU timings for {what}'s shading"))?))
+    };
+    let (ours, floor) = (shading(&timed[0], pipeline.name())?, shading(&timed[1], "the oracle")?);
     println!(
         "oracle: {} shades in {ours:.1} ms GPU, the oracle (exact per-pixel lists) in {floor:.1} ms: {:.2}x the floor (medians of 3)",
         pipeline.name(),
