@@ -37,7 +37,8 @@ pub struct RenderSchedule;
 pub struct CurrentSnapshot(pub FrameSnapshot);
 
 /// The view being rendered (its camera, image size and settings), whether the frame has
-/// lights to shade it with, and whether it draws blended materials.
+/// lights to shade it with, whether it draws blended materials, and whether it brings its own
+/// per-pixel light lists (`FrameSnapshot::pixel_light_lists`).
 #[derive(Resource, Clone, Copy, Debug)]
 pub struct CurrentView(pub RenderView, pub bool, pub bool, pub bool);
 
@@ -60,13 +61,17 @@ impl CurrentView {
         self.2
     }
 
+    fn has_pixel_lists(&self) -> bool {
+        self.3
+    }
+
     /// The plan's inputs for this view.
     fn plan_inputs(&self, accumulation: wgpu::TextureFormat) -> PlanInputs<'_> {
         PlanInputs {
             view: &self.0,
             has_lights: self.has_lights(),
             has_blended: self.has_blended(),
-            has_pixel_lists: self.3,
+            has_pixel_lists: self.has_pixel_lists(),
             accumulation,
         }
     }

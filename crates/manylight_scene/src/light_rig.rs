@@ -147,6 +147,13 @@ pub fn intensity_for_radius(r: f32) -> f32 {
     0.12 * r * r
 }
 
+/// `bounds`, or the cube [-1, 1]³ when they are empty or not finite.
+fn usable_bounds(bounds: Aabb) -> Aabb {
+    let usable =
+        !bounds.is_empty() && bounds.min.is_finite() && bounds.max.is_finite() && bounds.size().is_finite();
+    if usable { bounds } else { Aabb { min: Vec3::splat(-1.0), max: Vec3::ONE } }
+}
+
 /// `count` animated lights placed deterministically (for `seed`) inside `bounds`.
 ///
 /// Centres are uniform in `bounds` shrunk by 5 % of its size on each side, and orbit and bob
@@ -157,9 +164,7 @@ pub fn intensity_for_radius(r: f32) -> f32 {
 /// `count` grows (until the clamp); the intensity is [`intensity_for_radius`]. An empty or
 /// non-finite `bounds` is replaced by the cube [-1, 1]³.
 pub fn light_rig(count: usize, bounds: Aabb, seed: u64) -> Vec<AnimatedLight> {
-    let usable =
-        !bounds.is_empty() && bounds.min.is_finite() && bounds.max.is_finite() && bounds.size().is_finite();
-    let bounds = if usable { bounds } else { Aabb { min: Vec3::splat(-1.0), max: Vec3::ONE } };
+    let bounds = usable_bounds(bounds);
     let size = bounds.size();
     let inner = Aabb { min: bounds.min + size * 0.05, max: bounds.max - size * 0.05 };
     let volume = (size.x * size.y * size.z).max(1e-6);
@@ -244,9 +249,7 @@ pub fn sphere_shell_lights(count: usize, shell_radius: f32, light_range: f32, se
 /// `I · 0.88 / (2ρ)²` with the window at half the range, integrated over the cosine). An empty
 /// or non-finite `bounds` is replaced by the cube [-1, 1]³.
 pub fn studio_lights(count: usize, bounds: Aabb) -> Vec<SceneLight> {
-    let usable =
-        !bounds.is_empty() && bounds.min.is_finite() && bounds.max.is_finite() && bounds.size().is_finite();
-    let bounds = if usable { bounds } else { Aabb { min: Vec3::splat(-1.0), max: Vec3::ONE } };
+    let bounds = usable_bounds(bounds);
     let rho = (bounds.size().length() * 0.5).max(1e-3);
     let center = bounds.center();
     let intensity = 18.0 * rho * rho / count.max(1) as f32;
