@@ -1,21 +1,33 @@
-// Cluster light assignment on the GPU, in two levels of three dispatches each, in one compute
-// pass. Level 1 builds a list per screen tile (the column of clusters behind it); level 2
-// builds each cluster's list from its tile's list instead of from every light:
-// 1. `tile_count`: one invocation per (tile, chunk of TILE_LIGHT_CHUNK lights) counts the
-//    chunk's lights whose sphere passes the chosen test against the tile's whole column,
-//    radius inflated a little more: the column's box contains each cluster's box and its
-//    planes are each cluster's side planes moved outwards, so this is a superset of what any
-//    cluster of the column accepts (checked on the CPU by
+// Cluster light assignment on the GPU, in three levels of three dispatches each, in one compute
+// pass. Level 0 builds a list per coarse tile (span × span tiles); level 1 a list per screen
+// tile (the column of clusters behind it) from its coarse tile's list; level 2 each cluster's
+// list from its tile's list. So no level tests every light against every tile: at 100 000
+// lights on 40 × 23 tiles, level 1 alone used to run 92 million sphere tests twice.
+// 0. `coarse_count`, `coarse_scan`, `coarse_fill`: one invocation per (coarse tile, chunk of
+//    TILE_LIGHT_CHUNK lights) counts, then writes, the chunk's lights that `touches_coarse`: a
+//    superset of what any of its columns accepts (manylight_core::cluster::coarse_tile_accepts;
+//    checked on the CPU by crates/manylight_core/tests/tile_prefilter.rs). Without a coarse level (`coarse_span` 0: the planes test, which is not
+//    monotone in the tile, or a span below 2) these steps are not dispatched and level 1 takes
+//    every light as a candidate;
+// 1. `tile_count`: one invocation per (tile, chunk of TILE_LIGHT_CHUNK candidates of its coarse
+//    tile's list; `chunk_of`) counts the chunk's lights whose sphere passes the chosen test against the
+//    tile's whole column, radius inflated a little more: the column's box contains each
+//    cluster's box and its planes are each cluster's side planes moved outwards, so this is a
+//    superset of what any cluster of the column accepts (checked on the CPU by
 //    crates/manylight_core/tests/tile_prefilter.rs). Chunks keep every invocation's loop short:
 //    lavapipe stops an invocation after 65 535 loop iterations (gpu_types::TILE_LIGHT_CHUNK);
 // 2. `tile_scan`: one workgroup turns the (tile, chunk) counts, tile-major, into offsets
 //    (exclusive prefix sum), so a tile's chunks lie one after another;
 // 3. `tile_fill`: each (tile, chunk) writes its lights in ascending order, so each tile's
-//    list is in ascending light order;
+//    list is in ascending light order (the coarse lists are, chunk after chunk);
 // 4. `count`: one invocation per cluster tests its tile's lights against the cluster's bounds,
 //    stores the count (capped if a cap is set) and updates the counters;
 // 5. `scan`: prefix sum of the cluster counts, and the total the index list needs;
 // 6. `fill`: writes the first `count` hits, in ascending light order, at the cluster's offset.
+// Levels 0 and 1 share buffers (a device binds 8 storage buffers per stage): the coarse
+// tiles' bounds follow the tiles' in `tile_bounds`, their (coarse tile, chunk) ranges follow
+// the (tile, chunk) ranges in `tile_ranges`, and their lists follow the `tile_index_capacity`
+// entries of the tile lists in `tile_indices`.
 // Sums and offsets saturate at 2^32 - 1 instead of wrapping (`add_saturating`), so a frame
 // with more pairs than a u32 counts is seen as too large (PAIR_COUNT_SATURATED) rather than as
 // a small total whose lists would silently miss lights.
@@ -32,7 +44,7 @@ struct ClusterCounters {
     non_empty: atomic<u32>,
     tile_entries: atomic<u32>,
     max_tile_lights: atomic<u32>,
-    _pad: u32,
+    coarse_entries: atomic<u32>,
 };
 
 @group(0) @binding(0) var<uniform> params: ClusterParams;
@@ -95,15 +107,124 @@ fn tile_count_total() -> u32 {
     return params.dims.x * params.dims.y;
 }
 
-// Entries of `tile_ranges`: one per (tile, chunk), tile-major.
+// Entries of `tile_ranges` for level 1: one per (tile, chunk), tile-major.
 fn tile_entry_total() -> u32 {
     return tile_count_total() * params.tile_chunks;
 }
 
-// The lights [first, end) of entry `e`'s chunk.
-fn chunk_lights(e: u32) -> vec2<u32> {
-    let first = (e % params.tile_chunks) * TILE_LIGHT_CHUNK;
-    return vec2<u32>(first, min(first + TILE_LIGHT_CHUNK, params.light_count));
+fn coarse_count_total() -> u32 {
+    return params.coarse_dims.x * params.coarse_dims.y;
+}
+
+// Entries of `tile_ranges` for level 0, after level 1's: one per (coarse tile, chunk).
+fn coarse_entry_total() -> u32 {
+    return select(0u, coarse_count_total() * params.tile_chunks, params.coarse_span > 0u);
+}
+
+// The positions [first, end) of chunk `chunk` in a list of `n` candidates.
+fn chunk_range(chunk: u32, n: u32) -> vec2<u32> {
+    let first = chunk * TILE_LIGHT_CHUNK;
+    return vec2<u32>(first, min(first + TILE_LIGHT_CHUNK, n));
+}
+
+// Invocation `e` of levels 0 and 1 handles chunk `e / tiles` of tile `e % tiles` (of `tiles`
+// tiles or coarse tiles): neighbouring invocations, which run side by side in a SIMD group and
+// wait for its longest loop, take the same chunk of different tiles, so a group is either all
+// at work or all past the end of its lists. Returns (tile, chunk, entry): `entry` indexes the
+// tile-major ranges, where a tile's chunks lie one after another.
+fn chunk_of(e: u32, tiles: u32) -> vec3<u32> {
+    let tile = e % tiles;
+    let chunk = e / tiles;
+    return vec3<u32>(tile, chunk, tile * params.tile_chunks + chunk);
+}
+
+// The list (offset, count) made of the `tile_chunks` consecutive entries from `first` of
+// `tile_ranges`, or empty when it does not fit in `capacity` entries this frame (the frame is
+// rendered again).
+fn chunked_list(first: u32, capacity: u32) -> vec2<u32> {
+    let a = tile_ranges[first];
+    let z = tile_ranges[first + params.tile_chunks - 1u];
+    let range = vec2<u32>(a.x, add_saturating(z.x, z.y) - a.x);
+    return select(vec2<u32>(0u), range, fits(range, capacity));
+}
+
+// Level 0's test (manylight_core::cluster::coarse_tile_accepts, where the proof is): the
+// sphere, radius inflated as for level 1, must reach the hull of the coarse tile's columns'
+// AABBs, and, unless the AABB test is chosen, its planes with the radius inflated once more,
+// when the sphere lies in front of the eye by more than twice the column margin (`aabb_min.w`).
+fn touches_coarse(b: GpuClusterBounds, light: u32) -> bool {
+    let s = spheres[light];
+    let r = s.w * TILE_PREFILTER_INFLATION;
+    if !sphere_intersects_aabb(s.xyz, r, b.aabb_min.xyz, b.aabb_max.xyz) {
+        return false;
+    }
+    if params.cull_test == CULL_AABB {
+        return true;
+    }
+    let wide = r * TILE_PREFILTER_INFLATION;
+    let in_front = -s.z > wide * RADIUS_INFLATION + 2.0 * b.aabb_min.w;
+    return !in_front || sphere_intersects_planes(s.xyz, wide, b);
+}
+
+@compute @workgroup_size(WORKGROUP_SIZE)
+fn coarse_count(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let e = linear_index(id, groups);
+    if e >= coarse_entry_total() {
+        return;
+    }
+    let c = chunk_of(e, coarse_count_total());
+    let b = tile_bounds[tile_count_total() + c.x];
+    let lights = chunk_range(c.y, params.light_count);
+    var n = 0u;
+    for (var l = lights.x; l < lights.y; l++) {
+        if touches_coarse(b, l) {
+            n += 1u;
+        }
+    }
+    tile_ranges[tile_entry_total() + c.z] = vec2<u32>(0u, n);
+}
+
+@compute @workgroup_size(WORKGROUP_SIZE)
+fn coarse_fill(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let e = linear_index(id, groups);
+    if e >= coarse_entry_total() {
+        return;
+    }
+    let c = chunk_of(e, coarse_count_total());
+    let range = tile_ranges[tile_entry_total() + c.z];
+    if !fits(range, params.coarse_index_capacity) {
+        return;
+    }
+    let b = tile_bounds[tile_count_total() + c.x];
+    let lights = chunk_range(c.y, params.light_count);
+    let base = params.tile_index_capacity + range.x;
+    var k = 0u;
+    for (var l = lights.x; l < lights.y && k < range.y; l++) {
+        if touches_coarse(b, l) {
+            tile_indices[base + k] = l;
+            k += 1u;
+        }
+    }
+}
+
+// Level 1's candidates for tile `t`: its coarse tile's list (offset, count into the coarse
+// lists), or, without a coarse level, every light.
+fn tile_candidates(t: u32) -> vec2<u32> {
+    if params.coarse_span == 0u {
+        return vec2<u32>(0u, params.light_count);
+    }
+    let x = (t % params.dims.x) / params.coarse_span;
+    let y = (t / params.dims.x) / params.coarse_span;
+    let c = x + y * params.coarse_dims.x;
+    return chunked_list(tile_entry_total() + c * params.tile_chunks, params.coarse_index_capacity);
+}
+
+// Candidate `i` of a list from `tile_candidates`.
+fn candidate(list: vec2<u32>, i: u32) -> u32 {
+    if params.coarse_span == 0u {
+        return i;
+    }
+    return tile_indices[params.tile_index_capacity + list.x + i];
 }
 
 @compute @workgroup_size(WORKGROUP_SIZE)
@@ -112,15 +233,17 @@ fn tile_count(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgro
     if e >= tile_entry_total() {
         return;
     }
-    let b = tile_bounds[e / params.tile_chunks];
-    let lights = chunk_lights(e);
+    let t = chunk_of(e, tile_count_total());
+    let b = tile_bounds[t.x];
+    let list = tile_candidates(t.x);
+    let part = chunk_range(t.y, list.y);
     var n = 0u;
-    for (var l = lights.x; l < lights.y; l++) {
-        if touches_tile(b, l) {
+    for (var i = part.x; i < part.y; i++) {
+        if touches_tile(b, candidate(list, i)) {
             n += 1u;
         }
     }
-    tile_ranges[e] = vec2<u32>(0u, n);
+    tile_ranges[t.z] = vec2<u32>(0u, n);
 }
 
 @compute @workgroup_size(WORKGROUP_SIZE)
@@ -129,14 +252,17 @@ fn tile_fill(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgrou
     if e >= tile_entry_total() {
         return;
     }
-    let range = tile_ranges[e];
+    let t = chunk_of(e, tile_count_total());
+    let range = tile_ranges[t.z];
     if !fits(range, params.tile_index_capacity) {
         return;
     }
-    let b = tile_bounds[e / params.tile_chunks];
-    let lights = chunk_lights(e);
+    let b = tile_bounds[t.x];
+    let list = tile_candidates(t.x);
+    let part = chunk_range(t.y, list.y);
     var k = 0u;
-    for (var l = lights.x; l < lights.y && k < range.y; l++) {
+    for (var i = part.x; i < part.y && k < range.y; i++) {
+        let l = candidate(list, i);
         if touches_tile(b, l) {
             tile_indices[range.x + k] = l;
             k += 1u;
@@ -147,12 +273,7 @@ fn tile_fill(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgrou
 // The lights of the cluster's tile: (offset, count) into `tile_indices`, from its first and
 // last chunk's ranges.
 fn tile_lights(cluster: u32) -> vec2<u32> {
-    let first = (cluster % tile_count_total()) * params.tile_chunks;
-    let a = tile_ranges[first];
-    let z = tile_ranges[first + params.tile_chunks - 1u];
-    let range = vec2<u32>(a.x, add_saturating(z.x, z.y) - a.x);
-    // A tile list that did not fit this frame is empty; the frame is rendered again.
-    return select(vec2<u32>(0u), range, fits(range, params.tile_index_capacity));
+    return chunked_list((cluster % tile_count_total()) * params.tile_chunks, params.tile_index_capacity);
 }
 
 @compute @workgroup_size(WORKGROUP_SIZE)
@@ -185,18 +306,19 @@ fn count(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) 
 }
 
 var<workgroup> partial_sums: array<u32, SCAN_WORKGROUP_SIZE>;
+var<workgroup> scan_total: u32;
 
-// Exclusive prefix sum of the counts (`.y`) of `tiles ? tile_ranges : ranges` into their
-// offsets (`.x`); returns the total. One workgroup: each invocation sums a chunk, invocation
-// 0 scans the chunk sums, each invocation then writes its chunk's offsets.
-fn scan_ranges(tiles: bool, t: u32) -> u32 {
-    let total_entries = select(params.dims.w, tile_entry_total(), tiles);
-    let chunk = (total_entries + SCAN_WORKGROUP_SIZE - 1u) / SCAN_WORKGROUP_SIZE;
-    let begin = min(t * chunk, total_entries);
-    let end = min(begin + chunk, total_entries);
+// Exclusive prefix sum of the counts (`.y`) of `count` entries from `first` of `ranges`
+// (`clusters`) or `tile_ranges` into their offsets (`.x`); returns the total. One workgroup:
+// each invocation sums a chunk, invocation 0 scans the chunk sums, each invocation then writes
+// its chunk's offsets.
+fn scan_ranges(clusters: bool, first: u32, count: u32, t: u32) -> u32 {
+    let chunk = (count + SCAN_WORKGROUP_SIZE - 1u) / SCAN_WORKGROUP_SIZE;
+    let begin = first + min(t * chunk, count);
+    let end = min(begin + chunk, first + count);
     var sum = 0u;
     for (var c = begin; c < end; c++) {
-        sum = add_saturating(sum, select(ranges[c].y, tile_ranges[c].y, tiles));
+        sum = add_saturating(sum, select(tile_ranges[c].y, ranges[c].y, clusters));
     }
     partial_sums[t] = sum;
     workgroupBarrier();
@@ -213,24 +335,30 @@ fn scan_ranges(tiles: bool, t: u32) -> u32 {
     workgroupBarrier();
     var offset = partial_sums[t];
     for (var c = begin; c < end; c++) {
-        if tiles {
-            let n = tile_ranges[c].y;
-            tile_ranges[c].x = offset;
-            offset = add_saturating(offset, n);
-        } else {
+        if clusters {
             let n = ranges[c].y;
             ranges[c].x = offset;
+            offset = add_saturating(offset, n);
+        } else {
+            let n = tile_ranges[c].y;
+            tile_ranges[c].x = offset;
             offset = add_saturating(offset, n);
         }
     }
     return scan_total;
 }
 
-var<workgroup> scan_total: u32;
+@compute @workgroup_size(SCAN_WORKGROUP_SIZE)
+fn coarse_scan(@builtin(local_invocation_index) t: u32) {
+    let total = scan_ranges(false, tile_entry_total(), coarse_entry_total(), t);
+    if t == 0u {
+        atomicStore(&counters.coarse_entries, total);
+    }
+}
 
 @compute @workgroup_size(SCAN_WORKGROUP_SIZE)
 fn tile_scan(@builtin(local_invocation_index) t: u32) {
-    let total = scan_ranges(true, t);
+    let total = scan_ranges(false, 0u, tile_entry_total(), t);
     if t == 0u {
         atomicStore(&counters.tile_entries, total);
     }
@@ -238,7 +366,7 @@ fn tile_scan(@builtin(local_invocation_index) t: u32) {
 
 @compute @workgroup_size(SCAN_WORKGROUP_SIZE)
 fn scan(@builtin(local_invocation_index) t: u32) {
-    let total = scan_ranges(false, t);
+    let total = scan_ranges(true, 0u, params.dims.w, t);
     if t == 0u {
         atomicStore(&counters.total_entries, total);
     }

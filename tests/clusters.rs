@@ -140,10 +140,17 @@ fn gpu_lists_equal_the_cpu_reference_on_hard_cases() {
     let forward = -cam.transform.z_axis.truncate().normalize();
     let at = |d: f32| cam.transform.w_axis.truncate() + forward * d;
     let hard = hard_lights(&scene, size);
-    for cull in CullTest::ALL {
-        let snap = scene_snapshot(&scene, size, hard.clone(), clustered(cull, ZSlicing::Exponential, None));
-        let (_, gpu, cpu) = gpu_and_cpu(&mut r, snap);
-        assert_same_lists(&format!("hard cases {cull:?}"), &gpu, &cpu);
+    // Each test with coarse tiles of 2 × 2 tiles (3 × 2 of them, the last column and row
+    // clipped), one coarse tile over the whole grid (8) and no coarse level (0).
+    for (cull, coarse_tiles) in CullTest::ALL.into_iter().flat_map(|c| [(c, 2), (c, 8), (c, 0)]) {
+        let mut settings = clustered(cull, ZSlicing::Exponential, None);
+        settings.clusters.coarse_tiles = coarse_tiles;
+        let snap = scene_snapshot(&scene, size, hard.clone(), settings);
+        let (report, gpu, cpu) = gpu_and_cpu(&mut r, snap);
+        let c = report.clusters.as_ref().expect("cluster report");
+        let coarse = coarse_tiles > 0 && cull != CullTest::Planes;
+        assert_eq!(c.coarse_entries > 0, coarse, "{cull:?}, coarse {coarse_tiles}: {c:?}");
+        assert_same_lists(&format!("hard cases {cull:?}, coarse tiles {coarse_tiles}"), &gpu, &cpu);
         // The covering light is in every cluster; the radius-0 light in none.
         for c in 0..cpu.ranges.len() as u32 {
             assert!(cpu.lights_of(c).contains(&5), "cluster {c} misses the covering light");
@@ -166,6 +173,39 @@ fn gpu_lists_equal_the_cpu_reference_on_hard_cases() {
     let (report, gpu, cpu) = gpu_and_cpu(&mut r, snap);
     assert_same_lists("near 1e-4, far 1e6", &gpu, &cpu);
     assert!(report.clusters.is_some());
+}
+
+/// The sphere-shell stress scene with 100 000 lights of its lattice (each a few pixels wide, all
+/// at one depth), 256 × 144: the lists equal the CPU reference with the coarse level (coarse
+/// tiles of 2 × 2 tiles: 4 × 3 of them, the last row clipped) and without it, and the coarse
+/// lists are much shorter than the lights.
+#[test]
+fn gpu_lists_equal_the_cpu_reference_on_the_sphere_shell() {
+    let _gpu = gpu();
+    let mut r = HeadlessRenderer::new().expect("adapter");
+    let scene = manylight::scene::sphere_shell_scene();
+    let lights: Vec<ExtractedPointLight> = manylight::scene::sphere_shell_lights(
+        100_000,
+        manylight::scene::SHELL_RADIUS,
+        manylight::scene::SHELL_LIGHT_RANGE,
+        7,
+    )
+    .iter()
+    .map(extracted_light)
+    .collect();
+    for coarse_tiles in [2, 0] {
+        let mut settings = clustered(CullTest::Both, ZSlicing::Exponential, None);
+        settings.clusters.coarse_tiles = coarse_tiles;
+        let snap = scene_snapshot(&scene, UVec2::new(256, 144), lights.clone(), settings);
+        let (report, gpu, cpu) = gpu_and_cpu(&mut r, snap);
+        let c = report.clusters.as_ref().expect("cluster report");
+        assert!(c.total_entries > 0, "{c:?}");
+        assert_same_lists(&format!("sphere shell, coarse tiles {coarse_tiles}"), &gpu, &cpu);
+        if coarse_tiles > 0 {
+            let coarse = u64::from(c.dims[0].div_ceil(2) * c.dims[1].div_ceil(2));
+            assert!(c.coarse_entries < coarse * 20_000, "coarse lists barely cut: {c:?}");
+        }
+    }
 }
 
 /// Without a far plane the grid slices up to the farthest light's reach (a power of two), so
@@ -329,27 +369,35 @@ fn gpu_lists_are_exact_past_the_workgroups_per_dimension_limit() {
     assert_same_lists("256×256×2 grid, workgroup size 1", &gpu, &cpu);
 }
 
-/// 2 097 152 lights that each cover every one of 64 × 32 tiles make 2³² light–tile pairs, one more than the build's u32 sums hold. A wrapped
-/// sum would be 0 and pass every capacity check with empty lists; the saturating sums refuse
-/// the frame instead, naming the limit.
+/// 2 097 152 lights that each cover every one of 64 × 32 tiles make 2³² light–tile pairs, one
+/// more than the build's u32 sums hold. A wrapped sum would be 0 and pass every capacity check
+/// with empty lists; the saturating sums refuse the frame instead, naming the limit. The same
+/// holds for the coarse level: 64 × 32 coarse tiles of 2 × 2 tiles.
 #[test]
 fn more_pairs_than_32_bits_hold_are_refused_not_wrapped() {
     let _gpu = gpu();
     let mut r = HeadlessRenderer::new().expect("adapter");
     let scene = default_scene();
-    let mut settings = clustered(CullTest::Aabb, ZSlicing::Exponential, None);
     // 2^21 lights (48 bytes each: 96 MiB, under the 128 MiB a storage binding may hold)
-    // times 2^11 tiles.
-    settings.clusters.grid.dims = Some(glam::UVec3::new(64, 32, 1));
+    // times 2^11 tiles (no coarse level) or coarse tiles.
     let count = 1usize << 21;
     let center = scene.bounds().center();
     let lights = vec![light(center, 1e6); count];
-    let snapshot = scene_snapshot(&scene, UVec2::new(64, 64), lights, settings);
-    let start = std::time::Instant::now();
-    let err = r.render(snapshot, false).expect_err("2^32 pairs are refused");
-    eprintln!("refused in {:.1} s: {err}", start.elapsed().as_secs_f64());
-    assert!(matches!(err, manylight::render::RenderError::TooManyPairs { .. }), "{err}");
-    assert!(err.to_string().contains("PAIR_COUNT_SATURATED"), "{err}");
+    for (grid, coarse_tiles, level) in [
+        (glam::UVec3::new(64, 32, 1), 0, "light–tile"),
+        (glam::UVec3::new(128, 64, 1), 2, "light–coarse-tile"),
+    ] {
+        let mut settings = clustered(CullTest::Aabb, ZSlicing::Exponential, None);
+        settings.clusters.grid.dims = Some(grid);
+        settings.clusters.coarse_tiles = coarse_tiles;
+        let snapshot = scene_snapshot(&scene, UVec2::new(128, 64), lights.clone(), settings);
+        let start = std::time::Instant::now();
+        let err = r.render(snapshot, false).expect_err("2^32 pairs are refused");
+        eprintln!("refused in {:.1} s: {err}", start.elapsed().as_secs_f64());
+        assert!(matches!(err, manylight::render::RenderError::TooManyPairs { .. }), "{err}");
+        assert!(err.to_string().contains("PAIR_COUNT_SATURATED"), "{err}");
+        assert!(err.to_string().contains(level), "{level}: {err}");
+    }
 }
 
 /// 70 000 lights that all touch one tile make a tile list longer than lavapipe's 65 535 loop

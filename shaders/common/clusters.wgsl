@@ -12,8 +12,14 @@ struct ClusterParams {
     slicing: u32,
     log_far_over_near: f32,
     tile_index_capacity: u32,
-    // light chunks of level 1 (TILE_LIGHT_CHUNK lights each), at least 1
+    // light chunks of levels 0 and 1 (TILE_LIGHT_CHUNK lights each), at least 1
     tile_chunks: u32,
+    // coarse tiles across and down (level 0 of the build)
+    coarse_dims: vec2<u32>,
+    // entries of the coarse-tile lists, after the tile_index_capacity entries of the tile lists
+    coarse_index_capacity: u32,
+    // tiles per coarse-tile edge; 0: no coarse level (level 1 tests every light)
+    coarse_span: u32,
 };
 
 struct GpuClusterBounds {

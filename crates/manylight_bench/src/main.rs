@@ -309,6 +309,10 @@ struct ClusterArgs {
     /// Workgroup size of the cluster-build compute shader.
     #[arg(long, default_value_t = 64)]
     workgroup_size: u32,
+    /// Tiles per coarse-tile edge of the cluster build's first level (0: no coarse level,
+    /// every tile tests every light).
+    #[arg(long, default_value_t = manylight_render::DEFAULT_COARSE_TILES)]
+    coarse_tiles: u32,
     /// G-buffer layout of the deferred pipelines (clustered-deferred, light-volumes): full,
     /// packed or compact.
     #[arg(long, default_value = "full", value_parser = parse_gbuffer)]
@@ -343,6 +347,7 @@ impl ClusterArgs {
             cap: self.cluster_cap,
             depth_prepass: !self.no_depth_prepass,
             workgroup_size: self.workgroup_size,
+            coarse_tiles: self.coarse_tiles,
         }
     }
 }

@@ -1,12 +1,15 @@
-//! The GPU cluster build first keeps, per screen tile, the lights that pass the chosen test
-//! against the tile's whole column (one slice from near to far, radius × 1.001), then tests
-//! only those against each cluster. That is exact only if every light a cluster accepts is
-//! also accepted by its column, for each test on its own; this checks it on random lights.
+//! The GPU cluster build keeps, per coarse tile, the lights that can reach one of its tiles
+//! (level 0); then, per screen tile, those of its coarse tile that pass the chosen test against
+//! the tile's whole column (one slice from near to far, radius × 1.001); then tests only those
+//! against each cluster. That is exact only if every light a cluster accepts is also accepted
+//! by its column, and every light a column accepts by its coarse tile; this checks both on
+//! random lights.
 
 use glam::{UVec2, UVec3, Vec3};
 use manylight_core::Projection;
 use manylight_core::cluster::{
-    ClusterGrid, GridConfig, ViewSphere, ZSlicing, sphere_intersects_aabb, sphere_intersects_planes,
+    ClusterGrid, CullTest, GridConfig, ViewSphere, ZSlicing, coarse_dims, coarse_tile_accepts, coarse_tiles,
+    sphere_intersects_aabb, sphere_intersects_planes,
 };
 
 /// The GPU build's tile-level inflation (emitted into shaders/cluster_build.wgsl).
@@ -52,6 +55,81 @@ fn a_column_accepts_every_light_its_clusters_accept() {
                     assert!(sphere_intersects_planes(s.center, r, &cplanes), "planes: {s:?} in {k:?}");
                 }
             }
+        }
+    }
+}
+
+/// Level 0 of the build keeps, per coarse tile of `span × span` columns, the lights that
+/// `coarse_tile_accepts`; level 1 tests only those. Exact only if a coarse tile accepts every
+/// light one of its columns accepts (the tile level's test, radius × 1.001), for the AABB test
+/// and for both tests; checked on random lights, many of them around and behind the eye, where
+/// the side planes of a narrow and a wide column disagree.
+#[test]
+fn a_coarse_tile_accepts_every_light_its_columns_accept() {
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    let mut rnd = move || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (seed >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let cases = [
+        (UVec2::new(200, 120), Projection::perspective(1.0, 0.1, 200.0)),
+        (UVec2::new(1280, 720), Projection::perspective(0.8, 0.1, 1000.0)),
+        (UVec2::new(96, 64), Projection::perspective(2.8, 0.01, 50.0)),
+        (UVec2::new(640, 17), Projection::perspective(0.01, 0.5, 50.0)),
+        (UVec2::new(200, 120), Projection::orthographic(30.0, 0.5, 100.0)),
+    ];
+    for (viewport, projection) in cases {
+        let grid = ClusterGrid::new(viewport, &projection, &GridConfig::default());
+        let dims = UVec3::new(grid.dims.x, grid.dims.y, 1);
+        let column = ClusterGrid::new(
+            viewport,
+            &projection,
+            &GridConfig { dims: Some(dims), ..GridConfig::default() },
+        );
+        let extent = projection.far.min(100.0);
+        // The planes must make the coarse test tighter than the hull alone (perspective).
+        let mut planes_rejected = 0u32;
+        for span in [2, 3, 8] {
+            let coarse = coarse_tiles(&column, span);
+            let across = coarse_dims(dims.truncate(), span).x;
+            for i in 0..600 {
+                // A third of the lights within a few radii of the eye, some behind it.
+                let d = if i % 3 == 0 { (rnd() - 0.3) * 2.0 } else { rnd() * extent };
+                let spread = d.abs().max(1.0) * 2.0;
+                let s = ViewSphere {
+                    center: Vec3::new((rnd() - 0.5) * spread, (rnd() - 0.5) * spread, -d),
+                    radius: rnd() * if i % 3 == 0 { 2.0 } else { extent * 0.05 },
+                };
+                for tile in &coarse {
+                    let tighter = coarse_tile_accepts(tile, &s, CullTest::Aabb)
+                        && !coarse_tile_accepts(tile, &s, CullTest::Both);
+                    planes_rejected += u32::from(tighter);
+                }
+                let r = s.radius * INFLATION;
+                for t in 0..column.cluster_count() {
+                    let k = column.coords(t);
+                    let (min, max) = column.cluster_aabb(k.x, k.y, 0);
+                    let planes = column.cluster_planes(k.x, k.y, 0);
+                    let aabb = sphere_intersects_aabb(s.center, r, min, max);
+                    let both = aabb && sphere_intersects_planes(s.center, r, &planes);
+                    let tile = &coarse[(k.x / span + k.y / span * across) as usize];
+                    if aabb {
+                        assert!(
+                            coarse_tile_accepts(tile, &s, CullTest::Aabb),
+                            "aabb: {s:?} in {k:?}, span {span}"
+                        );
+                    }
+                    if both {
+                        assert!(
+                            coarse_tile_accepts(tile, &s, CullTest::Both),
+                            "both: {s:?} in {k:?}, span {span}"
+                        );
+                    }
+                }
+            }
+        }
+        if projection.orthographic_half_extent(1.0).is_none() {
+            assert!(planes_rejected > 0, "the planes never cut: {viewport:?} {projection:?}");
         }
     }
 }

@@ -17,7 +17,8 @@ use crate::snapshot::RenderView;
 use glam::Mat4;
 use manylight_core::Projection;
 use manylight_core::cluster::{
-    ClusterAssignment, ClusterGrid, CullTest, ListBounds, ViewSphere, list_bounds, view_spheres,
+    ClusterAssignment, ClusterGrid, CullTest, ListBounds, ViewSphere, coarse_dims, coarse_span, coarse_tiles,
+    list_bounds, view_spheres,
 };
 use serde::Serialize;
 
@@ -48,6 +49,11 @@ pub struct ClusterReport {
     pub tile_entries: u64,
     /// Longest per-tile list.
     pub max_per_tile: u32,
+    /// Entries of the per-coarse-tile lists the tile lists are filtered from (0 without a
+    /// coarse level).
+    pub coarse_entries: u64,
+    /// Tiles per coarse-tile edge (0: no coarse level).
+    pub coarse_span: u32,
     /// Times the lists had to grow after the frame was rendered (each renders it again): 0, since
     /// the CPU bounds size them before submission, unless a bound exceeds what the device binds.
     pub regrows: u32,
@@ -55,6 +61,8 @@ pub struct ClusterReport {
     pub pair_bound: u64,
     /// The CPU bound the per-tile lists were sized to (at least `tile_entries`).
     pub tile_entry_bound: u64,
+    /// The CPU bound the per-coarse-tile lists were sized to (at least `coarse_entries`).
+    pub coarse_entry_bound: u64,
     /// CPU milliseconds the two bounds took (before the frame was submitted).
     pub bound_cpu_ms: f64,
     /// Bytes of GPU buffers the cluster build and clustered shading hold (grid bounds, light
@@ -79,6 +87,7 @@ impl ClusterReport {
         self.dropped_pairs = u64::from(c.dropped_pairs);
         self.clusters_overflowed = c.clusters_overflowed;
         self.tile_entries = u64::from(c.tile_entries);
+        self.coarse_entries = u64::from(c.coarse_entries);
     }
 }
 
@@ -104,11 +113,19 @@ pub struct ClusterResources {
     pub indices: GrowableBuffer,
     bounds: GrowableBuffer,
     spheres: GrowableBuffer,
+    /// Bounds of the tile columns, then of the coarse tiles.
     tile_bounds: GrowableBuffer,
+    /// (tile, chunk) ranges, then (coarse tile, chunk) ranges.
     tile_ranges: GrowableBuffer,
+    /// The per-tile lists (`tile_list_capacity` entries), then the per-coarse-tile lists.
     tile_indices: GrowableBuffer,
     counters: wgpu::Buffer,
-    bounds_of: Option<ClusterGrid>,
+    /// The grid and coarse span the uploaded bounds are for.
+    bounds_of: Option<(ClusterGrid, Option<u32>)>,
+    /// Tiles per coarse-tile edge this frame, `None` without a coarse level.
+    coarse: Option<u32>,
+    tile_list_capacity: u32,
+    coarse_list_capacity: u32,
     generations: [u64; 7],
     /// The view-space spheres uploaded this frame (for the CPU reference in tests and stats).
     pub view_spheres: Vec<ViewSphere>,
@@ -197,6 +214,9 @@ impl ClusterResources {
             tile_indices,
             counters,
             bounds_of: None,
+            coarse: None,
+            tile_list_capacity: 0,
+            coarse_list_capacity: 0,
             generations: [0; 7],
             view_spheres: Vec::new(),
             bounds_estimate: ListBounds::default(),
@@ -287,8 +307,9 @@ impl ClusterResources {
         let projection = self.place_lights(view, view_from_world, lights);
         self.grid = ClusterGrid::new(view.size, &projection, &grid_config);
         self.cull = settings.cull;
+        self.coarse = coarse_span(settings.coarse_tiles, settings.cull);
         let count = self.grid.cluster_count();
-        if self.bounds_of != Some(self.grid) {
+        if self.bounds_of != Some((self.grid, self.coarse)) {
             let dims = self.grid.dims;
             let mut bounds = Vec::with_capacity(count as usize);
             for z in 0..dims.z {
@@ -325,8 +346,16 @@ impl ClusterResources {
                     });
                 }
             }
+            // Level 0: the coarse tiles after the tiles, the column margin in `aabb_min.w`.
+            if let Some(span) = self.coarse {
+                tiles.extend(coarse_tiles(&tile_grid, span).into_iter().map(|c| GpuClusterBounds {
+                    aabb_min: c.min.extend(c.margin).to_array(),
+                    aabb_max: c.max.extend(0.0).to_array(),
+                    planes: c.planes.map(|p| p.to_array()),
+                }));
+            }
             self.tile_bounds.write(gpu, bytemuck::cast_slice(&tiles))?;
-            self.bounds_of = Some(self.grid);
+            self.bounds_of = Some((self.grid, self.coarse));
         }
         let spheres: Vec<[f32; 4]> =
             self.view_spheres.iter().map(|s| s.center.extend(s.radius).to_array()).collect();
@@ -341,7 +370,7 @@ impl ClusterResources {
         // twice. A bound beyond what the device can bind reserves what it can; then the build's
         // counters decide, after the frame, whether the real lists fit.
         let started = std::time::Instant::now();
-        self.bounds_estimate = list_bounds(&self.grid, &self.view_spheres, settings.cull);
+        self.bounds_estimate = list_bounds(&self.grid, &self.view_spheres, settings.cull, self.coarse);
         self.bound_cpu_ms = started.elapsed().as_secs_f64() * 1e3;
         // A quarter of headroom: lights that move a little do not grow the lists every frame
         // (growing creates a buffer and rebinds), and the buffers grow in powers of two.
@@ -355,14 +384,34 @@ impl ClusterResources {
             }
         };
         self.indices.reserve(gpu, with_headroom(self.bounds_estimate.cluster_pairs, &self.indices))?;
-        self.tile_indices
-            .reserve(gpu, with_headroom(self.bounds_estimate.tile_entries, &self.tile_indices))?;
+        // The tile and coarse-tile lists share a buffer; the spare room is split between them.
+        let (tile_need, coarse_need) =
+            (self.bounds_estimate.tile_entries, self.bounds_estimate.coarse_entries);
+        self.tile_indices.reserve(gpu, with_headroom(tile_need + coarse_need, &self.tile_indices))?;
+        self.split_tile_lists(tile_need, coarse_need);
         let tiles = self.grid.dims.x as u64 * self.grid.dims.y as u64;
+        let coarse_tiles = self.coarse_dims().map_or(0, |d| u64::from(d.x) * u64::from(d.y));
         let tile_chunks = (spheres.len() as u32).div_ceil(TILE_LIGHT_CHUNK).max(1);
-        self.tile_ranges.reserve(gpu, tiles * tile_chunks as u64 * 8)?;
+        self.tile_ranges.reserve(gpu, (tiles + coarse_tiles) * tile_chunks as u64 * 8)?;
         let cap = settings.cap.unwrap_or(CLUSTER_NO_CAP);
         self.write_params(gpu, view, spheres.len() as u32, cap, tile_chunks);
         Ok(())
+    }
+
+    /// Coarse tiles across and down this frame, `None` without a coarse level.
+    fn coarse_dims(&self) -> Option<glam::UVec2> {
+        self.coarse.map(|span| coarse_dims(self.grid.dims.truncate(), span))
+    }
+
+    /// Splits the entries of the tile-lists buffer between the per-tile lists (first) and the
+    /// per-coarse-tile lists: each gets what it needs and half the spare room (the coarse
+    /// lists what is left when the buffer could not grow to both).
+    fn split_tile_lists(&mut self, tile_need: u64, coarse_need: u64) {
+        let total = (self.tile_indices.capacity() / 4).min(u64::from(u32::MAX));
+        let spare = total.saturating_sub(tile_need + coarse_need);
+        let tiles = (tile_need + spare / 2).min(total);
+        self.tile_list_capacity = tiles as u32;
+        self.coarse_list_capacity = (total - tiles) as u32;
     }
 
     /// Sets the lights' view-space spheres (`lights` in the order of the light buffer) and
@@ -403,8 +452,11 @@ impl ClusterResources {
             index_capacity: (self.indices.capacity() / 4).min(u32::MAX as u64) as u32,
             slicing: self.grid.slicing.gpu_id(),
             log_far_over_near: (far / near).ln(),
-            tile_index_capacity: (self.tile_indices.capacity() / 4).min(u32::MAX as u64) as u32,
+            tile_index_capacity: self.tile_list_capacity,
             tile_chunks,
+            coarse_dims: self.coarse_dims().unwrap_or(glam::UVec2::ZERO).to_array(),
+            coarse_index_capacity: self.coarse_list_capacity,
+            coarse_span: self.coarse.unwrap_or(0),
         };
         gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
         gpu.queue.write_buffer(&self.counters, 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
@@ -426,6 +478,8 @@ impl ClusterResources {
         let projection = self.place_lights(view, view_from_world, lights);
         self.grid = manylight_core::efficiency::pixel_grid(view.size, &projection);
         self.cull = view.settings.clusters.cull;
+        self.coarse = None;
+        self.split_tile_lists(0, 0);
         let count = self.grid.cluster_count();
         let bad =
             |problem: String| RenderError::UnsupportedSettings(format!("per-pixel light lists: {problem}"));
@@ -469,6 +523,9 @@ impl ClusterResources {
         if counters.tile_entries == PAIR_COUNT_SATURATED {
             return Err(RenderError::TooManyPairs { what: "light–tile" });
         }
+        if counters.coarse_entries == PAIR_COUNT_SATURATED {
+            return Err(RenderError::TooManyPairs { what: "light–coarse-tile" });
+        }
         if counters.total_entries == PAIR_COUNT_SATURATED {
             return Err(RenderError::TooManyPairs { what: "light–cluster" });
         }
@@ -478,6 +535,7 @@ impl ClusterResources {
     /// True when the index lists are too small for what the frame needed (`counters`).
     pub fn lists_short(&self, counters: &GpuClusterCounters) -> bool {
         counters.tile_entries > self.params.tile_index_capacity
+            || counters.coarse_entries > self.params.coarse_index_capacity
             || counters.total_entries > self.params.index_capacity
     }
 
@@ -489,14 +547,19 @@ impl ClusterResources {
         gpu: &GpuContext,
         counters: &GpuClusterCounters,
     ) -> Result<bool, RenderError> {
-        let tiles_short = counters.tile_entries > self.params.tile_index_capacity;
+        let tiles_short = counters.tile_entries > self.params.tile_index_capacity
+            || counters.coarse_entries > self.params.coarse_index_capacity;
         let clusters_short = counters.total_entries > self.params.index_capacity;
         if !tiles_short && !clusters_short {
             return Ok(false);
         }
         if tiles_short {
-            self.tile_indices.reserve(gpu, counters.tile_entries as u64 * 4)?;
-            self.params.tile_index_capacity = (self.tile_indices.capacity() / 4).min(u32::MAX as u64) as u32;
+            let tiles = u64::from(counters.tile_entries.max(self.params.tile_index_capacity));
+            let coarse = u64::from(counters.coarse_entries.max(self.params.coarse_index_capacity));
+            self.tile_indices.reserve(gpu, (tiles + coarse) * 4)?;
+            self.split_tile_lists(tiles, coarse);
+            self.params.tile_index_capacity = self.tile_list_capacity;
+            self.params.coarse_index_capacity = self.coarse_list_capacity;
         }
         if clusters_short {
             self.indices.reserve(gpu, counters.total_entries as u64 * 4)?;
@@ -517,6 +580,8 @@ impl ClusterResources {
             regrows,
             pair_bound: self.bounds_estimate.cluster_pairs,
             tile_entry_bound: self.bounds_estimate.tile_entries,
+            coarse_entry_bound: self.bounds_estimate.coarse_entries,
+            coarse_span: self.coarse.unwrap_or(0),
             bound_cpu_ms: self.bound_cpu_ms,
             buffer_bytes: self.buffer_bytes(),
             cull_test: self.cull.name().to_string(),
@@ -534,6 +599,7 @@ impl ClusterResources {
     pub fn bound_can_fail(&self, loop_limited: bool, loop_limit: u32) -> bool {
         self.bounds_estimate.cluster_pairs > u64::from(self.params.index_capacity)
             || self.bounds_estimate.tile_entries > u64::from(self.params.tile_index_capacity)
+            || self.bounds_estimate.coarse_entries > u64::from(self.params.coarse_index_capacity)
             || (loop_limited && self.bounds_estimate.max_tile_lights > loop_limit)
     }
 

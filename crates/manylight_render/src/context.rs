@@ -86,7 +86,7 @@ pub enum RenderError {
         u32::MAX
     )]
     TooManyPairs {
-        /// `light–cluster` or `light–tile`.
+        /// `light–cluster`, `light–tile` or `light–coarse-tile`.
         what: &'static str,
     },
     /// A shader loop would run longer than the adapter lets one invocation loop (lavapipe

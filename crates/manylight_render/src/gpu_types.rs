@@ -328,8 +328,15 @@ pub struct GpuClusterParams {
     pub log_far_over_near: f32,
     /// Entries the per-tile light lists (first level of the build) can hold.
     pub tile_index_capacity: u32,
-    /// Light chunks of level 1: `ceil(light_count / TILE_LIGHT_CHUNK)`, at least 1.
+    /// Light chunks of levels 0 and 1: `ceil(light_count / TILE_LIGHT_CHUNK)`, at least 1.
     pub tile_chunks: u32,
+    /// Coarse tiles across and down (level 0 of the build).
+    pub coarse_dims: [u32; 2],
+    /// Entries the coarse-tile lists can hold; they follow the `tile_index_capacity` entries of
+    /// the per-tile lists in the same buffer.
+    pub coarse_index_capacity: u32,
+    /// Tiles per coarse-tile edge, or 0 without a coarse level (level 1 then tests every light).
+    pub coarse_span: u32,
 }
 
 /// Bounds of one cluster in view space (`GpuClusterBounds` in `shaders/common/clusters.wgsl`).
@@ -362,8 +369,8 @@ pub struct GpuClusterCounters {
     pub tile_entries: u32,
     /// Longest per-tile list: the per-cluster loops of the build run this many iterations.
     pub max_tile_lights: u32,
-    /// Padding.
-    pub _pad: u32,
+    /// Entries the coarse-tile lists needed (level 0; 0 without a coarse level).
+    pub coarse_entries: u32,
 }
 
 #[cfg(test)]

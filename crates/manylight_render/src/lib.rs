@@ -32,9 +32,9 @@ pub use planner::FramePlanner;
 pub use readback::{HEADLESS_FORMAT, HeadlessTarget};
 pub use renderer::Renderer;
 pub use snapshot::{
-    BloomChain, BloomSettings, ClusterSettings, DebugViewMode, Exposure, ExtractedCamera,
-    ExtractedDirectionalLight, ExtractedInstance, ExtractedPointLight, ExtractedView, FrameSettings,
-    FrameSnapshot, GBufferLayout, MotionBlurSettings, PipelineKind, RenderSettings, RenderTextureId,
-    RenderView, ViewRect, ViewTarget,
+    BloomChain, BloomSettings, ClusterSettings, DEFAULT_COARSE_TILES, DebugViewMode, Exposure,
+    ExtractedCamera, ExtractedDirectionalLight, ExtractedInstance, ExtractedPointLight, ExtractedView,
+    FrameSettings, FrameSnapshot, GBufferLayout, MotionBlurSettings, PipelineKind, RenderSettings,
+    RenderTextureId, RenderView, ViewRect, ViewTarget,
 };
 pub use stats::{FrameReport, PassTiming, ViewReport};

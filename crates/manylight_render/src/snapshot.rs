@@ -235,6 +235,9 @@ impl DebugViewMode {
     }
 }
 
+/// Default [`ClusterSettings::coarse_tiles`].
+pub const DEFAULT_COARSE_TILES: u32 = 8;
+
 /// How lights are assigned to clusters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ClusterSettings {
@@ -249,6 +252,12 @@ pub struct ClusterSettings {
     pub depth_prepass: bool,
     /// Workgroup size of the cluster-build compute shader (pipeline-override constant).
     pub workgroup_size: u32,
+    /// Tiles per coarse-tile edge of the build's first level, which keeps per coarse tile the
+    /// lights that can reach any of its tiles, so the tile level tests those instead of every
+    /// light (8: 256-px coarse tiles with 32-px tiles). Below 2 there is no coarse level; the
+    /// planes test never has one (`manylight_core::cluster::coarse_span`). The lists are the
+    /// same either way; only the build's cost changes (`docs/benchmarks.md`).
+    pub coarse_tiles: u32,
 }
 
 impl Default for ClusterSettings {
@@ -259,6 +268,7 @@ impl Default for ClusterSettings {
             cap: None,
             depth_prepass: true,
             workgroup_size: 64,
+            coarse_tiles: DEFAULT_COARSE_TILES,
         }
     }
 }

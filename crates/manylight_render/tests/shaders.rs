@@ -2,8 +2,8 @@
 //! same size and field offsets on both sides. No GPU needed.
 
 use manylight_render::gpu_types::{
-    GpuClusterCounters, GpuDirectionalLight, GpuInstance, GpuMaterial, GpuPointLight, GpuTextureUv,
-    ViewUniform,
+    GpuClusterBounds, GpuClusterCounters, GpuClusterParams, GpuDirectionalLight, GpuInstance, GpuMaterial,
+    GpuPointLight, GpuTextureUv, ViewUniform,
 };
 use manylight_render::shaders::{SOURCES, compose};
 use std::mem::{offset_of, size_of};
@@ -167,6 +167,37 @@ fn shared_structs_match_rust() {
             ("non_empty", offset_of!(GpuClusterCounters, non_empty)),
             ("tile_entries", offset_of!(GpuClusterCounters, tile_entries)),
             ("max_tile_lights", offset_of!(GpuClusterCounters, max_tile_lights)),
+            ("coarse_entries", offset_of!(GpuClusterCounters, coarse_entries)),
+        ],
+    );
+    offsets(
+        &validate("cluster_build.wgsl"),
+        "GpuClusterBounds",
+        size_of::<GpuClusterBounds>(),
+        &[
+            ("aabb_min", offset_of!(GpuClusterBounds, aabb_min)),
+            ("aabb_max", offset_of!(GpuClusterBounds, aabb_max)),
+            ("planes", offset_of!(GpuClusterBounds, planes)),
+        ],
+    );
+    offsets(
+        &validate("cluster_build.wgsl"),
+        "ClusterParams",
+        size_of::<GpuClusterParams>(),
+        &[
+            ("dims", offset_of!(GpuClusterParams, dims)),
+            ("viewport", offset_of!(GpuClusterParams, viewport)),
+            ("light_count", offset_of!(GpuClusterParams, light_count)),
+            ("cap", offset_of!(GpuClusterParams, cap)),
+            ("cull_test", offset_of!(GpuClusterParams, cull_test)),
+            ("index_capacity", offset_of!(GpuClusterParams, index_capacity)),
+            ("slicing", offset_of!(GpuClusterParams, slicing)),
+            ("log_far_over_near", offset_of!(GpuClusterParams, log_far_over_near)),
+            ("tile_index_capacity", offset_of!(GpuClusterParams, tile_index_capacity)),
+            ("tile_chunks", offset_of!(GpuClusterParams, tile_chunks)),
+            ("coarse_dims", offset_of!(GpuClusterParams, coarse_dims)),
+            ("coarse_index_capacity", offset_of!(GpuClusterParams, coarse_index_capacity)),
+            ("coarse_span", offset_of!(GpuClusterParams, coarse_span)),
         ],
     );
 }

@@ -16,8 +16,9 @@
 //!    same three phases as the GPU compute passes — into per-cluster `(offset, count)` ranges
 //!    over one light-index list, each list in ascending light order. A per-cluster cap is
 //!    optional; what it drops is counted, never silent.
-//! 5. **List sizes** ([`list_bounds`], `bound.rs`): upper bounds of the cluster and tile lists,
-//!    from each light's candidate ranges, so the GPU lists are sized before a frame is submitted.
+//! 5. **List sizes** ([`list_bounds`], `bound.rs`): upper bounds of the cluster, tile and
+//!    coarse-tile lists, from each light's candidate ranges, so the GPU lists are sized before
+//!    a frame is submitted.
 //! 6. **Shading lookup** ([`ClusterGrid::cluster_of`]): pixel + view distance → cluster index.
 //! 7. **Measurement** ([`false_positive_counts`], `exact.rs`): how many accepted pairs an exact
 //!    sphere–frustum-piece distance rejects.
@@ -35,7 +36,10 @@ mod tests;
 mod tests_edge;
 
 pub use assign::{ClusterAssignment, ClusterStats, assign_lights};
-pub use bound::{ListBounds, TILE_PREFILTER_INFLATION, list_bounds};
+pub use bound::{
+    CoarseTile, ListBounds, TILE_PREFILTER_INFLATION, coarse_dims, coarse_span, coarse_tile_accepts,
+    coarse_tiles, list_bounds,
+};
 pub use cull::{
     RADIUS_INFLATION, ViewSphere, farthest_reach, inflated_radius, sphere_intersects_aabb,
     sphere_intersects_planes, to_view_space, view_spheres,

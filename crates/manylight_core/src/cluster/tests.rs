@@ -181,8 +181,11 @@ proptest! {
             .iter()
             .map(|l| ViewSphere { radius: l.radius * TILE_PREFILTER_INFLATION, ..*l })
             .collect();
+        let span = 2 + rng.below(3);
+        let coarse_list = coarse_tiles(&columns, span);
+        let coarse = coarse_dims(columns.dims.truncate(), span);
         for test in CullTest::ALL {
-            let bounds = list_bounds(&grid, &lights, test);
+            let bounds = list_bounds(&grid, &lights, test, coarse_span(span, test));
             let pairs = assign_lights_brute_force(&grid, &lights, test, None).indices.len() as u64;
             let tile_lists = assign_lights_brute_force(&columns, &inflated, test, None);
             let tiles = tile_lists.indices.len() as u64;
@@ -194,6 +197,27 @@ proptest! {
                 "{test:?}: {bounds:?} < a tile list of {longest}, {grid:?}"
             );
             prop_assert!(u64::from(bounds.max_tile_lights) <= bounds.tile_entries);
+            // Level 0: every (light, coarse tile) pair the hull test accepts, and every light a
+            // column accepts is in its coarse tile's list.
+            if coarse_span(span, test).is_none() {
+                prop_assert_eq!(bounds.coarse_entries, 0);
+                continue;
+            }
+            let mut coarse_pairs = 0u64;
+            for (c, tile) in coarse_list.iter().enumerate() {
+                let (cx, cy) = (c as u32 % coarse.x, c as u32 / coarse.x);
+                for (l, s) in lights.iter().enumerate() {
+                    let hit = coarse_tile_accepts(tile, s, test);
+                    coarse_pairs += u64::from(hit);
+                    for t in 0..columns.cluster_count() {
+                        let k = columns.coords(t);
+                        if (k.x / span, k.y / span) == (cx, cy) && tile_lists.lights_of(t).contains(&(l as u32)) {
+                            prop_assert!(hit, "{test:?}: light {l} in column {k:?} but not coarse tile {c}");
+                        }
+                    }
+                }
+            }
+            prop_assert!(bounds.coarse_entries >= coarse_pairs, "{test:?}: {bounds:?} < {coarse_pairs} coarse entries");
         }
     }
 

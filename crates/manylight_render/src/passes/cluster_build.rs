@@ -1,6 +1,7 @@
-//! The `cluster_build` compute pass: per-tile lists, then per-cluster lists from them, each by
-//! count → prefix sum → fill (see `shaders/cluster_build.wgsl`), producing per-cluster
-//! `(offset, count)` ranges into one light-index list.
+//! The `cluster_build` compute pass: per-coarse-tile lists, per-tile lists from them, then
+//! per-cluster lists from those, each by count → prefix sum → fill (see
+//! `shaders/cluster_build.wgsl`), producing per-cluster `(offset, count)` ranges into one
+//! light-index list.
 
 use super::CLUSTERS;
 use crate::context::RenderError;
@@ -19,8 +20,11 @@ impl PipelineKey for ClusterBuildKey {
     type Pipeline = ClusterBuildPipelines;
 }
 
-/// The six compute pipelines of the build (three per level), for one workgroup size.
+/// The nine compute pipelines of the build (three per level), for one workgroup size.
 pub struct ClusterBuildPipelines {
+    coarse_count: wgpu::ComputePipeline,
+    coarse_scan: wgpu::ComputePipeline,
+    coarse_fill: wgpu::ComputePipeline,
     tile_count: wgpu::ComputePipeline,
     tile_scan: wgpu::ComputePipeline,
     tile_fill: wgpu::ComputePipeline,
@@ -56,6 +60,9 @@ impl ClusterBuildPipelines {
             })
         };
         Ok(ClusterBuildPipelines {
+            coarse_count: make("coarse_count"),
+            coarse_scan: make("coarse_scan"),
+            coarse_fill: make("coarse_fill"),
             tile_count: make("tile_count"),
             tile_scan: make("tile_scan"),
             tile_fill: make("tile_fill"),
@@ -120,15 +127,23 @@ impl Pass for ClusterBuildPass {
         })?;
         let max_groups = ctx.gpu.device.limits().max_compute_workgroups_per_dimension;
         let groups = dispatch_size(clusters.params.dims[3], wg, max_groups)?;
-        // Level 1 runs one invocation per (tile, chunk of lights).
-        let tiles = u64::from(clusters.params.dims[0]) * u64::from(clusters.params.dims[1]);
-        let tile_entries = u32::try_from(tiles * u64::from(clusters.params.tile_chunks)).map_err(|_| {
-            RenderError::UnsupportedSettings(format!(
-                "{tiles} tiles × {} light chunks exceed 2^32 cluster-build invocations",
-                clusters.params.tile_chunks
-            ))
-        })?;
-        let tile_groups = dispatch_size(tile_entries, wg, max_groups)?;
+        // Levels 0 and 1 run one invocation per (coarse tile or tile, chunk of candidates).
+        let p = &clusters.params;
+        let entries = |tiles: u64| {
+            u32::try_from(tiles * u64::from(p.tile_chunks)).map_err(|_| {
+                RenderError::UnsupportedSettings(format!(
+                    "{tiles} tiles × {} light chunks exceed 2^32 cluster-build invocations",
+                    p.tile_chunks
+                ))
+            })
+        };
+        let tile_groups =
+            dispatch_size(entries(u64::from(p.dims[0]) * u64::from(p.dims[1]))?, wg, max_groups)?;
+        let coarse_groups = dispatch_size(
+            entries(u64::from(p.coarse_dims[0]) * u64::from(p.coarse_dims[1]))?,
+            wg,
+            max_groups,
+        )?;
         let timestamps = ctx.compute_timestamps(true, true);
         {
             let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -136,9 +151,14 @@ impl Pass for ClusterBuildPass {
                 timestamp_writes: timestamps,
             });
             pass.set_bind_group(0, &clusters.build_bind_group, &[]);
-            // The six steps of the build (shaders/cluster_build.wgsl), in order; the scans run
-            // as one workgroup.
-            let steps = [
+            // The steps of the build (shaders/cluster_build.wgsl), in order; the scans run as
+            // one workgroup. Level 0 only with a coarse level.
+            let coarse = [
+                (&pipelines.coarse_count, coarse_groups),
+                (&pipelines.coarse_scan, [1, 1]),
+                (&pipelines.coarse_fill, coarse_groups),
+            ];
+            let levels = [
                 (&pipelines.tile_count, tile_groups),
                 (&pipelines.tile_scan, [1, 1]),
                 (&pipelines.tile_fill, tile_groups),
@@ -146,7 +166,8 @@ impl Pass for ClusterBuildPass {
                 (&pipelines.scan, [1, 1]),
                 (&pipelines.fill, groups),
             ];
-            for (pipeline, workgroups) in steps {
+            let coarse = if p.coarse_span > 0 { &coarse[..] } else { &[] };
+            for &(pipeline, workgroups) in coarse.iter().chain(&levels) {
                 pass.set_pipeline(pipeline);
                 pass.dispatch_workgroups(workgroups[0], workgroups[1], 1);
             }
