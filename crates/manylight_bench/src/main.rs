@@ -297,7 +297,7 @@ struct ClusterArgs {
     /// Depth slicing: linear or exponential.
     #[arg(long, default_value = "exponential", value_parser = parse_slicing)]
     z_slicing: ZSlicing,
-    /// Grid size XxYxZ (default: tiles of about 32 px, 24 slices; Forward+ uses Z = 1).
+    /// Grid size XxYxZ (default: tiles of about 16 px, 24 slices; Forward+ uses Z = 1).
     #[arg(long, value_parser = parse_grid)]
     grid: Option<UVec3>,
     /// Keep at most N lights per cluster (dropped pairs are counted in the stats).

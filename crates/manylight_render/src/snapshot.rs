@@ -254,7 +254,7 @@ pub struct ClusterSettings {
     pub workgroup_size: u32,
     /// Tiles per coarse-tile edge of the build's first level, which keeps per coarse tile the
     /// lights that can reach any of its tiles, so the tile level tests those instead of every
-    /// light (8: 256-px coarse tiles with 32-px tiles). Below 2 there is no coarse level; the
+    /// light (8: 128-px coarse tiles with the default 16-px tiles). Below 2 there is no coarse level; the
     /// planes test never has one (`manylight_core::cluster::coarse_span`). The lists are the
     /// same either way; only the build's cost changes (`docs/benchmarks.md`).
     pub coarse_tiles: u32,

@@ -48,7 +48,7 @@ pub struct GridConfig {
 
 impl Default for GridConfig {
     fn default() -> Self {
-        Self { tile_px: 32, z_slices: 24, dims: None, slicing: ZSlicing::default() }
+        Self { tile_px: 16, z_slices: 24, dims: None, slicing: ZSlicing::default() }
     }
 }
 

@@ -42,19 +42,19 @@ fn names_round_trip_and_defaults() {
     assert_eq!(ZSlicing::default(), ZSlicing::Exponential);
     assert_eq!(CullTest::default(), CullTest::Both);
     let c = GridConfig::default();
-    assert_eq!((c.tile_px, c.z_slices, c.dims), (32, 24, None));
+    assert_eq!((c.tile_px, c.z_slices, c.dims), (16, 24, None));
 }
 
 #[test]
 fn auto_dims_and_clamps() {
-    assert_eq!(default_grid().dims, UVec3::new(40, 23, 24));
+    assert_eq!(default_grid().dims, UVec3::new(80, 45, 24));
     let auto =
         |w, h, config: GridConfig| ClusterGrid::new(UVec2::new(w, h), &Projection::default(), &config).dims;
     let c = GridConfig::default();
     assert_eq!(auto(1, 1, c), UVec3::new(1, 1, 24));
     assert_eq!(auto(0, 0, c), UVec3::new(1, 1, 24));
-    assert_eq!(auto(8191, 17, c), UVec3::new(256, 1, 24));
-    assert_eq!(auto(1, 4096, c), UVec3::new(1, 128, 24));
+    assert_eq!(auto(8191, 17, c), UVec3::new(512, 2, 24));
+    assert_eq!(auto(1, 4096, c), UVec3::new(1, 256, 24));
     let d = auto(1000, 1000, GridConfig { tile_px: 0, ..c });
     assert!(d.x == d.y && d.x * d.y * d.z <= MAX_CLUSTERS && d.x * d.y * d.z > MAX_CLUSTERS / 2, "{d}");
     let huge = GridConfig { dims: Some(UVec3::new(100_000, 4096, 0)), ..c };
@@ -70,16 +70,16 @@ fn auto_dims_and_clamps() {
 fn pixels_map_to_tiles_top_left_first() {
     let g = default_grid();
     assert_eq!(g.tile_of_pixel(Vec2::new(0.5, 0.5)), UVec2::ZERO);
-    assert_eq!(g.tile_of_pixel(Vec2::new(1279.5, 719.5)), UVec2::new(39, 22));
-    // 40 × 23 tiles: 32 px wide, 720 / 23 ≈ 31.3 px high.
-    assert_eq!(g.tile_of_pixel(Vec2::new(32.0, 31.2)), UVec2::new(1, 0));
+    assert_eq!(g.tile_of_pixel(Vec2::new(1279.5, 719.5)), UVec2::new(79, 44));
+    // 80 × 45 tiles: 16 px wide and high.
+    assert_eq!(g.tile_of_pixel(Vec2::new(16.0, 15.9)), UVec2::new(1, 0));
     for px in [Vec2::splat(-5.0), Vec2::splat(1e9), Vec2::NAN, Vec2::splat(f32::INFINITY)] {
-        assert!(g.tile_of_pixel(px).cmplt(UVec2::new(40, 23)).all());
+        assert!(g.tile_of_pixel(px).cmplt(UVec2::new(80, 45)).all());
     }
     // Tile y = 0 is the top of the screen: its AABB has positive view-space y.
     let (min, _) = g.cluster_aabb(0, 0, 3);
     assert!(min.y > 0.0 && min.x < 0.0);
-    assert_eq!(g.cluster_of(Vec2::new(0.5, 719.5), 0.05), g.index(0, 22, 0));
+    assert_eq!(g.cluster_of(Vec2::new(0.5, 719.5), 0.05), g.index(0, 44, 0));
 }
 
 #[test]
