@@ -15,13 +15,17 @@ use manylight_core::cluster::{
 /// The GPU build's tile-level inflation (emitted into shaders/cluster_build.wgsl).
 const INFLATION: f32 = manylight_core::cluster::TILE_PREFILTER_INFLATION;
 
-#[test]
-fn a_column_accepts_every_light_its_clusters_accept() {
-    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-    let mut rnd = move || {
+/// Uniform numbers in [0, 1) from a linear congruential generator seeded with `seed`.
+fn uniform(mut seed: u64) -> impl FnMut() -> f32 {
+    move || {
         seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         (seed >> 40) as f32 / (1u64 << 24) as f32
-    };
+    }
+}
+
+#[test]
+fn a_column_accepts_every_light_its_clusters_accept() {
+    let mut rnd = uniform(0x9e37_79b9_7f4a_7c15);
     let cases = [
         (UVec2::new(200, 120), Projection::perspective(1.0, 0.1, 200.0), ZSlicing::Exponential),
         (UVec2::new(96, 64), Projection::perspective(1.0, 0.1, 200.0), ZSlicing::Linear),
@@ -66,11 +70,7 @@ fn a_column_accepts_every_light_its_clusters_accept() {
 /// the side planes of a narrow and a wide column disagree.
 #[test]
 fn a_coarse_tile_accepts_every_light_its_columns_accept() {
-    let mut seed = 0x2545_f491_4f6c_dd1du64;
-    let mut rnd = move || {
-        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        (seed >> 40) as f32 / (1u64 << 24) as f32
-    };
+    let mut rnd = uniform(0x2545_f491_4f6c_dd1d);
     let cases = [
         (UVec2::new(200, 120), Projection::perspective(1.0, 0.1, 200.0)),
         (UVec2::new(1280, 720), Projection::perspective(0.8, 0.1, 1000.0)),

@@ -352,6 +352,10 @@ fn clusters_ui(ui: &mut egui::Ui, world: &mut World) {
     combo(ui, "z slicing", &mut grid.slicing, &ZSlicing::ALL, ZSlicing::name);
     combo(ui, "cull test", &mut s.clusters.cull, &CullTest::ALL, CullTest::name);
     ui.checkbox(&mut s.clusters.depth_prepass, "depth pre-pass (clustered forward)");
+    ui.add(
+        egui::Slider::new(&mut s.clusters.coarse_tiles, 0..=32)
+            .text("coarse tiles (tiles per edge; 0: none)"),
+    );
     if s != old {
         *world.resource_mut::<RenderSettings>() = s;
     }
@@ -365,8 +369,16 @@ fn clusters_ui(ui: &mut egui::Ui, world: &mut World) {
         match &v.clusters {
             Some(c) => {
                 ui.label(format!(
-                    "{name}: {}×{}×{} clusters, max {} / mean {:.1} lights per non-empty cluster",
-                    c.dims[0], c.dims[1], c.dims[2], c.max_per_cluster, c.mean_per_non_empty
+                    "{name}: {}×{}×{} clusters, max {} / mean {:.1} lights per non-empty cluster; \
+                     list entries: {} coarse-tile, {} tile, {} cluster",
+                    c.dims[0],
+                    c.dims[1],
+                    c.dims[2],
+                    c.max_per_cluster,
+                    c.mean_per_non_empty,
+                    c.coarse_entries,
+                    c.tile_entries,
+                    c.total_entries
                 ));
                 if c.dropped_pairs > 0 {
                     ui.colored_label(
