@@ -21,13 +21,9 @@
 // 3. `tile_fill`: each (tile, chunk) writes its lights in ascending order, so each tile's
 //    list is in ascending light order (the coarse lists are, chunk after chunk);
 // 4. `count`: one invocation per cluster tests its tile's lights against the cluster's bounds,
-//    stores the count (capped if a cap is set) and updates the counters; or `count_by_tile`
-//    (`slice_ranges`): one invocation per tile tests each light of its list against only the
-//    slices its sphere spans (`slice_range`), so the work is the lights' depth spans, not every
-//    slice;
+//    stores the count (capped if a cap is set) and updates the counters;
 // 5. `scan`: prefix sum of the cluster counts, and the total the index list needs;
-// 6. `fill` (or `fill_by_tile`): writes the first `count` hits, in ascending light order, at
-//    the cluster's offset.
+// 6. `fill`: writes the first `count` hits, in ascending light order, at the cluster's offset.
 // Levels 0 and 1 share buffers (a device binds 8 storage buffers per stage): the coarse
 // tiles' bounds follow the tiles' in `tile_bounds`, their (coarse tile, chunk) ranges follow
 // the (tile, chunk) ranges in `tile_ranges`, and their lists follow the `tile_index_capacity`
@@ -280,20 +276,6 @@ fn tile_lights(cluster: u32) -> vec2<u32> {
     return chunked_list((cluster % tile_count_total()) * params.tile_chunks, params.tile_index_capacity);
 }
 
-// Stores cluster `cluster`'s count `n` for the scan: `min(n, cap)`, and the counters.
-fn store_count(cluster: u32, n: u32) {
-    let kept = min(n, params.cap);
-    ranges[cluster] = vec2<u32>(0u, kept);
-    if n > kept {
-        atomicAdd(&counters.dropped_pairs, n - kept);
-        atomicAdd(&counters.clusters_overflowed, 1u);
-    }
-    if n > 0u {
-        atomicAdd(&counters.non_empty, 1u);
-    }
-    atomicMax(&counters.max_count, n);
-}
-
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn count(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let cluster = linear_index(id, groups);
@@ -311,56 +293,16 @@ fn count(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) 
             n += 1u;
         }
     }
-    store_count(cluster, n);
-}
-
-// The slices [first, last] a sphere can pass the test for: those its depth range, widened by
-// the largest cluster margin, meets, one more on each side for the rounding of
-// `cluster_slice`; every slice for a range that is not finite. (The CPU bound of the loop
-// lengths, manylight_core::cluster::list_bounds, widens the same range by two.)
-fn slice_range(s: vec4<f32>) -> vec2<u32> {
-    let reach = s.w * RADIUS_INFLATION + params.slice_margin;
-    let lo = -s.z - reach;
-    let hi = -s.z + reach;
-    let last = params.dims.z - 1u;
-    // x - x is 0 exactly when x is finite.
-    if !(lo - lo == 0.0 && hi - hi == 0.0) {
-        return vec2<u32>(0u, last);
+    let kept = min(n, params.cap);
+    ranges[cluster] = vec2<u32>(0u, kept);
+    if n > kept {
+        atomicAdd(&counters.dropped_pairs, n - kept);
+        atomicAdd(&counters.clusters_overflowed, 1u);
     }
-    let first = cluster_slice(params, lo);
-    return vec2<u32>(max(first, 1u) - 1u, min(cluster_slice(params, hi) + 1u, last));
-}
-
-// Level 2 by tile (`slice_ranges`): one invocation per tile counts, for each light of its list
-// in ascending order, the clusters of the slices the light spans that it passes, in the
-// clusters' own `.y` (the invocation owns the tile's clusters). A light is tested against a
-// few slices instead of all of them.
-@compute @workgroup_size(WORKGROUP_SIZE)
-fn count_by_tile(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
-    let t = linear_index(id, groups);
-    let tiles = tile_count_total();
-    if t >= tiles {
-        return;
+    if n > 0u {
+        atomicAdd(&counters.non_empty, 1u);
     }
-    let tile = tile_lights(t);
-    atomicMax(&counters.max_tile_lights, tile.y);
-    for (var z = 0u; z < params.dims.z; z++) {
-        ranges[t + z * tiles] = vec2<u32>(0u);
-    }
-    for (var i = 0u; i < tile.y; i++) {
-        let l = tile_indices[tile.x + i];
-        let zs = slice_range(spheres[l]);
-        for (var z = zs.x; z <= zs.y; z++) {
-            let c = t + z * tiles;
-            if touches(bounds[c], l) {
-                ranges[c].y += 1u;
-            }
-        }
-    }
-    for (var z = 0u; z < params.dims.z; z++) {
-        let c = t + z * tiles;
-        store_count(c, ranges[c].y);
-    }
+    atomicMax(&counters.max_count, n);
 }
 
 var<workgroup> partial_sums: array<u32, SCAN_WORKGROUP_SIZE>;
@@ -448,45 +390,6 @@ fn fill(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
         if touches(b, l) {
             indices[range.x + k] = l;
             k += 1u;
-        }
-    }
-}
-
-// `.y` of a cluster whose list does not fit this frame, during `fill_by_tile`.
-const FILL_SKIPPED: u32 = 0xffffffffu;
-
-// Level 2 by tile: writes each light, in ascending order, into the lists of the clusters it
-// passes among the slices it spans, while a list holds fewer than `cap`; each cluster's `.y`
-// counts its list up again from 0, ending at `min(n, cap)`, the count `count_by_tile` stored.
-@compute @workgroup_size(WORKGROUP_SIZE)
-fn fill_by_tile(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
-    let t = linear_index(id, groups);
-    let tiles = tile_count_total();
-    if t >= tiles {
-        return;
-    }
-    for (var z = 0u; z < params.dims.z; z++) {
-        let c = t + z * tiles;
-        // A list too small this frame is skipped; the renderer grows it and renders again.
-        ranges[c].y = select(FILL_SKIPPED, 0u, fits(ranges[c], params.index_capacity));
-    }
-    let tile = tile_lights(t);
-    for (var i = 0u; i < tile.y; i++) {
-        let l = tile_indices[tile.x + i];
-        let zs = slice_range(spheres[l]);
-        for (var z = zs.x; z <= zs.y; z++) {
-            let c = t + z * tiles;
-            let k = ranges[c].y;
-            if k != FILL_SKIPPED && k < params.cap && touches(bounds[c], l) {
-                indices[ranges[c].x + k] = l;
-                ranges[c].y = k + 1u;
-            }
-        }
-    }
-    for (var z = 0u; z < params.dims.z; z++) {
-        let c = t + z * tiles;
-        if ranges[c].y == FILL_SKIPPED {
-            ranges[c].y = 0u;
         }
     }
 }

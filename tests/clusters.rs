@@ -141,23 +141,16 @@ fn gpu_lists_equal_the_cpu_reference_on_hard_cases() {
     let at = |d: f32| cam.transform.w_axis.truncate() + forward * d;
     let hard = hard_lights(&scene, size);
     // Each test with coarse tiles of 2 × 2 tiles (3 × 2 of them, the last column and row
-    // clipped), one coarse tile over the whole grid (8) and no coarse level (0); the cluster
-    // level per tile over the slices each light spans, and per cluster over the whole tile list.
-    let variants = [(2, true), (8, true), (0, true), (2, false)];
-    for (cull, (coarse_tiles, slice_ranges)) in
-        CullTest::ALL.into_iter().flat_map(|c| variants.map(|v| (c, v)))
-    {
+    // clipped), one coarse tile over the whole grid (8) and no coarse level (0).
+    for (cull, coarse_tiles) in CullTest::ALL.into_iter().flat_map(|c| [(c, 2), (c, 8), (c, 0)]) {
         let mut settings = clustered(cull, ZSlicing::Exponential, None);
         settings.clusters.coarse_tiles = coarse_tiles;
-        settings.clusters.slice_ranges = slice_ranges;
         let snap = scene_snapshot(&scene, size, hard.clone(), settings);
         let (report, gpu, cpu) = gpu_and_cpu(&mut r, snap);
         let c = report.clusters.as_ref().expect("cluster report");
         let coarse = coarse_tiles > 0 && cull != CullTest::Planes;
         assert_eq!(c.coarse_entries > 0, coarse, "{cull:?}, coarse {coarse_tiles}: {c:?}");
-        assert_eq!(c.slice_ranges, slice_ranges, "{cull:?}: {c:?}");
-        let what = format!("hard cases {cull:?}, coarse tiles {coarse_tiles}, slice ranges {slice_ranges}");
-        assert_same_lists(&what, &gpu, &cpu);
+        assert_same_lists(&format!("hard cases {cull:?}, coarse tiles {coarse_tiles}"), &gpu, &cpu);
         // The covering light is in every cluster; the radius-0 light in none.
         for c in 0..cpu.ranges.len() as u32 {
             assert!(cpu.lights_of(c).contains(&5), "cluster {c} misses the covering light");
@@ -257,22 +250,17 @@ fn a_cap_drops_deterministically_and_is_counted() {
     let mut r = HeadlessRenderer::new().expect("adapter");
     let scene = default_scene();
     let size = UVec2::new(160, 96);
-    // The cluster level per tile (over the slices each light spans) and per cluster.
-    for slice_ranges in [true, false] {
-        let mut settings = clustered(CullTest::Planes, ZSlicing::Exponential, Some(2));
-        settings.clusters.slice_ranges = slice_ranges;
-        let snap = scene_snapshot(&scene, size, rig(&scene, 400, 5), settings);
-        let (report, gpu, cpu) = gpu_and_cpu(&mut r, snap);
-        assert_same_lists(&format!("cap 2, slice ranges {slice_ranges}"), &gpu, &cpu);
-        let c = report.clusters.expect("cluster report");
-        assert_eq!(c.slice_ranges, slice_ranges);
-        assert!(c.dropped_pairs > 0 && c.clusters_overflowed > 0, "{c:?}");
-        assert_eq!(c.dropped_pairs, cpu.dropped_pairs);
-        // The kept lights are the lowest, in ascending order.
-        for cluster in 0..cpu.ranges.len() as u32 {
-            assert_eq!(gpu.lights_of(cluster), cpu.lights_of(cluster), "cluster {cluster}");
-        }
-    }
+    let snap = scene_snapshot(
+        &scene,
+        size,
+        rig(&scene, 400, 5),
+        clustered(CullTest::Planes, ZSlicing::Exponential, Some(2)),
+    );
+    let (report, gpu, cpu) = gpu_and_cpu(&mut r, snap);
+    assert_same_lists("cap 2", &gpu, &cpu);
+    let c = report.clusters.expect("cluster report");
+    assert!(c.dropped_pairs > 0 && c.clusters_overflowed > 0, "{c:?}");
+    assert_eq!(c.dropped_pairs, cpu.dropped_pairs);
 }
 
 /// Lights that grow and move from frame to frame, so the lists must grow between frames: the

@@ -20,12 +20,6 @@ struct ClusterParams {
     coarse_index_capacity: u32,
     // tiles per coarse-tile edge; 0: no coarse level (level 1 tests every light)
     coarse_span: u32,
-    // 1: level 2 runs per tile, each light against the slices its sphere spans; 0: per cluster
-    slice_ranges: u32,
-    // the largest cluster margin (the last slice's), added to a sphere's reach in depth
-    slice_margin: f32,
-    _pad0: u32,
-    _pad1: u32,
 };
 
 struct GpuClusterBounds {

@@ -313,10 +313,6 @@ struct ClusterArgs {
     /// every tile tests every light).
     #[arg(long, default_value_t = manylight_render::DEFAULT_COARSE_TILES)]
     coarse_tiles: u32,
-    /// Build the cluster lists per cluster against the whole tile list, instead of per tile
-    /// against the slices each light spans.
-    #[arg(long)]
-    no_slice_ranges: bool,
     /// G-buffer layout of the deferred pipelines (clustered-deferred, light-volumes): full,
     /// packed or compact.
     #[arg(long, default_value = "full", value_parser = parse_gbuffer)]
@@ -352,7 +348,6 @@ impl ClusterArgs {
             depth_prepass: !self.no_depth_prepass,
             workgroup_size: self.workgroup_size,
             coarse_tiles: self.coarse_tiles,
-            slice_ranges: !self.no_slice_ranges,
         }
     }
 }

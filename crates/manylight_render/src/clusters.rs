@@ -54,10 +54,6 @@ pub struct ClusterReport {
     pub coarse_entries: u64,
     /// Tiles per coarse-tile edge (0: no coarse level).
     pub coarse_span: u32,
-    /// True when the cluster level ran per tile, each light against the slices it spans;
-    /// false when it ran per cluster (asked for, or a tile's loops could pass the adapter's
-    /// loop limit).
-    pub slice_ranges: bool,
     /// Times the lists had to grow after the frame was rendered (each renders it again): 0, since
     /// the CPU bounds size them before submission, unless a bound exceeds what the device binds.
     pub regrows: u32,
@@ -130,10 +126,6 @@ pub struct ClusterResources {
     coarse: Option<u32>,
     tile_list_capacity: u32,
     coarse_list_capacity: u32,
-    /// The cluster level runs per tile this frame (`GpuClusterParams::slice_ranges`).
-    slice_ranges: bool,
-    /// The adapter ends shader invocations after `LAVAPIPE_LOOP_LIMIT` loop iterations.
-    loop_limited: bool,
     generations: [u64; 7],
     /// The view-space spheres uploaded this frame (for the CPU reference in tests and stats).
     pub view_spheres: Vec<ViewSphere>,
@@ -225,8 +217,6 @@ impl ClusterResources {
             coarse: None,
             tile_list_capacity: 0,
             coarse_list_capacity: 0,
-            slice_ranges: false,
-            loop_limited: crate::gpu_types::has_loop_limit(&gpu.info),
             generations: [0; 7],
             view_spheres: Vec::new(),
             bounds_estimate: ListBounds::default(),
@@ -381,11 +371,6 @@ impl ClusterResources {
         // counters decide, after the frame, whether the real lists fit.
         let started = std::time::Instant::now();
         self.bounds_estimate = list_bounds(&self.grid, &self.view_spheres, settings.cull, self.coarse);
-        // Per tile only where its loops (the slices twice, the lights' slice tests) stay under
-        // the adapter's loop limit.
-        let tile_loops = 2 * u64::from(self.grid.dims.z) + self.bounds_estimate.max_tile_slice_tests;
-        self.slice_ranges = settings.slice_ranges
-            && (!self.loop_limited || tile_loops <= u64::from(crate::gpu_types::LAVAPIPE_LOOP_LIMIT));
         self.bound_cpu_ms = started.elapsed().as_secs_f64() * 1e3;
         // A quarter of headroom: lights that move a little do not grow the lists every frame
         // (growing creates a buffer and rebinds), and the buffers grow in powers of two.
@@ -472,9 +457,6 @@ impl ClusterResources {
             coarse_dims: self.coarse_dims().unwrap_or(glam::UVec2::ZERO).to_array(),
             coarse_index_capacity: self.coarse_list_capacity,
             coarse_span: self.coarse.unwrap_or(0),
-            slice_ranges: u32::from(self.slice_ranges),
-            slice_margin: self.grid.cluster_margin(self.grid.dims.z - 1),
-            _pad: [0; 2],
         };
         gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
         gpu.queue.write_buffer(&self.counters, 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
@@ -497,7 +479,6 @@ impl ClusterResources {
         self.grid = manylight_core::efficiency::pixel_grid(view.size, &projection);
         self.cull = view.settings.clusters.cull;
         self.coarse = None;
-        self.slice_ranges = false;
         self.split_tile_lists(0, 0);
         let count = self.grid.cluster_count();
         let bad =
@@ -601,7 +582,6 @@ impl ClusterResources {
             tile_entry_bound: self.bounds_estimate.tile_entries,
             coarse_entry_bound: self.bounds_estimate.coarse_entries,
             coarse_span: self.coarse.unwrap_or(0),
-            slice_ranges: self.slice_ranges,
             bound_cpu_ms: self.bound_cpu_ms,
             buffer_bytes: self.buffer_bytes(),
             cull_test: self.cull.name().to_string(),

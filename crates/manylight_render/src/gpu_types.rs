@@ -337,14 +337,6 @@ pub struct GpuClusterParams {
     pub coarse_index_capacity: u32,
     /// Tiles per coarse-tile edge, or 0 without a coarse level (level 1 then tests every light).
     pub coarse_span: u32,
-    /// 1: level 2 runs per tile, each light against the slices its sphere spans
-    /// (`count_by_tile`, `fill_by_tile`); 0: per cluster against its whole tile list.
-    pub slice_ranges: u32,
-    /// The largest cluster margin (`ClusterGrid::cluster_margin` of the last slice), added to a
-    /// sphere's reach in depth when its slices are found.
-    pub slice_margin: f32,
-    /// Padding to 16 bytes.
-    pub _pad: [u32; 2],
 }
 
 /// Bounds of one cluster in view space (`GpuClusterBounds` in `shaders/common/clusters.wgsl`).

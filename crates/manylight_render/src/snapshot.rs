@@ -258,11 +258,6 @@ pub struct ClusterSettings {
     /// planes test never has one (`manylight_core::cluster::coarse_span`). The lists are the
     /// same either way; only the build's cost changes (`docs/benchmarks.md`).
     pub coarse_tiles: u32,
-    /// Build the cluster lists per tile, testing each light against only the slices its
-    /// sphere spans, instead of per cluster against the whole tile list (the default; the lists
-    /// are the same). On lavapipe a tile whose loops could pass its limit of 65 535 iterations
-    /// falls back to the per-cluster build (`ClusterReport::slice_ranges` says which ran).
-    pub slice_ranges: bool,
 }
 
 impl Default for ClusterSettings {
@@ -274,7 +269,6 @@ impl Default for ClusterSettings {
             depth_prepass: true,
             workgroup_size: 64,
             coarse_tiles: DEFAULT_COARSE_TILES,
-            slice_ranges: true,
         }
     }
 }

@@ -198,8 +198,6 @@ fn shared_structs_match_rust() {
             ("coarse_dims", offset_of!(GpuClusterParams, coarse_dims)),
             ("coarse_index_capacity", offset_of!(GpuClusterParams, coarse_index_capacity)),
             ("coarse_span", offset_of!(GpuClusterParams, coarse_span)),
-            ("slice_ranges", offset_of!(GpuClusterParams, slice_ranges)),
-            ("slice_margin", offset_of!(GpuClusterParams, slice_margin)),
         ],
     );
 }

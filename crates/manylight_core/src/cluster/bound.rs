@@ -19,10 +19,7 @@
 //!    range), and the test's per-axis distances to it are those to one of the columns, bit for
 //!    bit, so a coarse tile accepts a light only if one of its columns' AABBs does: the light's
 //!    AABB candidate tiles, counted per coarse tile they meet, bound the coarse lists.
-//! 5. **Slice tests per tile**: the per-tile cluster level tests each light of a tile list
-//!    against the slices its sphere spans; the same difference array, weighted by one plus
-//!    each light's [`slice_span_bound`], bounds the loop length of the longest-running tile.
-//! 6. The cost is one candidate search per light and level (two binary searches over the
+//! 5. The cost is one candidate search per light and level (two binary searches over the
 //!    slices and a few divisions), no per-cluster work: linear in the light count.
 
 use glam::{UVec2, Vec3, Vec4};
@@ -46,10 +43,6 @@ pub struct ListBounds {
     pub max_tile_lights: u32,
     /// At least the (light, coarse tile) entries level 0 writes (0 without a coarse level).
     pub coarse_entries: u64,
-    /// At least the sum, over the lights of the longest-running tile list, of one plus the
-    /// slices the per-tile cluster level tests each against ([`slice_span_bound`]): the loop
-    /// iterations of `count_by_tile`, without its two loops over the tile's slices.
-    pub max_tile_slice_tests: u64,
 }
 
 /// Tiles per coarse-tile edge of the build's level 0 for a requested `span` and culling test,
@@ -158,11 +151,9 @@ pub fn list_bounds(
     let columns = ClusterGrid { dims: glam::UVec3::new(grid.dims.x, grid.dims.y, 1), ..*grid };
     let tiles = ClusterTables::new(&columns);
     let mut bounds = ListBounds::default();
-    // Difference arrays over the tile boxes (one row and column wider than the grid): of the
-    // lights, and of their slice tests in the per-tile cluster level.
+    // Difference array of the tile boxes, one row and column wider than the grid.
     let (w, h) = (grid.dims.x as usize + 1, grid.dims.y as usize + 1);
-    let mut lists = DifferenceArray::new(w, h);
-    let mut tests = DifferenceArray::new(w, h);
+    let mut starts = vec![0i64; w * h];
     for light in lights {
         bounds.cluster_pairs += clusters.candidates(light, test).map_or(0, |c| c.size());
         let inflated = ViewSphere { radius: light.radius * TILE_PREFILTER_INFLATION, ..*light };
@@ -177,69 +168,26 @@ pub fn list_bounds(
         }
         if let Some(c) = tile_box {
             bounds.tile_entries += c.size();
-            lists.add(c.x, c.y, 1);
-            tests.add(c.x, c.y, 1 + i64::from(slice_span_bound(grid, light)));
+            let (x0, x1) = (c.x[0] as usize, c.x[1] as usize + 1);
+            let (y0, y1) = (c.y[0] as usize, c.y[1] as usize + 1);
+            starts[y0 * w + x0] += 1;
+            starts[y0 * w + x1] -= 1;
+            starts[y1 * w + x0] -= 1;
+            starts[y1 * w + x1] += 1;
         }
     }
-    bounds.max_tile_lights = lists.max().clamp(0, i64::from(u32::MAX)) as u32;
-    bounds.max_tile_slice_tests = tests.max().max(0) as u64;
+    // Prefix sums over rows, then columns: the count of boxes covering each tile.
+    for y in 0..h {
+        for x in 1..w {
+            starts[y * w + x] += starts[y * w + x - 1];
+        }
+    }
+    for y in 1..h {
+        for x in 0..w {
+            starts[y * w + x] += starts[(y - 1) * w + x];
+        }
+    }
+    let longest = (0..h - 1).flat_map(|y| (0..w - 1).map(move |x| y * w + x)).map(|i| starts[i]).max();
+    bounds.max_tile_lights = longest.unwrap_or(0).clamp(0, i64::from(u32::MAX)) as u32;
     bounds
-}
-
-/// At least the number of slices the per-tile cluster level tests `light` against
-/// (`slice_range` in `shaders/cluster_build.wgsl`: the slices its depth range, widened by the
-/// last slice's margin, meets, plus one on each side), counted here with two more on each side
-/// for rounding; every slice for a range that is not finite.
-pub fn slice_span_bound(grid: &ClusterGrid, light: &ViewSphere) -> u32 {
-    let z = grid.dims.z;
-    let reach = inflated_radius(light.radius) + grid.cluster_margin(z - 1);
-    let (lo, hi) = (-light.center.z - reach, -light.center.z + reach);
-    if !(lo.is_finite() && hi.is_finite()) {
-        return z;
-    }
-    let first = grid.slice_of_depth(lo).saturating_sub(2);
-    let last = (grid.slice_of_depth(hi) + 2).min(z - 1);
-    last.saturating_sub(first) + 1
-}
-
-/// Counts over rectangles of a `w × h` grid (one row and column wider than the tiles): each
-/// rectangle adds at its corners, and prefix sums over rows and columns give the total over
-/// every cell.
-struct DifferenceArray {
-    w: usize,
-    h: usize,
-    cells: Vec<i64>,
-}
-
-impl DifferenceArray {
-    fn new(w: usize, h: usize) -> Self {
-        DifferenceArray { w, h, cells: vec![0; w * h] }
-    }
-
-    /// Adds `weight` to the inclusive tile ranges `x` × `y`.
-    fn add(&mut self, x: [u32; 2], y: [u32; 2], weight: i64) {
-        let (x0, x1) = (x[0] as usize, x[1] as usize + 1);
-        let (y0, y1) = (y[0] as usize, y[1] as usize + 1);
-        let w = self.w;
-        self.cells[y0 * w + x0] += weight;
-        self.cells[y0 * w + x1] -= weight;
-        self.cells[y1 * w + x0] -= weight;
-        self.cells[y1 * w + x1] += weight;
-    }
-
-    /// The largest total over a tile (0 without tiles).
-    fn max(mut self) -> i64 {
-        let (w, h) = (self.w, self.h);
-        for y in 0..h {
-            for x in 1..w {
-                self.cells[y * w + x] += self.cells[y * w + x - 1];
-            }
-        }
-        for y in 1..h {
-            for x in 0..w {
-                self.cells[y * w + x] += self.cells[(y - 1) * w + x];
-            }
-        }
-        (0..h - 1).flat_map(|y| (0..w - 1).map(move |x| y * w + x)).map(|i| self.cells[i]).max().unwrap_or(0)
-    }
 }

@@ -38,7 +38,7 @@ mod tests_edge;
 pub use assign::{ClusterAssignment, ClusterStats, assign_lights};
 pub use bound::{
     CoarseTile, ListBounds, TILE_PREFILTER_INFLATION, coarse_dims, coarse_span, coarse_tile_accepts,
-    coarse_tiles, list_bounds, slice_span_bound,
+    coarse_tiles, list_bounds,
 };
 pub use cull::{
     RADIUS_INFLATION, ViewSphere, farthest_reach, inflated_radius, sphere_intersects_aabb,

@@ -197,32 +197,6 @@ proptest! {
                 "{test:?}: {bounds:?} < a tile list of {longest}, {grid:?}"
             );
             prop_assert!(u64::from(bounds.max_tile_lights) <= bounds.tile_entries);
-            // Level 2 by tile: every slice a light passes lies in its depth range (widened by
-            // the last slice's margin), and the loop bound holds the longest tile's slice tests
-            // with the GPU's one slice of widening on each side.
-            let last = grid.dims.z - 1;
-            let reach_slices = |l: &ViewSphere| {
-                let reach = inflated_radius(l.radius) + grid.cluster_margin(last);
-                let (lo, hi) = (-l.center.z - reach, -l.center.z + reach);
-                if lo.is_finite() && hi.is_finite() { (grid.slice_of_depth(lo), grid.slice_of_depth(hi)) } else { (0, last) }
-            };
-            let pairs_by_cluster = assign_lights_brute_force(&grid, &lights, test, None);
-            for c in 0..grid.cluster_count() {
-                let z = grid.coords(c).z;
-                for &l in pairs_by_cluster.lights_of(c) {
-                    let (first, end) = reach_slices(&lights[l as usize]);
-                    prop_assert!(first <= z && z <= end, "{test:?}: light {l} passes slice {z} outside {first}..={end}");
-                }
-            }
-            let mut longest_tests = 0u64;
-            for t in 0..columns.cluster_count() {
-                let tests: u64 = tile_lists.lights_of(t).iter().map(|&l| {
-                    let (first, end) = reach_slices(&lights[l as usize]);
-                    1 + u64::from(end.saturating_add(1).min(last) - first.saturating_sub(1) + 1)
-                }).sum();
-                longest_tests = longest_tests.max(tests);
-            }
-            prop_assert!(bounds.max_tile_slice_tests >= longest_tests, "{test:?}: {bounds:?} < {longest_tests} slice tests");
             // Level 0: every (light, coarse tile) pair the hull test accepts, and every light a
             // column accepts is in its coarse tile's list.
             if coarse_span(span, test).is_none() {

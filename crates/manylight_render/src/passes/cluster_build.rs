@@ -20,11 +20,8 @@ impl PipelineKey for ClusterBuildKey {
     type Pipeline = ClusterBuildPipelines;
 }
 
-/// The compute pipelines of the build (three per level, and level 2's count and fill by tile),
-/// for one workgroup size.
+/// The nine compute pipelines of the build (three per level), for one workgroup size.
 pub struct ClusterBuildPipelines {
-    count_by_tile: wgpu::ComputePipeline,
-    fill_by_tile: wgpu::ComputePipeline,
     coarse_count: wgpu::ComputePipeline,
     coarse_scan: wgpu::ComputePipeline,
     coarse_fill: wgpu::ComputePipeline,
@@ -63,8 +60,6 @@ impl ClusterBuildPipelines {
             })
         };
         Ok(ClusterBuildPipelines {
-            count_by_tile: make("count_by_tile"),
-            fill_by_tile: make("fill_by_tile"),
             coarse_count: make("coarse_count"),
             coarse_scan: make("coarse_scan"),
             coarse_fill: make("coarse_fill"),
@@ -149,7 +144,6 @@ impl Pass for ClusterBuildPass {
             wg,
             max_groups,
         )?;
-        let by_tile = dispatch_size(p.dims[0].saturating_mul(p.dims[1]), wg, max_groups)?;
         let timestamps = ctx.compute_timestamps(true, true);
         {
             let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -164,7 +158,7 @@ impl Pass for ClusterBuildPass {
                 (&pipelines.coarse_scan, [1, 1]),
                 (&pipelines.coarse_fill, coarse_groups),
             ];
-            let mut levels = [
+            let levels = [
                 (&pipelines.tile_count, tile_groups),
                 (&pipelines.tile_scan, [1, 1]),
                 (&pipelines.tile_fill, tile_groups),
@@ -172,11 +166,6 @@ impl Pass for ClusterBuildPass {
                 (&pipelines.scan, [1, 1]),
                 (&pipelines.fill, groups),
             ];
-            // Level 2 per tile, each light against the slices it spans.
-            if p.slice_ranges != 0 {
-                levels[3] = (&pipelines.count_by_tile, by_tile);
-                levels[5] = (&pipelines.fill_by_tile, by_tile);
-            }
             let coarse = if p.coarse_span > 0 { &coarse[..] } else { &[] };
             for &(pipeline, workgroups) in coarse.iter().chain(&levels) {
                 pass.set_pipeline(pipeline);
