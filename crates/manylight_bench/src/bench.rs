@@ -21,6 +21,8 @@ pub struct Row {
     frame_ms: Vec<f64>,
     last: FrameReport,
     culling: Option<f64>,
+    /// The culling ratio the same lists would have with per-cluster depth bounds.
+    depth_bounded: Option<f64>,
     /// An oracle's row: the same frames shaded from exact per-pixel lists, by clustered forward
     /// (the forward oracle) or clustered deferred (the deferred oracle, per G-buffer layout).
     oracle: bool,
@@ -161,17 +163,18 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
         };
         let (frame_ms, last, oracle_culling) =
             timed_frames(&mut renderer, &lit, &rig, sweep, settings, oracle)?;
-        let culling = if oracle {
-            oracle_culling
+        let (culling, depth_bounded) = if oracle {
+            (oracle_culling, None)
         } else if sweep.culling_efficiency && pipeline.uses_clusters() && lights > 0 {
             let snap = snapshot(&lit, &rig, 0.0, sweep.size, settings, 0);
-            Some(measure_culling(&mut renderer, snap)?.1.ratio())
+            let c = measure_culling(&mut renderer, snap)?.1;
+            (Some(c.lists.ratio()), Some(c.depth_bounded.ratio()))
         } else {
-            None
+            (None, None)
         };
         let median_ms = median(&frame_ms);
         progress.step(|| format!("{label}: {median_ms:.1} ms"));
-        rows.push(Row { pipeline, gbuffer, lights, frame_ms, last, culling, oracle });
+        rows.push(Row { pipeline, gbuffer, lights, frame_ms, last, culling, depth_bounded, oracle });
     }
     progress.finish();
     Ok(csv(&rows, scene_name, sweep.size, &adapter))
@@ -267,7 +270,7 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
          forward_gpu_ms,clustered_forward_gpu_ms,gbuffer_gpu_ms,deferred_lighting_gpu_ms,light_volumes_gpu_ms,tonemap_gpu_ms,clusters,non_empty_clusters,list_entries,\
          max_per_cluster,mean_per_non_empty,dropped_pairs,culling_ratio,transient_mib,cluster_buffer_mib,\
          list_entry_bound,tile_entries,tile_entry_bound,list_bound_cpu_ms,shading_ms,shading_vs_oracle,\
-         coarse_tiles,coarse_entries\n",
+         coarse_tiles,coarse_entries,depth_bounded_ratio\n",
     );
     for r in rows {
         let c = r.last.clusters.as_ref();
@@ -283,7 +286,7 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
         let vs_oracle = shading.zip(oracle).filter(|&(_, o)| o > 0.0).map(|(s, o)| s / o);
         let _ = writeln!(
             out,
-            "\"{adapter}\",\"{scene}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{},{},{},{},{},{},{},{},{}",
+            "\"{adapter}\",\"{scene}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{},{},{},{},{},{},{},{},{},{}",
             match (r.oracle, r.pipeline.is_deferred()) {
                 (true, false) => "oracle-forward",
                 (true, true) => "oracle-deferred",
@@ -323,6 +326,7 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
             vs_oracle.map_or(String::new(), |x| format!("{x:.3}")),
             c.map_or(String::new(), |c| c.coarse_span.to_string()),
             c.map_or(String::new(), |c| c.coarse_entries.to_string()),
+            r.depth_bounded.map_or(String::new(), |x| format!("{x:.3}")),
         );
     }
     out

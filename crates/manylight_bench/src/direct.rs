@@ -6,7 +6,9 @@ use anyhow::{Context, Result};
 use glam::UVec2;
 use manylight_app::render_world::HeadlessRenderer;
 use manylight_app::scene::{extracted_light, scene_snapshot};
-use manylight_core::efficiency::{CullingEfficiency, culling_efficiency, exact_pixel_lists, pixel_grid};
+use manylight_core::efficiency::{
+    CullingEfficiency, culling_efficiency, depth_bounded_lists, exact_pixel_lists, pixel_grid,
+};
 use manylight_render::{FrameReport, FrameSettings, FrameSnapshot, PipelineKind};
 use manylight_scene::{AnimatedLight, Scene};
 use std::sync::Arc;
@@ -49,15 +51,28 @@ fn render_and_read_lists(renderer: &mut HeadlessRenderer, snapshot: FrameSnapsho
     Ok(FrameLists { report, projection, grid, assignment, spheres, depth })
 }
 
+/// The culling efficiency of a frame's lists, and of the lists per-cluster depth bounds would
+/// make of them (`depth_bounded_lists`: measured, not built).
+pub struct Culling {
+    /// The frame's cluster lists.
+    pub lists: CullingEfficiency,
+    /// The same lists cut to each cluster's depth range of pixels.
+    pub depth_bounded: CullingEfficiency,
+}
+
 /// Renders `snapshot` and measures the culling efficiency of its cluster lists against its
-/// depth buffer (every 64th covered pixel is also checked against all lights).
+/// depth buffer, and of those lists cut by per-cluster depth bounds (every 64th covered pixel is
+/// also checked against all lights).
 pub fn measure_culling(
     renderer: &mut HeadlessRenderer,
     snapshot: FrameSnapshot,
-) -> Result<(FrameReport, CullingEfficiency)> {
+) -> Result<(FrameReport, Culling)> {
+    let test = snapshot.settings.render.clusters.cull;
     let f = render_and_read_lists(renderer, snapshot)?;
-    let eff = culling_efficiency(&f.grid, &f.projection, &f.assignment, &f.spheres, &f.depth, 64);
-    Ok((f.report, eff))
+    let lists = culling_efficiency(&f.grid, &f.projection, &f.assignment, &f.spheres, &f.depth, 64);
+    let bounded = depth_bounded_lists(&f.grid, &f.projection, &f.assignment, &f.spheres, &f.depth, test);
+    let depth_bounded = culling_efficiency(&f.grid, &f.projection, &bounded, &f.spheres, &f.depth, 64);
+    Ok((f.report, Culling { lists, depth_bounded }))
 }
 
 /// The oracle of `snapshot`'s frame: renders it (so the view has cluster lists and a depth

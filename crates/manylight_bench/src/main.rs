@@ -494,7 +494,8 @@ fn render(args: RenderArgs) -> Result<()> {
     let culling = match &measured {
         Some(snap) if args.culling_efficiency => {
             let mut renderer = manylight_app::render_world::HeadlessRenderer::new()?;
-            let (_, eff) = direct::measure_culling(&mut renderer, snap.clone())?;
+            let (_, culling) = direct::measure_culling(&mut renderer, snap.clone())?;
+            let eff = culling.lists;
             println!(
                 "culling efficiency: {} light-pixel pairs evaluated, {} contributing: {:.3}x \
                  ({} sampled pixels, {} contributing pairs missing from the lists)",
@@ -503,6 +504,14 @@ fn render(args: RenderArgs) -> Result<()> {
                 eff.ratio(),
                 eff.sampled_pixels,
                 eff.missed_pairs
+            );
+            let bounded = culling.depth_bounded;
+            println!(
+                "with per-cluster depth bounds (measured on these lists, not built): {} pairs \
+                 evaluated: {:.3}x ({} contributing pairs missing)",
+                bounded.evaluated_pairs,
+                bounded.ratio(),
+                bounded.missed_pairs
             );
             Some(eff)
         }

@@ -10,7 +10,10 @@
 //!    the list (must be zero for a conservative assignment).
 
 use crate::Projection;
-use crate::cluster::{ClusterAssignment, ClusterGrid, GridConfig, ViewSphere, ZSlicing};
+use crate::cluster::{
+    ClusterAssignment, ClusterGrid, CullTest, GridConfig, ViewSphere, ZSlicing, sphere_intersects_aabb,
+    sphere_intersects_planes,
+};
 use glam::{Vec2, Vec3};
 
 /// The result of [`culling_efficiency`].
@@ -145,11 +148,124 @@ pub fn exact_pixel_lists(
     ClusterAssignment { ranges, indices, dropped_pairs: 0, clusters_overflowed: 0 }
 }
 
+/// The lists `assignment` would have with **per-cluster depth bounds** (the depth range of the
+/// pixels that fall in each cluster, from a depth pre-pass; Olsson et al. 2012): each cluster's
+/// bounds cut to its tile between the nearest and farthest of its pixels (widened by the
+/// cluster margin), and only the lights of its list that still pass `test` kept; clusters
+/// without a pixel keep none. It measures what the technique would save before it is built; it
+/// is conservative like the build (a pixel's position lies inside its cluster's cut bounds, so a
+/// light containing it passes both tests), which [`culling_efficiency`]'s sampled check
+/// confirms.
+pub fn depth_bounded_lists(
+    grid: &ClusterGrid,
+    projection: &Projection,
+    assignment: &ClusterAssignment,
+    lights: &[ViewSphere],
+    depth: &[f32],
+    test: CullTest,
+) -> ClusterAssignment {
+    let mut range = vec![(f32::INFINITY, f32::NEG_INFINITY); grid.cluster_count() as usize];
+    for_each_covered_pixel(grid, projection, depth, |_, q, cluster| {
+        let r = &mut range[cluster as usize];
+        *r = (r.0.min(-q.z), r.1.max(-q.z));
+    });
+    let mut out = ClusterAssignment { ranges: Vec::with_capacity(range.len()), ..Default::default() };
+    for (cluster, &(near, far)) in range.iter().enumerate() {
+        let offset = out.indices.len() as u32;
+        if near <= far {
+            let k = grid.coords(cluster as u32);
+            let m = grid.cluster_margin(k.z);
+            let (d0, d1) = (
+                (near - m).max(grid.slice_boundary(k.z) - m),
+                (far + m).min(grid.slice_boundary(k.z + 1) + m),
+            );
+            let (x0, x1) = depth_extent(grid, k.x, true, d0, d1, m);
+            let (y0, y1) = depth_extent(grid, k.y, false, d0, d1, m);
+            let (min, max) = (Vec3::new(x0, y0, -d1), Vec3::new(x1, y1, -d0));
+            let mut planes = grid.cluster_planes(k.x, k.y, k.z);
+            planes[4] = glam::Vec4::new(0.0, 0.0, -1.0, -d0);
+            planes[5] = glam::Vec4::new(0.0, 0.0, 1.0, d1);
+            let keeps = |s: &ViewSphere| match test {
+                CullTest::Aabb => sphere_intersects_aabb(s.center, s.radius, min, max),
+                CullTest::Planes => sphere_intersects_planes(s.center, s.radius, &planes),
+                CullTest::Both => {
+                    sphere_intersects_aabb(s.center, s.radius, min, max)
+                        && sphere_intersects_planes(s.center, s.radius, &planes)
+                }
+            };
+            let list = assignment.lights_of(cluster as u32);
+            out.indices.extend(list.iter().copied().filter(|&l| lights.get(l as usize).is_some_and(keeps)));
+        }
+        out.ranges.push([offset, out.indices.len() as u32 - offset]);
+    }
+    out
+}
+
+/// View-space x (`horizontal`) or y range of tile column or row `i` between view distances
+/// `d0` and `d1`, widened by `m` (the corners of the frustum piece; orthographic: the tile's
+/// edges at any depth).
+fn depth_extent(grid: &ClusterGrid, i: u32, horizontal: bool, d0: f32, d1: f32, m: f32) -> (f32, f32) {
+    let (e0, e1) = if horizontal {
+        (grid.ndc_x_edge(i), grid.ndc_x_edge(i + 1))
+    } else {
+        (grid.ndc_y_edge(i + 1), grid.ndc_y_edge(i))
+    };
+    let scale = |d: f32| {
+        let h = grid.half_extent_at(d);
+        if horizontal { h.x } else { h.y }
+    };
+    let c = [e0 * scale(d0), e0 * scale(d1), e1 * scale(d0), e1 * scale(d1)];
+    let lo = c.iter().copied().fold(f32::INFINITY, f32::min);
+    let hi = c.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+    (lo - m, hi + m)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::cluster::{CullTest, assign_lights};
     use glam::UVec2;
+
+    /// Depth bounds cut the lights of a slice that miss the only depth its pixels have: a wall
+    /// 4 units away, in a slice from 3.16 to 17.8; a light 8 units away (reaching 6 to 10) is in
+    /// the wall's clusters' lists but not in their depth-bounded lists, a light reaching the wall
+    /// stays, and no contributing pair is missing.
+    #[test]
+    fn depth_bounds_drop_lights_that_miss_the_pixels_depth_range() {
+        let size = UVec2::new(8, 4);
+        let projection = Projection::perspective(1.0, 0.1, 100.0);
+        let grid = ClusterGrid::new(
+            size,
+            &projection,
+            &GridConfig { tile_px: 4, z_slices: 4, ..GridConfig::default() },
+        );
+        let depth_of = |d: f32| projection.matrix(2.0).project_point3(glam::Vec3::new(0.0, 0.0, -d)).z;
+        let depth = vec![depth_of(4.0); 32];
+        let lights = [
+            ViewSphere { center: glam::Vec3::new(0.0, 0.0, -8.0), radius: 2.0 },
+            ViewSphere { center: glam::Vec3::new(0.0, 0.0, -5.0), radius: 1.5 },
+        ];
+        for test in CullTest::ALL {
+            let assignment = assign_lights(&grid, &lights, test, None);
+            let bounded = depth_bounded_lists(&grid, &projection, &assignment, &lights, &depth, test);
+            let wall = grid.cluster_of(glam::Vec2::new(3.5, 1.5), 4.0);
+            assert_eq!(assignment.lights_of(wall), [0, 1], "{test:?}");
+            assert_eq!(bounded.lights_of(wall), [1], "{test:?}");
+            // Clusters without pixels keep nothing; the rest is a subset.
+            for c in 0..grid.cluster_count() {
+                let (all, kept) = (assignment.lights_of(c), bounded.lights_of(c));
+                assert!(kept.iter().all(|l| all.contains(l)), "{test:?}: cluster {c}");
+                if grid.coords(c).z != grid.coords(wall).z {
+                    assert!(kept.is_empty(), "{test:?}: cluster {c} has no pixel");
+                }
+            }
+            let before = culling_efficiency(&grid, &projection, &assignment, &lights, &depth, 1);
+            let after = culling_efficiency(&grid, &projection, &bounded, &lights, &depth, 1);
+            assert_eq!(after.missed_pairs, 0, "{test:?}");
+            assert_eq!(after.contributing_pairs, before.contributing_pairs, "{test:?}");
+            assert!(after.evaluated_pairs < before.evaluated_pairs, "{test:?}: {after:?} vs {before:?}");
+        }
+    }
 
     /// A wall 4 units away filling an 8×4 view; the left half lit by one light, a light behind
     /// the camera and a radius-0 light lighting nothing.
