@@ -63,7 +63,7 @@ pub struct ClusterReport {
     pub tile_entry_bound: u64,
     /// The CPU bound the per-coarse-tile lists were sized to (at least `coarse_entries`).
     pub coarse_entry_bound: u64,
-    /// CPU milliseconds the two bounds took (before the frame was submitted).
+    /// CPU milliseconds the list bounds took (before the frame was submitted).
     pub bound_cpu_ms: f64,
     /// Bytes of GPU buffers the cluster build and clustered shading hold (grid bounds, light
     /// spheres, per-tile and per-cluster ranges and index lists, parameters, counters).
