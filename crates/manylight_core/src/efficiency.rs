@@ -11,8 +11,7 @@
 
 use crate::Projection;
 use crate::cluster::{
-    ClusterAssignment, ClusterGrid, CullTest, GridConfig, ViewSphere, ZSlicing, sphere_intersects_aabb,
-    sphere_intersects_planes,
+    ClusterAssignment, ClusterGrid, CullTest, GridConfig, ViewSphere, ZSlicing, sphere_passes,
 };
 use glam::{Vec2, Vec3};
 
@@ -179,20 +178,13 @@ pub fn depth_bounded_lists(
                 (near - m).max(grid.slice_boundary(k.z) - m),
                 (far + m).min(grid.slice_boundary(k.z + 1) + m),
             );
-            let (x0, x1) = depth_extent(grid, k.x, true, d0, d1, m);
-            let (y0, y1) = depth_extent(grid, k.y, false, d0, d1, m);
-            let (min, max) = (Vec3::new(x0, y0, -d1), Vec3::new(x1, y1, -d0));
+            let (x0, x1) = grid.x_extent_between(k.x, d0, d1, m);
+            let (y0, y1) = grid.y_extent_between(k.y, d0, d1, m);
+            let aabb = (Vec3::new(x0, y0, -d1), Vec3::new(x1, y1, -d0));
             let mut planes = grid.cluster_planes(k.x, k.y, k.z);
             planes[4] = glam::Vec4::new(0.0, 0.0, -1.0, -d0);
             planes[5] = glam::Vec4::new(0.0, 0.0, 1.0, d1);
-            let keeps = |s: &ViewSphere| match test {
-                CullTest::Aabb => sphere_intersects_aabb(s.center, s.radius, min, max),
-                CullTest::Planes => sphere_intersects_planes(s.center, s.radius, &planes),
-                CullTest::Both => {
-                    sphere_intersects_aabb(s.center, s.radius, min, max)
-                        && sphere_intersects_planes(s.center, s.radius, &planes)
-                }
-            };
+            let keeps = |s: &ViewSphere| sphere_passes(test, s, aabb, &planes);
             let list = assignment.lights_of(cluster as u32);
             out.indices.extend(list.iter().copied().filter(|&l| lights.get(l as usize).is_some_and(keeps)));
         }
@@ -201,37 +193,16 @@ pub fn depth_bounded_lists(
     out
 }
 
-/// View-space x (`horizontal`) or y range of tile column or row `i` between view distances
-/// `d0` and `d1`, widened by `m` (the corners of the frustum piece; orthographic: the tile's
-/// edges at any depth).
-fn depth_extent(grid: &ClusterGrid, i: u32, horizontal: bool, d0: f32, d1: f32, m: f32) -> (f32, f32) {
-    let (e0, e1) = if horizontal {
-        (grid.ndc_x_edge(i), grid.ndc_x_edge(i + 1))
-    } else {
-        (grid.ndc_y_edge(i + 1), grid.ndc_y_edge(i))
-    };
-    let scale = |d: f32| {
-        let h = grid.half_extent_at(d);
-        if horizontal { h.x } else { h.y }
-    };
-    let c = [e0 * scale(d0), e0 * scale(d1), e1 * scale(d0), e1 * scale(d1)];
-    let lo = c.iter().copied().fold(f32::INFINITY, f32::min);
-    let hi = c.iter().copied().fold(f32::NEG_INFINITY, f32::max);
-    (lo - m, hi + m)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::cluster::{CullTest, assign_lights};
     use glam::UVec2;
 
-    /// Depth bounds cut the lights of a slice that miss the only depth its pixels have: a wall
-    /// 4 units away, in a slice from 3.16 to 17.8; a light 8 units away (reaching 6 to 10) is in
-    /// the wall's clusters' lists but not in their depth-bounded lists, a light reaching the wall
-    /// stays, and no contributing pair is missing.
-    #[test]
-    fn depth_bounds_drop_lights_that_miss_the_pixels_depth_range() {
+    /// An 8×4 view (60° wide, near 0.1, far 100) on a grid of 4-px tiles and 4 exponential
+    /// slices (boundaries 0.1, 0.56, 3.16, 17.8, 100), and the reverse-Z depth of a point `d`
+    /// units ahead.
+    fn small_view() -> (ClusterGrid, Projection, impl Fn(f32) -> f32) {
         let size = UVec2::new(8, 4);
         let projection = Projection::perspective(1.0, 0.1, 100.0);
         let grid = ClusterGrid::new(
@@ -239,7 +210,17 @@ mod tests {
             &projection,
             &GridConfig { tile_px: 4, z_slices: 4, ..GridConfig::default() },
         );
-        let depth_of = |d: f32| projection.matrix(2.0).project_point3(glam::Vec3::new(0.0, 0.0, -d)).z;
+        let depth_of = move |d: f32| projection.matrix(2.0).project_point3(glam::Vec3::new(0.0, 0.0, -d)).z;
+        (grid, projection, depth_of)
+    }
+
+    /// Depth bounds cut the lights of a slice that miss the only depth its pixels have: a wall
+    /// 4 units away, in a slice from 3.16 to 17.8; a light 8 units away (reaching 6 to 10) is in
+    /// the wall's clusters' lists but not in their depth-bounded lists, a light reaching the wall
+    /// stays, and no contributing pair is missing.
+    #[test]
+    fn depth_bounds_drop_lights_that_miss_the_pixels_depth_range() {
+        let (grid, projection, depth_of) = small_view();
         let depth = vec![depth_of(4.0); 32];
         let lights = [
             ViewSphere { center: glam::Vec3::new(0.0, 0.0, -8.0), radius: 2.0 },
@@ -271,15 +252,7 @@ mod tests {
     /// the camera and a radius-0 light lighting nothing.
     #[test]
     fn exact_lists_hold_exactly_the_contributing_lights() {
-        let size = UVec2::new(8, 4);
-        let projection = Projection::perspective(1.0, 0.1, 100.0);
-        let grid = ClusterGrid::new(
-            size,
-            &projection,
-            &GridConfig { tile_px: 4, z_slices: 4, ..GridConfig::default() },
-        );
-        // The reverse-Z depth the projection gives a point `d` units ahead.
-        let depth_of = |d: f32| projection.matrix(2.0).project_point3(glam::Vec3::new(0.0, 0.0, -d)).z;
+        let (grid, projection, depth_of) = small_view();
         let mut depth = vec![depth_of(4.0); 32];
         depth[31] = 0.0; // one background pixel
         let left = projection.view_position(glam::Vec2::new(-0.75, 0.0), depth_of(4.0), 2.0);
@@ -301,7 +274,7 @@ mod tests {
             running += r[1];
         }
         assert_eq!(running as usize, lists.indices.len());
-        let pixels = pixel_grid(size, &projection);
+        let pixels = pixel_grid(grid.viewport, &projection);
         let e = culling_efficiency(&pixels, &projection, &lists, &lights, &depth, 1);
         assert_eq!((e.missed_pairs, e.evaluated_pairs), (0, e.contributing_pairs));
         assert_eq!(e.pixels, 31);

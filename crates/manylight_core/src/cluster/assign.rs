@@ -139,24 +139,13 @@ pub(crate) fn assign_lights_brute_force(
     test: CullTest,
     cap: Option<u32>,
 ) -> ClusterAssignment {
-    use super::cull::{sphere_intersects_aabb, sphere_intersects_planes};
     let lists: Vec<Vec<u32>> = (0..grid.cluster_count())
         .map(|i| {
             let c = grid.coords(i);
             let aabb = grid.cluster_aabb(c.x, c.y, c.z);
             let planes = grid.cluster_planes(c.x, c.y, c.z);
             (0..lights.len() as u32)
-                .filter(|&l| {
-                    let s = lights[l as usize];
-                    match test {
-                        CullTest::Aabb => sphere_intersects_aabb(s.center, s.radius, aabb.0, aabb.1),
-                        CullTest::Planes => sphere_intersects_planes(s.center, s.radius, &planes),
-                        CullTest::Both => {
-                            sphere_intersects_aabb(s.center, s.radius, aabb.0, aabb.1)
-                                && sphere_intersects_planes(s.center, s.radius, &planes)
-                        }
-                    }
-                })
+                .filter(|&l| super::cull::sphere_passes(test, &lights[l as usize], aabb, &planes))
                 .collect()
         })
         .collect();

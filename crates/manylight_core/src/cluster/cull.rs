@@ -11,6 +11,7 @@
 //! Both only ever err towards "touches": the AABB contains the frustum piece, and a sphere that
 //! meets the piece is within `r` of every one of its half-spaces.
 
+use super::CullTest;
 use glam::{Mat4, Vec3, Vec4};
 
 /// Factor applied to a light's radius before testing (module docs, step 2).
@@ -74,6 +75,19 @@ pub fn sphere_intersects_aabb(center: Vec3, radius: f32, min: Vec3, max: Vec3) -
     let r = inflated_radius(radius);
     let d = (min - center).max(center - max).max(Vec3::ZERO);
     d.dot(d) <= r * r
+}
+
+/// `test` for a sphere against a cluster's AABB `(min, max)` and its six planes: the AABB test,
+/// the planes test, or both.
+pub fn sphere_passes(test: CullTest, sphere: &ViewSphere, aabb: (Vec3, Vec3), planes: &[Vec4; 6]) -> bool {
+    let (c, r) = (sphere.center, sphere.radius);
+    match test {
+        CullTest::Aabb => sphere_intersects_aabb(c, r, aabb.0, aabb.1),
+        CullTest::Planes => sphere_intersects_planes(c, r, planes),
+        CullTest::Both => {
+            sphere_intersects_aabb(c, r, aabb.0, aabb.1) && sphere_intersects_planes(c, r, planes)
+        }
+    }
 }
 
 /// Conservative plane test: true unless the sphere (radius inflated) lies entirely outside one

@@ -238,24 +238,34 @@ impl ClusterGrid {
 
     /// View-space x range of column `x` over slice `z`, widened by the margin.
     pub(crate) fn x_extent(&self, x: u32, z: u32) -> (f32, f32) {
-        if let Some(h) = self.ortho_half {
-            let m = self.cluster_margin(z);
-            return (self.ndc_x_edge(x) * h.x - m, self.ndc_x_edge(x + 1) * h.x + m);
-        }
-        let tan_x = self.tan_half_fov().x;
-        let (a0, a1) = (self.ndc_x_edge(x) * tan_x, self.ndc_x_edge(x + 1) * tan_x);
-        extent(a0, a1, self.slice_boundary(z), self.slice_boundary(z + 1), self.cluster_margin(z))
+        self.x_extent_between(x, self.slice_boundary(z), self.slice_boundary(z + 1), self.cluster_margin(z))
     }
 
     /// View-space y range of row `y` over slice `z`, widened by the margin.
     pub(crate) fn y_extent(&self, y: u32, z: u32) -> (f32, f32) {
+        self.y_extent_between(y, self.slice_boundary(z), self.slice_boundary(z + 1), self.cluster_margin(z))
+    }
+
+    /// View-space x range of column `x` between view distances `d0` and `d1`, widened by `m`
+    /// (orthographic: the column's edges, at any distance).
+    pub(crate) fn x_extent_between(&self, x: u32, d0: f32, d1: f32, m: f32) -> (f32, f32) {
         if let Some(h) = self.ortho_half {
-            let m = self.cluster_margin(z);
+            return (self.ndc_x_edge(x) * h.x - m, self.ndc_x_edge(x + 1) * h.x + m);
+        }
+        let tan_x = self.tan_half_fov().x;
+        let (a0, a1) = (self.ndc_x_edge(x) * tan_x, self.ndc_x_edge(x + 1) * tan_x);
+        extent(a0, a1, d0, d1, m)
+    }
+
+    /// View-space y range of row `y` between view distances `d0` and `d1`, widened by `m`
+    /// (orthographic: the row's edges, at any distance).
+    pub(crate) fn y_extent_between(&self, y: u32, d0: f32, d1: f32, m: f32) -> (f32, f32) {
+        if let Some(h) = self.ortho_half {
             return (self.ndc_y_edge(y + 1) * h.y - m, self.ndc_y_edge(y) * h.y + m);
         }
         let tan_y = self.tan_half_fov().y;
         let (a0, a1) = (self.ndc_y_edge(y + 1) * tan_y, self.ndc_y_edge(y) * tan_y);
-        extent(a0, a1, self.slice_boundary(z), self.slice_boundary(z + 1), self.cluster_margin(z))
+        extent(a0, a1, d0, d1, m)
     }
 
     /// View-space z range of slice `z`, widened by the margin.

@@ -42,7 +42,7 @@ pub use bound::{
 };
 pub use cull::{
     RADIUS_INFLATION, ViewSphere, farthest_reach, inflated_radius, sphere_intersects_aabb,
-    sphere_intersects_planes, to_view_space, view_spheres,
+    sphere_intersects_planes, sphere_passes, to_view_space, view_spheres,
 };
 pub use exact::{false_positive_counts, sphere_touches_cluster_exact};
 pub use grid::{CLUSTER_MARGIN, ClusterGrid, GridConfig, MAX_CLUSTERS, MAX_GRID_DIM};
