@@ -117,15 +117,14 @@ pub struct ClusterResources {
     tile_bounds: GrowableBuffer,
     /// (tile, chunk) ranges, then (coarse tile, chunk) ranges.
     tile_ranges: GrowableBuffer,
-    /// The per-tile lists (`tile_list_capacity` entries), then the per-coarse-tile lists.
+    /// The per-tile lists (`GpuClusterParams::tile_index_capacity` entries), then the
+    /// per-coarse-tile lists (`tile_list_split`).
     tile_indices: GrowableBuffer,
     counters: wgpu::Buffer,
     /// The grid and coarse span the uploaded bounds are for.
     bounds_of: Option<(ClusterGrid, Option<u32>)>,
     /// Tiles per coarse-tile edge this frame, `None` without a coarse level.
     coarse: Option<u32>,
-    tile_list_capacity: u32,
-    coarse_list_capacity: u32,
     generations: [u64; 7],
     /// The view-space spheres uploaded this frame (for the CPU reference in tests and stats).
     pub view_spheres: Vec<ViewSphere>,
@@ -215,8 +214,6 @@ impl ClusterResources {
             counters,
             bounds_of: None,
             coarse: None,
-            tile_list_capacity: 0,
-            coarse_list_capacity: 0,
             generations: [0; 7],
             view_spheres: Vec::new(),
             bounds_estimate: ListBounds::default(),
@@ -388,7 +385,6 @@ impl ClusterResources {
         let (tile_need, coarse_need) =
             (self.bounds_estimate.tile_entries, self.bounds_estimate.coarse_entries);
         self.tile_indices.reserve(gpu, with_headroom(tile_need + coarse_need, &self.tile_indices))?;
-        self.split_tile_lists(tile_need, coarse_need);
         let tiles = self.grid.dims.x as u64 * self.grid.dims.y as u64;
         let coarse_tiles = self.coarse_dims().map_or(0, |d| u64::from(d.x) * u64::from(d.y));
         let tile_chunks = (spheres.len() as u32).div_ceil(TILE_LIGHT_CHUNK).max(1);
@@ -403,15 +399,14 @@ impl ClusterResources {
         self.coarse.map(|span| coarse_dims(self.grid.dims.truncate(), span))
     }
 
-    /// Splits the entries of the tile-lists buffer between the per-tile lists (first) and the
+    /// The entries of the tile-lists buffer for the per-tile lists (first) and the
     /// per-coarse-tile lists: each gets what it needs and half the spare room (the coarse
     /// lists what is left when the buffer could not grow to both).
-    fn split_tile_lists(&mut self, tile_need: u64, coarse_need: u64) {
+    fn tile_list_split(&self, tile_need: u64, coarse_need: u64) -> (u32, u32) {
         let total = (self.tile_indices.capacity() / 4).min(u64::from(u32::MAX));
         let spare = total.saturating_sub(tile_need + coarse_need);
         let tiles = (tile_need + spare / 2).min(total);
-        self.tile_list_capacity = tiles as u32;
-        self.coarse_list_capacity = (total - tiles) as u32;
+        (tiles as u32, (total - tiles) as u32)
     }
 
     /// Sets the lights' view-space spheres (`lights` in the order of the light buffer) and
@@ -439,6 +434,8 @@ impl ClusterResources {
         tile_chunks: u32,
     ) {
         let (near, far) = (self.grid.near, self.grid.far);
+        let (tile_lists, coarse_lists) =
+            self.tile_list_split(self.bounds_estimate.tile_entries, self.bounds_estimate.coarse_entries);
         self.params = GpuClusterParams {
             dims: [self.grid.dims.x, self.grid.dims.y, self.grid.dims.z, self.grid.cluster_count()],
             viewport: [view.size.x.max(1) as f32, view.size.y.max(1) as f32, near, far],
@@ -452,10 +449,10 @@ impl ClusterResources {
             index_capacity: (self.indices.capacity() / 4).min(u32::MAX as u64) as u32,
             slicing: self.grid.slicing.gpu_id(),
             log_far_over_near: (far / near).ln(),
-            tile_index_capacity: self.tile_list_capacity,
+            tile_index_capacity: tile_lists,
             tile_chunks,
             coarse_dims: self.coarse_dims().unwrap_or(glam::UVec2::ZERO).to_array(),
-            coarse_index_capacity: self.coarse_list_capacity,
+            coarse_index_capacity: coarse_lists,
             coarse_span: self.coarse.unwrap_or(0),
         };
         gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
@@ -479,7 +476,6 @@ impl ClusterResources {
         self.grid = manylight_core::efficiency::pixel_grid(view.size, &projection);
         self.cull = view.settings.clusters.cull;
         self.coarse = None;
-        self.split_tile_lists(0, 0);
         let count = self.grid.cluster_count();
         let bad =
             |problem: String| RenderError::UnsupportedSettings(format!("per-pixel light lists: {problem}"));
@@ -534,9 +530,16 @@ impl ClusterResources {
 
     /// True when the index lists are too small for what the frame needed (`counters`).
     pub fn lists_short(&self, counters: &GpuClusterCounters) -> bool {
-        counters.tile_entries > self.params.tile_index_capacity
-            || counters.coarse_entries > self.params.coarse_index_capacity
-            || counters.total_entries > self.params.index_capacity
+        let (tiles_short, clusters_short) = self.short_lists(counters);
+        tiles_short || clusters_short
+    }
+
+    /// Whether the tile-lists buffer (per-tile and per-coarse-tile lists) and the cluster index
+    /// list were too small for what the frame needed (`counters`).
+    fn short_lists(&self, counters: &GpuClusterCounters) -> (bool, bool) {
+        let tiles_short = counters.tile_entries > self.params.tile_index_capacity
+            || counters.coarse_entries > self.params.coarse_index_capacity;
+        (tiles_short, counters.total_entries > self.params.index_capacity)
     }
 
     /// True when the index lists were too small for what the frame needed (`counters`); grows
@@ -547,9 +550,7 @@ impl ClusterResources {
         gpu: &GpuContext,
         counters: &GpuClusterCounters,
     ) -> Result<bool, RenderError> {
-        let tiles_short = counters.tile_entries > self.params.tile_index_capacity
-            || counters.coarse_entries > self.params.coarse_index_capacity;
-        let clusters_short = counters.total_entries > self.params.index_capacity;
+        let (tiles_short, clusters_short) = self.short_lists(counters);
         if !tiles_short && !clusters_short {
             return Ok(false);
         }
@@ -557,9 +558,8 @@ impl ClusterResources {
             let tiles = u64::from(counters.tile_entries.max(self.params.tile_index_capacity));
             let coarse = u64::from(counters.coarse_entries.max(self.params.coarse_index_capacity));
             self.tile_indices.reserve(gpu, (tiles + coarse) * 4)?;
-            self.split_tile_lists(tiles, coarse);
-            self.params.tile_index_capacity = self.tile_list_capacity;
-            self.params.coarse_index_capacity = self.coarse_list_capacity;
+            (self.params.tile_index_capacity, self.params.coarse_index_capacity) =
+                self.tile_list_split(tiles, coarse);
         }
         if clusters_short {
             self.indices.reserve(gpu, counters.total_entries as u64 * 4)?;
