@@ -240,7 +240,7 @@ fn a_scene_without_lights_builds_no_clusters() {
 #[test]
 fn each_pipeline_builds_exactly_its_passes() {
     let _gpu = gpu();
-    let cases: [(PipelineKind, bool, &[&str]); 5] = [
+    let cases: [(PipelineKind, bool, &[&str]); 7] = [
         (PipelineKind::NaiveForward, true, &["forward", "tonemap"]),
         (
             PipelineKind::ForwardPlus,
@@ -257,8 +257,10 @@ fn each_pipeline_builds_exactly_its_passes() {
             true,
             &["cluster_build", "gbuffer", "deferred_lighting", "tonemap"],
         ),
+        (PipelineKind::TiledDeferred, true, &["cluster_build", "gbuffer", "tiled_deferred", "tonemap"]),
         // Without lights nothing is assigned: no cluster build, no light lists, plain forward.
         (PipelineKind::ClusteredDeferred, false, &["forward", "tonemap"]),
+        (PipelineKind::TiledDeferred, false, &["forward", "tonemap"]),
     ];
     for (pipeline, lights, expected) in cases {
         let mut app = App::new();

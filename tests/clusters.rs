@@ -557,3 +557,65 @@ fn exact_pixel_lists_shade_the_naive_image() {
     let err = r.render(FrameSnapshot { pixel_light_lists: Some(std::sync::Arc::new(wrong)), ..snap }, false);
     assert!(err.is_err(), "lists of 10 pixels for a 160×96 view must be refused");
 }
+
+/// Tiled deferred cuts each tile's list to its pixels' depths in workgroup memory, where no
+/// test can read it back; a contributing light it dropped would darken its pixels. With the
+/// same G-buffer and shading code its image equals clustered deferred's to one 8-bit step (the
+/// lists differ only by lights that add exactly zero, summed in another order) on the hard
+/// cases, a 70 000-light rig, the sphere shell with 100 000 lights, tiles wider than its
+/// workgroup (each invocation then visits several pixels) and an orthographic view.
+#[test]
+fn tiled_deferred_shades_what_clustered_deferred_shades() {
+    let _gpu = gpu();
+    let mut r = HeadlessRenderer::new().expect("adapter");
+    let settings = |pipeline, tile_px| FrameSettings {
+        render: RenderSettings {
+            pipeline,
+            clusters: ClusterSettings {
+                grid: GridConfig { tile_px, ..GridConfig::default() },
+                ..ClusterSettings::default()
+            },
+            ..Default::default()
+        },
+        ..FrameSettings::default()
+    };
+    let mut check = |what: &str, scene: &Scene, size: UVec2, lights: Vec<ExtractedPointLight>, tile_px| {
+        let clustered =
+            scene_snapshot(scene, size, lights.clone(), settings(PipelineKind::ClusteredDeferred, 16));
+        let (_, expected) = r.render(clustered, true).expect("clustered deferred renders");
+        let tiled = scene_snapshot(scene, size, lights, settings(PipelineKind::TiledDeferred, tile_px));
+        let (report, image) = r.render(tiled, true).expect("tiled deferred renders");
+        assert!(report.pass_names().contains(&"tiled_deferred"), "{what}: {:?}", report.pass_names());
+        assert_eq!(report.nonfinite_pixels, Some(0), "{what}");
+        let (image, expected) = (image.expect("image"), expected.expect("image"));
+        let steps =
+            image.as_raw().iter().zip(expected.as_raw()).map(|(a, b)| a.abs_diff(*b)).max().unwrap_or(0);
+        if steps > 1 {
+            support::assert_similar(&format!("tiled_deferred_{what}"), &expected, &image, support::STRICT);
+        }
+        assert!(steps <= 1, "{what}: tiled deferred differs from clustered deferred by {steps} steps");
+    };
+    let scene = default_scene();
+    let size = UVec2::new(160, 96);
+    check("hard cases", &scene, size, hard_lights(&scene, size), 16);
+    check("hard cases, 40-px tiles", &scene, size, hard_lights(&scene, size), 40);
+    check("70 000 lights", &scene, size, rig(&scene, 70_000, 5), 16);
+    let shell = manylight::scene::sphere_shell_scene();
+    let lights: Vec<ExtractedPointLight> = manylight::scene::sphere_shell_lights(
+        100_000,
+        manylight::scene::SHELL_RADIUS,
+        manylight::scene::SHELL_LIGHT_RANGE,
+        7,
+    )
+    .iter()
+    .map(extracted_light)
+    .collect();
+    check("sphere shell", &shell, UVec2::new(256, 144), lights, 16);
+    let mut ortho = default_scene();
+    let cam = ortho.camera_or_fit(size.x as f32 / size.y as f32);
+    ortho.cameras = vec![manylight::scene::SceneCamera {
+        transform: cam.transform,
+        projection: Projection::orthographic(12.0, 0.1, 200.0),
+    }];
+    check("orthographic", &ortho, size, rig(&ortho, 512, 9), 16);
+}

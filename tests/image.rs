@@ -48,8 +48,8 @@ fn with_pipeline(pipeline: PipelineKind) -> RenderSettings {
 }
 
 /// Forward+, clustered forward (with and without depth pre-pass, several culling tests and
-/// both slicings) and clustered deferred (both G-buffer layouts) match naive forward on the
-/// default scene and a glTF scene.
+/// both slicings), clustered deferred and tiled deferred (two G-buffer layouts each) match
+/// naive forward on the default scene and a glTF scene.
 #[test]
 fn tiled_and_clustered_pipelines_match_naive_forward() {
     use manylight::app::prelude::{ClusterSettings, CullTest, GridConfig, ZSlicing};
@@ -63,9 +63,12 @@ fn tiled_and_clustered_pipelines_match_naive_forward() {
     let naive_cornell = render(cornell(), small, 0, bright(PipelineKind::NaiveForward));
     use manylight::app::prelude::GBufferLayout;
     let deferred = |gbuffer| RenderSettings { gbuffer, ..with_pipeline(PipelineKind::ClusteredDeferred) };
+    let tiled = |gbuffer| RenderSettings { gbuffer, ..with_pipeline(PipelineKind::TiledDeferred) };
     let variants = [
         ("clustered_deferred_full", deferred(GBufferLayout::Full)),
         ("clustered_deferred_compact", deferred(GBufferLayout::Compact)),
+        ("tiled_deferred_full", tiled(GBufferLayout::Full)),
+        ("tiled_deferred_packed", tiled(GBufferLayout::Packed)),
         ("forward_plus", with_pipeline(PipelineKind::ForwardPlus)),
         ("clustered", with_pipeline(PipelineKind::ClusteredForward)),
         (
@@ -84,9 +87,7 @@ fn tiled_and_clustered_pipelines_match_naive_forward() {
     for (name, settings) in variants {
         // The Compact G-buffer stores albedo in 8 bits: a measured approximation (FLIP mean
         // ≈ 0.01 against naive, docs/accuracy.md), so it gets its own stated tolerance.
-        let tol = if settings.gbuffer == GBufferLayout::Compact
-            && settings.pipeline == PipelineKind::ClusteredDeferred
-        {
+        let tol = if settings.gbuffer == GBufferLayout::Compact && settings.pipeline.is_deferred() {
             support::COMPACT
         } else {
             STRICT

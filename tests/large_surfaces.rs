@@ -307,7 +307,7 @@ fn configurations() -> Vec<(String, RenderSettings)> {
 /// The tolerance of a configuration against naive forward on ordinary scenes
 /// (`tests/deferred.rs`, `tests/image.rs`).
 fn tolerance(settings: &RenderSettings) -> Tolerance {
-    let deferred = matches!(settings.pipeline, PipelineKind::ClusteredDeferred | PipelineKind::LightVolumes);
+    let deferred = settings.pipeline.is_deferred();
     match (deferred, settings.gbuffer, settings.normal_codec) {
         (true, GBufferLayout::Compact, _) => support::COMPACT,
         (true, GBufferLayout::Packed, NormalCodec::Xyz) => Tolerance { mean: 0.005, p99: 0.08 },
@@ -350,6 +350,8 @@ fn huge_floor_matches_the_tessellated_reference_in_every_pipeline() {
             assert!(passes.contains(&"light_volumes"), "{name}: {passes:?}");
         } else if settings.pipeline == PipelineKind::ClusteredDeferred {
             assert!(passes.contains(&"deferred_lighting"), "{name}: {passes:?}");
+        } else if settings.pipeline == PipelineKind::TiledDeferred {
+            assert!(passes.contains(&"tiled_deferred"), "{name}: {passes:?}");
         }
         let s = assert_similar(
             &format!("huge_floor_{name}"),

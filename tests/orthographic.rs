@@ -53,6 +53,8 @@ fn an_orthographic_view_matches_naive_forward_in_every_pipeline() {
         (PipelineKind::ClusteredDeferred, GBufferLayout::Full, NormalCodec::Octa16),
         (PipelineKind::ClusteredDeferred, GBufferLayout::Packed, NormalCodec::Octa16),
         (PipelineKind::ClusteredDeferred, GBufferLayout::Compact, NormalCodec::Octa16),
+        (PipelineKind::TiledDeferred, GBufferLayout::Full, NormalCodec::Octa16),
+        (PipelineKind::TiledDeferred, GBufferLayout::Compact, NormalCodec::Octa16),
         (PipelineKind::LightVolumes, GBufferLayout::Full, NormalCodec::Octa16),
     ];
     for (pipeline, gbuffer, normal_codec) in configs {

@@ -15,7 +15,8 @@ fn named<T: Copy>(what: &str, s: &str, all: &[T], name: impl Fn(T) -> &'static s
     })
 }
 
-/// `naive`, `forward-plus`, `clustered-forward`, `clustered-deferred` or `light-volumes`.
+/// `naive`, `forward-plus`, `clustered-forward`, `clustered-deferred`, `tiled-deferred` or
+/// `light-volumes`.
 pub fn parse_pipeline(s: &str) -> Result<PipelineKind, String> {
     named("pipeline", s, &PipelineKind::ALL, PipelineKind::name)
 }

@@ -42,8 +42,9 @@ impl Row {
 }
 
 /// Passes that shade lights (a pipeline's lighting cost): `forward`, `clustered_forward`,
-/// `deferred_lighting`, `light_volumes`.
-pub const SHADING_PASSES: [&str; 4] = ["forward", "clustered_forward", "deferred_lighting", "light_volumes"];
+/// `deferred_lighting`, `tiled_deferred`, `light_volumes`.
+pub const SHADING_PASSES: [&str; 5] =
+    ["forward", "clustered_forward", "deferred_lighting", "tiled_deferred", "light_volumes"];
 
 /// GPU milliseconds of `report`'s shading passes ([`SHADING_PASSES`]); `None` without timings.
 pub fn shading_ms(report: &FrameReport) -> Option<f64> {

@@ -7,7 +7,8 @@ use glam::UVec2;
 use manylight_app::render_world::HeadlessRenderer;
 use manylight_app::scene::{extracted_light, scene_snapshot};
 use manylight_core::efficiency::{
-    CullingEfficiency, culling_efficiency, depth_bounded_lists, exact_pixel_lists, pixel_grid,
+    CullingEfficiency, culling_efficiency, depth_bounded_lists, depth_masked_lists, exact_pixel_lists,
+    pixel_grid,
 };
 use manylight_render::{FrameReport, FrameSettings, FrameSnapshot, PipelineKind};
 use manylight_scene::{AnimatedLight, Scene};
@@ -54,22 +55,31 @@ fn render_and_read_lists(renderer: &mut HeadlessRenderer, snapshot: FrameSnapsho
 /// The culling efficiency of a frame's lists, and of the lists per-cluster depth bounds would
 /// make of them (`depth_bounded_lists`: measured, not built).
 pub struct Culling {
-    /// The frame's cluster lists.
+    /// The lists the frame shades from (its cluster lists; tiled deferred: cut by its depth masks).
     pub lists: CullingEfficiency,
     /// The same lists cut to each cluster's depth range of pixels.
     pub depth_bounded: CullingEfficiency,
 }
 
-/// Renders `snapshot` and measures the culling efficiency of its cluster lists against its
-/// depth buffer, and of those lists cut by per-cluster depth bounds (every 64th covered pixel is
-/// also checked against all lights).
+/// Renders `snapshot` and measures the culling efficiency of the lists its shading evaluates
+/// against its depth buffer, and of its cluster lists cut by per-cluster depth bounds (every
+/// 64th covered pixel is also checked against all lights). Tiled deferred shades from its tile
+/// lists cut by each tile's depth mask (`depth_masked_lists`, as its shader does); every other
+/// pipeline from its cluster lists.
 pub fn measure_culling(
     renderer: &mut HeadlessRenderer,
     snapshot: FrameSnapshot,
 ) -> Result<(FrameReport, Culling)> {
     let test = snapshot.settings.render.clusters.cull;
+    let tiled = snapshot.settings.render.pipeline == PipelineKind::TiledDeferred;
     let f = render_and_read_lists(renderer, snapshot)?;
-    let lists = culling_efficiency(&f.grid, &f.projection, &f.assignment, &f.spheres, &f.depth, 64);
+    let shaded = if tiled {
+        let cells = manylight_render::gpu_types::TILED_DEPTH_CELLS;
+        &depth_masked_lists(&f.grid, &f.projection, &f.assignment, &f.spheres, &f.depth, cells)
+    } else {
+        &f.assignment
+    };
+    let lists = culling_efficiency(&f.grid, &f.projection, shaded, &f.spheres, &f.depth, 64);
     let bounded = depth_bounded_lists(&f.grid, &f.projection, &f.assignment, &f.spheres, &f.depth, test);
     let depth_bounded = culling_efficiency(&f.grid, &f.projection, &bounded, &f.spheres, &f.depth, 64);
     Ok((f.report, Culling { lists, depth_bounded }))
@@ -78,8 +88,8 @@ pub fn measure_culling(
 /// The oracle of `snapshot`'s frame: renders it (so the view has cluster lists and a depth
 /// buffer), builds exact per-pixel light lists from the read-back depth and lists
 /// (`exact_pixel_lists`), and returns the snapshot that shades from them, with the culling
-/// efficiency of those lists (1: only contributing lights). Clustered deferred stays clustered
-/// deferred (the deferred oracle: its lighting pass reads the lists); every other pipeline
+/// efficiency of those lists (1: only contributing lights). Clustered and tiled deferred become
+/// clustered deferred (the deferred oracle: its lighting pass reads the lists); every other pipeline
 /// becomes clustered forward (the forward oracle). Callers time only the frame they render from
 /// the returned snapshot: building the lists is not the oracle's cost.
 pub fn oracle_snapshot(
@@ -87,9 +97,10 @@ pub fn oracle_snapshot(
     mut snapshot: FrameSnapshot,
 ) -> Result<(FrameSnapshot, CullingEfficiency)> {
     let render = &mut snapshot.settings.render;
-    if render.pipeline != PipelineKind::ClusteredDeferred {
-        render.pipeline = PipelineKind::ClusteredForward;
-    }
+    render.pipeline = match render.pipeline {
+        PipelineKind::ClusteredDeferred | PipelineKind::TiledDeferred => PipelineKind::ClusteredDeferred,
+        _ => PipelineKind::ClusteredForward,
+    };
     snapshot.pixel_light_lists = None;
     let f = render_and_read_lists(renderer, snapshot.clone())?;
     let lists = exact_pixel_lists(&f.grid, &f.projection, &f.assignment, &f.spheres, &f.depth);

@@ -179,7 +179,8 @@ struct BenchArgs {
     /// time against the oracle's (`shading_vs_oracle`).
     #[arg(long)]
     oracle: bool,
-    /// G-buffer layouts swept for clustered-deferred.
+    /// G-buffer layouts swept for the deferred pipelines (clustered-deferred, tiled-deferred,
+    /// light-volumes).
     #[arg(long, value_delimiter = ',', default_value = "full,compact", value_parser = parse_gbuffer)]
     gbuffers: Vec<GBufferLayout>,
     #[command(flatten)]
@@ -200,7 +201,8 @@ struct RenderArgs {
     /// `default` (embedded hall), `sphere-shell`, or a path to a .gltf/.glb file.
     #[arg(long, default_value = "default")]
     scene: String,
-    /// Pipeline: naive, forward-plus, clustered-forward, clustered-deferred or light-volumes.
+    /// Pipeline: naive, forward-plus, clustered-forward, clustered-deferred, tiled-deferred or
+    /// light-volumes.
     #[arg(long, default_value = "clustered-forward", value_parser = parse_pipeline)]
     pipeline: PipelineKind,
     #[command(flatten)]
@@ -313,8 +315,8 @@ struct ClusterArgs {
     /// every tile tests every light).
     #[arg(long, default_value_t = manylight_render::DEFAULT_COARSE_TILES)]
     coarse_tiles: u32,
-    /// G-buffer layout of the deferred pipelines (clustered-deferred, light-volumes): full,
-    /// packed or compact.
+    /// G-buffer layout of the deferred pipelines (clustered-deferred, tiled-deferred,
+    /// light-volumes): full, packed or compact.
     #[arg(long, default_value = "full", value_parser = parse_gbuffer)]
     gbuffer: GBufferLayout,
     /// Normal codec of the packed and compact G-buffers: xyz (packed only), spherical,

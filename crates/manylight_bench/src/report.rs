@@ -101,14 +101,15 @@ fn configurations(base: FrameSettings) -> Vec<(String, FrameSettings)> {
             ..base
         },
     ));
-    for pipeline in [PipelineKind::ClusteredDeferred, PipelineKind::LightVolumes] {
+    for pipeline in [PipelineKind::ClusteredDeferred, PipelineKind::TiledDeferred, PipelineKind::LightVolumes]
+    {
         for gbuffer in GBufferLayout::ALL {
             let codecs: Vec<NormalCodec> = if !gbuffer.uses_codec() {
                 vec![base.normal_codec]
             } else if pipeline == PipelineKind::ClusteredDeferred {
                 NormalCodec::ALL.into_iter().filter(|&c| gbuffer.supports(c)).collect()
             } else {
-                vec![NormalCodec::Octa16] // the codecs cost the same in both deferred pipelines
+                vec![NormalCodec::Octa16] // the codecs cost the same in every deferred pipeline
             };
             for normal_codec in codecs {
                 let name = if gbuffer.uses_codec() {

@@ -193,6 +193,57 @@ pub fn depth_bounded_lists(
     out
 }
 
+/// The lists tiled deferred lighting shades from (`shaders/tiled_deferred.wgsl`), for a frame
+/// whose clusters are tiles (one depth slice): per cluster, the depth range of its pixels split
+/// into `cells` equal cells (at most 32), a mask of the cells holding a pixel (2.5D culling,
+/// Harada 2012), and the lights of its list whose view-depth interval (centre ± radius) meets
+/// an occupied cell. Clusters without a pixel keep none. Conservative: a light reaching a pixel
+/// lies within its radius of it along the view axis too.
+pub fn depth_masked_lists(
+    grid: &ClusterGrid,
+    projection: &Projection,
+    assignment: &ClusterAssignment,
+    lights: &[ViewSphere],
+    depth: &[f32],
+    cells: u32,
+) -> ClusterAssignment {
+    let cells = cells.clamp(1, 32);
+    let count = grid.cluster_count() as usize;
+    let mut range = vec![(f32::INFINITY, f32::NEG_INFINITY); count];
+    for_each_covered_pixel(grid, projection, depth, |_, q, cluster| {
+        let r = &mut range[cluster as usize];
+        *r = (r.0.min(-q.z), r.1.max(-q.z));
+    });
+    let cell = |d: f32, (lo, hi): (f32, f32)| {
+        let c = ((d - lo) * (cells as f32 / (hi - lo).max(1e-30))).floor();
+        c.clamp(0.0, cells as f32 - 1.0) as u32
+    };
+    let mut mask = vec![0u32; count];
+    for_each_covered_pixel(grid, projection, depth, |_, q, cluster| {
+        mask[cluster as usize] |= 1 << cell(-q.z, range[cluster as usize]);
+    });
+    let mut out = ClusterAssignment { ranges: Vec::with_capacity(count), ..Default::default() };
+    for (cluster, (&r, &m)) in range.iter().zip(&mask).enumerate() {
+        let offset = out.indices.len() as u32;
+        if r.0 <= r.1 {
+            let keeps = |s: &ViewSphere| {
+                let reach = s.radius * crate::cluster::RADIUS_INFLATION;
+                let (lo, hi) = (-s.center.z - reach, -s.center.z + reach);
+                if !s.is_valid() || hi < r.0 || lo > r.1 {
+                    return false;
+                }
+                let (first, last) = (cell(lo, r), cell(hi, r));
+                let span = (u32::MAX >> (31 - last)) & (u32::MAX << first);
+                span & m != 0
+            };
+            let list = assignment.lights_of(cluster as u32);
+            out.indices.extend(list.iter().copied().filter(|&l| lights.get(l as usize).is_some_and(keeps)));
+        }
+        out.ranges.push([offset, out.indices.len() as u32 - offset]);
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -245,6 +296,40 @@ mod tests {
             assert_eq!(after.missed_pairs, 0, "{test:?}");
             assert_eq!(after.contributing_pairs, before.contributing_pairs, "{test:?}");
             assert!(after.evaluated_pairs < before.evaluated_pairs, "{test:?}: {after:?} vs {before:?}");
+        }
+    }
+
+    /// A tile whose pixels lie at two depths (a wall at 4 with a post at 12 in its left column):
+    /// the 2.5D mask drops a light between them (reaching 7 to 9) that the depth range alone
+    /// keeps, keeps lights reaching either surface, and misses no contributing pair.
+    #[test]
+    fn a_depth_mask_drops_lights_between_a_tiles_surfaces() {
+        let (grid, projection, depth_of) = small_view();
+        let grid = ClusterGrid::new(
+            grid.viewport,
+            &projection,
+            &GridConfig { tile_px: 4, z_slices: 1, ..GridConfig::default() },
+        );
+        let mut depth = vec![depth_of(12.0); 32];
+        for y in 0..4 {
+            depth[y * 8] = depth_of(4.0);
+        }
+        let lights = [
+            ViewSphere { center: glam::Vec3::new(0.0, 0.0, -8.0), radius: 1.0 },
+            ViewSphere { center: glam::Vec3::new(0.0, 0.0, -4.5), radius: 1.0 },
+            ViewSphere { center: glam::Vec3::new(0.0, 0.0, -12.5), radius: 1.0 },
+        ];
+        let assignment = assign_lights(&grid, &lights, CullTest::Aabb, None);
+        let masked = depth_masked_lists(&grid, &projection, &assignment, &lights, &depth, 32);
+        let ranged = depth_masked_lists(&grid, &projection, &assignment, &lights, &depth, 1);
+        let tile = grid.cluster_of(glam::Vec2::new(0.5, 0.5), 4.0);
+        assert!(assignment.lights_of(tile).contains(&0), "{:?}", assignment.lights_of(tile));
+        assert!(ranged.lights_of(tile).contains(&0), "one cell is the depth range alone");
+        assert!(!masked.lights_of(tile).contains(&0), "{:?}", masked.lights_of(tile));
+        for lists in [&masked, &ranged] {
+            let e = culling_efficiency(&grid, &projection, lists, &lights, &depth, 1);
+            let all = culling_efficiency(&grid, &projection, &assignment, &lights, &depth, 1);
+            assert_eq!((e.missed_pairs, e.contributing_pairs), (0, all.contributing_pairs));
         }
     }
 

@@ -159,7 +159,8 @@ impl ClusterResources {
                 storage_entry(8, compute, false),
             ],
         });
-        let shade = wgpu::ShaderStages::FRAGMENT;
+        // Read by the shading passes: fragment shaders, and tiled deferred's compute shader.
+        let shade = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
         let shading_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("cluster_lists"),
             entries: &[uniform_entry(0, shade), storage_entry(1, shade, true), storage_entry(2, shade, true)],

@@ -35,6 +35,15 @@ pub fn has_loop_limit(adapter: &wgpu::AdapterInfo) -> bool {
     adapter.device_type == wgpu::DeviceType::Cpu && adapter.name.contains("llvmpipe")
 }
 
+/// Tiled deferred lighting: pixels along each edge of its workgroup (one workgroup per tile;
+/// tiles wider than this are visited in steps of it).
+pub const TILED_EDGE: u32 = 16;
+/// Tiled deferred lighting: light indices a tile keeps in workgroup memory (4 bytes each); a
+/// tile that keeps more shades from its column's whole list.
+pub const TILED_LIST_CAPACITY: u32 = 2048;
+/// Tiled deferred lighting: cells of a tile's depth range in its 2.5D mask (bits of a u32).
+pub const TILED_DEPTH_CELLS: u32 = 32;
+
 /// Workgroup size of the prefix-sum step of the cluster build (one workgroup scans all).
 pub const SCAN_WORKGROUP_SIZE: u32 = 256;
 /// `GpuClusterParams::cull_test` values.
@@ -70,6 +79,9 @@ pub fn shared_u32_constants() -> Vec<(&'static str, u32)> {
         ("PAIR_COUNT_SATURATED", PAIR_COUNT_SATURATED),
         ("SCAN_WORKGROUP_SIZE", SCAN_WORKGROUP_SIZE),
         ("TILE_LIGHT_CHUNK", TILE_LIGHT_CHUNK),
+        ("TILED_EDGE", TILED_EDGE),
+        ("TILED_LIST_CAPACITY", TILED_LIST_CAPACITY),
+        ("TILED_DEPTH_CELLS", TILED_DEPTH_CELLS),
         ("CULL_AABB", CULL_AABB),
         ("CULL_PLANES", CULL_PLANES),
         ("CULL_BOTH", CULL_BOTH),

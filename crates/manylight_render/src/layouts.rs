@@ -27,11 +27,12 @@ fn buffer_entry(
     }
 }
 
-/// A fragment-stage 2D texture layout entry (no sampler: passes use `textureLoad`).
+/// A 2D texture layout entry for fragment and compute shaders (no sampler: passes use
+/// `textureLoad`).
 pub fn texture_entry(binding: u32, sample_type: wgpu::TextureSampleType) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
+        visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
         ty: wgpu::BindingType::Texture {
             sample_type,
             view_dimension: wgpu::TextureViewDimension::D2,

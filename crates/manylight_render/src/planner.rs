@@ -7,13 +7,14 @@ use crate::passes;
 use crate::plan::{PlanInputs, Planner};
 
 /// The stages, in order: each pass module's `plan` function.
-pub const STAGES: [(&str, Planner); 12] = [
+pub const STAGES: [(&str, Planner); 13] = [
     ("depth_prepass", passes::depth_prepass::plan),
     ("cluster_build", passes::cluster_build::plan),
     ("forward", passes::forward::plan),
     ("clustered_forward", passes::clustered_forward::plan),
     ("gbuffer", passes::gbuffer::plan),
     ("deferred_lighting", passes::deferred_lighting::plan),
+    ("tiled_deferred", passes::tiled_deferred::plan),
     ("light_volumes", passes::light_volumes::plan),
     ("transparent", passes::transparent::plan),
     ("motion_blur", passes::motion_blur::plan),

@@ -30,6 +30,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("debug_view.wgsl", include_str!("../../../shaders/debug_view.wgsl")),
     ("gbuffer.wgsl", include_str!("../../../shaders/gbuffer.wgsl")),
     ("deferred_lighting.wgsl", include_str!("../../../shaders/deferred_lighting.wgsl")),
+    ("tiled_deferred.wgsl", include_str!("../../../shaders/tiled_deferred.wgsl")),
     ("tonemap.wgsl", include_str!("../../../shaders/tonemap.wgsl")),
     ("bloom.wgsl", include_str!("../../../shaders/bloom.wgsl")),
     ("motion_blur.wgsl", include_str!("../../../shaders/motion_blur.wgsl")),

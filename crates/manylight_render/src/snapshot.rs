@@ -22,6 +22,11 @@ pub enum PipelineKind {
     /// Clustered deferred: a G-buffer pass, then one full-screen pass walks each pixel's
     /// cluster list.
     ClusteredDeferred,
+    /// Tiled deferred in compute: a G-buffer pass, then one workgroup per screen tile finds its
+    /// pixels' depth range and 2.5D depth mask, keeps the tile's lights that reach them in
+    /// workgroup memory and shades its pixels from that shared list (one depth slice: the
+    /// tile lists of the cluster build).
+    TiledDeferred,
     /// Deferred light volumes: a G-buffer pass, then each light drawn as an instanced sphere
     /// proxy that adds its light to the pixels it covers (no cluster lists).
     LightVolumes,
@@ -29,11 +34,12 @@ pub enum PipelineKind {
 
 impl PipelineKind {
     /// Every pipeline, in the order the CLI lists them.
-    pub const ALL: [PipelineKind; 5] = [
+    pub const ALL: [PipelineKind; 6] = [
         PipelineKind::NaiveForward,
         PipelineKind::ForwardPlus,
         PipelineKind::ClusteredForward,
         PipelineKind::ClusteredDeferred,
+        PipelineKind::TiledDeferred,
         PipelineKind::LightVolumes,
     ];
 
@@ -44,6 +50,7 @@ impl PipelineKind {
             PipelineKind::ForwardPlus => "forward-plus",
             PipelineKind::ClusteredForward => "clustered-forward",
             PipelineKind::ClusteredDeferred => "clustered-deferred",
+            PipelineKind::TiledDeferred => "tiled-deferred",
             PipelineKind::LightVolumes => "light-volumes",
         }
     }
@@ -55,14 +62,20 @@ impl PipelineKind {
 
     /// True for the pipelines that render a G-buffer and light it afterwards.
     pub fn is_deferred(self) -> bool {
-        matches!(self, PipelineKind::ClusteredDeferred | PipelineKind::LightVolumes)
+        matches!(
+            self,
+            PipelineKind::ClusteredDeferred | PipelineKind::TiledDeferred | PipelineKind::LightVolumes
+        )
     }
 
     /// True for pipelines that build light lists per tile or cluster.
     pub fn uses_clusters(self) -> bool {
         matches!(
             self,
-            PipelineKind::ForwardPlus | PipelineKind::ClusteredForward | PipelineKind::ClusteredDeferred
+            PipelineKind::ForwardPlus
+                | PipelineKind::ClusteredForward
+                | PipelineKind::ClusteredDeferred
+                | PipelineKind::TiledDeferred
         )
     }
 }
@@ -274,10 +287,11 @@ impl Default for ClusterSettings {
 }
 
 impl ClusterSettings {
-    /// The grid configuration a pipeline actually uses (Forward+ has one depth slice).
+    /// The grid configuration a pipeline actually uses (Forward+ and tiled deferred have one
+    /// depth slice: tiles).
     pub fn grid_for(&self, pipeline: PipelineKind) -> GridConfig {
         let mut grid = self.grid;
-        if pipeline == PipelineKind::ForwardPlus {
+        if matches!(pipeline, PipelineKind::ForwardPlus | PipelineKind::TiledDeferred) {
             grid.z_slices = 1;
             if let Some(d) = &mut grid.dims {
                 d.z = 1;

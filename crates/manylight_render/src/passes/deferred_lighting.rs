@@ -104,10 +104,17 @@ impl Pass for DeferredLightingPass {
     }
 }
 
-/// Needed for clustered deferred with lights.
+/// Needed for clustered deferred with lights, and for tiled deferred when the frame brings its
+/// own per-pixel lists (they are no tiles' lists).
 pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
+    use crate::snapshot::PipelineKind;
     let s = p.settings();
-    if p.shades_deferred() && s.pipeline == crate::snapshot::PipelineKind::ClusteredDeferred {
+    let lit_here = match s.pipeline {
+        PipelineKind::ClusteredDeferred => true,
+        PipelineKind::TiledDeferred => p.has_pixel_lists,
+        _ => false,
+    };
+    if p.shades_deferred() && lit_here {
         let (layout, codec, clear_color) = (s.gbuffer, s.normal_codec, s.clear_color);
         out.push(Box::new(DeferredLightingPass { layout, codec, clear_color }));
     }

@@ -1,7 +1,7 @@
 //! How the deferred passes agree on a G-buffer layout: its targets and formats, the shader
 //! entry points and constants of each layout and codec, and the bind group through which the
 //! lighting passes read it (`shaders/common/gbuffer_read.wgsl`). Shared by the G-buffer,
-//! deferred-lighting and light-volume passes.
+//! deferred-lighting, tiled-deferred and light-volume passes.
 
 use super::DEPTH;
 use super::common::{texture_entry, uniform_entry};
@@ -77,7 +77,7 @@ pub fn gbuffer_read_layout(device: &wgpu::Device, layout: GBufferLayout) -> wgpu
         })
         .collect();
     entries.push(texture_entry(4, wgpu::TextureSampleType::Depth));
-    entries.push(uniform_entry(5, wgpu::ShaderStages::FRAGMENT));
+    entries.push(uniform_entry(5, wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE));
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("gbuffer_read"),
         entries: &entries,

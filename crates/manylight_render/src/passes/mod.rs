@@ -18,6 +18,7 @@ pub mod gbuffer_layout;
 pub mod light_volumes;
 pub mod motion_blur;
 pub mod scene_draw;
+pub mod tiled_deferred;
 pub mod tonemap;
 pub mod transparent;
 
@@ -31,6 +32,7 @@ pub use forward::ForwardPass;
 pub use gbuffer::GBufferPass;
 pub use light_volumes::LightVolumesPass;
 pub use motion_blur::MotionBlurPass;
+pub use tiled_deferred::TiledDeferredPass;
 pub use tonemap::TonemapPass;
 pub use transparent::TransparentPass;
 

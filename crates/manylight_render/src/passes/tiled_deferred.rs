@@ -1,0 +1,174 @@
+//! Tiled deferred lighting in compute (`shaders/tiled_deferred.wgsl`): one workgroup per tile
+//! of the light grid cuts the tile's list to its pixels' depths (range and 2.5D mask) in
+//! workgroup memory and shades its pixels from it into [`HDR`].
+
+use super::gbuffer_layout::{codec_constants, gbuffer_read_bind_group, gbuffer_read_layout, targets};
+use super::{CLUSTERS, DEPTH, HDR};
+use crate::bindings::Binding;
+use crate::context::RenderError;
+use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::pipelines::PipelineKey;
+use crate::plan::PlanInputs;
+use crate::resources::HDR_FORMAT;
+use crate::snapshot::{GBufferLayout, PipelineKind};
+use manylight_core::codec::NormalCodec;
+
+/// Tiled deferred's pipelines: per G-buffer layout and normal codec.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct TiledDeferredKey {
+    /// The G-buffer read.
+    pub layout: GBufferLayout,
+    /// Its normal codec.
+    pub codec: NormalCodec,
+}
+
+impl PipelineKey for TiledDeferredKey {
+    type Pipeline = TiledDeferredPipeline;
+}
+
+/// The compute pipeline of [`TiledDeferredPass`] for one layout.
+pub struct TiledDeferredPipeline {
+    pipeline: wgpu::ComputePipeline,
+    gbuffer_layout: wgpu::BindGroupLayout,
+    output_layout: wgpu::BindGroupLayout,
+}
+
+/// The compute entry point of `tiled_deferred.wgsl` for a layout.
+fn compute_entry(layout: GBufferLayout) -> &'static str {
+    match layout {
+        GBufferLayout::Full => "cs_full",
+        GBufferLayout::Packed => "cs_packed",
+        GBufferLayout::Compact => "cs_compact",
+    }
+}
+
+impl TiledDeferredPipeline {
+    fn new(
+        device: &wgpu::Device,
+        view_layout: &wgpu::BindGroupLayout,
+        cluster_layout: &wgpu::BindGroupLayout,
+        layout: GBufferLayout,
+        codec: NormalCodec,
+    ) -> Result<Self, RenderError> {
+        let gbuffer_layout = gbuffer_read_layout(device, layout);
+        let output_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("tiled_deferred_output"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::StorageTexture {
+                    access: wgpu::StorageTextureAccess::WriteOnly,
+                    format: HDR_FORMAT,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                },
+                count: None,
+            }],
+        });
+        let module = crate::shaders::create_module(device, "tiled_deferred.wgsl")?;
+        let layouts = [Some(view_layout), Some(&gbuffer_layout), Some(cluster_layout), Some(&output_layout)];
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("tiled_deferred"),
+            bind_group_layouts: &layouts,
+            immediate_size: 0,
+        });
+        let constants = codec_constants(codec);
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("tiled_deferred"),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some(compute_entry(layout)),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants: &constants,
+                ..Default::default()
+            },
+            cache: None,
+        });
+        Ok(TiledDeferredPipeline { pipeline, gbuffer_layout, output_layout })
+    }
+}
+
+/// Lights the G-buffer tile by tile in compute.
+pub struct TiledDeferredPass {
+    /// The G-buffer layout to read.
+    pub layout: GBufferLayout,
+    /// Normal codec of the `Packed` and `Compact` layouts.
+    pub codec: NormalCodec,
+    /// Linear colour of pixels no geometry covers.
+    pub clear_color: [f32; 3],
+}
+
+impl Pass for TiledDeferredPass {
+    fn name(&self) -> &'static str {
+        "tiled_deferred"
+    }
+    fn reads(&self) -> Vec<ResourceName> {
+        targets(self.layout).iter().map(|&(name, _)| name).chain([DEPTH, CLUSTERS]).collect()
+    }
+    fn writes(&self) -> Vec<ResourceName> {
+        vec![HDR]
+    }
+    fn creates(&self) -> Vec<TextureSpec> {
+        // Written by the compute pass; drawn over by the transparent pass; read by post.
+        let usage = wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING;
+        vec![TextureSpec { name: HDR, format: HDR_FORMAT, usage, scale: 1.0 }]
+    }
+    fn is_compute(&self) -> bool {
+        true
+    }
+    fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
+        let clusters = ctx
+            .clusters
+            .ok_or_else(|| RenderError::Graph("tiled_deferred needs cluster resources".into()))?;
+        let [tiles_x, tiles_y, slices, _] = clusters.params.dims;
+        if slices != 1 {
+            return Err(RenderError::Graph(format!(
+                "tiled_deferred needs a grid of one depth slice, got {slices}"
+            )));
+        }
+        let max = ctx.gpu.device.limits().max_compute_workgroups_per_dimension;
+        if tiles_x > max || tiles_y > max {
+            return Err(RenderError::UnsupportedSettings(format!(
+                "tiled deferred runs a workgroup per tile: {tiles_x}×{tiles_y} tiles exceed \
+                 max_compute_workgroups_per_dimension ({max})"
+            )));
+        }
+        let device = &ctx.gpu.device;
+        let (layout, codec) = (self.layout, self.codec);
+        let view_layout = &ctx.scene.view_layout;
+        let pipeline = ctx.pipelines.get_or_create(TiledDeferredKey { layout, codec }, |k| {
+            TiledDeferredPipeline::new(device, view_layout, &clusters.shading_layout, k.layout, k.codec)
+        })?;
+        let gbuffer = gbuffer_read_bind_group(ctx, &pipeline.gbuffer_layout, layout, self.clear_color)?;
+        let output = ctx.bind_group(
+            "tiled_deferred_output",
+            &pipeline.output_layout,
+            &[Binding::Texture(ctx.texture(HDR)?)],
+        );
+        let timestamps = ctx.compute_timestamps(true, true);
+        let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("tiled_deferred"),
+            timestamp_writes: timestamps,
+        });
+        pass.set_pipeline(&pipeline.pipeline);
+        for (i, group) in [&ctx.scene.view_bind_group, &gbuffer, &clusters.shading_bind_group, &output]
+            .into_iter()
+            .enumerate()
+        {
+            pass.set_bind_group(i as u32, group, &[]);
+        }
+        pass.dispatch_workgroups(tiles_x, tiles_y, 1);
+        Ok(())
+    }
+}
+
+/// Needed for tiled deferred with lights and tile lists of its own (a frame that brings
+/// per-pixel lists is lit by the full-screen deferred pass instead: `deferred_lighting`).
+pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
+    let s = p.settings();
+    if p.shades_deferred() && s.pipeline == PipelineKind::TiledDeferred && !p.has_pixel_lists {
+        let (layout, codec, clear_color) = (s.gbuffer, s.normal_codec, s.clear_color);
+        out.push(Box::new(TiledDeferredPass { layout, codec, clear_color }));
+    }
+}
