@@ -276,14 +276,75 @@ fn tile_lights(cluster: u32) -> vec2<u32> {
     return chunked_list((cluster % tile_count_total()) * params.tile_chunks, params.tile_index_capacity);
 }
 
+// The coordinate (x for planes 0 and 1, y for 2 and 3: `along` is the plane's normal along
+// that axis) where side plane `p` of a tile column (normal (nx, ny, nz), through the eye or
+// axis-parallel) crosses view depth `d`: x = (nz d - w) / nx. A column's extent between two
+// depths lies between its side planes' crossings at those depths (linear in the depth).
+fn plane_crossing(p: vec4<f32>, along: f32, d: f32) -> f32 {
+    return (p.z * d - p.w) / along;
+}
+
+// The x (planes 0 and 1) or y (2 and 3) extent of the column between depths `near` and `far`,
+// widened for rounding; the whole axis when a normal has no component along it.
+fn column_extent(a: vec4<f32>, b: vec4<f32>, along_a: f32, along_b: f32, near: f32, far: f32) -> vec2<f32> {
+    let c = vec4<f32>(
+        plane_crossing(a, along_a, near),
+        plane_crossing(a, along_a, far),
+        plane_crossing(b, along_b, near),
+        plane_crossing(b, along_b, far),
+    );
+    let lo = min(min(c.x, c.y), min(c.z, c.w));
+    let hi = max(max(c.x, c.y), max(c.z, c.w));
+    let widen = 1e-5 * (max(abs(lo), abs(hi)) + far);
+    // `>=` is false for NaN (a zero normal component): then the whole axis.
+    if abs(along_a) >= 1e-6 && abs(along_b) >= 1e-6 && hi >= lo {
+        return vec2<f32>(lo - widen, hi + widen);
+    }
+    return vec2<f32>(-3.0e38, 3.0e38);
+}
+
+// The cluster's bounds for level 2: with depth bounds, cut to the depth range of the pixels in it
+// (`cluster_depth.wgsl`, kept after the cluster ranges as order keys: the complement of the
+// nearest, the farthest; both 0 when no pixel falls in the cluster). `.w` of aabb_min is 1
+// for a cluster no pixel falls in (it keeps no light).
+fn level2_bounds(cluster: u32) -> GpuClusterBounds {
+    var b = bounds[cluster];
+    b.aabb_min.w = 0.0;
+    if params.depth_bounds != 0u {
+        let r = ranges[params.dims.w + cluster];
+        if r.y == 0u {
+            b.aabb_min.w = 1.0;
+            return b;
+        }
+        let near = from_order_key(~r.x);
+        let far = from_order_key(r.y);
+        // Planes 4 and 5 are the slice's near (0, 0, -1, -d0) and far (0, 0, 1, d1) planes.
+        b.planes[4].w = min(b.planes[4].w, -near);
+        b.planes[5].w = min(b.planes[5].w, far);
+        b.aabb_min.z = max(b.aabb_min.z, -far);
+        b.aabb_max.z = min(b.aabb_max.z, -near);
+        let p = b.planes;
+        let x = column_extent(p[0], p[1], p[0].x, p[1].x, near, far);
+        let y = column_extent(p[2], p[3], p[2].y, p[3].y, near, far);
+        b.aabb_min.x = max(b.aabb_min.x, x.x);
+        b.aabb_max.x = min(b.aabb_max.x, x.y);
+        b.aabb_min.y = max(b.aabb_min.y, y.x);
+        b.aabb_max.y = min(b.aabb_max.y, y.y);
+    }
+    return b;
+}
+
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn count(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let cluster = linear_index(id, groups);
     if cluster >= params.dims.w {
         return;
     }
-    let b = bounds[cluster];
-    let tile = tile_lights(cluster);
+    let b = level2_bounds(cluster);
+    var tile = tile_lights(cluster);
+    if b.aabb_min.w != 0.0 {
+        tile.y = 0u;
+    }
     // The longest tile list: the loops below run that often (lavapipe ends an invocation
     // after LAVAPIPE_LOOP_LIMIT iterations, so the renderer refuses longer lists there).
     atomicMax(&counters.max_tile_lights, tile.y);
@@ -382,7 +443,7 @@ fn fill(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
     if !fits(range, params.index_capacity) {
         return; // the list is too small this frame; the renderer grows it and renders again
     }
-    let b = bounds[cluster];
+    let b = level2_bounds(cluster);
     let tile = tile_lights(cluster);
     var k = 0u;
     for (var i = 0u; i < tile.y && k < range.y; i++) {

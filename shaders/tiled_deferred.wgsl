@@ -43,16 +43,6 @@ const PHASE_BOUNDS: u32 = 0u;
 const PHASE_MASK: u32 = 1u;
 const PHASE_SHADE: u32 = 2u;
 
-// A u32 that orders as `d` does among floats (sign-magnitude to two's-complement order).
-fn order_key(d: f32) -> u32 {
-    let b = bitcast<u32>(d);
-    return select(b | 0x80000000u, ~b, (b & 0x80000000u) != 0u);
-}
-
-fn from_order_key(k: u32) -> f32 {
-    return bitcast<f32>(select(~k, k & 0x7fffffffu, (k & 0x80000000u) != 0u));
-}
-
 // Tile of pixel `px` along an axis of `n` tiles over `size` pixels: `cluster_index`'s expression
 // at the pixel centre.
 fn tile_of_pixel(px: u32, n: u32, size: f32) -> u32 {

@@ -32,6 +32,8 @@ fn light(position: Vec3, radius: f32) -> ExtractedPointLight {
     ExtractedPointLight { position, color: Vec3::ONE, intensity: 1.0, radius, spot: None }
 }
 
+/// Clustered forward with whole slices: the lists the CPU reference (`assign_lights`) builds.
+/// With depth bounds the lists are a subset (`depth_bounded_lists_keep_every_contributing_light`).
 fn clustered(cull: CullTest, slicing: ZSlicing, cap: Option<u32>) -> FrameSettings {
     FrameSettings {
         render: RenderSettings {
@@ -40,6 +42,7 @@ fn clustered(cull: CullTest, slicing: ZSlicing, cap: Option<u32>) -> FrameSettin
                 grid: GridConfig { slicing, ..GridConfig::default() },
                 cull,
                 cap,
+                depth_bounds: false,
                 ..ClusterSettings::default()
             },
             ..Default::default()
@@ -618,4 +621,117 @@ fn tiled_deferred_shades_what_clustered_deferred_shades() {
         projection: Projection::orthographic(12.0, 0.1, 200.0),
     }];
     check("orthographic", &ortho, size, rig(&ortho, 512, 9), 16);
+}
+
+/// Per-cluster depth bounds (`ClusterSettings::depth_bounds`) cut each cluster
+/// to the depth range of its pixels: every list is a subset of the CPU reference's whole-slice
+/// list, and no light that contributes at a pixel (rebuilt from the read-back depth) is missing
+/// from that pixel's list — on an ordinary rig, the hard cases, near 1e-4 / far 1e6, an
+/// orthographic view and the sphere shell with 100 000 lights, for every culling test where the
+/// scene is small, and for the forward pipelines (after the depth pre-pass) and the deferred
+/// ones (after the G-buffer).
+#[test]
+fn depth_bounded_lists_keep_every_contributing_light() {
+    use manylight::core::efficiency::culling_efficiency;
+    let _gpu = gpu();
+    let mut r = HeadlessRenderer::new().expect("adapter");
+    let size = UVec2::new(160, 96);
+    let settings = |pipeline, cull| FrameSettings {
+        render: RenderSettings {
+            pipeline,
+            clusters: ClusterSettings { cull, depth_bounds: true, ..ClusterSettings::default() },
+            ..Default::default()
+        },
+        ..FrameSettings::default()
+    };
+    // Returns (entries with bounds, entries of the whole-slice reference).
+    let mut check = |what: &str, snapshot: FrameSnapshot, stride: usize| -> (usize, usize) {
+        let projection = snapshot.camera().map(|c| c.projection).unwrap_or_default();
+        let cull = snapshot.settings.render.clusters.cull;
+        let (report, _) = r.render(snapshot, false).expect("renders");
+        assert!(report.pass_names().contains(&"cluster_depth"), "{what}: {:?}", report.pass_names());
+        let renderer = r.render_world.renderer();
+        let clusters = renderer.view_clusters(0).expect("the frame built clusters");
+        let gpu = clusters.read_assignment(&renderer.gpu).expect("readback");
+        let cpu = assign_lights(&clusters.grid, &clusters.view_spheres, cull, None);
+        for c in 0..cpu.ranges.len() as u32 {
+            let whole = cpu.lights_of(c);
+            let kept = gpu.lights_of(c);
+            assert!(
+                kept.iter().all(|l| whole.contains(l)),
+                "{what}: cluster {c} keeps a light outside its slice"
+            );
+        }
+        let (_, _, depth) = renderer.read_depth().expect("depth readback").expect("a depth buffer");
+        let e = culling_efficiency(&clusters.grid, &projection, &gpu, &clusters.view_spheres, &depth, stride);
+        assert!(e.sampled_pixels > 0, "{what}: {e:?}");
+        assert_eq!(e.missed_pairs, 0, "{what}: contributing lights missing: {e:?}");
+        (gpu.indices.len(), cpu.indices.len())
+    };
+    let scene = default_scene();
+    let pipelines = [
+        PipelineKind::ClusteredForward,
+        PipelineKind::ForwardPlus,
+        PipelineKind::ClusteredDeferred,
+        PipelineKind::TiledDeferred,
+    ];
+    for pipeline in pipelines {
+        for cull in CullTest::ALL {
+            let what = format!("{} {cull:?}", pipeline.name());
+            let snap = scene_snapshot(&scene, size, rig(&scene, 1024, 3), settings(pipeline, cull));
+            let (bounded, whole) = check(&format!("{what}, 1 024 lights"), snap, 1);
+            assert!(bounded < whole, "{what}: depth bounds cut nothing ({bounded} of {whole} entries)");
+            let snap = scene_snapshot(&scene, size, hard_lights(&scene, size), settings(pipeline, cull));
+            check(&format!("{what}, hard cases"), snap, 1);
+        }
+    }
+
+    let cam = scene.camera_or_fit(size.x as f32 / size.y as f32);
+    let forward = -cam.transform.z_axis.truncate().normalize();
+    let at = |d: f32| cam.transform.w_axis.truncate() + forward * d;
+    let mut extreme = default_scene();
+    extreme.cameras = vec![manylight::scene::SceneCamera {
+        transform: cam.transform,
+        projection: Projection::perspective(1.0, 1e-4, 1e6),
+    }];
+    let lights: Vec<ExtractedPointLight> = (0..24)
+        .map(|k| {
+            let d = 1e-4 * (1e10f32).powf(k as f32 / 24.0);
+            light(at(d.min(5e5)), d.min(5e5) * 0.01)
+        })
+        .chain(rig(&extreme, 256, 4))
+        .collect();
+    for pipeline in [PipelineKind::ClusteredForward, PipelineKind::ClusteredDeferred] {
+        let snap = scene_snapshot(&extreme, size, lights.clone(), settings(pipeline, CullTest::Both));
+        check(&format!("{}, near 1e-4, far 1e6", pipeline.name()), snap, 1);
+    }
+
+    let mut ortho = default_scene();
+    ortho.cameras = vec![manylight::scene::SceneCamera {
+        transform: cam.transform,
+        projection: Projection::orthographic(12.0, 0.1, 200.0),
+    }];
+    for pipeline in [PipelineKind::ClusteredForward, PipelineKind::ClusteredDeferred] {
+        let snap = scene_snapshot(&ortho, size, rig(&ortho, 1024, 9), settings(pipeline, CullTest::Both));
+        let (bounded, whole) = check(&format!("{}, orthographic", pipeline.name()), snap, 1);
+        assert!(bounded < whole, "orthographic: depth bounds cut nothing ({bounded} of {whole} entries)");
+    }
+
+    let shell = manylight::scene::sphere_shell_scene();
+    let lights: Vec<ExtractedPointLight> = manylight::scene::sphere_shell_lights(
+        100_000,
+        manylight::scene::SHELL_RADIUS,
+        manylight::scene::SHELL_LIGHT_RANGE,
+        7,
+    )
+    .iter()
+    .map(extracted_light)
+    .collect();
+    let snap = scene_snapshot(
+        &shell,
+        UVec2::new(256, 144),
+        lights,
+        settings(PipelineKind::ClusteredForward, CullTest::Both),
+    );
+    check("sphere shell, 100 000 lights", snap, 61);
 }

@@ -106,6 +106,8 @@ fn orthographic_gpu_lists_equal_the_cpu_reference() {
                         // Exponential is asked for; an orthographic grid slices linearly anyway.
                         grid: GridConfig { slicing: ZSlicing::Exponential, ..GridConfig::default() },
                         cull,
+                        // The CPU reference has whole slices (depth bounds: tests/clusters.rs).
+                        depth_bounds: false,
                         ..ClusterSettings::default()
                     },
                     ..Default::default()

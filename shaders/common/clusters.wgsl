@@ -20,7 +20,23 @@ struct ClusterParams {
     coarse_index_capacity: u32,
     // tiles per coarse-tile edge; 0: no coarse level (level 1 tests every light)
     coarse_span: u32,
+    // 1: the cluster level cuts each cluster to its pixels' depth range (`cluster_depth.wgsl`
+    // writes them after the cluster ranges); 0: whole slices
+    depth_bounds: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 };
+
+// A u32 that orders as `d` does among floats (sign-magnitude to two's-complement order).
+fn order_key(d: f32) -> u32 {
+    let b = bitcast<u32>(d);
+    return select(b | 0x80000000u, ~b, (b & 0x80000000u) != 0u);
+}
+
+fn from_order_key(k: u32) -> f32 {
+    return bitcast<f32>(select(~k, k & 0x7fffffffu, (k & 0x80000000u) != 0u));
+}
 
 struct GpuClusterBounds {
     aabb_min: vec4<f32>,

@@ -633,7 +633,8 @@ fn prepare(
     view: Res<CurrentView>,
     mut outcome: ResMut<FrameOutcome>,
 ) {
-    if let Err(e) = renderer.0.prepare_view(&view.0, view.has_lights()) {
+    let depth_bounds = view.plan_inputs(manylight_render::resources::HDR_FORMAT).bounds_clusters_by_depth();
+    if let Err(e) = renderer.0.prepare_view(&view.0, view.has_lights(), depth_bounds) {
         outcome.error.get_or_insert(e);
     }
 }

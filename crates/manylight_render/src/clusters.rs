@@ -101,16 +101,23 @@ pub struct ClusterResources {
     pub build_layout: wgpu::BindGroupLayout,
     /// Layout of the shading passes' cluster group (params, ranges, indices; read-only).
     pub shading_layout: wgpu::BindGroupLayout,
+    /// Layout of group 2 of the `cluster_depth` pass (`shaders/common/cluster_depth.wgsl`):
+    /// params, and the ranges buffer, whose per-cluster depth ranges it writes.
+    pub depth_layout: wgpu::BindGroupLayout,
     /// Group 0 of the build.
     pub build_bind_group: wgpu::BindGroup,
     /// The shading group.
     pub shading_bind_group: wgpu::BindGroup,
     /// The params uniform.
     pub params_buffer: wgpu::Buffer,
-    /// Per-cluster `(offset, count)`.
+    /// Per-cluster `(offset, count)`, then (with depth bounds) per-cluster depth ranges
+    /// (`shaders/cluster_depth.wgsl`).
     pub ranges: GrowableBuffer,
     /// The light-index list.
     pub indices: GrowableBuffer,
+    /// Per-cluster depth ranges as the `cluster_depth` pass records them; copied after the
+    /// cluster ranges in [`Self::ranges`], where the build reads them.
+    pub depth_ranges: GrowableBuffer,
     bounds: GrowableBuffer,
     spheres: GrowableBuffer,
     /// Bounds of the tile columns, then of the coarse tiles.
@@ -133,6 +140,8 @@ pub struct ClusterResources {
     pub bounds_estimate: ListBounds,
     bound_cpu_ms: f64,
     cull: CullTest,
+    /// The build cuts clusters to their pixels' depth range this frame.
+    depth_bounds: bool,
 }
 
 /// Initial entries of the cluster light-index list (it grows as frames need).
@@ -165,6 +174,10 @@ impl ClusterResources {
             label: Some("cluster_lists"),
             entries: &[uniform_entry(0, shade), storage_entry(1, shade, true), storage_entry(2, shade, true)],
         });
+        let depth_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("cluster_depth"),
+            entries: &[uniform_entry(0, compute), storage_entry(1, compute, false)],
+        });
         let params_buffer = gpu.create_buffer(&wgpu::BufferDescriptor {
             label: Some("cluster_params"),
             size: std::mem::size_of::<GpuClusterParams>() as u64,
@@ -175,9 +188,21 @@ impl ClusterResources {
         let copy = wgpu::BufferUsages::COPY_SRC;
         let bounds = GrowableBuffer::new(gpu, "cluster_bounds", storage, 128 * 1024);
         let spheres = GrowableBuffer::new(gpu, "light_view_spheres", storage, 16 * 1024);
-        let ranges = GrowableBuffer::new(gpu, "cluster_ranges", storage | copy, 8 * 8192);
+        // Cleared in part each frame (the depth ranges after the cluster ranges).
+        let ranges = GrowableBuffer::new(
+            gpu,
+            "cluster_ranges",
+            storage | copy | wgpu::BufferUsages::COPY_DST,
+            8 * 8192,
+        );
         let indices =
             GrowableBuffer::new(gpu, "light_index_list", storage | copy, 4 * INITIAL_INDEX_CAPACITY);
+        let depth_ranges = GrowableBuffer::new(
+            gpu,
+            "cluster_depth_ranges",
+            storage | copy | wgpu::BufferUsages::COPY_DST,
+            8 * 8192,
+        );
         let tile_bounds = GrowableBuffer::new(gpu, "tile_bounds", storage, 128 * 256);
         let tile_ranges = GrowableBuffer::new(gpu, "tile_ranges", storage, 8 * 256);
         let tile_indices =
@@ -202,11 +227,13 @@ impl ClusterResources {
             params: GpuClusterParams::default(),
             build_layout,
             shading_layout,
+            depth_layout,
             build_bind_group,
             shading_bind_group,
             params_buffer,
             ranges,
             indices,
+            depth_ranges,
             bounds,
             spheres,
             tile_bounds,
@@ -220,6 +247,7 @@ impl ClusterResources {
             bounds_estimate: ListBounds::default(),
             bound_cpu_ms: 0.0,
             cull: CullTest::default(),
+            depth_bounds: false,
         }
     }
 
@@ -292,15 +320,18 @@ impl ClusterResources {
 
     /// Uploads the grid bounds (when the grid changed), the lights' view-space spheres and the
     /// parameters, and zeroes the counters. `lights` are the (position, radius) pairs in the
-    /// order of the light buffer.
+    /// order of the light buffer; `depth_bounds`: the build cuts clusters to their pixels'
+    /// depth range (`PlanInputs::bounds_clusters_by_depth`).
     pub fn prepare(
         &mut self,
         gpu: &GpuContext,
         view: &RenderView,
         view_from_world: &Mat4,
         lights: &[(glam::Vec3, f32)],
+        depth_bounds: bool,
     ) -> Result<(), RenderError> {
         let settings = &view.settings.clusters;
+        self.depth_bounds = depth_bounds;
         let grid_config = settings.grid_for(view.settings.pipeline);
         let projection = self.place_lights(view, view_from_world, lights);
         self.grid = ClusterGrid::new(view.size, &projection, &grid_config);
@@ -362,7 +393,11 @@ impl ClusterResources {
         } else {
             self.spheres.write(gpu, bytemuck::cast_slice(&spheres))?;
         }
-        self.ranges.reserve(gpu, count as u64 * 8)?;
+        // The cluster ranges, then the depth ranges of the clusters.
+        self.ranges.reserve(gpu, count as u64 * 16)?;
+        if depth_bounds {
+            self.depth_ranges.reserve(gpu, count as u64 * 8)?;
+        }
         // Lists sized before the frame is submitted, from a CPU bound of what the build can
         // write (`list_bounds`): the GPU lists cannot overflow, so the frame is never rendered
         // twice. A bound beyond what the device can bind reserves what it can; then the build's
@@ -455,6 +490,8 @@ impl ClusterResources {
             coarse_dims: self.coarse_dims().unwrap_or(glam::UVec2::ZERO).to_array(),
             coarse_index_capacity: coarse_lists,
             coarse_span: self.coarse.unwrap_or(0),
+            depth_bounds: u32::from(self.depth_bounds),
+            _pad: [0; 3],
         };
         gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
         gpu.queue.write_buffer(&self.counters, 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
@@ -498,6 +535,7 @@ impl ClusterResources {
         }
         self.bounds_estimate = ListBounds { cluster_pairs: entries, ..ListBounds::default() };
         self.bound_cpu_ms = 0.0;
+        self.depth_bounds = false;
         self.write_params(gpu, view, lights.len() as u32, CLUSTER_NO_CAP, 1);
         Ok(())
     }

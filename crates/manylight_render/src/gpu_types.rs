@@ -44,6 +44,12 @@ pub const TILED_LIST_CAPACITY: u32 = 2048;
 /// Tiled deferred lighting: cells of a tile's depth range in its 2.5D mask (bits of a u32).
 pub const TILED_DEPTH_CELLS: u32 = 32;
 
+/// Relative slack of a pixel's view distance in the per-cluster depth bounds
+/// (`shaders/cluster_depth.wgsl`): the depth buffer's distance and the one a shading pass
+/// computes from the surface position agree to rounding (about 1e-6 relative); a pixel marks
+/// `d ± CLUSTER_DEPTH_SLACK · d`.
+pub const CLUSTER_DEPTH_SLACK: f32 = 1e-3;
+
 /// Workgroup size of the prefix-sum step of the cluster build (one workgroup scans all).
 pub const SCAN_WORKGROUP_SIZE: u32 = 256;
 /// `GpuClusterParams::cull_test` values.
@@ -307,6 +313,7 @@ impl GpuTextureUv {
 pub fn shared_f32_constants() -> Vec<(&'static str, f32)> {
     vec![
         ("RADIUS_INFLATION", manylight_core::cluster::RADIUS_INFLATION),
+        ("CLUSTER_DEPTH_SLACK", CLUSTER_DEPTH_SLACK),
         ("LIGHT_MIN_DISTANCE", manylight_core::attenuation::LIGHT_MIN_DISTANCE),
         ("TILE_PREFILTER_INFLATION", manylight_core::cluster::TILE_PREFILTER_INFLATION),
         ("TOON_RIM_STRENGTH", manylight_core::material::TOON_RIM_STRENGTH),
@@ -349,6 +356,11 @@ pub struct GpuClusterParams {
     pub coarse_index_capacity: u32,
     /// Tiles per coarse-tile edge, or 0 without a coarse level (level 1 then tests every light).
     pub coarse_span: u32,
+    /// 1 when the cluster level cuts each cluster to its pixels' depth range (written after the
+    /// cluster ranges by `shaders/cluster_depth.wgsl`), 0 for whole slices.
+    pub depth_bounds: u32,
+    /// Padding to 16 bytes.
+    pub _pad: [u32; 3],
 }
 
 /// Bounds of one cluster in view space (`GpuClusterBounds` in `shaders/common/clusters.wgsl`).

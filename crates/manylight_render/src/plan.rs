@@ -63,6 +63,21 @@ impl PlanInputs<'_> {
             && (s.pipeline == PipelineKind::ForwardPlus || s.clusters.depth_prepass)
     }
 
+    /// True when the cluster build cuts clusters to their pixels' depth range
+    /// ([`crate::snapshot::ClusterSettings::depth_bounds`]): the setting is on, the view shades
+    /// with its own cluster lists (no per-pixel lists, no debug view) from a depth known before
+    /// the build (a depth pre-pass, or a G-buffer), and every fragment it shades is in that
+    /// depth (no blended materials).
+    pub fn bounds_clusters_by_depth(&self) -> bool {
+        let s = self.settings();
+        s.clusters.depth_bounds
+            && self.shades_with_clusters()
+            && self.shows_image()
+            && !self.has_blended
+            && !self.has_pixel_lists
+            && (self.shades_deferred() || self.runs_depth_prepass())
+    }
+
     /// True when no debug view replaces the image (post stages run).
     pub fn shows_image(&self) -> bool {
         self.settings().debug_view == DebugViewMode::None

@@ -104,8 +104,15 @@ impl Renderer {
 
     /// Writes one view's constants and, when it needs them, its cluster grid and light
     /// spheres (before the view is executed; views run one after the other).
-    /// `has_lights`: the frame has a valid light ([`FrameSnapshot::has_lights`]).
-    pub fn prepare_view(&mut self, view: &RenderView, has_lights: bool) -> Result<(), RenderError> {
+    /// `has_lights`: the frame has a valid light ([`FrameSnapshot::has_lights`]);
+    /// `depth_bounds`: the build cuts clusters to their pixels' depth range
+    /// ([`crate::PlanInputs::bounds_clusters_by_depth`]).
+    pub fn prepare_view(
+        &mut self,
+        view: &RenderView,
+        has_lights: bool,
+        depth_bounds: bool,
+    ) -> Result<(), RenderError> {
         self.scene.prepare_view(&self.gpu, view);
         if view.needs_clusters(has_lights) {
             if self.clusters.len() <= view.index {
@@ -122,7 +129,9 @@ impl Renderer {
                     &self.scene.light_spheres,
                     lists,
                 )?,
-                None => clusters.prepare(gpu, view, &view_from_world, &self.scene.light_spheres)?,
+                None => {
+                    clusters.prepare(gpu, view, &view_from_world, &self.scene.light_spheres, depth_bounds)?
+                }
             }
         }
         Ok(())

@@ -271,6 +271,16 @@ pub struct ClusterSettings {
     /// planes test never has one (`manylight_core::cluster::coarse_span`). The lists are the
     /// same either way; only the build's cost changes (`docs/benchmarks.md`).
     pub coarse_tiles: u32,
+    /// Cut each cluster to the depth range of the pixels in it before its lights are tested
+    /// (per-cluster depth bounds, from the depth pre-pass or the G-buffer: `cluster_depth`
+    /// pass); clusters no pixel falls in keep no light. Applies where the depth is known before
+    /// the build and every shaded fragment is in it: forward pipelines with a depth pre-pass and
+    /// the deferred ones, without blended materials (the transparent pass shades fragments the
+    /// depth buffer does not hold) and without a debug view (`PlanInputs::bounds_clusters_by_depth`).
+    /// Off by default: on lavapipe the pass that records the ranges grows the process's memory
+    /// by about 0.3 MB a frame (inside the driver; `docs/benchmarks.md`, "Per-cluster depth
+    /// bounds").
+    pub depth_bounds: bool,
 }
 
 impl Default for ClusterSettings {
@@ -282,6 +292,7 @@ impl Default for ClusterSettings {
             depth_prepass: true,
             workgroup_size: 64,
             coarse_tiles: DEFAULT_COARSE_TILES,
+            depth_bounds: false,
         }
     }
 }

@@ -198,6 +198,8 @@ fn shared_structs_match_rust() {
             ("coarse_dims", offset_of!(GpuClusterParams, coarse_dims)),
             ("coarse_index_capacity", offset_of!(GpuClusterParams, coarse_index_capacity)),
             ("coarse_span", offset_of!(GpuClusterParams, coarse_span)),
+            ("depth_bounds", offset_of!(GpuClusterParams, depth_bounds)),
+            ("_pad0", offset_of!(GpuClusterParams, _pad)),
         ],
     );
 }

@@ -3,7 +3,7 @@
 //! `shaders/cluster_build.wgsl`), producing per-cluster `(offset, count)` ranges into one
 //! light-index list.
 
-use super::CLUSTERS;
+use super::{CLUSTER_DEPTHS, CLUSTERS};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName};
 use crate::pipelines::PipelineKey;
@@ -77,6 +77,9 @@ impl ClusterBuildPipelines {
 pub struct ClusterBuildPass {
     /// Invocations per workgroup of the count and fill steps.
     pub workgroup_size: u32,
+    /// The cluster level cuts clusters to their pixels' depth range (written by
+    /// [`super::ClusterDepthPass`], which then runs first).
+    pub depth_bounds: bool,
 }
 
 /// Workgroups `[x, y]` for `invocations` invocations of `workgroup_size`: one row while it fits
@@ -109,7 +112,7 @@ impl Pass for ClusterBuildPass {
         "cluster_build"
     }
     fn reads(&self) -> Vec<ResourceName> {
-        Vec::new()
+        if self.depth_bounds { vec![CLUSTER_DEPTHS] } else { Vec::new() }
     }
     fn writes(&self) -> Vec<ResourceName> {
         vec![CLUSTERS]
@@ -209,7 +212,9 @@ pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
         if p.has_pixel_lists {
             out.push(Box::new(PixelListsPass));
         } else {
-            out.push(Box::new(ClusterBuildPass { workgroup_size: p.settings().clusters.workgroup_size }));
+            let (workgroup_size, depth_bounds) =
+                (p.settings().clusters.workgroup_size, p.bounds_clusters_by_depth());
+            out.push(Box::new(ClusterBuildPass { workgroup_size, depth_bounds }));
         }
     }
 }

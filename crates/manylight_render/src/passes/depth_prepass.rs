@@ -1,8 +1,8 @@
 //! Depth pre-pass: lays down depth so the lighting pass shades each visible pixel once.
 
-use super::DEPTH;
-use super::common::{MeshPipelineDesc, mesh_pipeline};
+use super::common::{MeshPipelineDesc, color_attachment, mesh_pipeline};
 use super::scene_draw::{ScenePipeline, record_scene_pass, variant_pipelines};
+use super::{DEPTH, SHADING_DISTANCE};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::pipelines::PipelineKey;
@@ -10,9 +10,15 @@ use crate::plan::PlanInputs;
 use crate::resources::{DEPTH_FORMAT, SceneResources, SurfaceVariant};
 
 /// The depth pre-pass's pipeline: one per surface variant (alpha-masked ones run a fragment
-/// stage that discards, the others none).
+/// stage that discards, the others none) and per whether it writes the shading distance for
+/// per-cluster depth bounds (then every variant runs a fragment stage).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct DepthPrepassKey(pub SurfaceVariant);
+pub struct DepthPrepassKey {
+    /// Culling and alpha masking.
+    pub variant: SurfaceVariant,
+    /// Writes [`SHADING_DISTANCE`].
+    pub distance: bool,
+}
 
 impl PipelineKey for DepthPrepassKey {
     type Pipeline = DepthPrepassPipeline;
@@ -24,19 +30,23 @@ pub struct DepthPrepassPipeline {
 }
 
 impl DepthPrepassPipeline {
-    fn new(
-        device: &wgpu::Device,
-        scene: &SceneResources,
-        variant: SurfaceVariant,
-    ) -> Result<Self, RenderError> {
+    fn new(device: &wgpu::Device, scene: &SceneResources, key: DepthPrepassKey) -> Result<Self, RenderError> {
+        let variant = key.variant;
+        let fragment = match (key.distance, variant.alpha_mask) {
+            (false, false) => None,
+            (false, true) => Some("fs_mask"),
+            (true, false) => Some("fs_distance"),
+            (true, true) => Some("fs_mask_distance"),
+        };
+        let targets: &[wgpu::TextureFormat] = if key.distance { &[SHADING_DISTANCE_FORMAT] } else { &[] };
         let pipeline = mesh_pipeline(
             device,
             &MeshPipelineDesc {
                 label: "depth_prepass",
                 shader: "depth_prepass.wgsl",
                 layouts: &[&scene.view_layout, &scene.material_layout],
-                fragment: variant.alpha_mask.then_some("fs_mask"),
-                targets: &[],
+                fragment,
+                targets,
                 depth_write: true,
                 depth_compare: wgpu::CompareFunction::Greater,
                 variant,
@@ -52,8 +62,15 @@ impl ScenePipeline for DepthPrepassPipeline {
     }
 }
 
-/// Writes [`DEPTH`] for every drawn instance.
-pub struct DepthPrepass;
+/// Format of [`SHADING_DISTANCE`].
+pub const SHADING_DISTANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+
+/// Writes [`DEPTH`] for every drawn instance, and with `distance` each pixel's shading distance
+/// ([`SHADING_DISTANCE`], for per-cluster depth bounds).
+pub struct DepthPrepass {
+    /// Also writes [`SHADING_DISTANCE`].
+    pub distance: bool,
+}
 
 impl Pass for DepthPrepass {
     fn name(&self) -> &'static str {
@@ -63,18 +80,30 @@ impl Pass for DepthPrepass {
         Vec::new()
     }
     fn writes(&self) -> Vec<ResourceName> {
-        vec![DEPTH]
+        if self.distance { vec![DEPTH, SHADING_DISTANCE] } else { vec![DEPTH] }
     }
     fn creates(&self) -> Vec<TextureSpec> {
-        vec![TextureSpec { name: DEPTH, format: DEPTH_FORMAT, usage: super::DEPTH_USAGE, scale: 1.0 }]
+        let depth = TextureSpec { name: DEPTH, format: DEPTH_FORMAT, usage: super::DEPTH_USAGE, scale: 1.0 };
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        let distance =
+            TextureSpec { name: SHADING_DISTANCE, format: SHADING_DISTANCE_FORMAT, usage, scale: 1.0 };
+        if self.distance { vec![depth, distance] } else { vec![depth] }
     }
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
         let scene = ctx.scene;
-        let pipelines = variant_pipelines(ctx, DepthPrepassKey, |k| {
-            DepthPrepassPipeline::new(&ctx.gpu.device, scene, k.0)
-        })?;
+        let distance = self.distance;
+        let pipelines = variant_pipelines(
+            ctx,
+            |variant| DepthPrepassKey { variant, distance },
+            |k| DepthPrepassPipeline::new(&ctx.gpu.device, scene, *k),
+        )?;
         let depth = ctx.texture(DEPTH)?;
-        record_scene_pass(ctx, "depth_prepass", &[], depth, true, &pipelines, &[]);
+        let colors = if distance {
+            vec![color_attachment(ctx.texture(SHADING_DISTANCE)?, wgpu::Color::TRANSPARENT)]
+        } else {
+            Vec::new()
+        };
+        record_scene_pass(ctx, "depth_prepass", &colors, depth, true, &pipelines, &[]);
         Ok(())
     }
 }
@@ -83,6 +112,6 @@ impl Pass for DepthPrepass {
 /// depth debug view.
 pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
     if p.runs_depth_prepass() || p.settings().debug_view == crate::snapshot::DebugViewMode::Depth {
-        out.push(Box::new(DepthPrepass));
+        out.push(Box::new(DepthPrepass { distance: p.bounds_clusters_by_depth() }));
     }
 }

@@ -7,6 +7,7 @@
 
 pub mod bloom;
 pub mod cluster_build;
+pub mod cluster_depth;
 pub mod clustered_forward;
 pub mod common;
 pub mod debug_view;
@@ -24,6 +25,7 @@ pub mod transparent;
 
 pub use bloom::{BloomBlurPass, BloomBrightPass, BloomCompositePass, BloomUpsamplePass};
 pub use cluster_build::ClusterBuildPass;
+pub use cluster_depth::ClusterDepthPass;
 pub use clustered_forward::ClusteredForwardPass;
 pub use debug_view::DebugViewPass;
 pub use deferred_lighting::DeferredLightingPass;
@@ -58,6 +60,12 @@ pub const GBUFFER_EMISSIVE: crate::graph::ResourceName = "gbuffer_emissive";
 pub const LIGHT_ACCUM: crate::graph::ResourceName = "light_accum";
 /// Graph resource: the cluster light lists (persistent buffers, ordered through the graph).
 pub const CLUSTERS: crate::graph::ResourceName = "clusters";
+/// Graph resource: each pixel's view distance as forward shading computes it (the depth
+/// pre-pass writes it for per-cluster depth bounds).
+pub const SHADING_DISTANCE: crate::graph::ResourceName = "shading_distance";
+/// Graph resource: the depth range of every cluster's pixels (after the cluster ranges, in the
+/// same buffer), which the cluster build cuts clusters to.
+pub const CLUSTER_DEPTHS: crate::graph::ResourceName = "cluster_depths";
 
 /// Usages of the depth buffer: attachment, sampled by debug views, copied for readback.
 pub const DEPTH_USAGE: wgpu::TextureUsages = wgpu::TextureUsages::RENDER_ATTACHMENT

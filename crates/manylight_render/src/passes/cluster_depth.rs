@@ -1,0 +1,168 @@
+//! The `cluster_depth` pass: per-cluster depth bounds (`shaders/cluster_depth.wgsl`). One
+//! compute pass over the pixels, after the depth pre-pass or the G-buffer pass and before the
+//! cluster build, records for every cluster the range of its pixels' shading distances; the
+//! build then cuts each cluster to that range
+//! ([`crate::snapshot::ClusterSettings::depth_bounds`]).
+
+use super::common::texture_entry;
+use super::gbuffer_layout::{codec_constants, gbuffer_read_bind_group, gbuffer_read_layout, targets};
+use super::{CLUSTER_DEPTHS, DEPTH, SHADING_DISTANCE};
+use crate::bindings::Binding;
+use crate::context::RenderError;
+use crate::graph::{Pass, PassContext, ResourceName};
+use crate::pipelines::PipelineKey;
+use crate::plan::PlanInputs;
+use crate::snapshot::GBufferLayout;
+use manylight_core::codec::NormalCodec;
+
+/// Where the pass reads each pixel's shading distance.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum DistanceSource {
+    /// The depth pre-pass's [`SHADING_DISTANCE`] (forward pipelines).
+    Prepass,
+    /// The G-buffer's stored position (deferred pipelines), in this layout and normal codec.
+    GBuffer(GBufferLayout, NormalCodec),
+}
+
+impl PipelineKey for DistanceSource {
+    type Pipeline = ClusterDepthPipeline;
+}
+
+/// The pipeline of [`ClusterDepthPass`] for one source, and the layout of its group 1.
+pub struct ClusterDepthPipeline {
+    pipeline: wgpu::ComputePipeline,
+    source_layout: wgpu::BindGroupLayout,
+}
+
+impl ClusterDepthPipeline {
+    fn new(
+        device: &wgpu::Device,
+        view_layout: &wgpu::BindGroupLayout,
+        depth_layout: &wgpu::BindGroupLayout,
+        source: DistanceSource,
+    ) -> Result<Self, RenderError> {
+        let (source_layout, entry, constants) = match source {
+            DistanceSource::Prepass => {
+                let unfilterable = wgpu::TextureSampleType::Float { filterable: false };
+                let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some("shading_distance"),
+                    entries: &[texture_entry(9, unfilterable)],
+                });
+                (layout, "cs_forward", codec_constants(NormalCodec::Octa16))
+            }
+            DistanceSource::GBuffer(layout, codec) => {
+                let entry = match layout {
+                    GBufferLayout::Full => "cs_full",
+                    GBufferLayout::Packed => "cs_packed",
+                    GBufferLayout::Compact => "cs_compact",
+                };
+                (gbuffer_read_layout(device, layout), entry, codec_constants(codec))
+            }
+        };
+        let module = crate::shaders::create_module(device, "cluster_depth.wgsl")?;
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("cluster_depth"),
+            bind_group_layouts: &[Some(view_layout), Some(&source_layout), Some(depth_layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("cluster_depth"),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants: &constants,
+                ..Default::default()
+            },
+            cache: None,
+        });
+        Ok(ClusterDepthPipeline { pipeline, source_layout })
+    }
+}
+
+/// Writes every cluster's pixel depth range after the cluster ranges (zeroed first).
+pub struct ClusterDepthPass {
+    /// Where the shading distances come from.
+    pub source: DistanceSource,
+    /// The view's clear colour (the G-buffer read group holds it, as for deferred lighting,
+    /// which shares that group's uniform).
+    pub clear_color: [f32; 3],
+}
+
+impl Pass for ClusterDepthPass {
+    fn name(&self) -> &'static str {
+        "cluster_depth"
+    }
+    fn reads(&self) -> Vec<ResourceName> {
+        match self.source {
+            DistanceSource::Prepass => vec![SHADING_DISTANCE, DEPTH],
+            DistanceSource::GBuffer(layout, _) => {
+                targets(layout).iter().map(|&(name, _)| name).chain([DEPTH]).collect()
+            }
+        }
+    }
+    fn writes(&self) -> Vec<ResourceName> {
+        vec![CLUSTER_DEPTHS]
+    }
+    fn is_compute(&self) -> bool {
+        true
+    }
+    fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
+        let clusters =
+            ctx.clusters.ok_or_else(|| RenderError::Graph("cluster_depth needs cluster resources".into()))?;
+        let scene = ctx.scene;
+        let device = &ctx.gpu.device;
+        let pipeline = ctx.pipelines.get_or_create(self.source, |&source| {
+            ClusterDepthPipeline::new(device, &scene.view_layout, &clusters.depth_layout, source)
+        })?;
+        let source = match self.source {
+            DistanceSource::Prepass => ctx.bind_group_numbered(
+                "shading_distance",
+                &pipeline.source_layout,
+                &[(9, Binding::Texture(ctx.texture(SHADING_DISTANCE)?))],
+            ),
+            DistanceSource::GBuffer(layout, _) => {
+                gbuffer_read_bind_group(ctx, &pipeline.source_layout, layout, self.clear_color)?
+            }
+        };
+        // Zero the depth ranges (no pixel yet).
+        let depth_ranges = clusters.depth_ranges.buffer();
+        let bytes = u64::from(clusters.params.dims[3]) * 8;
+        ctx.encoder.clear_buffer(depth_ranges, 0, Some(bytes));
+        let depths = ctx.bind_group(
+            "cluster_depth",
+            &clusters.depth_layout,
+            &[Binding::Buffer(&clusters.params_buffer), Binding::Buffer(depth_ranges)],
+        );
+        let depth = ctx.texture(DEPTH)?.texture();
+        let groups = [depth.width().div_ceil(8), depth.height().div_ceil(8)];
+        let timestamps = ctx.compute_timestamps(true, true);
+        let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("cluster_depth"),
+            timestamp_writes: timestamps,
+        });
+        pass.set_pipeline(&pipeline.pipeline);
+        pass.set_bind_group(0, &scene.view_bind_group, &[]);
+        pass.set_bind_group(1, &source, &[]);
+        pass.set_bind_group(2, &depths, &[]);
+        pass.dispatch_workgroups(groups[0], groups[1], 1);
+        drop(pass);
+        // The build reads them after the cluster ranges.
+        ctx.encoder.copy_buffer_to_buffer(depth_ranges, 0, clusters.ranges.buffer(), bytes, bytes);
+        Ok(())
+    }
+}
+
+/// Needed when the view bounds its clusters by depth (`PlanInputs::bounds_clusters_by_depth`):
+/// from the G-buffer when it is shaded deferred, else from the depth pre-pass.
+pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
+    if p.bounds_clusters_by_depth() {
+        let s = p.settings();
+        let source = if p.shades_deferred() {
+            DistanceSource::GBuffer(s.gbuffer, s.normal_codec)
+        } else {
+            DistanceSource::Prepass
+        };
+        out.push(Box::new(ClusterDepthPass { source, clear_color: s.clear_color }));
+    }
+}
