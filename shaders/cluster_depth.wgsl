@@ -5,9 +5,7 @@
 // shading position on triangles much larger than their distance from the camera, as a floor
 // seen from close by): forward shading's `surface_point` distance, which the depth pre-pass
 // writes to `shading_distance`, or that of the position the G-buffer stores, as deferred
-// lighting reads it. On lavapipe (Mesa 22.3) this pass grows the process's memory by about
-// 0.3 MB a frame inside the driver (0.7 MB as a fragment pass), which is why depth bounds are
-// off by default (docs/benchmarks.md).
+// lighting reads it.
 //!include common/view.wgsl
 //!include common/lights.wgsl
 //!include common/brdf.wgsl

@@ -34,7 +34,10 @@ fn frame_stats_list_the_passes_with_timings() {
     }
     let s = stats(&app);
     assert_eq!(s.frames_rendered, 3);
-    assert_eq!(s.pass_names(), ["depth_prepass", "cluster_build", "clustered_forward", "tonemap"]);
+    assert_eq!(
+        s.pass_names(),
+        ["depth_prepass", "cluster_depth", "cluster_build", "clustered_forward", "tonemap"]
+    );
     let report = s.last.expect("a report");
     assert_eq!(report.light_count as usize, default_scene().lights.len() + 8);
     assert_eq!(report.instance_count as usize, default_scene().instances.len());
@@ -57,12 +60,12 @@ fn transient_textures_are_reused_across_frames() {
         app.update();
     }
     let report = stats(&app).last.expect("a report");
-    assert_eq!(report.transient_textures, 2, "hdr + depth");
+    assert_eq!(report.transient_textures, 3, "hdr + depth + shading distance");
     let pixels = (SIZE.x * SIZE.y) as u64;
-    assert_eq!(report.transient_bytes, pixels * (8 + 4), "rgba16f hdr + depth32f");
+    assert_eq!(report.transient_bytes, pixels * (8 + 4 + 4), "rgba16f hdr + depth32f + r32f distance");
     let clusters = report.clusters.as_ref().expect("clusters were built");
     assert!(clusters.buffer_bytes >= clusters.index_capacity * 4, "{clusters:?}");
-    assert_eq!(report.transient_allocations, 2, "no texture re-created after the first frame");
+    assert_eq!(report.transient_allocations, 3, "no texture re-created after the first frame");
 }
 
 #[test]
@@ -76,9 +79,9 @@ fn resizing_reallocates_and_frees_old_transients() {
     }
     let report = stats(&app).last.expect("a report");
     assert_eq!((report.width, report.height), (64, 48));
-    assert_eq!(report.transient_allocations, 4);
-    assert_eq!(report.transient_textures, 2, "the old size's textures were freed");
-    assert_eq!(report.transient_bytes, 64 * 48 * (8 + 4));
+    assert_eq!(report.transient_allocations, 6);
+    assert_eq!(report.transient_textures, 3, "the old size's textures were freed");
+    assert_eq!(report.transient_bytes, 64 * 48 * (8 + 4 + 4));
     let image = app.world().resource::<HeadlessCapture>().image.clone().expect("image");
     assert_eq!(image.dimensions(), (64, 48));
 }
@@ -167,7 +170,10 @@ fn pipelined_mode_renders_every_frame_and_shuts_down_cleanly() {
     finish_frames(&mut app);
     let s = stats(&app);
     assert_eq!(s.frames_rendered, 4);
-    assert_eq!(s.pass_names(), ["depth_prepass", "cluster_build", "clustered_forward", "tonemap"]);
+    assert_eq!(
+        s.pass_names(),
+        ["depth_prepass", "cluster_depth", "cluster_build", "clustered_forward", "tonemap"]
+    );
     assert!(app.world().resource::<HeadlessCapture>().image.is_some());
 
     // Dropping an app with a frame in flight joins the render thread without hanging.
@@ -245,19 +251,23 @@ fn each_pipeline_builds_exactly_its_passes() {
         (
             PipelineKind::ForwardPlus,
             true,
-            &["depth_prepass", "cluster_build", "clustered_forward", "tonemap"],
+            &["depth_prepass", "cluster_depth", "cluster_build", "clustered_forward", "tonemap"],
         ),
         (
             PipelineKind::ClusteredForward,
             true,
-            &["depth_prepass", "cluster_build", "clustered_forward", "tonemap"],
+            &["depth_prepass", "cluster_depth", "cluster_build", "clustered_forward", "tonemap"],
         ),
         (
             PipelineKind::ClusteredDeferred,
             true,
-            &["cluster_build", "gbuffer", "deferred_lighting", "tonemap"],
+            &["gbuffer", "cluster_depth", "cluster_build", "deferred_lighting", "tonemap"],
         ),
-        (PipelineKind::TiledDeferred, true, &["cluster_build", "gbuffer", "tiled_deferred", "tonemap"]),
+        (
+            PipelineKind::TiledDeferred,
+            true,
+            &["gbuffer", "cluster_depth", "cluster_build", "tiled_deferred", "tonemap"],
+        ),
         // Without lights nothing is assigned: no cluster build, no light lists, plain forward.
         (PipelineKind::ClusteredDeferred, false, &["forward", "tonemap"]),
         (PipelineKind::TiledDeferred, false, &["forward", "tonemap"]),

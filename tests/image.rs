@@ -48,8 +48,9 @@ fn with_pipeline(pipeline: PipelineKind) -> RenderSettings {
 }
 
 /// Forward+, clustered forward (with and without depth pre-pass, several culling tests and
-/// both slicings), clustered deferred and tiled deferred (two G-buffer layouts each), and each
-/// with per-cluster depth bounds, match naive forward on the default scene and a glTF scene.
+/// both slicings), clustered deferred and tiled deferred (two G-buffer layouts each), with
+/// per-cluster depth bounds (the default) and without, match naive forward on the default scene
+/// and a glTF scene.
 #[test]
 fn tiled_and_clustered_pipelines_match_naive_forward() {
     use manylight::app::prelude::{ClusterSettings, CullTest, GridConfig, ZSlicing};
@@ -64,8 +65,9 @@ fn tiled_and_clustered_pipelines_match_naive_forward() {
     use manylight::app::prelude::GBufferLayout;
     let deferred = |gbuffer| RenderSettings { gbuffer, ..with_pipeline(PipelineKind::ClusteredDeferred) };
     let tiled = |gbuffer| RenderSettings { gbuffer, ..with_pipeline(PipelineKind::TiledDeferred) };
-    let bounded = |mut settings: RenderSettings| {
-        settings.clusters.depth_bounds = true;
+    // Without per-cluster depth bounds (on by default).
+    let whole = |mut settings: RenderSettings| {
+        settings.clusters.depth_bounds = false;
         settings
     };
     let variants = [
@@ -73,10 +75,8 @@ fn tiled_and_clustered_pipelines_match_naive_forward() {
         ("clustered_deferred_compact", deferred(GBufferLayout::Compact)),
         ("tiled_deferred_full", tiled(GBufferLayout::Full)),
         ("tiled_deferred_packed", tiled(GBufferLayout::Packed)),
-        ("forward_plus_depth_bounds", bounded(with_pipeline(PipelineKind::ForwardPlus))),
-        ("clustered_depth_bounds", bounded(with_pipeline(PipelineKind::ClusteredForward))),
-        ("clustered_deferred_compact_depth_bounds", bounded(deferred(GBufferLayout::Compact))),
-        ("tiled_deferred_depth_bounds", bounded(tiled(GBufferLayout::Full))),
+        ("forward_plus_whole_tiles", whole(with_pipeline(PipelineKind::ForwardPlus))),
+        ("clustered_deferred_whole_slices", whole(deferred(GBufferLayout::Full))),
         ("forward_plus", with_pipeline(PipelineKind::ForwardPlus)),
         ("clustered", with_pipeline(PipelineKind::ClusteredForward)),
         (

@@ -281,12 +281,13 @@ fn configurations() -> Vec<(String, RenderSettings)> {
     let mut out = Vec::new();
     for pipeline in PipelineKind::ALL {
         let base = settings_for(pipeline);
-        if pipeline.uses_clusters() {
-            // Per-cluster depth bounds take the distance the shading computes, not the depth
-            // buffer's, which drifts on these triangles (the bounds would drop lights).
-            let mut bounded = base;
-            bounded.clusters.depth_bounds = true;
-            out.push((format!("{}_depth_bounds", pipeline.name()), bounded));
+        // Per-cluster depth bounds (on by default) take the distance the shading computes, not
+        // the depth buffer's, which drifts on these triangles (the bounds would drop lights);
+        // clustered forward also runs with whole slices.
+        if pipeline == PipelineKind::ClusteredForward {
+            let mut whole = base;
+            whole.clusters.depth_bounds = false;
+            out.push((format!("{}_whole_slices", pipeline.name()), whole));
         }
         if !matches!(pipeline, PipelineKind::ClusteredDeferred | PipelineKind::LightVolumes) {
             out.push((pipeline.name().to_string(), base));

@@ -52,9 +52,10 @@ const DEBUG_MODE: DebugViewMode = DebugViewMode::LightCount;
 /// The passes a point needs, written out rule by rule.
 fn expected(p: Point) -> Vec<&'static str> {
     let mut passes: Vec<&'static str> = match (p.debug, p.deferred, p.lights) {
-        // Shading: clustered forward (with its depth pre-pass) or G-buffer + deferred lighting.
-        (false, false, true) => vec!["depth_prepass", "cluster_build", "clustered_forward"],
-        (false, true, true) => vec!["cluster_build", "gbuffer", "deferred_lighting"],
+        // Shading: clustered forward (with its depth pre-pass) or G-buffer + deferred lighting,
+        // each with per-cluster depth bounds between the depth and the build.
+        (false, false, true) => vec!["depth_prepass", "cluster_depth", "cluster_build", "clustered_forward"],
+        (false, true, true) => vec!["gbuffer", "cluster_depth", "cluster_build", "deferred_lighting"],
         // No lights: no cluster build, no light lists, no G-buffer: the ambient forward pass.
         (false, _, false) => vec!["forward"],
         // The light-count view replaces shading: depth (pre-pass or G-buffer) + clusters only.
@@ -213,7 +214,7 @@ fn removing_bloom_frees_its_textures() {
     let live =
         |app: &App| app.world().resource::<FrameStats>().last.as_ref().expect("report").transient_textures;
     let without = live(&app);
-    assert_eq!(without, 2, "hdr + depth");
+    assert_eq!(without, 3, "hdr + depth + shading distance");
     set_point(&mut app, Point { bloom: true, ..base });
     app.update();
     // Downsampled chain, 5 levels: each level and its horizontal intermediate.

@@ -46,7 +46,10 @@ fn many_animated_lights_render_move_and_follow_the_light_count() {
     let first = update(&mut app);
     let report = first.last.expect("a report");
     assert_eq!(report.light_count, 65_536 + scene_lights);
-    assert_eq!(report.pass_names(), ["depth_prepass", "cluster_build", "clustered_forward", "tonemap"]);
+    assert_eq!(
+        report.pass_names(),
+        ["depth_prepass", "cluster_depth", "cluster_build", "clustered_forward", "tonemap"]
+    );
     let before = light_positions(&mut app);
     let second = update(&mut app);
     assert_eq!(second.frames_rendered, 2);

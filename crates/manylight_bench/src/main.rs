@@ -315,10 +315,11 @@ struct ClusterArgs {
     /// every tile tests every light).
     #[arg(long, default_value_t = manylight_render::DEFAULT_COARSE_TILES)]
     coarse_tiles: u32,
-    /// Cut clusters to their pixels' depth range before their lights are tested (per-cluster
-    /// depth bounds; applies after a depth pre-pass or a G-buffer, without blended materials).
+    /// Do not cut clusters to their pixels' depth range (per-cluster depth bounds, on by
+    /// default where the depth is known before the build: after a depth pre-pass or a
+    /// G-buffer, without blended materials).
     #[arg(long)]
-    depth_bounds: bool,
+    no_depth_bounds: bool,
     /// G-buffer layout of the deferred pipelines (clustered-deferred, tiled-deferred,
     /// light-volumes): full, packed or compact.
     #[arg(long, default_value = "full", value_parser = parse_gbuffer)]
@@ -354,7 +355,7 @@ impl ClusterArgs {
             depth_prepass: !self.no_depth_prepass,
             workgroup_size: self.workgroup_size,
             coarse_tiles: self.coarse_tiles,
-            depth_bounds: self.depth_bounds,
+            depth_bounds: !self.no_depth_bounds,
         }
     }
 }

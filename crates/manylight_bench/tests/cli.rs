@@ -90,7 +90,7 @@ fn render_writes_png_and_stats_json() {
     let last = &stats["last_frame"];
     let names: Vec<&str> =
         last["passes"].as_array().expect("passes").iter().map(|p| p["name"].as_str().unwrap_or("")).collect();
-    assert_eq!(names, ["depth_prepass", "cluster_build", "clustered_forward", "tonemap"]);
+    assert_eq!(names, ["depth_prepass", "cluster_depth", "cluster_build", "clustered_forward", "tonemap"]);
     assert!(last["clusters"]["total_entries"].as_u64().is_some_and(|n| n > 0));
     assert_eq!(last["clusters"]["dropped_pairs"].as_u64(), Some(0));
     assert!(last["passes"][0]["gpu_ms"].is_number());
@@ -99,7 +99,11 @@ fn render_writes_png_and_stats_json() {
     assert_eq!(last["light_count"].as_u64(), Some(16 + 6));
     assert_eq!(last["nonfinite_pixels"].as_u64(), Some(0));
     assert_eq!(last["invalid_lights"].as_u64(), Some(0));
-    assert_eq!(last["transient_bytes"].as_u64(), Some(96 * 64 * (8 + 4)), "rgba16f hdr + depth");
+    assert_eq!(
+        last["transient_bytes"].as_u64(),
+        Some(96 * 64 * (8 + 4 + 4)),
+        "rgba16f hdr + depth + r32f shading distance"
+    );
     assert_eq!(stats["frames_rendered"].as_u64(), Some(2));
 }
 
@@ -219,10 +223,11 @@ fn bench_writes_a_csv_row_per_configuration() {
     let clustered = lines.iter().find(|l| l.contains(",clustered-forward,,,32,")).expect("row");
     let culling = field(clustered, "culling_ratio");
     assert!(culling.parse::<f64>().is_ok_and(|r| r >= 1.0), "culling ratio `{culling}`");
-    // 96×64 rgba16f HDR + depth32f = 72 KiB of frame textures; cluster buffers exist.
+    // 96×64 rgba16f HDR + depth32f + r32f shading distance (per-cluster depth bounds) = 96 KiB
+    // of frame textures; cluster buffers exist.
     let textures = field(clustered, "transient_mib");
     assert!(
-        textures.parse::<f64>().is_ok_and(|m| (m - 96.0 * 64.0 * 12.0 / 1048576.0).abs() < 0.01),
+        textures.parse::<f64>().is_ok_and(|m| (m - 96.0 * 64.0 * 16.0 / 1048576.0).abs() < 0.01),
         "{textures}"
     );
     assert!(field(clustered, "cluster_buffer_mib").parse::<f64>().is_ok_and(|m| m > 0.0));

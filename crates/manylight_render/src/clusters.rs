@@ -176,12 +176,13 @@ impl ClusterResources {
         });
         let depth_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("cluster_depth"),
-            entries: &[uniform_entry(0, compute), storage_entry(1, compute, false)],
+            entries: &[storage_entry(0, compute, true), storage_entry(1, compute, false)],
         });
         let params_buffer = gpu.create_buffer(&wgpu::BufferDescriptor {
             label: Some("cluster_params"),
             size: std::mem::size_of::<GpuClusterParams>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            // Also bound as storage by the `cluster_depth` pass (shaders/common/cluster_depth.wgsl).
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let storage = wgpu::BufferUsages::STORAGE;

@@ -277,9 +277,7 @@ pub struct ClusterSettings {
     /// the build and every shaded fragment is in it: forward pipelines with a depth pre-pass and
     /// the deferred ones, without blended materials (the transparent pass shades fragments the
     /// depth buffer does not hold) and without a debug view (`PlanInputs::bounds_clusters_by_depth`).
-    /// Off by default: on lavapipe the pass that records the ranges grows the process's memory
-    /// by about 0.3 MB a frame (inside the driver; `docs/benchmarks.md`, "Per-cluster depth
-    /// bounds").
+    /// On by default (`docs/benchmarks.md`, "Per-cluster depth bounds").
     pub depth_bounds: bool,
 }
 
@@ -292,7 +290,7 @@ impl Default for ClusterSettings {
             depth_prepass: true,
             workgroup_size: 64,
             coarse_tiles: DEFAULT_COARSE_TILES,
-            depth_bounds: false,
+            depth_bounds: true,
         }
     }
 }
