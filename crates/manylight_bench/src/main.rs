@@ -315,11 +315,12 @@ struct ClusterArgs {
     /// every tile tests every light).
     #[arg(long, default_value_t = manylight_render::DEFAULT_COARSE_TILES)]
     coarse_tiles: u32,
-    /// Do not cut clusters to their pixels' depth range (per-cluster depth bounds, on by
-    /// default where the depth is known before the build: after a depth pre-pass or a
-    /// G-buffer, without blended materials).
-    #[arg(long)]
-    no_depth_bounds: bool,
+    /// Per-cluster depth bounds (cut clusters to their pixels' depth range; applies after a
+    /// depth pre-pass or a G-buffer, without blended materials): on or off. Default: on, off for
+    /// `sphere-shell`, whose lights hug its only surface, so the bounds cut nothing there and
+    /// cost their pass (docs/benchmarks.md).
+    #[arg(long, value_parser = parse_on_off)]
+    depth_bounds: Option<bool>,
     /// G-buffer layout of the deferred pipelines (clustered-deferred, tiled-deferred,
     /// light-volumes): full, packed or compact.
     #[arg(long, default_value = "full", value_parser = parse_gbuffer)]
@@ -347,7 +348,8 @@ impl ClusterArgs {
         Ok(scene)
     }
 
-    fn settings(&self) -> ClusterSettings {
+    /// The cluster settings for scene `spec` (`--depth-bounds` defaults per scene).
+    fn settings(&self, spec: &str) -> ClusterSettings {
         ClusterSettings {
             grid: GridConfig { dims: self.grid, slicing: self.z_slicing, ..GridConfig::default() },
             cull: self.cull,
@@ -355,8 +357,17 @@ impl ClusterArgs {
             depth_prepass: !self.no_depth_prepass,
             workgroup_size: self.workgroup_size,
             coarse_tiles: self.coarse_tiles,
-            depth_bounds: !self.no_depth_bounds,
+            depth_bounds: self.depth_bounds.unwrap_or(spec != "sphere-shell"),
         }
+    }
+}
+
+/// `on` or `off`.
+fn parse_on_off(s: &str) -> Result<bool, String> {
+    match s {
+        "on" => Ok(true),
+        "off" => Ok(false),
+        _ => Err(format!("`{s}`: expected on or off")),
     }
 }
 
@@ -490,7 +501,7 @@ fn render(args: RenderArgs) -> Result<()> {
             render: manylight_render::RenderSettings {
                 pipeline: args.pipeline,
                 shading: args.shading,
-                clusters: args.clusters.settings(),
+                clusters: args.clusters.settings(&args.scene),
                 gbuffer: args.clusters.gbuffer,
                 normal_codec: args.clusters.normal_codec,
                 ..Default::default()
@@ -534,7 +545,7 @@ fn render(args: RenderArgs) -> Result<()> {
         shading: args.shading,
         exposure: args.ev100.map_or(args.exposure, |ev100| manylight_app::Exposure { ev100 }.multiplier()),
         ambient,
-        clusters: args.clusters.settings(),
+        clusters: args.clusters.settings(&args.scene),
         gbuffer: args.clusters.gbuffer,
         normal_codec: args.clusters.normal_codec,
         ..RenderSettings::default()
@@ -637,7 +648,10 @@ fn write_plots(dir: &std::path::Path, name: &str, csv: &str) -> Result<()> {
 /// The settings `report` and `rangeless-lights` start from.
 fn report_base(args: &ReportArgs) -> manylight_render::FrameSettings {
     manylight_render::FrameSettings {
-        render: manylight_render::RenderSettings { clusters: args.clusters.settings(), ..Default::default() },
+        render: manylight_render::RenderSettings {
+            clusters: args.clusters.settings(&args.scene),
+            ..Default::default()
+        },
         ..Default::default()
     }
 }
@@ -665,7 +679,10 @@ fn report_cmd(args: ReportArgs) -> Result<()> {
 fn post_cmd(args: ReportArgs) -> Result<()> {
     let scene = args.clusters.load(&args.scene)?;
     let base = manylight_render::FrameSettings {
-        render: manylight_render::RenderSettings { clusters: args.clusters.settings(), ..Default::default() },
+        render: manylight_render::RenderSettings {
+            clusters: args.clusters.settings(&args.scene),
+            ..Default::default()
+        },
         ..Default::default()
     };
     let name = scene_name(&args.scene);
@@ -680,7 +697,10 @@ fn post_cmd(args: ReportArgs) -> Result<()> {
 fn views_cmd(args: ViewsArgs) -> Result<()> {
     let scene = args.clusters.load(&args.scene)?;
     let base = manylight_render::FrameSettings {
-        render: manylight_render::RenderSettings { clusters: args.clusters.settings(), ..Default::default() },
+        render: manylight_render::RenderSettings {
+            clusters: args.clusters.settings(&args.scene),
+            ..Default::default()
+        },
         ..Default::default()
     };
     let name = scene_name(&args.scene);
@@ -720,7 +740,7 @@ fn bench_cmd(args: BenchArgs) -> Result<()> {
         gbuffers: args.gbuffers,
         settings: manylight_render::FrameSettings {
             render: manylight_render::RenderSettings {
-                clusters: args.clusters.settings(),
+                clusters: args.clusters.settings(&args.scene),
                 gbuffer: args.clusters.gbuffer,
                 normal_codec: args.clusters.normal_codec,
                 shading: args.shading,

@@ -352,6 +352,7 @@ fn clusters_ui(ui: &mut egui::Ui, world: &mut World) {
     combo(ui, "z slicing", &mut grid.slicing, &ZSlicing::ALL, ZSlicing::name);
     combo(ui, "cull test", &mut s.clusters.cull, &CullTest::ALL, CullTest::name);
     ui.checkbox(&mut s.clusters.depth_prepass, "depth pre-pass (clustered forward)");
+    ui.checkbox(&mut s.clusters.depth_bounds, "per-cluster depth bounds");
     ui.add(
         egui::Slider::new(&mut s.clusters.coarse_tiles, 0..=32)
             .text("coarse tiles (tiles per edge; 0: none)"),
