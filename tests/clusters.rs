@@ -28,6 +28,19 @@ fn rig(scene: &Scene, count: usize, seed: u64) -> Vec<ExtractedPointLight> {
         .collect()
 }
 
+/// The sphere-shell scene's 100 000 lights (each a few pixels wide, all at one depth).
+fn shell_lights() -> Vec<ExtractedPointLight> {
+    manylight::scene::sphere_shell_lights(
+        100_000,
+        manylight::scene::SHELL_RADIUS,
+        manylight::scene::SHELL_LIGHT_RANGE,
+        7,
+    )
+    .iter()
+    .map(extracted_light)
+    .collect()
+}
+
 fn light(position: Vec3, radius: f32) -> ExtractedPointLight {
     ExtractedPointLight { position, color: Vec3::ONE, intensity: 1.0, radius, spot: None }
 }
@@ -187,15 +200,7 @@ fn gpu_lists_equal_the_cpu_reference_on_the_sphere_shell() {
     let _gpu = gpu();
     let mut r = HeadlessRenderer::new().expect("adapter");
     let scene = manylight::scene::sphere_shell_scene();
-    let lights: Vec<ExtractedPointLight> = manylight::scene::sphere_shell_lights(
-        100_000,
-        manylight::scene::SHELL_RADIUS,
-        manylight::scene::SHELL_LIGHT_RANGE,
-        7,
-    )
-    .iter()
-    .map(extracted_light)
-    .collect();
+    let lights = shell_lights();
     for coarse_tiles in [2, 0] {
         let mut settings = clustered(CullTest::Both, ZSlicing::Exponential, None);
         settings.clusters.coarse_tiles = coarse_tiles;
@@ -604,15 +609,7 @@ fn tiled_deferred_shades_what_clustered_deferred_shades() {
     check("hard cases, 40-px tiles", &scene, size, hard_lights(&scene, size), 40);
     check("70 000 lights", &scene, size, rig(&scene, 70_000, 5), 16);
     let shell = manylight::scene::sphere_shell_scene();
-    let lights: Vec<ExtractedPointLight> = manylight::scene::sphere_shell_lights(
-        100_000,
-        manylight::scene::SHELL_RADIUS,
-        manylight::scene::SHELL_LIGHT_RANGE,
-        7,
-    )
-    .iter()
-    .map(extracted_light)
-    .collect();
+    let lights = shell_lights();
     check("sphere shell", &shell, UVec2::new(256, 144), lights, 16);
     let mut ortho = default_scene();
     let cam = ortho.camera_or_fit(size.x as f32 / size.y as f32);
@@ -718,15 +715,7 @@ fn depth_bounded_lists_keep_every_contributing_light() {
     }
 
     let shell = manylight::scene::sphere_shell_scene();
-    let lights: Vec<ExtractedPointLight> = manylight::scene::sphere_shell_lights(
-        100_000,
-        manylight::scene::SHELL_RADIUS,
-        manylight::scene::SHELL_LIGHT_RANGE,
-        7,
-    )
-    .iter()
-    .map(extracted_light)
-    .collect();
+    let lights = shell_lights();
     let snap = scene_snapshot(
         &shell,
         UVec2::new(256, 144),

@@ -5,7 +5,7 @@
 //! ([`crate::snapshot::ClusterSettings::depth_bounds`]).
 
 use super::common::texture_entry;
-use super::gbuffer_layout::{codec_constants, gbuffer_read_bind_group, gbuffer_read_layout, targets};
+use super::gbuffer_layout::{codec_constants, gbuffer_read_bind_group, gbuffer_read_layout, gbuffer_reads};
 use super::{CLUSTER_DEPTHS, DEPTH, SHADING_DISTANCE};
 use crate::bindings::Binding;
 use crate::context::RenderError;
@@ -96,9 +96,7 @@ impl Pass for ClusterDepthPass {
     fn reads(&self) -> Vec<ResourceName> {
         match self.source {
             DistanceSource::Prepass => vec![SHADING_DISTANCE, DEPTH],
-            DistanceSource::GBuffer(layout, _) => {
-                targets(layout).iter().map(|&(name, _)| name).chain([DEPTH]).collect()
-            }
+            DistanceSource::GBuffer(layout, _) => gbuffer_reads(layout).collect(),
         }
     }
     fn writes(&self) -> Vec<ResourceName> {

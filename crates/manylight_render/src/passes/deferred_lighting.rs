@@ -3,9 +3,9 @@
 
 use super::common::{FullscreenPipelineDesc, draw_fullscreen, fullscreen_pipeline_desc};
 use super::gbuffer_layout::{
-    codec_constants, fragment_entry, gbuffer_read_bind_group, gbuffer_read_layout, targets,
+    codec_constants, fragment_entry, gbuffer_read_bind_group, gbuffer_read_layout, gbuffer_reads,
 };
-use super::{CLUSTERS, DEPTH, HDR};
+use super::{CLUSTERS, HDR};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
 use crate::pipelines::PipelineKey;
@@ -76,7 +76,7 @@ impl Pass for DeferredLightingPass {
         "deferred_lighting"
     }
     fn reads(&self) -> Vec<ResourceName> {
-        targets(self.layout).iter().map(|&(name, _)| name).chain([DEPTH, CLUSTERS]).collect()
+        gbuffer_reads(self.layout).chain([CLUSTERS]).collect()
     }
     fn writes(&self) -> Vec<ResourceName> {
         vec![HDR]

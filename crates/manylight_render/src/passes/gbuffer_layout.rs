@@ -39,6 +39,11 @@ pub fn targets(layout: GBufferLayout) -> &'static [(ResourceName, wgpu::TextureF
     }
 }
 
+/// What a pass that reads the G-buffer of `layout` reads: its targets and [`DEPTH`].
+pub fn gbuffer_reads(layout: GBufferLayout) -> impl Iterator<Item = ResourceName> {
+    targets(layout).iter().map(|&(name, _)| name).chain([DEPTH])
+}
+
 /// The fragment entry point of `gbuffer.wgsl` and `deferred_lighting.wgsl` for a layout.
 pub fn fragment_entry(layout: GBufferLayout) -> &'static str {
     match layout {

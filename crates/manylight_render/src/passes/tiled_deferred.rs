@@ -2,8 +2,8 @@
 //! of the light grid cuts the tile's list to its pixels' depths (range and 2.5D mask) in
 //! workgroup memory and shades its pixels from it into [`HDR`].
 
-use super::gbuffer_layout::{codec_constants, gbuffer_read_bind_group, gbuffer_read_layout, targets};
-use super::{CLUSTERS, DEPTH, HDR};
+use super::gbuffer_layout::{codec_constants, gbuffer_read_bind_group, gbuffer_read_layout, gbuffer_reads};
+use super::{CLUSTERS, HDR};
 use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
@@ -102,7 +102,7 @@ impl Pass for TiledDeferredPass {
         "tiled_deferred"
     }
     fn reads(&self) -> Vec<ResourceName> {
-        targets(self.layout).iter().map(|&(name, _)| name).chain([DEPTH, CLUSTERS]).collect()
+        gbuffer_reads(self.layout).chain([CLUSTERS]).collect()
     }
     fn writes(&self) -> Vec<ResourceName> {
         vec![HDR]
