@@ -50,7 +50,8 @@ pub struct Args {
     /// Lights (default 4096; 100 000 for sphere-shell).
     #[arg(long)]
     pub lights: Option<u32>,
-    /// The many-light pipeline (default: clustered-forward).
+    /// The many-light pipeline (default: clustered-forward; forward-plus for sphere-shell,
+    /// whose lights hug its one surface, so depth slices add build cost and cut nothing).
     #[arg(long, value_parser = parse_pipeline)]
     pub pipeline: Option<PipelineKind>,
     /// Window or image size, WxH.
@@ -289,7 +290,11 @@ pub fn setup(app: &mut App, args: &Args, exit_when_done: bool) -> Result<()> {
     let aspect = args.size.x as f32 / args.size.y.max(1) as f32;
     let layout = StressLayout { shell, bounds: scene.bounds(), seed: args.seed };
     let mut settings = RenderSettings {
-        pipeline: args.pipeline.unwrap_or(RenderSettings::default().pipeline),
+        pipeline: args.pipeline.unwrap_or(if shell {
+            PipelineKind::ForwardPlus
+        } else {
+            RenderSettings::default().pipeline
+        }),
         ..RenderSettings::default()
     };
     // The shell's lights hug its only surface: per-cluster depth bounds cut nothing there and

@@ -78,6 +78,11 @@ fn sphere_shell_preset_has_its_lattice_and_turns_the_camera() {
     let report = stats.last.expect("a report");
     assert_eq!(report.light_count, 2048);
     assert_eq!(report.instance_count, 2);
+    // The shell's pipeline: Forward+ without depth bounds (docs/benchmarks.md).
+    assert_eq!(report.pass_names(), ["depth_prepass", "cluster_build", "clustered_forward", "tonemap"]);
+    let settings = app.world().resource::<manylight::app::RenderSettings>();
+    assert_eq!(settings.pipeline, PipelineKind::ForwardPlus);
+    assert!(!settings.clusters.depth_bounds);
     let world = app.world_mut();
     let mut cameras = world.query_filtered::<(&Transform, &Projection), (With<Camera3d>, With<Turning>)>();
     let (t, cam) = cameras.single(world).expect("one turning camera");
