@@ -188,19 +188,7 @@ fn lights_of(scene: &Scene, shell_lattice: bool, count: usize) -> (Scene, Vec<An
         let lights = sphere_shell_lights(count, SHELL_RADIUS, SHELL_LIGHT_RANGE, 1);
         (Scene { lights, ..scene.clone() }, Vec::new())
     } else {
-        let mut rig = light_rig(count, scene.bounds(), 1);
-        if std::env::var_os("MANYLIGHT_MORTON_RIG").is_some() {
-            // Experiment: lights in Morton order of their orbit centres (10 bits an axis).
-            let b = scene.bounds();
-            let size = (b.max - b.min).max(glam::Vec3::splat(1e-6));
-            let morton = |p: glam::Vec3| {
-                let q = ((p - b.min) / size).clamp(glam::Vec3::ZERO, glam::Vec3::ONE) * 1023.0;
-                let spread = |v: u32| (0..10).fold(0u64, |acc, i| acc | (u64::from((v >> i) & 1) << (3 * i)));
-                spread(q.x as u32) | spread(q.y as u32) << 1 | spread(q.z as u32) << 2
-            };
-            rig.sort_by_key(|l| morton(l.center));
-        }
-        (scene.clone(), rig)
+        (scene.clone(), light_rig(count, scene.bounds(), 1))
     }
 }
 
