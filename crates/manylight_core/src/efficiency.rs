@@ -147,6 +147,17 @@ pub fn exact_pixel_lists(
     ClusterAssignment { ranges, indices, dropped_pairs: 0, clusters_overflowed: 0 }
 }
 
+/// Per cluster, the nearest and farthest view distance of the covered pixels in it;
+/// `(inf, -inf)` for a cluster without a pixel.
+fn pixel_depth_ranges(grid: &ClusterGrid, projection: &Projection, depth: &[f32]) -> Vec<(f32, f32)> {
+    let mut range = vec![(f32::INFINITY, f32::NEG_INFINITY); grid.cluster_count() as usize];
+    for_each_covered_pixel(grid, projection, depth, |_, q, cluster| {
+        let r = &mut range[cluster as usize];
+        *r = (r.0.min(-q.z), r.1.max(-q.z));
+    });
+    range
+}
+
 /// The lists `assignment` would have with **per-cluster depth bounds** (the depth range of the
 /// pixels that fall in each cluster, from a depth pre-pass; Olsson et al. 2012): each cluster's
 /// bounds cut to its tile between the nearest and farthest of its pixels (widened by the
@@ -163,11 +174,7 @@ pub fn depth_bounded_lists(
     depth: &[f32],
     test: CullTest,
 ) -> ClusterAssignment {
-    let mut range = vec![(f32::INFINITY, f32::NEG_INFINITY); grid.cluster_count() as usize];
-    for_each_covered_pixel(grid, projection, depth, |_, q, cluster| {
-        let r = &mut range[cluster as usize];
-        *r = (r.0.min(-q.z), r.1.max(-q.z));
-    });
+    let range = pixel_depth_ranges(grid, projection, depth);
     let mut out = ClusterAssignment { ranges: Vec::with_capacity(range.len()), ..Default::default() };
     for (cluster, &(near, far)) in range.iter().enumerate() {
         let offset = out.indices.len() as u32;
@@ -209,11 +216,7 @@ pub fn depth_masked_lists(
 ) -> ClusterAssignment {
     let cells = cells.clamp(1, 32);
     let count = grid.cluster_count() as usize;
-    let mut range = vec![(f32::INFINITY, f32::NEG_INFINITY); count];
-    for_each_covered_pixel(grid, projection, depth, |_, q, cluster| {
-        let r = &mut range[cluster as usize];
-        *r = (r.0.min(-q.z), r.1.max(-q.z));
-    });
+    let range = pixel_depth_ranges(grid, projection, depth);
     let cell = |d: f32, (lo, hi): (f32, f32)| {
         let c = ((d - lo) * (cells as f32 / (hi - lo).max(1e-30))).floor();
         c.clamp(0.0, cells as f32 - 1.0) as u32
