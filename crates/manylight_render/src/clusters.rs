@@ -101,8 +101,8 @@ pub struct ClusterResources {
     pub build_layout: wgpu::BindGroupLayout,
     /// Layout of the shading passes' cluster group (params, ranges, indices; read-only).
     pub shading_layout: wgpu::BindGroupLayout,
-    /// Layout of group 2 of the `cluster_depth` pass (`shaders/common/cluster_depth.wgsl`):
-    /// params, and the ranges buffer, whose per-cluster depth ranges it writes.
+    /// Layout of group 2 of the `cluster_depth` pass (`shaders/cluster_depth.wgsl`): params, and
+    /// the ranges buffer, whose per-cluster depth ranges it writes after the cluster ranges.
     pub depth_layout: wgpu::BindGroupLayout,
     /// Group 0 of the build.
     pub build_bind_group: wgpu::BindGroup,
@@ -115,9 +115,6 @@ pub struct ClusterResources {
     pub ranges: GrowableBuffer,
     /// The light-index list.
     pub indices: GrowableBuffer,
-    /// Per-cluster depth ranges as the `cluster_depth` pass records them; copied after the
-    /// cluster ranges in [`Self::ranges`], where the build reads them.
-    pub depth_ranges: GrowableBuffer,
     bounds: GrowableBuffer,
     spheres: GrowableBuffer,
     /// Bounds of the tile columns, then of the coarse tiles.
@@ -181,7 +178,7 @@ impl ClusterResources {
         let params_buffer = gpu.create_buffer(&wgpu::BufferDescriptor {
             label: Some("cluster_params"),
             size: std::mem::size_of::<GpuClusterParams>() as u64,
-            // Also bound as storage by the `cluster_depth` pass (shaders/common/cluster_depth.wgsl).
+            // Also bound as storage by the `cluster_depth` pass (shaders/cluster_depth.wgsl).
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -189,7 +186,8 @@ impl ClusterResources {
         let copy = wgpu::BufferUsages::COPY_SRC;
         let bounds = GrowableBuffer::new(gpu, "cluster_bounds", storage, 128 * 1024);
         let spheres = GrowableBuffer::new(gpu, "light_view_spheres", storage, 16 * 1024);
-        // Cleared in part each frame (the depth ranges after the cluster ranges).
+        // With depth bounds the `cluster_depth` pass clears the depth ranges after the cluster
+        // ranges each frame.
         let ranges = GrowableBuffer::new(
             gpu,
             "cluster_ranges",
@@ -198,12 +196,6 @@ impl ClusterResources {
         );
         let indices =
             GrowableBuffer::new(gpu, "light_index_list", storage | copy, 4 * INITIAL_INDEX_CAPACITY);
-        let depth_ranges = GrowableBuffer::new(
-            gpu,
-            "cluster_depth_ranges",
-            storage | copy | wgpu::BufferUsages::COPY_DST,
-            8 * 8192,
-        );
         let tile_bounds = GrowableBuffer::new(gpu, "tile_bounds", storage, 128 * 256);
         let tile_ranges = GrowableBuffer::new(gpu, "tile_ranges", storage, 8 * 256);
         let tile_indices =
@@ -234,7 +226,6 @@ impl ClusterResources {
             params_buffer,
             ranges,
             indices,
-            depth_ranges,
             bounds,
             spheres,
             tile_bounds,
@@ -394,11 +385,8 @@ impl ClusterResources {
         } else {
             self.spheres.write(gpu, bytemuck::cast_slice(&spheres))?;
         }
-        // The cluster ranges, then the depth ranges of the clusters.
-        self.ranges.reserve(gpu, count as u64 * 16)?;
-        if depth_bounds {
-            self.depth_ranges.reserve(gpu, count as u64 * 8)?;
-        }
+        // The cluster ranges, then (with depth bounds) the depth ranges of the clusters.
+        self.ranges.reserve(gpu, count as u64 * if depth_bounds { 16 } else { 8 })?;
         // Lists sized before the frame is submitted, from a CPU bound of what the build can
         // write (`list_bounds`): the GPU lists cannot overflow, so the frame is never rendered
         // twice. A bound beyond what the device can bind reserves what it can; then the build's

@@ -21,7 +21,6 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("common/gbuffer_codec.wgsl", include_str!("../../../shaders/common/gbuffer_codec.wgsl")),
     ("common/gbuffer_read.wgsl", include_str!("../../../shaders/common/gbuffer_read.wgsl")),
     ("common/light_lists.wgsl", include_str!("../../../shaders/common/light_lists.wgsl")),
-    ("common/cluster_depth.wgsl", include_str!("../../../shaders/common/cluster_depth.wgsl")),
     ("light_volumes.wgsl", include_str!("../../../shaders/light_volumes.wgsl")),
     ("forward.wgsl", include_str!("../../../shaders/forward.wgsl")),
     ("depth_prepass.wgsl", include_str!("../../../shaders/depth_prepass.wgsl")),

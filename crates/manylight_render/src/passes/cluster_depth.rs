@@ -123,14 +123,14 @@ impl Pass for ClusterDepthPass {
                 gbuffer_read_bind_group(ctx, &pipeline.source_layout, layout, self.clear_color)?
             }
         };
-        // Zero the depth ranges (no pixel yet).
-        let depth_ranges = clusters.depth_ranges.buffer();
+        // Zero the depth ranges (no pixel yet), which follow the cluster ranges.
+        let ranges = clusters.ranges.buffer();
         let bytes = u64::from(clusters.params.dims[3]) * 8;
-        ctx.encoder.clear_buffer(depth_ranges, 0, Some(bytes));
+        ctx.encoder.clear_buffer(ranges, bytes, Some(bytes));
         let depths = ctx.bind_group(
             "cluster_depth",
             &clusters.depth_layout,
-            &[Binding::Buffer(&clusters.params_buffer), Binding::Buffer(depth_ranges)],
+            &[Binding::Buffer(&clusters.params_buffer), Binding::Buffer(ranges)],
         );
         let depth = ctx.texture(DEPTH)?.texture();
         let groups = [depth.width().div_ceil(8), depth.height().div_ceil(8)];
@@ -144,9 +144,6 @@ impl Pass for ClusterDepthPass {
         pass.set_bind_group(1, &source, &[]);
         pass.set_bind_group(2, &depths, &[]);
         pass.dispatch_workgroups(groups[0], groups[1], 1);
-        drop(pass);
-        // The build reads them after the cluster ranges.
-        ctx.encoder.copy_buffer_to_buffer(depth_ranges, 0, clusters.ranges.buffer(), bytes, bytes);
         Ok(())
     }
 }
