@@ -64,16 +64,11 @@ fn cs_forward(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
-// The view distance deferred lighting computes for a stored position.
-fn stored_distance(g: GSurface) -> f32 {
-    return -(view.view_from_world * vec4<f32>(g.world_position, 1.0)).z;
-}
-
 @compute @workgroup_size(8, 8)
 fn cs_full(@builtin(global_invocation_id) id: vec3<u32>) {
     let px = vec2<i32>(id.xy);
     if all(id.xy < textureDimensions(gb_depth)) && gbuffer_depth(px) > 0.0 {
-        mark_cluster_depth(vec2<f32>(id.xy) + 0.5, stored_distance(gbuffer_read_full(px)));
+        mark_cluster_depth(vec2<f32>(id.xy) + 0.5, gbuffer_view_distance(gbuffer_read_full(px).world_position));
     }
 }
 
@@ -81,7 +76,7 @@ fn cs_full(@builtin(global_invocation_id) id: vec3<u32>) {
 fn cs_packed(@builtin(global_invocation_id) id: vec3<u32>) {
     let px = vec2<i32>(id.xy);
     if all(id.xy < textureDimensions(gb_depth)) && gbuffer_depth(px) > 0.0 {
-        mark_cluster_depth(vec2<f32>(id.xy) + 0.5, stored_distance(gbuffer_read_packed(px)));
+        mark_cluster_depth(vec2<f32>(id.xy) + 0.5, gbuffer_view_distance(gbuffer_read_packed(px).world_position));
     }
 }
 
@@ -89,6 +84,6 @@ fn cs_packed(@builtin(global_invocation_id) id: vec3<u32>) {
 fn cs_compact(@builtin(global_invocation_id) id: vec3<u32>) {
     let px = vec2<i32>(id.xy);
     if all(id.xy < textureDimensions(gb_depth)) && gbuffer_depth(px) > 0.0 {
-        mark_cluster_depth(vec2<f32>(id.xy) + 0.5, stored_distance(gbuffer_read_compact(px)));
+        mark_cluster_depth(vec2<f32>(id.xy) + 0.5, gbuffer_view_distance(gbuffer_read_compact(px).world_position));
     }
 }

@@ -18,8 +18,7 @@
 
 fn shade(g: GSurface, frag: vec2<f32>) -> vec4<f32> {
     let view_dir = direction_to_eye(view, g.world_position);
-    let view_distance = -(view.view_from_world * vec4<f32>(g.world_position, 1.0)).z;
-    let range = cluster_ranges[cluster_index(cluster_params, frag, view_distance)];
+    let range = cluster_ranges[cluster_index(cluster_params, frag, gbuffer_view_distance(g.world_position))];
     var color = gbuffer_base_radiance(g) + shade_directional_lights(view, g.params, view_dir);
     for (var i = 0u; i < range.y; i++) {
         color += shade_point_light(g.params, g.world_position, view_dir, lights[cluster_indices[range.x + i]]);

@@ -81,11 +81,6 @@ fn tile_rect(tile: vec2<u32>) -> vec4<u32> {
     );
 }
 
-// View distance of a shaded position: the deferred lighting pass's `view_distance`.
-fn view_distance(p: vec3<f32>) -> f32 {
-    return -(view.view_from_world * vec4<f32>(p, 1.0)).z;
-}
-
 fn begin_tile(li: u32) {
     if li == 0u {
         atomicStore(&depth_lo, 0xffffffffu);
@@ -113,7 +108,7 @@ fn depth_cell(d: f32, r: vec2<f32>) -> u32 {
 fn light_reaches_tile(light: GpuPointLight, r: vec2<f32>, mask: u32) -> bool {
     let p = light.position_radius.xyz;
     let z_row = vec3<f32>(view.view_from_world[0].z, view.view_from_world[1].z, view.view_from_world[2].z);
-    let d = view_distance(p);
+    let d = gbuffer_view_distance(p);
     // Reach along the view axis, widened by the radius inflation of the cluster tests and by
     // a bound on the rounding of both view distances (their terms' magnitudes times 1e-5).
     let magnitude = dot(abs(z_row), abs(p)) + abs(view.view_from_world[3].z);
@@ -173,7 +168,7 @@ fn tile_pixel(phase: u32, px: vec2<i32>, depth: f32, g: GSurface, tile: vec2<u32
     let covered = depth > 0.0;
     if phase == PHASE_BOUNDS {
         if covered {
-            let d = view_distance(g.world_position);
+            let d = gbuffer_view_distance(g.world_position);
             if abs(d) <= 3.0e38 {
                 atomicMin(&depth_lo, order_key(d));
                 atomicMax(&depth_hi, order_key(d));
@@ -183,7 +178,7 @@ fn tile_pixel(phase: u32, px: vec2<i32>, depth: f32, g: GSurface, tile: vec2<u32
         }
     } else if phase == PHASE_MASK {
         if covered {
-            atomicOr(&depth_mask, 1u << depth_cell(view_distance(g.world_position), tile_depths()));
+            atomicOr(&depth_mask, 1u << depth_cell(gbuffer_view_distance(g.world_position), tile_depths()));
         }
     } else if covered {
         textureStore(hdr_out, px, shade(g, tile));

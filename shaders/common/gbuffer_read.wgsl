@@ -44,6 +44,12 @@ fn gbuffer_base_radiance(g: GSurface) -> vec3<f32> {
     return g.params.albedo * view.params.w * g.occlusion + g.emissive;
 }
 
+// View distance of a stored position (view-space -z), as the deferred passes compute it: the
+// lighting passes pick the cluster with it, `cluster_depth.wgsl` bounds the clusters by it.
+fn gbuffer_view_distance(p: vec3<f32>) -> f32 {
+    return -(view.view_from_world * vec4<f32>(p, 1.0)).z;
+}
+
 // Reverse-Z depth of the pixel (0: nothing was drawn there).
 fn gbuffer_depth(px: vec2<i32>) -> f32 {
     return textureLoad(gb_depth, px, 0);
