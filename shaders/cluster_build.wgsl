@@ -303,19 +303,18 @@ fn column_extent(a: vec4<f32>, b: vec4<f32>, along_a: f32, along_b: f32, near: f
     return vec2<f32>(-3.0e38, 3.0e38);
 }
 
+// With depth bounds: true when no pixel falls in the cluster (its depth range, kept after the
+// cluster ranges by `cluster_depth.wgsl`, is still zero), so it keeps no light.
+fn cluster_without_pixels(cluster: u32) -> bool {
+    return params.depth_bounds != 0u && ranges[params.dims.w + cluster].y == 0u;
+}
+
 // The cluster's bounds for level 2: with depth bounds, cut to the depth range of the pixels in it
-// (`cluster_depth.wgsl`, kept after the cluster ranges as order keys: the complement of the
-// nearest, the farthest; both 0 when no pixel falls in the cluster). `.w` of aabb_min is 1
-// for a cluster no pixel falls in (it keeps no light).
+// (order keys after the cluster ranges: the complement of the nearest, the farthest).
 fn level2_bounds(cluster: u32) -> GpuClusterBounds {
     var b = bounds[cluster];
-    b.aabb_min.w = 0.0;
     if params.depth_bounds != 0u {
         let r = ranges[params.dims.w + cluster];
-        if r.y == 0u {
-            b.aabb_min.w = 1.0;
-            return b;
-        }
         let near = from_order_key(~r.x);
         let far = from_order_key(r.y);
         // Planes 4 and 5 are the slice's near (0, 0, -1, -d0) and far (0, 0, 1, d1) planes.
@@ -342,7 +341,7 @@ fn count(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) 
     }
     let b = level2_bounds(cluster);
     var tile = tile_lights(cluster);
-    if b.aabb_min.w != 0.0 {
+    if cluster_without_pixels(cluster) {
         tile.y = 0u;
     }
     // The longest tile list: the loops below run that often (lavapipe ends an invocation
