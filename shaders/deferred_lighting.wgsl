@@ -1,6 +1,6 @@
 // Clustered deferred lighting: one full-screen pass reads the G-buffer (any layout, see
-// gbuffer.wgsl and common/gbuffer_read.wgsl) and walks the pixel's cluster list, with the same
-// shading code as the forward pipelines.
+// gbuffer.wgsl and common/gbuffer_read.wgsl) and walks the pixel's light list (its cluster's,
+// or its block's refined list), with the same shading code as the forward pipelines.
 //!include common/view.wgsl
 //!include common/lights.wgsl
 //!include common/brdf.wgsl
@@ -12,13 +12,12 @@
 
 //!include common/gbuffer_read.wgsl
 
-@group(2) @binding(0) var<uniform> cluster_params: ClusterParams;
-@group(2) @binding(1) var<storage, read> cluster_ranges: array<vec2<u32>>;
-@group(2) @binding(2) var<storage, read> cluster_indices: array<u32>;
+// group 2: the light lists
+//!include common/cluster_lists.wgsl
 
 fn shade(g: GSurface, frag: vec2<f32>) -> vec4<f32> {
     let view_dir = direction_to_eye(view, g.world_position);
-    let range = cluster_ranges[cluster_index(cluster_params, frag, gbuffer_view_distance(g.world_position))];
+    let range = light_list_range(frag, gbuffer_view_distance(g.world_position));
     var color = gbuffer_base_radiance(g) + shade_directional_lights(view, g.params, view_dir);
     for (var i = 0u; i < range.y; i++) {
         color += shade_point_light(g.params, g.world_position, view_dir, lights[cluster_indices[range.x + i]]);

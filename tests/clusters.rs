@@ -724,3 +724,149 @@ fn depth_bounded_lists_keep_every_contributing_light() {
     );
     check("sphere shell, 100 000 lights", snap, 61);
 }
+
+/// Refined light lists (`light_refine` pass) are exact and tight: at every pixel every light
+/// that contributes there is in the list the pixel shades from (its block's, or, where the
+/// block fell back, its cluster's), and each block's list holds only lights of its pixels'
+/// cluster lists that reach the box around its pixels (the CPU model
+/// `efficiency::refined_lists`, with a wider slack: the CPU rebuilds positions from the depth
+/// buffer, the GPU from the shading distance), each once and at most `REFINED_LIST_SLOTS`.
+/// On the rig and hard cases for the forward pipelines (after the depth pre-pass) and clustered
+/// deferred in every G-buffer layout, every culling test, with and without depth bounds; a
+/// 70 000-light rig; near 1e-4 / far 1e6; orthographic; and the sphere shell with 100 000
+/// lights, whose lists the refinement must cut to a small part.
+#[test]
+fn refined_lists_keep_every_contributing_light() {
+    use manylight::app::prelude::GBufferLayout;
+    use manylight::core::efficiency::{
+        Refinement, block_lists_per_pixel, culling_efficiency, pixel_grid, refined_lists,
+    };
+    use manylight::render::gpu_types::{REFINE_EDGE, REFINED_FALLBACK, REFINED_LIST_SLOTS};
+    let _gpu = gpu();
+    let mut r = HeadlessRenderer::new().expect("adapter");
+    let size = UVec2::new(160, 96);
+    // The CPU rebuilds positions from the depth buffer: a wider slack than the GPU's.
+    let refinement = Refinement { edge: REFINE_EDGE, slack: 1e-3, offset: 0.0 };
+    let settings = |pipeline, cull, depth_bounds, gbuffer| FrameSettings {
+        render: RenderSettings {
+            pipeline,
+            gbuffer,
+            clusters: ClusterSettings {
+                cull,
+                depth_bounds,
+                refined_lists: true,
+                ..ClusterSettings::default()
+            },
+            ..Default::default()
+        },
+        ..FrameSettings::default()
+    };
+    // Returns (pairs evaluated with the refined lists, with the cluster lists).
+    let mut check = |what: &str, snapshot: FrameSnapshot, stride: usize| -> (u64, u64) {
+        let projection = snapshot.camera().map(|c| c.projection).unwrap_or_default();
+        let (report, _) = r.render(snapshot, false).expect("renders");
+        assert!(report.pass_names().contains(&"light_refine"), "{what}: {:?}", report.pass_names());
+        let renderer = r.render_world.renderer();
+        let clusters = renderer.view_clusters(0).expect("the frame built clusters");
+        let lists = clusters.read_assignment(&renderer.gpu).expect("readback");
+        let refined = clusters.read_refined(&renderer.gpu).expect("readback").expect("refined lists");
+        let (_, _, depth) = renderer.read_depth().expect("depth readback").expect("a depth buffer");
+        let spheres = &clusters.view_spheres;
+        let blocks = ClusterAssignment {
+            ranges: refined.ranges.clone(),
+            indices: refined.indices.clone(),
+            ..Default::default()
+        };
+        let model = refined_lists(&clusters.grid, &projection, &lists, spheres, &depth, refinement);
+        assert_eq!(model.ranges.len(), blocks.ranges.len(), "{what}: block count");
+        for (b, r) in blocks.ranges.iter().enumerate() {
+            if r[1] == REFINED_FALLBACK {
+                continue;
+            }
+            let kept = blocks.lights_of(b as u32);
+            assert!(kept.len() <= REFINED_LIST_SLOTS as usize, "{what}: block {b} holds {}", kept.len());
+            let allowed = model.lights_of(b as u32);
+            for (i, l) in kept.iter().enumerate() {
+                assert!(allowed.contains(l), "{what}: block {b} keeps light {l}, not in {allowed:?}");
+                assert!(!kept[..i].contains(l), "{what}: block {b} holds light {l} twice");
+            }
+        }
+        let per_pixel = block_lists_per_pixel(
+            &clusters.grid,
+            &projection,
+            &lists,
+            &depth,
+            REFINE_EDGE,
+            &blocks,
+            REFINED_FALLBACK,
+        );
+        let pixels = pixel_grid(clusters.grid.viewport, &projection);
+        let e = culling_efficiency(&pixels, &projection, &per_pixel, spheres, &depth, stride);
+        assert!(e.sampled_pixels > 0, "{what}: {e:?}");
+        assert_eq!(e.missed_pairs, 0, "{what}: contributing lights missing: {e:?}");
+        let whole = culling_efficiency(&clusters.grid, &projection, &lists, spheres, &depth, 0);
+        assert_eq!(e.contributing_pairs, whole.contributing_pairs, "{what}");
+        (e.evaluated_pairs, whole.evaluated_pairs)
+    };
+    let scene = default_scene();
+    let full = GBufferLayout::Full;
+    let pipelines = [
+        (PipelineKind::ClusteredForward, full),
+        (PipelineKind::ForwardPlus, full),
+        (PipelineKind::ClusteredDeferred, full),
+        (PipelineKind::ClusteredDeferred, GBufferLayout::Packed),
+        (PipelineKind::ClusteredDeferred, GBufferLayout::Compact),
+    ];
+    for (pipeline, gbuffer) in pipelines {
+        for cull in CullTest::ALL {
+            for bounds in [true, false] {
+                let what = format!("{} {} {cull:?}, depth bounds {bounds}", pipeline.name(), gbuffer.name());
+                let s = settings(pipeline, cull, bounds, gbuffer);
+                let snap = scene_snapshot(&scene, size, rig(&scene, 1024, 3), s);
+                let (refined, whole) = check(&format!("{what}, 1 024 lights"), snap, 1);
+                assert!(refined < whole, "{what}: refinement cut nothing ({refined} of {whole} pairs)");
+                let snap = scene_snapshot(&scene, size, hard_lights(&scene, size), s);
+                check(&format!("{what}, hard cases"), snap, 1);
+            }
+        }
+    }
+    let s = settings(PipelineKind::ForwardPlus, CullTest::Both, true, full);
+    check("forward+, 70 000 lights", scene_snapshot(&scene, size, rig(&scene, 70_000, 5), s), 7);
+
+    let cam = scene.camera_or_fit(size.x as f32 / size.y as f32);
+    let forward = -cam.transform.z_axis.truncate().normalize();
+    let at = |d: f32| cam.transform.w_axis.truncate() + forward * d;
+    let mut extreme = default_scene();
+    extreme.cameras = vec![manylight::scene::SceneCamera {
+        transform: cam.transform,
+        projection: Projection::perspective(1.0, 1e-4, 1e6),
+    }];
+    let lights: Vec<ExtractedPointLight> = (0..24)
+        .map(|k| {
+            let d = 1e-4 * (1e10f32).powf(k as f32 / 24.0);
+            light(at(d.min(5e5)), d.min(5e5) * 0.01)
+        })
+        .chain(rig(&extreme, 256, 4))
+        .collect();
+    let mut ortho = default_scene();
+    ortho.cameras = vec![manylight::scene::SceneCamera {
+        transform: cam.transform,
+        projection: Projection::orthographic(12.0, 0.1, 200.0),
+    }];
+    for pipeline in [PipelineKind::ClusteredForward, PipelineKind::ClusteredDeferred] {
+        let s = settings(pipeline, CullTest::Both, true, full);
+        let snap = scene_snapshot(&extreme, size, lights.clone(), s);
+        check(&format!("{}, near 1e-4, far 1e6", pipeline.name()), snap, 1);
+        let snap = scene_snapshot(&ortho, size, rig(&ortho, 1024, 9), s);
+        let (refined, whole) = check(&format!("{}, orthographic", pipeline.name()), snap, 1);
+        assert!(refined < whole, "orthographic: refinement cut nothing ({refined} of {whole} pairs)");
+    }
+
+    let shell = manylight::scene::sphere_shell_scene();
+    for pipeline in [PipelineKind::ForwardPlus, PipelineKind::ClusteredDeferred] {
+        let s = settings(pipeline, CullTest::Both, false, full);
+        let snap = scene_snapshot(&shell, UVec2::new(256, 144), shell_lights(), s);
+        let (refined, whole) = check(&format!("{}, sphere shell, 100 000 lights", pipeline.name()), snap, 61);
+        assert!(3 * refined < whole, "sphere shell: {refined} of {whole} pairs left");
+    }
+}

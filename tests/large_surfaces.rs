@@ -289,6 +289,18 @@ fn configurations() -> Vec<(String, RenderSettings)> {
             whole.clusters.depth_bounds = false;
             out.push((format!("{}_whole_slices", pipeline.name()), whole));
         }
+        // Refined light lists (off by default) take the same distances; their boxes are much
+        // tighter than a cluster's.
+        if matches!(pipeline, PipelineKind::ClusteredForward | PipelineKind::ForwardPlus) {
+            let mut refined = base;
+            refined.clusters.refined_lists = true;
+            out.push((format!("{}_refined", pipeline.name()), refined));
+        }
+        if pipeline == PipelineKind::ClusteredDeferred {
+            let mut refined = base;
+            refined.clusters.refined_lists = true;
+            out.push((format!("{}_full_refined", pipeline.name()), refined));
+        }
         if !matches!(pipeline, PipelineKind::ClusteredDeferred | PipelineKind::LightVolumes) {
             out.push((pipeline.name().to_string(), base));
             continue;

@@ -433,3 +433,50 @@ fn the_transparent_pass_runs_only_for_blended_materials() {
         assert!(!plan_passes(snapshot(p)).expect("plan").contains(&"transparent"), "{p:?}");
     }
 }
+
+/// Refined light lists (`ClusterSettings::refined_lists`) add the `light_refine` pass after the
+/// build where every shaded fragment's distance is known before shading (depth pre-pass,
+/// G-buffer), and the pre-pass then writes the shading distance; not without lights, with a
+/// debug view, in tiled deferred (which cuts its tile lists itself), or in clustered forward
+/// without a pre-pass.
+#[test]
+fn refined_lists_plan_a_refine_pass_where_distances_are_known() {
+    use PipelineKind::*;
+    let with = |pipeline, lights, debug, depth_bounds, prepass| {
+        let p = Point { lights, bloom: false, motion_blur: false, deferred: false, debug };
+        let mut s = snapshot(p);
+        s.settings.pipeline = pipeline;
+        s.settings.render.clusters.refined_lists = true;
+        s.settings.render.clusters.depth_bounds = depth_bounds;
+        s.settings.render.clusters.depth_prepass = prepass;
+        plan_passes(s).expect("plan")
+    };
+    let forward =
+        ["depth_prepass", "cluster_depth", "cluster_build", "light_refine", "clustered_forward", "tonemap"];
+    assert_eq!(with(ClusteredForward, true, false, true, true), forward);
+    assert_eq!(
+        with(ForwardPlus, true, false, false, true),
+        ["depth_prepass", "cluster_build", "light_refine", "clustered_forward", "tonemap"]
+    );
+    assert_eq!(
+        with(ClusteredDeferred, true, false, false, true),
+        ["cluster_build", "gbuffer", "light_refine", "deferred_lighting", "tonemap"]
+    );
+    assert_eq!(
+        with(ClusteredDeferred, true, false, true, true),
+        ["gbuffer", "cluster_depth", "cluster_build", "light_refine", "deferred_lighting", "tonemap"]
+    );
+    assert_eq!(
+        with(TiledDeferred, true, false, false, true),
+        ["cluster_build", "gbuffer", "tiled_deferred", "tonemap"]
+    );
+    assert_eq!(
+        with(ClusteredForward, true, false, true, false),
+        ["cluster_build", "clustered_forward", "tonemap"]
+    );
+    assert_eq!(with(ClusteredForward, false, false, true, true), ["forward", "tonemap"]);
+    assert_eq!(
+        with(ClusteredForward, true, true, true, true),
+        ["depth_prepass", "cluster_build", "debug_view"]
+    );
+}

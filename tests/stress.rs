@@ -83,6 +83,7 @@ fn sphere_shell_preset_has_its_lattice_and_turns_the_camera() {
     let settings = app.world().resource::<manylight::app::RenderSettings>();
     assert_eq!(settings.pipeline, PipelineKind::ForwardPlus);
     assert!(!settings.clusters.depth_bounds);
+    assert!(!settings.clusters.refined_lists, "few lights: no refined lists");
     let world = app.world_mut();
     let mut cameras = world.query_filtered::<(&Transform, &Projection), (With<Camera3d>, With<Turning>)>();
     let (t, cam) = cameras.single(world).expect("one turning camera");
@@ -93,6 +94,13 @@ fn sphere_shell_preset_has_its_lattice_and_turns_the_camera() {
         * Quat::from_rotation_z(stress::SHELL_TURN_PER_FRAME);
     let expected = step * step * step;
     assert!(t.rotation.angle_between(expected) < 1e-5, "camera rotation {:?}", t.rotation);
+    // Many lights: refined light lists after the build.
+    let mut app = stress_app(&["--scene", "sphere-shell", "--lights", "20000", "--size", "128x72"]);
+    let report = update(&mut app).last.expect("a report");
+    assert_eq!(
+        report.pass_names(),
+        ["depth_prepass", "cluster_build", "light_refine", "clustered_forward", "tonemap"]
+    );
     let mut lights = world.query::<(&Transform, &PointLight)>();
     for (t, l) in lights.iter(world) {
         let r = t.translation.length();

@@ -23,9 +23,11 @@ struct ClusterParams {
     // 1: the cluster level cuts each cluster to its pixels' depth range (`cluster_depth.wgsl`
     // writes them after the cluster ranges); 0: whole slices
     depth_bounds: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    // blocks across and down of the refined lists (light_refine.wgsl); 0: no refinement
+    refine_blocks_x: u32,
+    refine_blocks_y: u32,
+    // index in the ranges of block 0's refined range; its lists follow `index_capacity` entries
+    refined_first: u32,
 };
 
 // A u32 that orders as `d` does among floats (sign-magnitude to two's-complement order).

@@ -3,13 +3,9 @@
 // then the point and spot lights it sums, either every light or its cluster's list.
 //!include common/mesh_pass.wgsl
 //!include common/brdf.wgsl
-//!include common/clusters.wgsl
-
-// The cluster lists (group 2; Rust: `ClusterResources::shading_layout`), bound only by the
-// pipelines whose entry point calls `add_cluster_lights`.
-@group(2) @binding(0) var<uniform> cluster_params: ClusterParams;
-@group(2) @binding(1) var<storage, read> cluster_ranges: array<vec2<u32>>;
-@group(2) @binding(2) var<storage, read> cluster_indices: array<u32>;
+// The light lists (group 2), bound only by the pipelines whose entry point calls
+// `add_cluster_lights`.
+//!include common/cluster_lists.wgsl
 
 struct ForwardFragment {
     p: SurfacePoint,
@@ -50,10 +46,11 @@ fn add_every_light(f: ForwardFragment) -> vec3<f32> {
     return color;
 }
 
-// `f.color` plus the lights of the cluster of the fragment at `frag` (pixel coordinates).
+// `f.color` plus the lights of the list of the fragment at `frag` (pixel coordinates): its
+// block's refined list or its cluster's.
 fn add_cluster_lights(f: ForwardFragment, frag: vec2<f32>) -> vec3<f32> {
     var color = f.color;
-    let range = cluster_ranges[cluster_index(cluster_params, frag, f.p.view_depth)];
+    let range = light_list_range(frag, f.p.view_depth);
     for (var i = 0u; i < range.y; i++) {
         color += shade_point_light(f.m.params, f.p.world_position, f.view_dir, lights[cluster_indices[range.x + i]]);
     }

@@ -36,6 +36,15 @@ pub fn parse_normal_codec(s: &str) -> Result<NormalCodec, String> {
     named("normal codec", s, &NormalCodec::ALL, NormalCodec::name)
 }
 
+/// `on` or `off`.
+pub fn parse_on_off(s: &str) -> Result<bool, String> {
+    match s {
+        "on" => Ok(true),
+        "off" => Ok(false),
+        _ => Err(format!("`{s}`: expected on or off")),
+    }
+}
+
 /// `aabb`, `planes` or `both`.
 pub fn parse_cull(s: &str) -> Result<CullTest, String> {
     named("culling test", s, &CullTest::ALL, CullTest::name)

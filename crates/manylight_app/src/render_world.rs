@@ -633,8 +633,10 @@ fn prepare(
     view: Res<CurrentView>,
     mut outcome: ResMut<FrameOutcome>,
 ) {
-    let depth_bounds = view.plan_inputs(manylight_render::resources::HDR_FORMAT).bounds_clusters_by_depth();
-    if let Err(e) = renderer.0.prepare_view(&view.0, view.has_lights(), depth_bounds) {
+    let options = manylight_render::clusters::ListOptions::of(
+        &view.plan_inputs(manylight_render::resources::HDR_FORMAT),
+    );
+    if let Err(e) = renderer.0.prepare_view(&view.0, view.has_lights(), options) {
         outcome.error.get_or_insert(e);
     }
 }

@@ -271,7 +271,7 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
          forward_gpu_ms,clustered_forward_gpu_ms,gbuffer_gpu_ms,deferred_lighting_gpu_ms,light_volumes_gpu_ms,tonemap_gpu_ms,clusters,non_empty_clusters,list_entries,\
          max_per_cluster,mean_per_non_empty,dropped_pairs,culling_ratio,transient_mib,cluster_buffer_mib,\
          list_entry_bound,tile_entries,tile_entry_bound,list_bound_cpu_ms,shading_ms,shading_vs_oracle,\
-         coarse_tiles,coarse_entries,depth_bounded_ratio\n",
+         coarse_tiles,coarse_entries,depth_bounded_ratio,cluster_depth_gpu_ms,light_refine_gpu_ms\n",
     );
     for r in rows {
         let c = r.last.clusters.as_ref();
@@ -287,7 +287,7 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
         let vs_oracle = shading.zip(oracle).filter(|&(_, o)| o > 0.0).map(|(s, o)| s / o);
         let _ = writeln!(
             out,
-            "\"{adapter}\",\"{scene}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{},{},{},{},{},{},{},{},{},{}",
+            "\"{adapter}\",\"{scene}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{},{},{},{},{},{},{},{},{},{},{},{}",
             match (r.oracle, r.pipeline.is_deferred()) {
                 (true, false) => "oracle-forward",
                 (true, true) => "oracle-deferred",
@@ -328,6 +328,8 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
             c.map_or(String::new(), |c| c.coarse_span.to_string()),
             c.map_or(String::new(), |c| c.coarse_entries.to_string()),
             r.depth_bounded.map_or(String::new(), |x| format!("{x:.3}")),
+            pass_ms(&r.last, "cluster_depth"),
+            pass_ms(&r.last, "light_refine"),
         );
     }
     out

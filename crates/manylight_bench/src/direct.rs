@@ -6,9 +6,10 @@ use anyhow::{Context, Result};
 use glam::UVec2;
 use manylight_app::render_world::HeadlessRenderer;
 use manylight_app::scene::{extracted_light, scene_snapshot};
+use manylight_core::cluster::ClusterAssignment;
 use manylight_core::efficiency::{
-    CullingEfficiency, culling_efficiency, depth_bounded_lists, depth_masked_lists, exact_pixel_lists,
-    pixel_grid,
+    CullingEfficiency, block_lists_per_pixel, culling_efficiency, depth_bounded_lists, depth_masked_lists,
+    exact_pixel_lists, pixel_grid,
 };
 use manylight_render::{FrameReport, FrameSettings, FrameSnapshot, PipelineKind};
 use manylight_scene::{AnimatedLight, Scene};
@@ -37,6 +38,8 @@ struct FrameLists {
     assignment: manylight_core::cluster::ClusterAssignment,
     spheres: Vec<manylight_core::cluster::ViewSphere>,
     depth: Vec<f32>,
+    /// The per-block refined lists, when the frame refined its lists.
+    refined: Option<manylight_render::clusters::RefinedLists>,
 }
 
 /// Renders `snapshot` and reads back view 0's cluster grid, lists, light spheres and depth.
@@ -47,15 +50,17 @@ fn render_and_read_lists(renderer: &mut HeadlessRenderer, snapshot: FrameSnapsho
     let clusters =
         r.view_clusters(0).context("the frame built no clusters (naive pipeline, or no lights)")?;
     let assignment = clusters.read_assignment(&r.gpu)?;
+    let refined = clusters.read_refined(&r.gpu)?;
     let (_, _, depth) = r.read_depth()?.context("the frame has no depth buffer")?;
     let (grid, spheres) = (clusters.grid, clusters.view_spheres.clone());
-    Ok(FrameLists { report, projection, grid, assignment, spheres, depth })
+    Ok(FrameLists { report, projection, grid, assignment, spheres, depth, refined })
 }
 
 /// The culling efficiency of a frame's lists, and of the lists per-cluster depth bounds would
 /// make of them (`depth_bounded_lists`: measured, not built).
 pub struct Culling {
-    /// The lists the frame shades from (its cluster lists; tiled deferred: cut by its depth masks).
+    /// The lists the frame shades from (its cluster lists; with refined lists, each pixel's
+    /// block's list or its cluster's; tiled deferred: cut by its depth masks).
     pub lists: CullingEfficiency,
     /// The same lists cut to each cluster's depth range of pixels.
     pub depth_bounded: CullingEfficiency,
@@ -64,8 +69,8 @@ pub struct Culling {
 /// Renders `snapshot` and measures the culling efficiency of the lists its shading evaluates
 /// against its depth buffer, and of its cluster lists cut by per-cluster depth bounds (every
 /// 64th covered pixel is also checked against all lights). Tiled deferred shades from its tile
-/// lists cut by each tile's depth mask (`depth_masked_lists`, as its shader does); every other
-/// pipeline from its cluster lists.
+/// lists cut by each tile's depth mask (`depth_masked_lists`, as its shader does); a frame with
+/// refined lists from its blocks' lists (read back); every other frame from its cluster lists.
 pub fn measure_culling(
     renderer: &mut HeadlessRenderer,
     snapshot: FrameSnapshot,
@@ -73,13 +78,31 @@ pub fn measure_culling(
     let test = snapshot.settings.render.clusters.cull;
     let tiled = snapshot.settings.render.pipeline == PipelineKind::TiledDeferred;
     let f = render_and_read_lists(renderer, snapshot)?;
-    let shaded = if tiled {
+    let lists = if tiled {
         let cells = manylight_render::gpu_types::TILED_DEPTH_CELLS;
-        &depth_masked_lists(&f.grid, &f.projection, &f.assignment, &f.spheres, &f.depth, cells)
+        let masked = depth_masked_lists(&f.grid, &f.projection, &f.assignment, &f.spheres, &f.depth, cells);
+        culling_efficiency(&f.grid, &f.projection, &masked, &f.spheres, &f.depth, 64)
+    } else if let Some(refined) = &f.refined {
+        use manylight_render::gpu_types::{REFINE_EDGE, REFINED_FALLBACK};
+        let blocks = ClusterAssignment {
+            ranges: refined.ranges.clone(),
+            indices: refined.indices.clone(),
+            ..Default::default()
+        };
+        let per_pixel = block_lists_per_pixel(
+            &f.grid,
+            &f.projection,
+            &f.assignment,
+            &f.depth,
+            REFINE_EDGE,
+            &blocks,
+            REFINED_FALLBACK,
+        );
+        let pixels = pixel_grid(f.grid.viewport, &f.projection);
+        culling_efficiency(&pixels, &f.projection, &per_pixel, &f.spheres, &f.depth, 64)
     } else {
-        &f.assignment
+        culling_efficiency(&f.grid, &f.projection, &f.assignment, &f.spheres, &f.depth, 64)
     };
-    let lists = culling_efficiency(&f.grid, &f.projection, shaded, &f.spheres, &f.depth, 64);
     let bounded = depth_bounded_lists(&f.grid, &f.projection, &f.assignment, &f.spheres, &f.depth, test);
     let depth_bounded = culling_efficiency(&f.grid, &f.projection, &bounded, &f.spheres, &f.depth, 64);
     Ok((f.report, Culling { lists, depth_bounded }))

@@ -247,6 +247,124 @@ pub fn depth_masked_lists(
     out
 }
 
+/// Blocks across and down of `edge`-pixel blocks over `viewport` (the last row and column cut
+/// by the viewport); block `(x / edge, y / edge)` holds pixel `(x, y)`, row-major.
+pub fn block_dims(viewport: glam::UVec2, edge: u32) -> glam::UVec2 {
+    viewport.max(glam::UVec2::ONE).map(|v| v.div_ceil(edge.max(1)))
+}
+
+/// How [`refined_lists`] makes its blocks and their boxes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Refinement {
+    /// Pixels along a block's edge.
+    pub edge: u32,
+    /// Relative widening of a block's box (see [`refined_lists`]).
+    pub slack: f32,
+    /// Added to each pixel's distance before `slack` scales it.
+    pub offset: f32,
+}
+
+/// **Refined light lists** (`shaders/light_refine.wgsl` in the renderer): per block of `edge` ×
+/// `edge` pixels ([`block_dims`], row-major; `edge`, `slack` and `offset` from `refinement`), the lights of its pixels' cluster lists (each
+/// once, in order of first mention) whose sphere reaches the view-space box around the block's
+/// pixel positions, widened on every axis by `slack` × (each pixel's distance + `offset`; the
+/// renderer's `offset` is the camera's distance from the world origin). The candidates are the
+/// lists of the box of clusters (tiles and slices) its pixels' widened distances fall in, as
+/// the renderer takes them. Blocks
+/// without a pixel keep none. Conservative: a pixel's position lies in its block's box, so a
+/// light containing it reaches the box, and is in its cluster's list.
+pub fn refined_lists(
+    grid: &ClusterGrid,
+    projection: &Projection,
+    assignment: &ClusterAssignment,
+    lights: &[ViewSphere],
+    depth: &[f32],
+    refinement: Refinement,
+) -> ClusterAssignment {
+    let Refinement { edge, slack, offset } = refinement;
+    let (viewport, edge) = (grid.viewport.max(glam::UVec2::ONE), edge.max(1));
+    let dims = block_dims(viewport, edge);
+    let count = (dims.x * dims.y) as usize;
+    let mut boxes = vec![(Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)); count];
+    // Per block, the box of clusters (tile x, y and slice) its pixels' widened distances fall in.
+    let mut cluster_box = vec![(glam::UVec3::MAX, glam::UVec3::ZERO); count];
+    for_each_covered_pixel(grid, projection, depth, |index, q, _| {
+        let (x, y) = (index as u32 % viewport.x, index as u32 / viewport.x);
+        let b = (x / edge + y / edge * dims.x) as usize;
+        let s = slack * (q.z.abs() + offset);
+        boxes[b] = (boxes[b].0.min(q - s), boxes[b].1.max(q + s));
+        let px = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+        for d in [(-q.z - s).max(0.0), -q.z + s] {
+            let k = grid.coords(grid.cluster_of(px, d));
+            cluster_box[b] = (cluster_box[b].0.min(k), cluster_box[b].1.max(k));
+        }
+    });
+    let clusters: Vec<Vec<u32>> = cluster_box
+        .iter()
+        .map(|&(lo, hi)| {
+            let mut cs = Vec::new();
+            for z in lo.z..=hi.z {
+                for y in lo.y..=hi.y {
+                    for x in lo.x..=hi.x {
+                        cs.push(grid.index(x, y, z));
+                    }
+                }
+            }
+            cs
+        })
+        .collect();
+    let mut out = ClusterAssignment { ranges: Vec::with_capacity(count), ..Default::default() };
+    let mut seen = vec![u32::MAX; lights.len()];
+    for (b, (&(min, max), cs)) in boxes.iter().zip(&clusters).enumerate() {
+        let offset = out.indices.len() as u32;
+        for &l in cs.iter().flat_map(|&c| assignment.lights_of(c)) {
+            let Some(s) = lights.get(l as usize) else { continue };
+            if seen[l as usize] != b as u32
+                && crate::cluster::sphere_intersects_aabb(s.center, s.radius, min, max)
+            {
+                seen[l as usize] = b as u32;
+                out.indices.push(l);
+            }
+        }
+        out.ranges.push([offset, out.indices.len() as u32 - offset]);
+    }
+    out
+}
+
+/// The list every pixel shades from when `edge`-pixel blocks have lists of their own
+/// (`blocks`, as [`refined_lists`] makes them): its block's, or, for a block whose count is
+/// `fallback`, its cluster's in `assignment`. An assignment over [`pixel_grid`] (for
+/// [`culling_efficiency`]); background pixels keep none.
+pub fn block_lists_per_pixel(
+    grid: &ClusterGrid,
+    projection: &Projection,
+    assignment: &ClusterAssignment,
+    depth: &[f32],
+    edge: u32,
+    blocks: &ClusterAssignment,
+    fallback: u32,
+) -> ClusterAssignment {
+    let (viewport, edge) = (grid.viewport.max(glam::UVec2::ONE), edge.max(1));
+    let dims = block_dims(viewport, edge);
+    // The block lists, then the cluster lists.
+    let mut indices = blocks.indices.clone();
+    let cluster_base = indices.len() as u32;
+    indices.extend_from_slice(&assignment.indices);
+    let mut ranges = vec![[0u32; 2]; (viewport.x * viewport.y) as usize];
+    for_each_covered_pixel(grid, projection, depth, |index, _, cluster| {
+        let (x, y) = (index as u32 % viewport.x, index as u32 / viewport.x);
+        let block = blocks.ranges.get((x / edge + y / edge * dims.x) as usize).copied();
+        ranges[index] = match block {
+            Some(r) if r[1] != fallback => r,
+            _ => {
+                let r = assignment.ranges.get(cluster as usize).copied().unwrap_or_default();
+                [cluster_base + r[0], r[1]]
+            }
+        };
+    });
+    ClusterAssignment { ranges, indices, dropped_pairs: 0, clusters_overflowed: 0 }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -333,6 +451,39 @@ mod tests {
             let e = culling_efficiency(&grid, &projection, lists, &lights, &depth, 1);
             let all = culling_efficiency(&grid, &projection, &assignment, &lights, &depth, 1);
             assert_eq!((e.missed_pairs, e.contributing_pairs), (0, all.contributing_pairs));
+        }
+    }
+
+    /// A wall 4 units away filling the 8×4 view, a small light in front of its leftmost pixels:
+    /// its 4-px tile's clusters list it for all 16 of their pixels, 2-px blocks only where it
+    /// reaches their box, and nothing that lights a pixel is missing, with or without a block
+    /// sent back to its cluster lists.
+    #[test]
+    fn refined_lists_cut_to_the_blocks_a_light_reaches() {
+        let (grid, projection, depth_of) = small_view();
+        let depth = vec![depth_of(4.0); 32];
+        let left = projection.view_position(glam::Vec2::new(-0.875, 0.75), depth_of(4.0), 2.0);
+        let lights = [ViewSphere { center: left + glam::Vec3::new(0.0, 0.0, 0.05), radius: 0.2 }];
+        let assignment = assign_lights(&grid, &lights, CullTest::Both, None);
+        let refinement = Refinement { edge: 2, slack: 1e-5, offset: 0.0 };
+        let blocks = refined_lists(&grid, &projection, &assignment, &lights, &depth, refinement);
+        assert_eq!(block_dims(grid.viewport, 2), glam::UVec2::new(4, 2));
+        assert_eq!(blocks.ranges.len(), 8);
+        assert_eq!(blocks.lights_of(0), [0], "the block holding the light's pixel");
+        assert!(blocks.lights_of(3).is_empty() && blocks.lights_of(7).is_empty(), "far blocks");
+        let pixels = pixel_grid(grid.viewport, &projection);
+        let whole = culling_efficiency(&grid, &projection, &assignment, &lights, &depth, 1);
+        for fallback_block in [None, Some(0usize)] {
+            let mut b = blocks.clone();
+            if let Some(i) = fallback_block {
+                b.ranges[i][1] = u32::MAX;
+            }
+            let per_pixel = block_lists_per_pixel(&grid, &projection, &assignment, &depth, 2, &b, u32::MAX);
+            let e = culling_efficiency(&pixels, &projection, &per_pixel, &lights, &depth, 1);
+            assert_eq!(e.missed_pairs, 0, "{fallback_block:?}");
+            assert_eq!(e.contributing_pairs, whole.contributing_pairs);
+            assert!(e.contributing_pairs > 0);
+            assert!(e.evaluated_pairs < whole.evaluated_pairs, "{e:?} vs {whole:?}");
         }
     }
 

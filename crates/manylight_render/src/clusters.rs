@@ -8,7 +8,7 @@
 use crate::context::{GpuContext, RenderError};
 use crate::gpu_types::{
     CLUSTER_NO_CAP, CULL_AABB, CULL_BOTH, CULL_PLANES, GpuClusterBounds, GpuClusterCounters,
-    GpuClusterParams, TILE_LIGHT_CHUNK,
+    GpuClusterParams, REFINE_EDGE, REFINED_LIST_SLOTS, TILE_LIGHT_CHUNK,
 };
 use crate::layouts::{storage_entry, uniform_entry};
 use crate::pool::GrowableBuffer;
@@ -91,6 +91,38 @@ impl ClusterReport {
     }
 }
 
+/// How a view's lists are built beyond the grid and culling test (from its plan).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ListOptions {
+    /// The build cuts clusters to their pixels' depth range
+    /// (`PlanInputs::bounds_clusters_by_depth`).
+    pub depth_bounds: bool,
+    /// The `light_refine` pass refines the lists per pixel block
+    /// (`PlanInputs::refines_lists`).
+    pub refined_lists: bool,
+}
+
+impl ListOptions {
+    /// The options `inputs` plan for.
+    pub fn of(inputs: &crate::plan::PlanInputs<'_>) -> ListOptions {
+        ListOptions { depth_bounds: inputs.bounds_clusters_by_depth(), refined_lists: inputs.refines_lists() }
+    }
+}
+
+/// The refined lists of a frame, read back (`ClusterResources::read_refined`): per block of
+/// `REFINE_EDGE` × `REFINE_EDGE` pixels (row-major, `blocks` across and down) its
+/// `(offset, count)` into `indices`, or a count of `REFINED_FALLBACK` when its pixels shade
+/// from their cluster lists.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RefinedLists {
+    /// Blocks across and down.
+    pub blocks: glam::UVec2,
+    /// Per block `(offset, count)`, offsets into `indices`.
+    pub ranges: Vec<[u32; 2]>,
+    /// The blocks' light indices.
+    pub indices: Vec<u32>,
+}
+
 /// GPU buffers and bind groups of the cluster build and of clustered shading.
 pub struct ClusterResources {
     /// The grid of the current frame.
@@ -104,6 +136,9 @@ pub struct ClusterResources {
     /// Layout of group 2 of the `cluster_depth` pass (`shaders/cluster_depth.wgsl`): params, and
     /// the ranges buffer, whose per-cluster depth ranges it writes after the cluster ranges.
     pub depth_layout: wgpu::BindGroupLayout,
+    /// Layout of group 2 of the `light_refine` pass (`shaders/light_refine.wgsl`): params, the
+    /// light spheres, and the ranges and index buffers, whose refined part it writes.
+    pub refine_layout: wgpu::BindGroupLayout,
     /// Group 0 of the build.
     pub build_bind_group: wgpu::BindGroup,
     /// The shading group.
@@ -111,12 +146,15 @@ pub struct ClusterResources {
     /// The params uniform.
     pub params_buffer: wgpu::Buffer,
     /// Per-cluster `(offset, count)`, then (with depth bounds) per-cluster depth ranges
-    /// (`shaders/cluster_depth.wgsl`).
+    /// (`shaders/cluster_depth.wgsl`), then (with refined lists) per-block ranges
+    /// (`shaders/light_refine.wgsl`).
     pub ranges: GrowableBuffer,
-    /// The light-index list.
+    /// The light-index list: the cluster lists (`GpuClusterParams::index_capacity` entries),
+    /// then (with refined lists) `REFINED_LIST_SLOTS` entries per block.
     pub indices: GrowableBuffer,
     bounds: GrowableBuffer,
-    spheres: GrowableBuffer,
+    /// The lights' view-space spheres (centre, radius).
+    pub spheres: GrowableBuffer,
     /// Bounds of the tile columns, then of the coarse tiles.
     tile_bounds: GrowableBuffer,
     /// (tile, chunk) ranges, then (coarse tile, chunk) ranges.
@@ -139,6 +177,8 @@ pub struct ClusterResources {
     cull: CullTest,
     /// The build cuts clusters to their pixels' depth range this frame.
     depth_bounds: bool,
+    /// Blocks across and down of this frame's refined lists, `None` without them.
+    refine_blocks: Option<glam::UVec2>,
 }
 
 /// Initial entries of the cluster light-index list (it grows as frames need).
@@ -175,10 +215,19 @@ impl ClusterResources {
             label: Some("cluster_depth"),
             entries: &[storage_entry(0, compute, true), storage_entry(1, compute, false)],
         });
+        let refine_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("light_refine"),
+            entries: &[
+                storage_entry(0, compute, true),
+                storage_entry(1, compute, true),
+                storage_entry(2, compute, false),
+                storage_entry(3, compute, false),
+            ],
+        });
         let params_buffer = gpu.create_buffer(&wgpu::BufferDescriptor {
             label: Some("cluster_params"),
             size: std::mem::size_of::<GpuClusterParams>() as u64,
-            // Also bound as storage by the `cluster_depth` pass (shaders/cluster_depth.wgsl).
+            // Also bound as storage by the `cluster_depth` and `light_refine` passes.
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -221,6 +270,7 @@ impl ClusterResources {
             build_layout,
             shading_layout,
             depth_layout,
+            refine_layout,
             build_bind_group,
             shading_bind_group,
             params_buffer,
@@ -240,6 +290,7 @@ impl ClusterResources {
             bound_cpu_ms: 0.0,
             cull: CullTest::default(),
             depth_bounds: false,
+            refine_blocks: None,
         }
     }
 
@@ -312,18 +363,21 @@ impl ClusterResources {
 
     /// Uploads the grid bounds (when the grid changed), the lights' view-space spheres and the
     /// parameters, and zeroes the counters. `lights` are the (position, radius) pairs in the
-    /// order of the light buffer; `depth_bounds`: the build cuts clusters to their pixels'
-    /// depth range (`PlanInputs::bounds_clusters_by_depth`).
+    /// order of the light buffer; `options`: depth bounds and refined lists, from the view's
+    /// plan.
     pub fn prepare(
         &mut self,
         gpu: &GpuContext,
         view: &RenderView,
         view_from_world: &Mat4,
         lights: &[(glam::Vec3, f32)],
-        depth_bounds: bool,
+        options: ListOptions,
     ) -> Result<(), RenderError> {
         let settings = &view.settings.clusters;
+        let depth_bounds = options.depth_bounds;
         self.depth_bounds = depth_bounds;
+        self.refine_blocks =
+            options.refined_lists.then(|| view.size.max(glam::UVec2::ONE).map(|v| v.div_ceil(REFINE_EDGE)));
         let grid_config = settings.grid_for(view.settings.pipeline);
         let projection = self.place_lights(view, view_from_world, lights);
         self.grid = ClusterGrid::new(view.size, &projection, &grid_config);
@@ -385,8 +439,10 @@ impl ClusterResources {
         } else {
             self.spheres.write(gpu, bytemuck::cast_slice(&spheres))?;
         }
-        // The cluster ranges, then (with depth bounds) the depth ranges of the clusters.
-        self.ranges.reserve(gpu, count as u64 * if depth_bounds { 16 } else { 8 })?;
+        // The cluster ranges, then (with depth bounds) the depth ranges of the clusters, then
+        // (with refined lists) the blocks' ranges.
+        let cluster_ranges = count as u64 * if depth_bounds { 16 } else { 8 };
+        self.ranges.reserve(gpu, cluster_ranges + self.refined_blocks() * 8)?;
         // Lists sized before the frame is submitted, from a CPU bound of what the build can
         // write (`list_bounds`): the GPU lists cannot overflow, so the frame is never rendered
         // twice. A bound beyond what the device can bind reserves what it can; then the build's
@@ -405,7 +461,9 @@ impl ClusterResources {
                 bytes(entries + entries / 4, buffer)
             }
         };
-        self.indices.reserve(gpu, with_headroom(self.bounds_estimate.cluster_pairs, &self.indices))?;
+        // The refined lists' slots follow the cluster lists.
+        let entries = self.bounds_estimate.cluster_pairs + self.refined_entries();
+        self.indices.reserve(gpu, with_headroom(entries, &self.indices))?;
         // The tile and coarse-tile lists share a buffer; the spare room is split between them.
         let (tile_need, coarse_need) =
             (self.bounds_estimate.tile_entries, self.bounds_estimate.coarse_entries);
@@ -417,6 +475,21 @@ impl ClusterResources {
         let cap = settings.cap.unwrap_or(CLUSTER_NO_CAP);
         self.write_params(gpu, view, spheres.len() as u32, cap, tile_chunks);
         Ok(())
+    }
+
+    /// Blocks of this frame's refined lists (0 without them).
+    fn refined_blocks(&self) -> u64 {
+        self.refine_blocks.map_or(0, |b| u64::from(b.x) * u64::from(b.y))
+    }
+
+    /// Entries of the index list this frame's refined lists take, after the cluster lists.
+    fn refined_entries(&self) -> u64 {
+        self.refined_blocks() * u64::from(REFINED_LIST_SLOTS)
+    }
+
+    /// Entries of the index list the cluster lists can take (what the refined lists leave).
+    fn cluster_index_capacity(&self) -> u32 {
+        (self.indices.capacity() / 4).saturating_sub(self.refined_entries()).min(u64::from(u32::MAX)) as u32
     }
 
     /// Coarse tiles across and down this frame, `None` without a coarse level.
@@ -459,6 +532,7 @@ impl ClusterResources {
         tile_chunks: u32,
     ) {
         let (near, far) = (self.grid.near, self.grid.far);
+        let count_ranges = self.grid.cluster_count() * if self.depth_bounds { 2 } else { 1 };
         let (tile_lists, coarse_lists) =
             self.tile_list_split(self.bounds_estimate.tile_entries, self.bounds_estimate.coarse_entries);
         self.params = GpuClusterParams {
@@ -471,7 +545,7 @@ impl ClusterResources {
                 CullTest::Planes => CULL_PLANES,
                 CullTest::Both => CULL_BOTH,
             },
-            index_capacity: (self.indices.capacity() / 4).min(u32::MAX as u64) as u32,
+            index_capacity: self.cluster_index_capacity(),
             slicing: self.grid.slicing.gpu_id(),
             log_far_over_near: (far / near).ln(),
             tile_index_capacity: tile_lists,
@@ -480,7 +554,9 @@ impl ClusterResources {
             coarse_index_capacity: coarse_lists,
             coarse_span: self.coarse.unwrap_or(0),
             depth_bounds: u32::from(self.depth_bounds),
-            _pad: [0; 3],
+            refine_blocks_x: self.refine_blocks.map_or(0, |b| b.x),
+            refine_blocks_y: self.refine_blocks.map_or(0, |b| b.y),
+            refined_first: count_ranges,
         };
         gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
         gpu.queue.write_buffer(&self.counters, 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
@@ -525,6 +601,7 @@ impl ClusterResources {
         self.bounds_estimate = ListBounds { cluster_pairs: entries, ..ListBounds::default() };
         self.bound_cpu_ms = 0.0;
         self.depth_bounds = false;
+        self.refine_blocks = None;
         self.write_params(gpu, view, lights.len() as u32, CLUSTER_NO_CAP, 1);
         Ok(())
     }
@@ -590,8 +667,8 @@ impl ClusterResources {
                 self.tile_list_split(tiles, coarse);
         }
         if clusters_short {
-            self.indices.reserve(gpu, counters.total_entries as u64 * 4)?;
-            self.params.index_capacity = (self.indices.capacity() / 4).min(u32::MAX as u64) as u32;
+            self.indices.reserve(gpu, (counters.total_entries as u64 + self.refined_entries()) * 4)?;
+            self.params.index_capacity = self.cluster_index_capacity();
         }
         gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
         gpu.queue.write_buffer(&self.counters, 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
@@ -643,6 +720,31 @@ impl ClusterResources {
             &self.tile_indices,
         ];
         growable.iter().map(|b| b.capacity()).sum::<u64>() + self.params_buffer.size() + self.counters.size()
+    }
+
+    /// Reads the refined lists of the last submitted view back (waits for the GPU); `None` when
+    /// the view did not refine its lists.
+    pub fn read_refined(&self, gpu: &GpuContext) -> Result<Option<RefinedLists>, RenderError> {
+        let Some(blocks) = self.refine_blocks else {
+            return Ok(None);
+        };
+        let n = self.refined_blocks();
+        let first = u64::from(self.params.refined_first) * 8;
+        let mut ranges: Vec<[u32; 2]> =
+            bytemuck::pod_collect_to_vec(&read_buffer(gpu, self.ranges.buffer(), first, n * 8)?);
+        let base = u64::from(self.params.index_capacity);
+        let indices: Vec<u32> = bytemuck::pod_collect_to_vec(&read_buffer(
+            gpu,
+            self.indices.buffer(),
+            base * 4,
+            self.refined_entries() * 4,
+        )?);
+        for r in &mut ranges {
+            if r[1] != crate::gpu_types::REFINED_FALLBACK {
+                r[0] = r[0].saturating_sub(base as u32);
+            }
+        }
+        Ok(Some(RefinedLists { blocks, ranges, indices }))
     }
 
     /// Reads the GPU's assignment back into the CPU structure (tests compare it with

@@ -50,6 +50,29 @@ pub const TILED_DEPTH_CELLS: u32 = 32;
 /// `d ± CLUSTER_DEPTH_SLACK · d`.
 pub const CLUSTER_DEPTH_SLACK: f32 = 1e-3;
 
+/// Refined light lists (`shaders/light_refine.wgsl`): pixels along each edge of a block, the
+/// unit a refined list is kept for.
+pub const REFINE_EDGE: u32 = 4;
+/// Refined light lists: the most lights a block's list holds; a block whose pixels need more
+/// shades from its pixels' cluster lists ([`REFINED_FALLBACK`]).
+pub const REFINED_LIST_SLOTS: u32 = 16;
+/// Refined light lists: the most cluster-list entries a block tests (all the clusters its
+/// pixels fall in together); a block with more shades from its cluster lists. Keeps an
+/// invocation well inside lavapipe's loop limit ([`LAVAPIPE_LOOP_LIMIT`]) with the duplicate
+/// checks across up to [`REFINE_MAX_CLUSTERS`] lists.
+pub const REFINE_CANDIDATE_LIMIT: u32 = 1024;
+/// Refined light lists: the most clusters a block's pixels may fall in; a block spanning more
+/// shades from its cluster lists.
+pub const REFINE_MAX_CLUSTERS: u32 = 4;
+/// Refined light lists: a block's box around its pixels' positions is widened on every axis by
+/// `REFINE_SLACK · (d + |camera|)` (`d` a pixel's view distance, `|camera|` the camera's
+/// distance from the world origin): the shading pass computes each position again, in world
+/// space, from the same data, which agrees to rounding of those magnitudes (a few 1e-7
+/// relative); this is about 80 times that.
+pub const REFINE_SLACK: f32 = 1e-5;
+/// The count of a block's refined range that sends its pixels to their cluster lists.
+pub const REFINED_FALLBACK: u32 = u32::MAX;
+
 /// Workgroup size of the prefix-sum step of the cluster build (one workgroup scans all).
 pub const SCAN_WORKGROUP_SIZE: u32 = 256;
 /// `GpuClusterParams::cull_test` values.
@@ -88,6 +111,11 @@ pub fn shared_u32_constants() -> Vec<(&'static str, u32)> {
         ("TILED_EDGE", TILED_EDGE),
         ("TILED_LIST_CAPACITY", TILED_LIST_CAPACITY),
         ("TILED_DEPTH_CELLS", TILED_DEPTH_CELLS),
+        ("REFINE_EDGE", REFINE_EDGE),
+        ("REFINED_LIST_SLOTS", REFINED_LIST_SLOTS),
+        ("REFINE_CANDIDATE_LIMIT", REFINE_CANDIDATE_LIMIT),
+        ("REFINE_MAX_CLUSTERS", REFINE_MAX_CLUSTERS),
+        ("REFINED_FALLBACK", REFINED_FALLBACK),
         ("CULL_AABB", CULL_AABB),
         ("CULL_PLANES", CULL_PLANES),
         ("CULL_BOTH", CULL_BOTH),
@@ -314,6 +342,7 @@ pub fn shared_f32_constants() -> Vec<(&'static str, f32)> {
     vec![
         ("RADIUS_INFLATION", manylight_core::cluster::RADIUS_INFLATION),
         ("CLUSTER_DEPTH_SLACK", CLUSTER_DEPTH_SLACK),
+        ("REFINE_SLACK", REFINE_SLACK),
         ("LIGHT_MIN_DISTANCE", manylight_core::attenuation::LIGHT_MIN_DISTANCE),
         ("TILE_PREFILTER_INFLATION", manylight_core::cluster::TILE_PREFILTER_INFLATION),
         ("TOON_RIM_STRENGTH", manylight_core::material::TOON_RIM_STRENGTH),
@@ -359,8 +388,15 @@ pub struct GpuClusterParams {
     /// 1 when the cluster level cuts each cluster to its pixels' depth range (written after the
     /// cluster ranges by `shaders/cluster_depth.wgsl`), 0 for whole slices.
     pub depth_bounds: u32,
-    /// Padding to 16 bytes.
-    pub _pad: [u32; 3],
+    /// Blocks across of the refined light lists (`shaders/light_refine.wgsl`), 0 when the view
+    /// does not refine its lists.
+    pub refine_blocks_x: u32,
+    /// Blocks down of the refined light lists, 0 when the view does not refine its lists.
+    pub refine_blocks_y: u32,
+    /// Index in the ranges buffer of block 0's refined range (after the cluster ranges and,
+    /// with depth bounds, their depth ranges); the blocks' lists follow the `index_capacity`
+    /// entries of the cluster lists, [`REFINED_LIST_SLOTS`] entries each.
+    pub refined_first: u32,
 }
 
 /// Bounds of one cluster in view space (`GpuClusterBounds` in `shaders/common/clusters.wgsl`).

@@ -78,6 +78,28 @@ impl PlanInputs<'_> {
             && (self.shades_deferred() || self.runs_depth_prepass())
     }
 
+    /// True when the view refines its cluster lists per pixel block after the build
+    /// ([`crate::snapshot::ClusterSettings::refined_lists`]): under the same conditions as
+    /// [`Self::bounds_clusters_by_depth`] (every shaded fragment's distance is known before
+    /// shading), except tiled deferred, whose lighting pass cuts its tile lists itself.
+    pub fn refines_lists(&self) -> bool {
+        let s = self.settings();
+        s.clusters.refined_lists
+            && s.pipeline != PipelineKind::TiledDeferred
+            && self.shades_with_clusters()
+            && self.shows_image()
+            && !self.has_blended
+            && !self.has_pixel_lists
+            && (self.shades_deferred() || self.runs_depth_prepass())
+    }
+
+    /// True when the depth pre-pass also writes each pixel's shading distance
+    /// ([`crate::passes::SHADING_DISTANCE`]): a forward view bounding its clusters by depth or
+    /// refining its lists.
+    pub fn prepass_writes_distance(&self) -> bool {
+        self.runs_depth_prepass() && (self.bounds_clusters_by_depth() || self.refines_lists())
+    }
+
     /// True when no debug view replaces the image (post stages run).
     pub fn shows_image(&self) -> bool {
         self.settings().debug_view == DebugViewMode::None

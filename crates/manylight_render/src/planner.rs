@@ -7,10 +7,11 @@ use crate::passes;
 use crate::plan::{PlanInputs, Planner};
 
 /// The stages, in order: each pass module's `plan` function.
-pub const STAGES: [(&str, Planner); 14] = [
+pub const STAGES: [(&str, Planner); 15] = [
     ("depth_prepass", passes::depth_prepass::plan),
     ("cluster_depth", passes::cluster_depth::plan),
     ("cluster_build", passes::cluster_build::plan),
+    ("light_refine", passes::light_refine::plan),
     ("forward", passes::forward::plan),
     ("clustered_forward", passes::clustered_forward::plan),
     ("gbuffer", passes::gbuffer::plan),

@@ -105,13 +105,13 @@ impl Renderer {
     /// Writes one view's constants and, when it needs them, its cluster grid and light
     /// spheres (before the view is executed; views run one after the other).
     /// `has_lights`: the frame has a valid light ([`FrameSnapshot::has_lights`]);
-    /// `depth_bounds`: the build cuts clusters to their pixels' depth range
-    /// ([`crate::PlanInputs::bounds_clusters_by_depth`]).
+    /// `options`: depth bounds and refined lists, from the view's plan
+    /// ([`ListOptions::of`](crate::clusters::ListOptions::of)).
     pub fn prepare_view(
         &mut self,
         view: &RenderView,
         has_lights: bool,
-        depth_bounds: bool,
+        options: crate::clusters::ListOptions,
     ) -> Result<(), RenderError> {
         self.scene.prepare_view(&self.gpu, view);
         if view.needs_clusters(has_lights) {
@@ -129,9 +129,7 @@ impl Renderer {
                     &self.scene.light_spheres,
                     lists,
                 )?,
-                None => {
-                    clusters.prepare(gpu, view, &view_from_world, &self.scene.light_spheres, depth_bounds)?
-                }
+                None => clusters.prepare(gpu, view, &view_from_world, &self.scene.light_spheres, options)?,
             }
         }
         Ok(())

@@ -279,6 +279,14 @@ pub struct ClusterSettings {
     /// depth buffer does not hold) and without a debug view (`PlanInputs::bounds_clusters_by_depth`).
     /// On by default (`docs/benchmarks.md`, "Per-cluster depth bounds").
     pub depth_bounds: bool,
+    /// Refine the lists per block of `REFINE_EDGE` × `REFINE_EDGE` pixels after the build
+    /// (`light_refine` pass): each block keeps the lights of its pixels' cluster lists that
+    /// reach the box around its pixels' surface positions, and shades from that list (a block
+    /// whose list would be long shades from its cluster lists). Applies where per-cluster depth
+    /// bounds can (`PlanInputs::refines_lists`), in every tiled and clustered pipeline but
+    /// tiled deferred (which refines its tiles itself). Off by default
+    /// (`docs/benchmarks.md`, "Refined light lists").
+    pub refined_lists: bool,
 }
 
 impl Default for ClusterSettings {
@@ -291,6 +299,7 @@ impl Default for ClusterSettings {
             workgroup_size: 64,
             coarse_tiles: DEFAULT_COARSE_TILES,
             depth_bounds: true,
+            refined_lists: false,
         }
     }
 }

@@ -199,7 +199,9 @@ fn shared_structs_match_rust() {
             ("coarse_index_capacity", offset_of!(GpuClusterParams, coarse_index_capacity)),
             ("coarse_span", offset_of!(GpuClusterParams, coarse_span)),
             ("depth_bounds", offset_of!(GpuClusterParams, depth_bounds)),
-            ("_pad0", offset_of!(GpuClusterParams, _pad)),
+            ("refine_blocks_x", offset_of!(GpuClusterParams, refine_blocks_x)),
+            ("refine_blocks_y", offset_of!(GpuClusterParams, refine_blocks_y)),
+            ("refined_first", offset_of!(GpuClusterParams, refined_first)),
         ],
     );
 }

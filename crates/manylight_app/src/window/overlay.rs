@@ -353,6 +353,7 @@ fn clusters_ui(ui: &mut egui::Ui, world: &mut World) {
     combo(ui, "cull test", &mut s.clusters.cull, &CullTest::ALL, CullTest::name);
     ui.checkbox(&mut s.clusters.depth_prepass, "depth pre-pass (clustered forward)");
     ui.checkbox(&mut s.clusters.depth_bounds, "per-cluster depth bounds");
+    ui.checkbox(&mut s.clusters.refined_lists, "refined light lists (4 × 4-px blocks)");
     ui.add(
         egui::Slider::new(&mut s.clusters.coarse_tiles, 0..=32)
             .text("coarse tiles (tiles per edge; 0: none)"),

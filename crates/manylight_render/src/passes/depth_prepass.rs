@@ -112,6 +112,6 @@ impl Pass for DepthPrepass {
 /// depth debug view.
 pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
     if p.runs_depth_prepass() || p.settings().debug_view == crate::snapshot::DebugViewMode::Depth {
-        out.push(Box::new(DepthPrepass { distance: p.bounds_clusters_by_depth() }));
+        out.push(Box::new(DepthPrepass { distance: p.prepass_writes_distance() }));
     }
 }

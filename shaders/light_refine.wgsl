@@ -1,0 +1,247 @@
+// Refined light lists: one compute pass after the cluster build, one invocation per block of
+// REFINE_EDGE × REFINE_EDGE pixels. A cluster is a whole tile deep in a depth slice; the lights
+// of a tile that reach a block's few surface points are far fewer when lights are small (a
+// light a few pixels wide on a 16-pixel tile). Each block:
+// 1. reads its pixels' shading distances (the depth pre-pass's `shading_distance`, or the
+//    G-buffer's stored position as deferred lighting reads it) and makes the view-space box
+//    around their surface positions, widened on every axis by REFINE_SLACK × (distance +
+//    the camera's distance from the origin) (the shading pass computes each position again,
+//    in world space, from the same data, which agrees to rounding), and the box of the
+//    clusters those widened distances fall in;
+// 2. keeps the lights of those clusters' lists whose sphere reaches the box (the cluster
+//    test's `sphere_intersects_aabb`), each once (a light in several of the clusters' lists,
+//    all in ascending light order, is kept from the first), in cluster order, in its
+//    REFINED_LIST_SLOTS slots after the cluster lists;
+// 3. writes its range after the cluster ranges: (offset, count), or a count of
+//    REFINED_FALLBACK when its pixels are to shade from their cluster lists: more than
+//    REFINED_LIST_SLOTS lights kept, more than REFINE_MAX_CLUSTERS clusters or
+//    REFINE_CANDIDATE_LIMIT list entries to test (which keeps the invocation far inside
+//    lavapipe's loop limit), or a distance that is not finite.
+// Exact as the cluster lists are: a light that lights a pixel reaches the pixel's position,
+// which lies in the block's box, and is in the list of the pixel's cluster.
+//!include common/view.wgsl
+//!include common/lights.wgsl
+//!include common/brdf.wgsl
+//!include common/clusters.wgsl
+
+// group 0, binding 0: `view`, declared in common/gbuffer_read.wgsl; group 1: the G-buffer
+//!include common/gbuffer_read.wgsl
+
+// Storage, not uniform: see cluster_depth.wgsl (lavapipe recompiles small shaders whose
+// uniforms change).
+@group(2) @binding(0) var<storage, read> cluster_params: ClusterParams;
+@group(2) @binding(1) var<storage, read> spheres: array<vec4<f32>>;
+@group(2) @binding(2) var<storage, read_write> ranges: array<vec2<u32>>;
+@group(2) @binding(3) var<storage, read_write> indices: array<u32>;
+
+// Forward pipelines: the depth pre-pass's shading distances (0: background).
+@group(1) @binding(9) var shading_distance: texture_2d<f32>;
+
+// The block being refined: the box around its pixels' positions, and the clusters they fall in.
+var<private> box_min: vec3<f32>;
+var<private> box_max: vec3<f32>;
+var<private> clusters_min: vec3<u32>;
+var<private> clusters_max: vec3<u32>;
+var<private> covered: bool;
+var<private> unbounded: bool;
+
+fn begin_block() {
+    box_min = vec3<f32>(3.0e38);
+    box_max = vec3<f32>(-3.0e38);
+    clusters_min = vec3<u32>(0xffffffffu);
+    clusters_max = vec3<u32>(0u);
+    covered = false;
+    unbounded = false;
+}
+
+// Pixel `i` (row-major) of block `b`.
+fn block_pixel(b: vec2<u32>, i: u32) -> vec2<u32> {
+    return b * REFINE_EDGE + vec2<u32>(i % REFINE_EDGE, i / REFINE_EDGE);
+}
+
+fn cluster_coords(c: u32) -> vec3<u32> {
+    let d = cluster_params.dims;
+    return vec3<u32>(c % d.x, (c / d.x) % d.y, c / (d.x * d.y));
+}
+
+// Adds the pixel `px` whose surface lies at view-space `q`.
+fn add_pixel(px: vec2<u32>, q: vec3<f32>) {
+    let d = -q.z;
+    if !all(abs(q) <= vec3<f32>(3.0e38)) {
+        unbounded = true;
+        return;
+    }
+    let s = REFINE_SLACK * (abs(d) + length(view.camera_position.xyz));
+    box_min = min(box_min, q - s);
+    box_max = max(box_max, q + s);
+    let frag = vec2<f32>(px) + 0.5;
+    let first = cluster_coords(cluster_index(cluster_params, frag, max(d - s, 0.0)));
+    let last = cluster_coords(cluster_index(cluster_params, frag, d + s));
+    clusters_min = min(clusters_min, min(first, last));
+    clusters_max = max(clusters_max, max(first, last));
+    covered = true;
+}
+
+// The linear index of the `k`-th cluster of the block's cluster box.
+fn box_cluster(k: u32) -> u32 {
+    let n = clusters_max - clusters_min + 1u;
+    let c = clusters_min + vec3<u32>(k % n.x, (k / n.x) % n.y, k / (n.x * n.y));
+    let d = cluster_params.dims;
+    return c.x + c.y * d.x + c.z * d.x * d.y;
+}
+
+// True when light `l` is in the (ascending) list `r`.
+fn list_holds(r: vec2<u32>, l: u32) -> bool {
+    var lo = 0u;
+    var hi = r.y;
+    while lo < hi {
+        let mid = (lo + hi) / 2u;
+        let v = indices[r.x + mid];
+        if v == l {
+            return true;
+        }
+        if v < l {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    return false;
+}
+
+// The block's list (steps 2 and 3 above), written at `slot`: its range.
+fn refine_lights(slot: u32) -> vec2<u32> {
+    let fallback = vec2<u32>(0u, REFINED_FALLBACK);
+    if !covered {
+        return vec2<u32>(slot, 0u);
+    }
+    if unbounded {
+        return fallback;
+    }
+    let n3 = clusters_max - clusters_min + 1u;
+    let n = n3.x * n3.y * n3.z;
+    if n > REFINE_MAX_CLUSTERS {
+        return fallback;
+    }
+    var candidates = 0u;
+    for (var k = 0u; k < n; k++) {
+        candidates += min(ranges[box_cluster(k)].y, REFINE_CANDIDATE_LIMIT + 1u);
+    }
+    if candidates > REFINE_CANDIDATE_LIMIT {
+        return fallback;
+    }
+    var count = 0u;
+    for (var k = 0u; k < n; k++) {
+        let r = ranges[box_cluster(k)];
+        for (var j = 0u; j < r.y; j++) {
+            let l = indices[r.x + j];
+            let s = spheres[l];
+            if !sphere_intersects_aabb(s.xyz, s.w, box_min, box_max) {
+                continue;
+            }
+            var seen = false;
+            for (var e = 0u; e < k && !seen; e++) {
+                seen = list_holds(ranges[box_cluster(e)], l);
+            }
+            if seen {
+                continue;
+            }
+            if count == REFINED_LIST_SLOTS {
+                return fallback;
+            }
+            indices[slot + count] = l;
+            count += 1u;
+        }
+    }
+    return vec2<u32>(slot, count);
+}
+
+// Writes block `b`'s range from the pixels added since `begin_block`.
+fn finish_block(b: vec2<u32>) {
+    let block = b.x + b.y * cluster_params.refine_blocks_x;
+    let slot = cluster_params.index_capacity + block * REFINED_LIST_SLOTS;
+    ranges[cluster_params.refined_first + block] = refine_lights(slot);
+}
+
+fn in_blocks(b: vec2<u32>) -> bool {
+    return b.x < cluster_params.refine_blocks_x && b.y < cluster_params.refine_blocks_y;
+}
+
+// The view-space position forward shading computes for a pixel at view distance `d`
+// (common/surface.wgsl's `surface_point`: on the ray through the pixel centre).
+fn forward_position(px: vec2<u32>, d: f32) -> vec3<f32> {
+    let ndc = frag_ndc(view, vec2<f32>(px) + 0.5);
+    let across = ndc / vec2<f32>(view.clip_from_view[0][0], view.clip_from_view[1][1]);
+    return vec3<f32>(across * select(d, 1.0, is_orthographic(view)), -d);
+}
+
+fn gbuffer_position(p: vec3<f32>) -> vec3<f32> {
+    return (view.view_from_world * vec4<f32>(p, 1.0)).xyz;
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_forward(@builtin(global_invocation_id) id: vec3<u32>) {
+    if !in_blocks(id.xy) {
+        return;
+    }
+    begin_block();
+    let size = textureDimensions(shading_distance);
+    for (var i = 0u; i < REFINE_EDGE * REFINE_EDGE; i++) {
+        let px = block_pixel(id.xy, i);
+        if all(px < size) {
+            let d = textureLoad(shading_distance, vec2<i32>(px), 0).r;
+            if d > 0.0 || !(abs(d) <= 3.0e38) {
+                add_pixel(px, forward_position(px, d));
+            }
+        }
+    }
+    finish_block(id.xy);
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_full(@builtin(global_invocation_id) id: vec3<u32>) {
+    if !in_blocks(id.xy) {
+        return;
+    }
+    begin_block();
+    let size = textureDimensions(gb_depth);
+    for (var i = 0u; i < REFINE_EDGE * REFINE_EDGE; i++) {
+        let px = block_pixel(id.xy, i);
+        if all(px < size) && gbuffer_depth(vec2<i32>(px)) > 0.0 {
+            add_pixel(px, gbuffer_position(gbuffer_read_full(vec2<i32>(px)).world_position));
+        }
+    }
+    finish_block(id.xy);
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_packed(@builtin(global_invocation_id) id: vec3<u32>) {
+    if !in_blocks(id.xy) {
+        return;
+    }
+    begin_block();
+    let size = textureDimensions(gb_depth);
+    for (var i = 0u; i < REFINE_EDGE * REFINE_EDGE; i++) {
+        let px = block_pixel(id.xy, i);
+        if all(px < size) && gbuffer_depth(vec2<i32>(px)) > 0.0 {
+            add_pixel(px, gbuffer_position(gbuffer_read_packed(vec2<i32>(px)).world_position));
+        }
+    }
+    finish_block(id.xy);
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_compact(@builtin(global_invocation_id) id: vec3<u32>) {
+    if !in_blocks(id.xy) {
+        return;
+    }
+    begin_block();
+    let size = textureDimensions(gb_depth);
+    for (var i = 0u; i < REFINE_EDGE * REFINE_EDGE; i++) {
+        let px = block_pixel(id.xy, i);
+        if all(px < size) && gbuffer_depth(vec2<i32>(px)) > 0.0 {
+            add_pixel(px, gbuffer_position(gbuffer_read_compact(vec2<i32>(px)).world_position));
+        }
+    }
+    finish_block(id.xy);
+}
