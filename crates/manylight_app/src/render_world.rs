@@ -633,9 +633,7 @@ fn prepare(
     view: Res<CurrentView>,
     mut outcome: ResMut<FrameOutcome>,
 ) {
-    let options = manylight_render::clusters::ListOptions::of(
-        &view.plan_inputs(manylight_render::resources::HDR_FORMAT),
-    );
+    let options = view.plan_inputs(manylight_render::resources::HDR_FORMAT).list_options();
     if let Err(e) = renderer.0.prepare_view(&view.0, view.has_lights(), options) {
         outcome.error.get_or_insert(e);
     }

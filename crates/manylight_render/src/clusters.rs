@@ -91,7 +91,8 @@ impl ClusterReport {
     }
 }
 
-/// How a view's lists are built beyond the grid and culling test (from its plan).
+/// How a view's lists are built beyond the grid and culling test (from its plan:
+/// [`PlanInputs::list_options`](crate::plan::PlanInputs::list_options)).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ListOptions {
     /// The build cuts clusters to their pixels' depth range
@@ -100,13 +101,6 @@ pub struct ListOptions {
     /// The `light_refine` pass refines the lists per pixel block
     /// (`PlanInputs::refines_lists`).
     pub refined_lists: bool,
-}
-
-impl ListOptions {
-    /// The options `inputs` plan for.
-    pub fn of(inputs: &crate::plan::PlanInputs<'_>) -> ListOptions {
-        ListOptions { depth_bounds: inputs.bounds_clusters_by_depth(), refined_lists: inputs.refines_lists() }
-    }
 }
 
 /// The refined lists of a frame, read back (`ClusterResources::read_refined`): per block of

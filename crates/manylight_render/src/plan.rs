@@ -93,6 +93,14 @@ impl PlanInputs<'_> {
             && (self.shades_deferred() || self.runs_depth_prepass())
     }
 
+    /// How the view's light lists are built: depth bounds and refined lists.
+    pub fn list_options(&self) -> crate::clusters::ListOptions {
+        crate::clusters::ListOptions {
+            depth_bounds: self.bounds_clusters_by_depth(),
+            refined_lists: self.refines_lists(),
+        }
+    }
+
     /// True when the depth pre-pass also writes each pixel's shading distance
     /// ([`crate::passes::SHADING_DISTANCE`]): a forward view bounding its clusters by depth or
     /// refining its lists.

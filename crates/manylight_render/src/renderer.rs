@@ -106,7 +106,7 @@ impl Renderer {
     /// spheres (before the view is executed; views run one after the other).
     /// `has_lights`: the frame has a valid light ([`FrameSnapshot::has_lights`]);
     /// `options`: depth bounds and refined lists, from the view's plan
-    /// ([`ListOptions::of`](crate::clusters::ListOptions::of)).
+    /// ([`crate::PlanInputs::list_options`]).
     pub fn prepare_view(
         &mut self,
         view: &RenderView,

@@ -4,27 +4,19 @@
 //! build then cuts each cluster to that range
 //! ([`crate::snapshot::ClusterSettings::depth_bounds`]).
 
-use super::common::texture_entry;
-use super::gbuffer_layout::{codec_constants, gbuffer_read_bind_group, gbuffer_read_layout, gbuffer_reads};
-use super::{CLUSTER_DEPTHS, DEPTH, SHADING_DISTANCE};
+use super::gbuffer_layout::DistanceSource;
+use super::{CLUSTER_DEPTHS, DEPTH};
 use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
-use crate::snapshot::GBufferLayout;
-use manylight_core::codec::NormalCodec;
 
-/// Where the pass reads each pixel's shading distance.
+/// The pipeline key of [`ClusterDepthPass`]: where it reads the shading distances.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum DistanceSource {
-    /// The depth pre-pass's [`SHADING_DISTANCE`] (forward pipelines).
-    Prepass,
-    /// The G-buffer's stored position (deferred pipelines), in this layout and normal codec.
-    GBuffer(GBufferLayout, NormalCodec),
-}
+pub struct ClusterDepthKey(pub DistanceSource);
 
-impl PipelineKey for DistanceSource {
+impl PipelineKey for ClusterDepthKey {
     type Pipeline = ClusterDepthPipeline;
 }
 
@@ -41,24 +33,7 @@ impl ClusterDepthPipeline {
         depth_layout: &wgpu::BindGroupLayout,
         source: DistanceSource,
     ) -> Result<Self, RenderError> {
-        let (source_layout, entry, constants) = match source {
-            DistanceSource::Prepass => {
-                let unfilterable = wgpu::TextureSampleType::Float { filterable: false };
-                let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                    label: Some("shading_distance"),
-                    entries: &[texture_entry(9, unfilterable)],
-                });
-                (layout, "cs_forward", codec_constants(NormalCodec::Octa16))
-            }
-            DistanceSource::GBuffer(layout, codec) => {
-                let entry = match layout {
-                    GBufferLayout::Full => "cs_full",
-                    GBufferLayout::Packed => "cs_packed",
-                    GBufferLayout::Compact => "cs_compact",
-                };
-                (gbuffer_read_layout(device, layout), entry, codec_constants(codec))
-            }
-        };
+        let (source_layout, entry, constants) = source.layout(device);
         let module = crate::shaders::create_module(device, "cluster_depth.wgsl")?;
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("cluster_depth"),
@@ -94,10 +69,7 @@ impl Pass for ClusterDepthPass {
         "cluster_depth"
     }
     fn reads(&self) -> Vec<ResourceName> {
-        match self.source {
-            DistanceSource::Prepass => vec![SHADING_DISTANCE, DEPTH],
-            DistanceSource::GBuffer(layout, _) => gbuffer_reads(layout).collect(),
-        }
+        self.source.reads()
     }
     fn writes(&self) -> Vec<ResourceName> {
         vec![CLUSTER_DEPTHS]
@@ -110,19 +82,11 @@ impl Pass for ClusterDepthPass {
             ctx.clusters.ok_or_else(|| RenderError::Graph("cluster_depth needs cluster resources".into()))?;
         let scene = ctx.scene;
         let device = &ctx.gpu.device;
-        let pipeline = ctx.pipelines.get_or_create(self.source, |&source| {
-            ClusterDepthPipeline::new(device, &scene.view_layout, &clusters.depth_layout, source)
-        })?;
-        let source = match self.source {
-            DistanceSource::Prepass => ctx.bind_group_numbered(
-                "shading_distance",
-                &pipeline.source_layout,
-                &[(9, Binding::Texture(ctx.texture(SHADING_DISTANCE)?))],
-            ),
-            DistanceSource::GBuffer(layout, _) => {
-                gbuffer_read_bind_group(ctx, &pipeline.source_layout, layout, self.clear_color)?
-            }
-        };
+        let pipeline =
+            ctx.pipelines.get_or_create(ClusterDepthKey(self.source), |&ClusterDepthKey(source)| {
+                ClusterDepthPipeline::new(device, &scene.view_layout, &clusters.depth_layout, source)
+            })?;
+        let source = self.source.bind_group(ctx, &pipeline.source_layout, self.clear_color)?;
         // Zero the depth ranges (no pixel yet), which follow the cluster ranges.
         let ranges = clusters.ranges.buffer();
         let bytes = u64::from(clusters.params.dims[3]) * 8;
@@ -152,12 +116,7 @@ impl Pass for ClusterDepthPass {
 /// from the G-buffer when it is shaded deferred, else from the depth pre-pass.
 pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
     if p.bounds_clusters_by_depth() {
-        let s = p.settings();
-        let source = if p.shades_deferred() {
-            DistanceSource::GBuffer(s.gbuffer, s.normal_codec)
-        } else {
-            DistanceSource::Prepass
-        };
-        out.push(Box::new(ClusterDepthPass { source, clear_color: s.clear_color }));
+        let source = DistanceSource::of(p);
+        out.push(Box::new(ClusterDepthPass { source, clear_color: p.settings().clear_color }));
     }
 }

@@ -1,10 +1,12 @@
 //! How the deferred passes agree on a G-buffer layout: its targets and formats, the shader
 //! entry points and constants of each layout and codec, and the bind group through which the
 //! lighting passes read it (`shaders/common/gbuffer_read.wgsl`). Shared by the G-buffer,
-//! deferred-lighting, tiled-deferred and light-volume passes.
+//! deferred-lighting, tiled-deferred and light-volume passes; and where the passes that need
+//! each pixel's shading distance before shading (`cluster_depth`, `light_refine`) read it:
+//! [`DistanceSource`].
 
-use super::DEPTH;
 use super::common::{texture_entry, uniform_entry};
+use super::{DEPTH, SHADING_DISTANCE};
 use super::{
     GBUFFER_ALBEDO, GBUFFER_COMPACT, GBUFFER_EMISSIVE, GBUFFER_NORMAL, GBUFFER_PACKED_ALBEDO,
     GBUFFER_PACKED_POSITION, GBUFFER_POSITION,
@@ -106,4 +108,79 @@ pub fn gbuffer_read_bind_group(
     bindings.push((4, Binding::Texture(ctx.texture(DEPTH)?)));
     bindings.push((5, Binding::Buffer(&clear)));
     Ok(ctx.bind_group_numbered("gbuffer_read", bind_group_layout, &bindings))
+}
+
+/// Where a pass reads each pixel's shading distance (the `cluster_depth` and `light_refine`
+/// passes; their shaders have one entry point per source: `cs_forward`, `cs_full`, `cs_packed`,
+/// `cs_compact`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum DistanceSource {
+    /// The depth pre-pass's [`SHADING_DISTANCE`] (forward pipelines).
+    Prepass,
+    /// The G-buffer's stored position (deferred pipelines), in this layout and normal codec.
+    GBuffer(GBufferLayout, NormalCodec),
+}
+
+impl DistanceSource {
+    /// The source of a view: the G-buffer when it shades deferred, else the depth pre-pass.
+    pub fn of(p: &crate::plan::PlanInputs<'_>) -> DistanceSource {
+        let s = p.settings();
+        if p.shades_deferred() {
+            DistanceSource::GBuffer(s.gbuffer, s.normal_codec)
+        } else {
+            DistanceSource::Prepass
+        }
+    }
+
+    /// What a pass reading this source reads.
+    pub fn reads(self) -> Vec<ResourceName> {
+        match self {
+            DistanceSource::Prepass => vec![SHADING_DISTANCE, DEPTH],
+            DistanceSource::GBuffer(layout, _) => gbuffer_reads(layout).collect(),
+        }
+    }
+
+    /// The layout of the source's bind group (group 1), the shader entry point and its
+    /// pipeline constants.
+    pub fn layout(
+        self,
+        device: &wgpu::Device,
+    ) -> (wgpu::BindGroupLayout, &'static str, [(&'static str, f64); 1]) {
+        match self {
+            DistanceSource::Prepass => {
+                let unfilterable = wgpu::TextureSampleType::Float { filterable: false };
+                let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some("shading_distance"),
+                    entries: &[texture_entry(9, unfilterable)],
+                });
+                (layout, "cs_forward", codec_constants(NormalCodec::Octa16))
+            }
+            DistanceSource::GBuffer(layout, codec) => {
+                let entry = match layout {
+                    GBufferLayout::Full => "cs_full",
+                    GBufferLayout::Packed => "cs_packed",
+                    GBufferLayout::Compact => "cs_compact",
+                };
+                (gbuffer_read_layout(device, layout), entry, codec_constants(codec))
+            }
+        }
+    }
+
+    /// The source's bind group for `layout` (from [`Self::layout`]); `clear_color` is the
+    /// view's (the G-buffer read group holds it).
+    pub fn bind_group(
+        self,
+        ctx: &PassContext<'_>,
+        layout: &wgpu::BindGroupLayout,
+        clear_color: [f32; 3],
+    ) -> Result<wgpu::BindGroup, RenderError> {
+        match self {
+            DistanceSource::Prepass => Ok(ctx.bind_group_numbered(
+                "shading_distance",
+                layout,
+                &[(9, Binding::Texture(ctx.texture(SHADING_DISTANCE)?))],
+            )),
+            DistanceSource::GBuffer(g, _) => gbuffer_read_bind_group(ctx, layout, g, clear_color),
+        }
+    }
 }

@@ -4,18 +4,13 @@
 //! positions; the shading passes read a block's list instead of its pixels' cluster lists
 //! ([`crate::snapshot::ClusterSettings::refined_lists`]).
 
-use super::cluster_depth::DistanceSource;
-use super::common::texture_entry;
-use super::gbuffer_layout::{codec_constants, gbuffer_read_bind_group, gbuffer_read_layout, gbuffer_reads};
-use super::{CLUSTERS, DEPTH, SHADING_DISTANCE};
+use super::CLUSTERS;
+use super::gbuffer_layout::DistanceSource;
 use crate::bindings::Binding;
 use crate::context::RenderError;
-use crate::gpu_types::REFINE_EDGE;
 use crate::graph::{Pass, PassContext, ResourceName};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
-use crate::snapshot::GBufferLayout;
-use manylight_core::codec::NormalCodec;
 
 /// The pipeline key of [`LightRefinePass`]: where it reads the shading distances.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -38,24 +33,7 @@ impl LightRefinePipeline {
         refine_layout: &wgpu::BindGroupLayout,
         source: DistanceSource,
     ) -> Result<Self, RenderError> {
-        let (source_layout, entry, constants) = match source {
-            DistanceSource::Prepass => {
-                let unfilterable = wgpu::TextureSampleType::Float { filterable: false };
-                let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                    label: Some("shading_distance"),
-                    entries: &[texture_entry(9, unfilterable)],
-                });
-                (layout, "cs_forward", codec_constants(NormalCodec::Octa16))
-            }
-            DistanceSource::GBuffer(layout, codec) => {
-                let entry = match layout {
-                    GBufferLayout::Full => "cs_full",
-                    GBufferLayout::Packed => "cs_packed",
-                    GBufferLayout::Compact => "cs_compact",
-                };
-                (gbuffer_read_layout(device, layout), entry, codec_constants(codec))
-            }
-        };
+        let (source_layout, entry, constants) = source.layout(device);
         let module = crate::shaders::create_module(device, "light_refine.wgsl")?;
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("light_refine"),
@@ -90,10 +68,7 @@ impl Pass for LightRefinePass {
         "light_refine"
     }
     fn reads(&self) -> Vec<ResourceName> {
-        let mut reads: Vec<ResourceName> = match self.source {
-            DistanceSource::Prepass => vec![SHADING_DISTANCE, DEPTH],
-            DistanceSource::GBuffer(layout, _) => gbuffer_reads(layout).collect(),
-        };
+        let mut reads = self.source.reads();
         reads.push(CLUSTERS);
         reads
     }
@@ -111,16 +86,7 @@ impl Pass for LightRefinePass {
         let pipeline = ctx.pipelines.get_or_create(RefineKey(self.source), |&RefineKey(source)| {
             LightRefinePipeline::new(device, &scene.view_layout, &clusters.refine_layout, source)
         })?;
-        let source = match self.source {
-            DistanceSource::Prepass => ctx.bind_group_numbered(
-                "shading_distance",
-                &pipeline.source_layout,
-                &[(9, Binding::Texture(ctx.texture(SHADING_DISTANCE)?))],
-            ),
-            DistanceSource::GBuffer(layout, _) => {
-                gbuffer_read_bind_group(ctx, &pipeline.source_layout, layout, self.clear_color)?
-            }
-        };
+        let source = self.source.bind_group(ctx, &pipeline.source_layout, self.clear_color)?;
         let lists = ctx.bind_group(
             "light_refine",
             &clusters.refine_layout,
@@ -148,16 +114,10 @@ impl Pass for LightRefinePass {
 }
 
 /// Needed when the view refines its lists (`PlanInputs::refines_lists`): from the G-buffer when
-/// it is shaded deferred, else from the depth pre-pass. `REFINE_EDGE` pixels a block edge.
+/// it is shaded deferred, else from the depth pre-pass.
 pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
-    const _: () = assert!(REFINE_EDGE > 0);
     if p.refines_lists() {
-        let s = p.settings();
-        let source = if p.shades_deferred() {
-            DistanceSource::GBuffer(s.gbuffer, s.normal_codec)
-        } else {
-            DistanceSource::Prepass
-        };
-        out.push(Box::new(LightRefinePass { source, clear_color: s.clear_color }));
+        let source = DistanceSource::of(p);
+        out.push(Box::new(LightRefinePass { source, clear_color: p.settings().clear_color }));
     }
 }
