@@ -611,12 +611,7 @@ fn tiled_deferred_shades_what_clustered_deferred_shades() {
     let shell = manylight::scene::sphere_shell_scene();
     let lights = shell_lights();
     check("sphere shell", &shell, UVec2::new(256, 144), lights, 16);
-    let mut ortho = default_scene();
-    let cam = ortho.camera_or_fit(size.x as f32 / size.y as f32);
-    ortho.cameras = vec![manylight::scene::SceneCamera {
-        transform: cam.transform,
-        projection: Projection::orthographic(12.0, 0.1, 200.0),
-    }];
+    let ortho = orthographic(size);
     check("orthographic", &ortho, size, rig(&ortho, 512, 9), 16);
 }
 
@@ -683,31 +678,13 @@ fn depth_bounded_lists_keep_every_contributing_light() {
         }
     }
 
-    let cam = scene.camera_or_fit(size.x as f32 / size.y as f32);
-    let forward = -cam.transform.z_axis.truncate().normalize();
-    let at = |d: f32| cam.transform.w_axis.truncate() + forward * d;
-    let mut extreme = default_scene();
-    extreme.cameras = vec![manylight::scene::SceneCamera {
-        transform: cam.transform,
-        projection: Projection::perspective(1.0, 1e-4, 1e6),
-    }];
-    let lights: Vec<ExtractedPointLight> = (0..24)
-        .map(|k| {
-            let d = 1e-4 * (1e10f32).powf(k as f32 / 24.0);
-            light(at(d.min(5e5)), d.min(5e5) * 0.01)
-        })
-        .chain(rig(&extreme, 256, 4))
-        .collect();
+    let (extreme, lights) = near_far_extremes(size);
     for pipeline in [PipelineKind::ClusteredForward, PipelineKind::ClusteredDeferred] {
         let snap = scene_snapshot(&extreme, size, lights.clone(), settings(pipeline, CullTest::Both));
         check(&format!("{}, near 1e-4, far 1e6", pipeline.name()), snap, 1);
     }
 
-    let mut ortho = default_scene();
-    ortho.cameras = vec![manylight::scene::SceneCamera {
-        transform: cam.transform,
-        projection: Projection::orthographic(12.0, 0.1, 200.0),
-    }];
+    let ortho = orthographic(size);
     for pipeline in [PipelineKind::ClusteredForward, PipelineKind::ClusteredDeferred] {
         let snap = scene_snapshot(&ortho, size, rig(&ortho, 1024, 9), settings(pipeline, CullTest::Both));
         let (bounded, whole) = check(&format!("{}, orthographic", pipeline.name()), snap, 1);
@@ -833,26 +810,8 @@ fn refined_lists_keep_every_contributing_light() {
     let s = settings(PipelineKind::ForwardPlus, CullTest::Both, true, full);
     check("forward+, 70 000 lights", scene_snapshot(&scene, size, rig(&scene, 70_000, 5), s), 7);
 
-    let cam = scene.camera_or_fit(size.x as f32 / size.y as f32);
-    let forward = -cam.transform.z_axis.truncate().normalize();
-    let at = |d: f32| cam.transform.w_axis.truncate() + forward * d;
-    let mut extreme = default_scene();
-    extreme.cameras = vec![manylight::scene::SceneCamera {
-        transform: cam.transform,
-        projection: Projection::perspective(1.0, 1e-4, 1e6),
-    }];
-    let lights: Vec<ExtractedPointLight> = (0..24)
-        .map(|k| {
-            let d = 1e-4 * (1e10f32).powf(k as f32 / 24.0);
-            light(at(d.min(5e5)), d.min(5e5) * 0.01)
-        })
-        .chain(rig(&extreme, 256, 4))
-        .collect();
-    let mut ortho = default_scene();
-    ortho.cameras = vec![manylight::scene::SceneCamera {
-        transform: cam.transform,
-        projection: Projection::orthographic(12.0, 0.1, 200.0),
-    }];
+    let (extreme, lights) = near_far_extremes(size);
+    let ortho = orthographic(size);
     for pipeline in [PipelineKind::ClusteredForward, PipelineKind::ClusteredDeferred] {
         let s = settings(pipeline, CullTest::Both, true, full);
         let snap = scene_snapshot(&extreme, size, lights.clone(), s);
@@ -869,4 +828,37 @@ fn refined_lists_keep_every_contributing_light() {
         let (refined, whole) = check(&format!("{}, sphere shell, 100 000 lights", pipeline.name()), snap, 61);
         assert!(3 * refined < whole, "sphere shell: {refined} of {whole} pairs left");
     }
+}
+
+/// The default scene seen through near 1e-4 / far 1e6, with 24 lights spread over that range
+/// (radius 1 % of their distance) and a 256-light rig.
+fn near_far_extremes(size: UVec2) -> (Scene, Vec<ExtractedPointLight>) {
+    let mut extreme = default_scene();
+    let cam = extreme.camera_or_fit(size.x as f32 / size.y as f32);
+    let forward = -cam.transform.z_axis.truncate().normalize();
+    let at = |d: f32| cam.transform.w_axis.truncate() + forward * d;
+    extreme.cameras = vec![manylight::scene::SceneCamera {
+        transform: cam.transform,
+        projection: Projection::perspective(1.0, 1e-4, 1e6),
+    }];
+    let lights = (0..24)
+        .map(|k| {
+            let d = 1e-4 * (1e10f32).powf(k as f32 / 24.0);
+            light(at(d.min(5e5)), d.min(5e5) * 0.01)
+        })
+        .chain(rig(&extreme, 256, 4))
+        .collect();
+    (extreme, lights)
+}
+
+/// The default scene through an orthographic camera (12 units high, near 0.1, far 200) where
+/// its fitted camera stands.
+fn orthographic(size: UVec2) -> Scene {
+    let mut ortho = default_scene();
+    let cam = ortho.camera_or_fit(size.x as f32 / size.y as f32);
+    ortho.cameras = vec![manylight::scene::SceneCamera {
+        transform: cam.transform,
+        projection: Projection::orthographic(12.0, 0.1, 200.0),
+    }];
+    ortho
 }

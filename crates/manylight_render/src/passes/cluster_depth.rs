@@ -4,7 +4,7 @@
 //! build then cuts each cluster to that range
 //! ([`crate::snapshot::ClusterSettings::depth_bounds`]).
 
-use super::gbuffer_layout::DistanceSource;
+use super::gbuffer_layout::{DistancePipeline, DistanceSource};
 use super::{CLUSTER_DEPTHS, DEPTH};
 use crate::bindings::Binding;
 use crate::context::RenderError;
@@ -17,42 +17,7 @@ use crate::plan::PlanInputs;
 pub struct ClusterDepthKey(pub DistanceSource);
 
 impl PipelineKey for ClusterDepthKey {
-    type Pipeline = ClusterDepthPipeline;
-}
-
-/// The pipeline of [`ClusterDepthPass`] for one source, and the layout of its group 1.
-pub struct ClusterDepthPipeline {
-    pipeline: wgpu::ComputePipeline,
-    source_layout: wgpu::BindGroupLayout,
-}
-
-impl ClusterDepthPipeline {
-    fn new(
-        device: &wgpu::Device,
-        view_layout: &wgpu::BindGroupLayout,
-        depth_layout: &wgpu::BindGroupLayout,
-        source: DistanceSource,
-    ) -> Result<Self, RenderError> {
-        let (source_layout, entry, constants) = source.layout(device);
-        let module = crate::shaders::create_module(device, "cluster_depth.wgsl")?;
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("cluster_depth"),
-            bind_group_layouts: &[Some(view_layout), Some(&source_layout), Some(depth_layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("cluster_depth"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some(entry),
-            compilation_options: wgpu::PipelineCompilationOptions {
-                constants: &constants,
-                ..Default::default()
-            },
-            cache: None,
-        });
-        Ok(ClusterDepthPipeline { pipeline, source_layout })
-    }
+    type Pipeline = DistancePipeline;
 }
 
 /// Writes every cluster's pixel depth range after the cluster ranges (zeroed first).
@@ -84,7 +49,13 @@ impl Pass for ClusterDepthPass {
         let device = &ctx.gpu.device;
         let pipeline =
             ctx.pipelines.get_or_create(ClusterDepthKey(self.source), |&ClusterDepthKey(source)| {
-                ClusterDepthPipeline::new(device, &scene.view_layout, &clusters.depth_layout, source)
+                DistancePipeline::new(
+                    device,
+                    "cluster_depth.wgsl",
+                    "cluster_depth",
+                    [&scene.view_layout, &clusters.depth_layout],
+                    source,
+                )
             })?;
         let source = self.source.bind_group(ctx, &pipeline.source_layout, self.clear_color)?;
         // Zero the depth ranges (no pixel yet), which follow the cluster ranges.

@@ -184,3 +184,44 @@ impl DistanceSource {
         }
     }
 }
+
+/// A compute pipeline over one [`DistanceSource`]: group 0 the view, group 1 the source, group 2
+/// the pass's own; and the layout of its group 1 (the `cluster_depth` and `light_refine`
+/// passes).
+pub struct DistancePipeline {
+    /// The pipeline.
+    pub pipeline: wgpu::ComputePipeline,
+    /// Layout of group 1 (the source).
+    pub source_layout: wgpu::BindGroupLayout,
+}
+
+impl DistancePipeline {
+    /// The pipeline of `shader`'s entry point for `source` (`label` names both).
+    pub fn new(
+        device: &wgpu::Device,
+        shader: &str,
+        label: &str,
+        [view_layout, pass_layout]: [&wgpu::BindGroupLayout; 2],
+        source: DistanceSource,
+    ) -> Result<Self, RenderError> {
+        let (source_layout, entry, constants) = source.layout(device);
+        let module = crate::shaders::create_module(device, shader)?;
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: &[Some(view_layout), Some(&source_layout), Some(pass_layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(label),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants: &constants,
+                ..Default::default()
+            },
+            cache: None,
+        });
+        Ok(DistancePipeline { pipeline, source_layout })
+    }
+}

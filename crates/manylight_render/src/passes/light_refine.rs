@@ -5,7 +5,7 @@
 //! ([`crate::snapshot::ClusterSettings::refined_lists`]).
 
 use super::CLUSTERS;
-use super::gbuffer_layout::DistanceSource;
+use super::gbuffer_layout::{DistancePipeline, DistanceSource};
 use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName};
@@ -17,42 +17,7 @@ use crate::plan::PlanInputs;
 pub struct RefineKey(pub DistanceSource);
 
 impl PipelineKey for RefineKey {
-    type Pipeline = LightRefinePipeline;
-}
-
-/// The pipeline of [`LightRefinePass`] for one source, and the layout of its group 1.
-pub struct LightRefinePipeline {
-    pipeline: wgpu::ComputePipeline,
-    source_layout: wgpu::BindGroupLayout,
-}
-
-impl LightRefinePipeline {
-    fn new(
-        device: &wgpu::Device,
-        view_layout: &wgpu::BindGroupLayout,
-        refine_layout: &wgpu::BindGroupLayout,
-        source: DistanceSource,
-    ) -> Result<Self, RenderError> {
-        let (source_layout, entry, constants) = source.layout(device);
-        let module = crate::shaders::create_module(device, "light_refine.wgsl")?;
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("light_refine"),
-            bind_group_layouts: &[Some(view_layout), Some(&source_layout), Some(refine_layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("light_refine"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some(entry),
-            compilation_options: wgpu::PipelineCompilationOptions {
-                constants: &constants,
-                ..Default::default()
-            },
-            cache: None,
-        });
-        Ok(LightRefinePipeline { pipeline, source_layout })
-    }
+    type Pipeline = DistancePipeline;
 }
 
 /// Writes every pixel block's refined list and range after the cluster lists and ranges.
@@ -84,7 +49,13 @@ impl Pass for LightRefinePass {
         let scene = ctx.scene;
         let device = &ctx.gpu.device;
         let pipeline = ctx.pipelines.get_or_create(RefineKey(self.source), |&RefineKey(source)| {
-            LightRefinePipeline::new(device, &scene.view_layout, &clusters.refine_layout, source)
+            DistancePipeline::new(
+                device,
+                "light_refine.wgsl",
+                "light_refine",
+                [&scene.view_layout, &clusters.refine_layout],
+                source,
+            )
         })?;
         let source = self.source.bind_group(ctx, &pipeline.source_layout, self.clear_color)?;
         let lists = ctx.bind_group(
