@@ -23,6 +23,8 @@ pub struct Row {
     culling: Option<f64>,
     /// The culling ratio the same lists would have with per-cluster depth bounds.
     depth_bounded: Option<f64>,
+    /// The culling ratio the same tile lists would have with z-binning (one-slice grids).
+    zbinned: Option<f64>,
     /// An oracle's row: the same frames shaded from exact per-pixel lists, by clustered forward
     /// (the forward oracle) or clustered deferred (the deferred oracle, per G-buffer layout).
     oracle: bool,
@@ -164,18 +166,18 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
         };
         let (frame_ms, last, oracle_culling) =
             timed_frames(&mut renderer, &lit, &rig, sweep, settings, oracle)?;
-        let (culling, depth_bounded) = if oracle {
-            (oracle_culling, None)
+        let (culling, depth_bounded, zbinned) = if oracle {
+            (oracle_culling, None, None)
         } else if sweep.culling_efficiency && pipeline.uses_clusters() && lights > 0 {
             let snap = snapshot(&lit, &rig, 0.0, sweep.size, settings, 0);
             let c = measure_culling(&mut renderer, snap)?.1;
-            (Some(c.lists.ratio()), Some(c.depth_bounded.ratio()))
+            (Some(c.lists.ratio()), Some(c.depth_bounded.ratio()), c.zbinned.map(|z| z.ratio()))
         } else {
-            (None, None)
+            (None, None, None)
         };
         let median_ms = median(&frame_ms);
         progress.step(|| format!("{label}: {median_ms:.1} ms"));
-        rows.push(Row { pipeline, gbuffer, lights, frame_ms, last, culling, depth_bounded, oracle });
+        rows.push(Row { pipeline, gbuffer, lights, frame_ms, last, culling, depth_bounded, zbinned, oracle });
     }
     progress.finish();
     Ok(csv(&rows, scene_name, sweep.size, &adapter))
@@ -271,7 +273,8 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
          forward_gpu_ms,clustered_forward_gpu_ms,gbuffer_gpu_ms,deferred_lighting_gpu_ms,light_volumes_gpu_ms,tonemap_gpu_ms,clusters,non_empty_clusters,list_entries,\
          max_per_cluster,mean_per_non_empty,dropped_pairs,culling_ratio,transient_mib,cluster_buffer_mib,\
          list_entry_bound,tile_entries,tile_entry_bound,list_bound_cpu_ms,shading_ms,shading_vs_oracle,\
-         coarse_tiles,coarse_entries,depth_bounded_ratio,cluster_depth_gpu_ms,light_refine_gpu_ms\n",
+         coarse_tiles,coarse_entries,depth_bounded_ratio,cluster_depth_gpu_ms,light_refine_gpu_ms,\
+         zbinned_ratio\n",
     );
     for r in rows {
         let c = r.last.clusters.as_ref();
@@ -287,7 +290,7 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
         let vs_oracle = shading.zip(oracle).filter(|&(_, o)| o > 0.0).map(|(s, o)| s / o);
         let _ = writeln!(
             out,
-            "\"{adapter}\",\"{scene}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "\"{adapter}\",\"{scene}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             match (r.oracle, r.pipeline.is_deferred()) {
                 (true, false) => "oracle-forward",
                 (true, true) => "oracle-deferred",
@@ -330,6 +333,7 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
             r.depth_bounded.map_or(String::new(), |x| format!("{x:.3}")),
             pass_ms(&r.last, "cluster_depth"),
             pass_ms(&r.last, "light_refine"),
+            r.zbinned.map_or(String::new(), |x| format!("{x:.3}")),
         );
     }
     out

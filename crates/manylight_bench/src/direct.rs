@@ -9,7 +9,7 @@ use manylight_app::scene::{extracted_light, scene_snapshot};
 use manylight_core::cluster::ClusterAssignment;
 use manylight_core::efficiency::{
     CullingEfficiency, block_lists_per_pixel, culling_efficiency, depth_bounded_lists, depth_masked_lists,
-    exact_pixel_lists, pixel_grid,
+    exact_pixel_lists, pixel_grid, zbinned_lists,
 };
 use manylight_render::{FrameReport, FrameSettings, FrameSnapshot, PipelineKind};
 use manylight_scene::{AnimatedLight, Scene};
@@ -64,7 +64,13 @@ pub struct Culling {
     pub lists: CullingEfficiency,
     /// The same lists cut to each cluster's depth range of pixels.
     pub depth_bounded: CullingEfficiency,
+    /// For a frame of one-slice tiles (Forward+, tiled deferred): its tile lists with z-binning
+    /// (`zbinned_lists`, [`ZBINS`] bins: measured, not built).
+    pub zbinned: Option<CullingEfficiency>,
 }
+
+/// Depth bins of the z-binning measurement (`Culling::zbinned`).
+pub const ZBINS: u32 = 1024;
 
 /// Renders `snapshot` and measures the culling efficiency of the lists its shading evaluates
 /// against its depth buffer, and of its cluster lists cut by per-cluster depth bounds (every
@@ -105,7 +111,18 @@ pub fn measure_culling(
     };
     let bounded = depth_bounded_lists(&f.grid, &f.projection, &f.assignment, &f.spheres, &f.depth, test);
     let depth_bounded = culling_efficiency(&f.grid, &f.projection, &bounded, &f.spheres, &f.depth, 64);
-    Ok((f.report, Culling { lists, depth_bounded }))
+    let zbinned = (f.grid.dims.z == 1).then(|| {
+        let binned = zbinned_lists(&f.grid, &f.projection, &f.assignment, &f.spheres, &f.depth, ZBINS);
+        culling_efficiency(
+            &pixel_grid(f.grid.viewport, &f.projection),
+            &f.projection,
+            &binned,
+            &f.spheres,
+            &f.depth,
+            64,
+        )
+    });
+    Ok((f.report, Culling { lists, depth_bounded, zbinned }))
 }
 
 /// The oracle of `snapshot`'s frame: renders it (so the view has cluster lists and a depth

@@ -531,6 +531,16 @@ fn render(args: RenderArgs) -> Result<()> {
                 bounded.ratio(),
                 bounded.missed_pairs
             );
+            if let Some(z) = culling.zbinned {
+                println!(
+                    "with z-binning of the tile lists ({} bins; measured, not built): {} pairs \
+                     evaluated: {:.3}x ({} contributing pairs missing)",
+                    direct::ZBINS,
+                    z.evaluated_pairs,
+                    z.ratio(),
+                    z.missed_pairs
+                );
+            }
             Some(eff)
         }
         _ => None,
