@@ -809,6 +809,13 @@ fn refined_lists_keep_every_contributing_light() {
     }
     let s = settings(PipelineKind::ForwardPlus, CullTest::Both, true, full);
     check("forward+, 70 000 lights", scene_snapshot(&scene, size, rig(&scene, 70_000, 5), s), 7);
+    // A size that is not a multiple of the block or the tile: partial blocks at the edges.
+    let odd = UVec2::new(130, 77);
+    for pipeline in [PipelineKind::ClusteredForward, PipelineKind::ClusteredDeferred] {
+        let s = settings(pipeline, CullTest::Both, true, full);
+        let snap = scene_snapshot(&scene, odd, rig(&scene, 1024, 11), s);
+        check(&format!("{}, 130 × 77", pipeline.name()), snap, 1);
+    }
 
     let (extreme, lights) = near_far_extremes(size);
     let ortho = orthographic(size);
