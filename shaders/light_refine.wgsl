@@ -37,9 +37,12 @@
 // Forward pipelines: the depth pre-pass's shading distances (0: background).
 @group(1) @binding(9) var shading_distance: texture_2d<f32>;
 
-// The block being refined: the box around its pixels' positions, and the clusters they fall in.
+// The block being refined: the box around its pixels' positions, the first and last of its
+// covered pixels along x and y, and the box of clusters they fall in (`find_clusters`).
 var<private> box_min: vec3<f32>;
 var<private> box_max: vec3<f32>;
+var<private> pixels_min: vec2<u32>;
+var<private> pixels_max: vec2<u32>;
 var<private> clusters_min: vec3<u32>;
 var<private> clusters_max: vec3<u32>;
 var<private> covered: bool;
@@ -48,8 +51,8 @@ var<private> unbounded: bool;
 fn begin_block() {
     box_min = vec3<f32>(3.0e38);
     box_max = vec3<f32>(-3.0e38);
-    clusters_min = vec3<u32>(0xffffffffu);
-    clusters_max = vec3<u32>(0u);
+    pixels_min = vec2<u32>(0xffffffffu);
+    pixels_max = vec2<u32>(0u);
     covered = false;
     unbounded = false;
 }
@@ -74,12 +77,20 @@ fn add_pixel(px: vec2<u32>, q: vec3<f32>) {
     let s = REFINE_SLACK * (abs(d) + length(view.camera_position.xyz));
     box_min = min(box_min, q - s);
     box_max = max(box_max, q + s);
-    let frag = vec2<f32>(px) + 0.5;
-    let first = cluster_coords(cluster_index(cluster_params, frag, max(d - s, 0.0)));
-    let last = cluster_coords(cluster_index(cluster_params, frag, d + s));
-    clusters_min = min(clusters_min, min(first, last));
-    clusters_max = max(clusters_max, max(first, last));
+    pixels_min = min(pixels_min, px);
+    pixels_max = max(pixels_max, px);
     covered = true;
+}
+
+// The box of clusters the block's pixels fall in with their widened distances: tiles grow with
+// the pixel position and slices with the distance, so the clusters of the first pixel at the
+// nearest widened distance and of the last at the farthest (the box's z: -(d + s) at its min,
+// -(d - s) at its max) bound those of every pixel.
+fn find_clusters() {
+    let first = vec2<f32>(pixels_min) + 0.5;
+    let last = vec2<f32>(pixels_max) + 0.5;
+    clusters_min = cluster_coords(cluster_index(cluster_params, first, max(-box_max.z, 0.0)));
+    clusters_max = cluster_coords(cluster_index(cluster_params, last, -box_min.z));
 }
 
 // The linear index of the `k`-th cluster of the block's cluster box.
@@ -118,6 +129,7 @@ fn refine_lights(slot: u32) -> vec2<u32> {
     if unbounded {
         return fallback;
     }
+    find_clusters();
     let n3 = clusters_max - clusters_min + 1u;
     let n = n3.x * n3.y * n3.z;
     if n > REFINE_MAX_CLUSTERS {
