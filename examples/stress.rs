@@ -13,8 +13,8 @@
 //!   white inward-facing sphere of radius 50, a 5×5×5 box at (0, 50, 0), and a camera at the
 //!   origin (45° fov, near 0.1, far 1000) turning 0.0025 rad per frame about the z and x axes
 //!   ([`turn_camera`]; per frame, not per second, so every run shows the same views). Shaded
-//!   with Forward+ without per-cluster depth bounds, and from 16 384 lights on with refined
-//!   light lists (the fastest on this scene: docs/benchmarks.md).
+//!   with Forward+ without per-cluster depth bounds, and refined light lists only from 16 384
+//!   lights on (the fastest on this scene: docs/benchmarks.md).
 //! - `--frames F --warmup W`: renders W + F frames, prints `median_frame_ms=… mean_frame_ms=…`
 //!   over the last F (wall time between updates; in a window with vsync off) and the last
 //!   frame's passes, then exits.
@@ -38,7 +38,8 @@ use std::time::Instant;
 /// Lights of the default and glTF scenes unless `--lights` says otherwise.
 pub const DEFAULT_LIGHTS: u32 = 4096;
 /// Light count from which the sphere-shell preset shades from refined light lists (at 1 024
-/// lights their pass costs ~20 ms more than it saves on lavapipe, at 100 000 it saves ~15 ms).
+/// lights their pass costs 15–19 ms more than it saves on lavapipe; at 100 000 the window's
+/// frame is 10–13 % faster with them).
 const SHELL_REFINE_FROM: u32 = 16_384;
 /// Lights of the sphere-shell preset unless `--lights` says otherwise.
 pub const DEFAULT_SHELL_LIGHTS: u32 = 100_000;
@@ -59,8 +60,8 @@ pub struct Args {
     /// whose lights hug its one surface, so depth slices add build cost and cut nothing).
     #[arg(long, value_parser = parse_pipeline)]
     pub pipeline: Option<PipelineKind>,
-    /// Refined light lists (4 × 4-pixel blocks): on or off (default: on for sphere-shell from
-    /// 16 384 lights, else off).
+    /// Refined light lists (4 × 4-pixel blocks): on or off (default: on, but off for
+    /// sphere-shell below 16 384 lights).
     #[arg(long, value_parser = parse_on_off)]
     pub refined_lists: Option<bool>,
     /// Window or image size, WxH.
@@ -309,10 +310,9 @@ pub fn setup(app: &mut App, args: &Args, exit_when_done: bool) -> Result<()> {
     // The shell's lights hug its only surface: per-cluster depth bounds cut nothing there and
     // cost their pass (docs/benchmarks.md, "Per-cluster depth bounds").
     settings.clusters.depth_bounds = !shell;
-    // Its lights are a few pixels wide on 16-pixel tiles: from SHELL_REFINE_FROM lights on,
-    // refined light lists save more shading than their pass costs (docs/benchmarks.md,
-    // "Refined light lists").
-    settings.clusters.refined_lists = args.refined_lists.unwrap_or(shell && count >= SHELL_REFINE_FROM);
+    // Below SHELL_REFINE_FROM shell lights the pairs refined lists would save are too few to
+    // pay for their pass (docs/benchmarks.md, "Refined light lists").
+    settings.clusters.refined_lists = args.refined_lists.unwrap_or(!shell || count >= SHELL_REFINE_FROM);
     app.insert_resource(settings)
         .insert_resource(layout)
         .insert_resource(LightControls { count, radius_scale: 1.0 })

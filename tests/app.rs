@@ -36,7 +36,7 @@ fn frame_stats_list_the_passes_with_timings() {
     assert_eq!(s.frames_rendered, 3);
     assert_eq!(
         s.pass_names(),
-        ["depth_prepass", "cluster_depth", "cluster_build", "clustered_forward", "tonemap"]
+        ["depth_prepass", "cluster_depth", "cluster_build", "light_refine", "clustered_forward", "tonemap"]
     );
     let report = s.last.expect("a report");
     assert_eq!(report.light_count as usize, default_scene().lights.len() + 8);
@@ -172,7 +172,7 @@ fn pipelined_mode_renders_every_frame_and_shuts_down_cleanly() {
     assert_eq!(s.frames_rendered, 4);
     assert_eq!(
         s.pass_names(),
-        ["depth_prepass", "cluster_depth", "cluster_build", "clustered_forward", "tonemap"]
+        ["depth_prepass", "cluster_depth", "cluster_build", "light_refine", "clustered_forward", "tonemap"]
     );
     assert!(app.world().resource::<HeadlessCapture>().image.is_some());
 
@@ -251,17 +251,31 @@ fn each_pipeline_builds_exactly_its_passes() {
         (
             PipelineKind::ForwardPlus,
             true,
-            &["depth_prepass", "cluster_depth", "cluster_build", "clustered_forward", "tonemap"],
+            &[
+                "depth_prepass",
+                "cluster_depth",
+                "cluster_build",
+                "light_refine",
+                "clustered_forward",
+                "tonemap",
+            ],
         ),
         (
             PipelineKind::ClusteredForward,
             true,
-            &["depth_prepass", "cluster_depth", "cluster_build", "clustered_forward", "tonemap"],
+            &[
+                "depth_prepass",
+                "cluster_depth",
+                "cluster_build",
+                "light_refine",
+                "clustered_forward",
+                "tonemap",
+            ],
         ),
         (
             PipelineKind::ClusteredDeferred,
             true,
-            &["gbuffer", "cluster_depth", "cluster_build", "deferred_lighting", "tonemap"],
+            &["gbuffer", "cluster_depth", "cluster_build", "light_refine", "deferred_lighting", "tonemap"],
         ),
         (
             PipelineKind::TiledDeferred,

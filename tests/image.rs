@@ -49,7 +49,7 @@ fn with_pipeline(pipeline: PipelineKind) -> RenderSettings {
 
 /// Forward+, clustered forward (with and without depth pre-pass, several culling tests and
 /// both slicings), clustered deferred and tiled deferred (two G-buffer layouts each), with
-/// per-cluster depth bounds (the default) and without, and with refined light lists, match
+/// per-cluster depth bounds and refined light lists (the defaults) and without each, match
 /// naive forward on the default scene and a glTF scene.
 #[test]
 fn tiled_and_clustered_pipelines_match_naive_forward() {
@@ -70,15 +70,15 @@ fn tiled_and_clustered_pipelines_match_naive_forward() {
         settings.clusters.depth_bounds = false;
         settings
     };
-    // With refined light lists (off by default).
-    let refined = |mut settings: RenderSettings| {
-        settings.clusters.refined_lists = true;
+    // Shading from the cluster lists, without refined light lists (on by default).
+    let unrefined = |mut settings: RenderSettings| {
+        settings.clusters.refined_lists = false;
         settings
     };
     let variants = [
-        ("forward_plus_refined", refined(with_pipeline(PipelineKind::ForwardPlus))),
-        ("clustered_refined", refined(with_pipeline(PipelineKind::ClusteredForward))),
-        ("clustered_deferred_packed_refined", refined(deferred(GBufferLayout::Packed))),
+        ("forward_plus_unrefined", unrefined(with_pipeline(PipelineKind::ForwardPlus))),
+        ("clustered_unrefined", unrefined(with_pipeline(PipelineKind::ClusteredForward))),
+        ("clustered_deferred_packed_unrefined", unrefined(deferred(GBufferLayout::Packed))),
         ("clustered_deferred_full", deferred(GBufferLayout::Full)),
         ("clustered_deferred_compact", deferred(GBufferLayout::Compact)),
         ("tiled_deferred_full", tiled(GBufferLayout::Full)),

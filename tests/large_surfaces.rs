@@ -289,17 +289,17 @@ fn configurations() -> Vec<(String, RenderSettings)> {
             whole.clusters.depth_bounds = false;
             out.push((format!("{}_whole_slices", pipeline.name()), whole));
         }
-        // Refined light lists (off by default) take the same distances; their boxes are much
-        // tighter than a cluster's.
+        // Refined light lists (on by default) take the same distances, in boxes much tighter
+        // than a cluster; these shade from the cluster lists alone.
         if matches!(pipeline, PipelineKind::ClusteredForward | PipelineKind::ForwardPlus) {
-            let mut refined = base;
-            refined.clusters.refined_lists = true;
-            out.push((format!("{}_refined", pipeline.name()), refined));
+            let mut unrefined = base;
+            unrefined.clusters.refined_lists = false;
+            out.push((format!("{}_unrefined", pipeline.name()), unrefined));
         }
         if pipeline == PipelineKind::ClusteredDeferred {
-            let mut refined = base;
-            refined.clusters.refined_lists = true;
-            out.push((format!("{}_full_refined", pipeline.name()), refined));
+            let mut unrefined = base;
+            unrefined.clusters.refined_lists = false;
+            out.push((format!("{}_full_unrefined", pipeline.name()), unrefined));
         }
         if !matches!(pipeline, PipelineKind::ClusteredDeferred | PipelineKind::LightVolumes) {
             out.push((pipeline.name().to_string(), base));

@@ -53,9 +53,14 @@ const DEBUG_MODE: DebugViewMode = DebugViewMode::LightCount;
 fn expected(p: Point) -> Vec<&'static str> {
     let mut passes: Vec<&'static str> = match (p.debug, p.deferred, p.lights) {
         // Shading: clustered forward (with its depth pre-pass) or G-buffer + deferred lighting,
-        // each with per-cluster depth bounds between the depth and the build.
-        (false, false, true) => vec!["depth_prepass", "cluster_depth", "cluster_build", "clustered_forward"],
-        (false, true, true) => vec!["gbuffer", "cluster_depth", "cluster_build", "deferred_lighting"],
+        // each with per-cluster depth bounds between the depth and the build and refined light
+        // lists after it.
+        (false, false, true) => {
+            vec!["depth_prepass", "cluster_depth", "cluster_build", "light_refine", "clustered_forward"]
+        }
+        (false, true, true) => {
+            vec!["gbuffer", "cluster_depth", "cluster_build", "light_refine", "deferred_lighting"]
+        }
         // No lights: no cluster build, no light lists, no G-buffer: the ambient forward pass.
         (false, _, false) => vec!["forward"],
         // The light-count view replaces shading: depth (pre-pass or G-buffer) + clusters only.

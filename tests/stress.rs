@@ -48,7 +48,7 @@ fn many_animated_lights_render_move_and_follow_the_light_count() {
     assert_eq!(report.light_count, 65_536 + scene_lights);
     assert_eq!(
         report.pass_names(),
-        ["depth_prepass", "cluster_depth", "cluster_build", "clustered_forward", "tonemap"]
+        ["depth_prepass", "cluster_depth", "cluster_build", "light_refine", "clustered_forward", "tonemap"]
     );
     let before = light_positions(&mut app);
     let second = update(&mut app);

@@ -323,9 +323,7 @@ struct ClusterArgs {
     depth_bounds: Option<bool>,
     /// Refined light lists (each 4 × 4-pixel block keeps the lights of its cluster lists that
     /// reach its pixels' surface box; applies where depth bounds can, not to tiled deferred):
-    /// on or off. Default: off, on for `sphere-shell`, whose lights are a few pixels wide on
-    /// 16-pixel tiles (at 100 000 lights they cut the culling ratio from 8 to 1.9 and the
-    /// frame by ~10 %; at 1 024 lights their pass costs more than it saves: docs/benchmarks.md).
+    /// on or off (default on; docs/benchmarks.md, "Refined light lists").
     #[arg(long, value_parser = parse_on_off)]
     refined_lists: Option<bool>,
     /// G-buffer layout of the deferred pipelines (clustered-deferred, tiled-deferred,
@@ -365,7 +363,7 @@ impl ClusterArgs {
             workgroup_size: self.workgroup_size,
             coarse_tiles: self.coarse_tiles,
             depth_bounds: self.depth_bounds.unwrap_or(spec != "sphere-shell"),
-            refined_lists: self.refined_lists.unwrap_or(spec == "sphere-shell"),
+            refined_lists: self.refined_lists.unwrap_or(true),
         }
     }
 }

@@ -90,7 +90,10 @@ fn render_writes_png_and_stats_json() {
     let last = &stats["last_frame"];
     let names: Vec<&str> =
         last["passes"].as_array().expect("passes").iter().map(|p| p["name"].as_str().unwrap_or("")).collect();
-    assert_eq!(names, ["depth_prepass", "cluster_depth", "cluster_build", "clustered_forward", "tonemap"]);
+    assert_eq!(
+        names,
+        ["depth_prepass", "cluster_depth", "cluster_build", "light_refine", "clustered_forward", "tonemap"]
+    );
     assert!(last["clusters"]["total_entries"].as_u64().is_some_and(|n| n > 0));
     assert_eq!(last["clusters"]["dropped_pairs"].as_u64(), Some(0));
     assert!(last["passes"][0]["gpu_ms"].is_number());

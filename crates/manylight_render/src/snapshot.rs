@@ -284,8 +284,9 @@ pub struct ClusterSettings {
     /// reach the box around its pixels' surface positions, and shades from that list (a block
     /// whose list would be long shades from its cluster lists). Applies where per-cluster depth
     /// bounds can (`PlanInputs::refines_lists`), in every tiled and clustered pipeline but
-    /// tiled deferred (which refines its tiles itself). Off by default
-    /// (`docs/benchmarks.md`, "Refined light lists").
+    /// tiled deferred (which refines its tiles itself). On by default: it wins or breaks even
+    /// everywhere measured but with few small lights (`docs/benchmarks.md`, "Refined light
+    /// lists").
     pub refined_lists: bool,
 }
 
@@ -299,7 +300,7 @@ impl Default for ClusterSettings {
             workgroup_size: 64,
             coarse_tiles: DEFAULT_COARSE_TILES,
             depth_bounds: true,
-            refined_lists: false,
+            refined_lists: true,
         }
     }
 }
