@@ -63,34 +63,34 @@ impl PlanInputs<'_> {
             && (s.pipeline == PipelineKind::ForwardPlus || s.clusters.depth_prepass)
     }
 
-    /// True when the cluster build cuts clusters to their pixels' depth range
-    /// ([`crate::snapshot::ClusterSettings::depth_bounds`]): the setting is on, the view shades
-    /// with its own cluster lists (no per-pixel lists, no debug view) from a depth known before
-    /// the build (a depth pre-pass, or a G-buffer), and every fragment it shades is in that
-    /// depth (no blended materials).
-    pub fn bounds_clusters_by_depth(&self) -> bool {
-        let s = self.settings();
-        s.clusters.depth_bounds
-            && self.shades_with_clusters()
+    /// True when every fragment the view shades has its shading distance known before the
+    /// build: it shades with its own cluster lists (no per-pixel lists, no debug view) after a
+    /// depth pre-pass or a G-buffer, and every fragment it shades is in that depth (no blended
+    /// materials). Per-cluster depth bounds and refined lists rely on it.
+    fn knows_shading_distances(&self) -> bool {
+        self.shades_with_clusters()
             && self.shows_image()
             && !self.has_blended
             && !self.has_pixel_lists
             && (self.shades_deferred() || self.runs_depth_prepass())
     }
 
+    /// True when the cluster build cuts clusters to their pixels' depth range
+    /// ([`crate::snapshot::ClusterSettings::depth_bounds`]): the setting is on and the
+    /// distances are known (`knows_shading_distances`).
+    pub fn bounds_clusters_by_depth(&self) -> bool {
+        self.settings().clusters.depth_bounds && self.knows_shading_distances()
+    }
+
     /// True when the view refines its cluster lists per pixel block after the build
-    /// ([`crate::snapshot::ClusterSettings::refined_lists`]): under the same conditions as
-    /// [`Self::bounds_clusters_by_depth`] (every shaded fragment's distance is known before
-    /// shading), except tiled deferred, whose lighting pass cuts its tile lists itself.
+    /// ([`crate::snapshot::ClusterSettings::refined_lists`]): where the distances are known, as
+    /// for [`Self::bounds_clusters_by_depth`], except tiled deferred, whose lighting pass cuts
+    /// its tile lists itself.
     pub fn refines_lists(&self) -> bool {
         let s = self.settings();
         s.clusters.refined_lists
             && s.pipeline != PipelineKind::TiledDeferred
-            && self.shades_with_clusters()
-            && self.shows_image()
-            && !self.has_blended
-            && !self.has_pixel_lists
-            && (self.shades_deferred() || self.runs_depth_prepass())
+            && self.knows_shading_distances()
     }
 
     /// How the view's light lists are built: depth bounds and refined lists.
