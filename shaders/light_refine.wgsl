@@ -62,11 +62,6 @@ fn block_pixel(b: vec2<u32>, i: u32) -> vec2<u32> {
     return b * REFINE_EDGE + vec2<u32>(i % REFINE_EDGE, i / REFINE_EDGE);
 }
 
-fn cluster_coords(c: u32) -> vec3<u32> {
-    let d = cluster_params.dims;
-    return vec3<u32>(c % d.x, (c / d.x) % d.y, c / (d.x * d.y));
-}
-
 // Adds the pixel `px` whose surface lies at view-space `q`.
 fn add_pixel(px: vec2<u32>, q: vec3<f32>) {
     let d = -q.z;
@@ -89,16 +84,14 @@ fn add_pixel(px: vec2<u32>, q: vec3<f32>) {
 fn find_clusters() {
     let first = vec2<f32>(pixels_min) + 0.5;
     let last = vec2<f32>(pixels_max) + 0.5;
-    clusters_min = cluster_coords(cluster_index(cluster_params, first, max(-box_max.z, 0.0)));
-    clusters_max = cluster_coords(cluster_index(cluster_params, last, -box_min.z));
+    clusters_min = cluster_coords(cluster_params, first, max(-box_max.z, 0.0));
+    clusters_max = cluster_coords(cluster_params, last, -box_min.z);
 }
 
 // The linear index of the `k`-th cluster of the block's cluster box.
 fn box_cluster(k: u32) -> u32 {
     let n = clusters_max - clusters_min + 1u;
-    let c = clusters_min + vec3<u32>(k % n.x, (k / n.x) % n.y, k / (n.x * n.y));
-    let d = cluster_params.dims;
-    return c.x + c.y * d.x + c.z * d.x * d.y;
+    return cluster_at(cluster_params, clusters_min + vec3<u32>(k % n.x, (k / n.x) % n.y, k / (n.x * n.y)));
 }
 
 // True when light `l` is in the (ascending) list `r`.
@@ -170,9 +163,9 @@ fn refine_lights(slot: u32) -> vec2<u32> {
 
 // Writes block `b`'s range from the pixels added since `begin_block`.
 fn finish_block(b: vec2<u32>) {
-    let block = b.x + b.y * cluster_params.refine_blocks_x;
-    let slot = cluster_params.index_capacity + block * REFINED_LIST_SLOTS;
-    ranges[cluster_params.refined_first + block] = refine_lights(slot);
+    let at = refined_range_index(cluster_params, b);
+    let slot = cluster_params.index_capacity + (at - cluster_params.refined_first) * REFINED_LIST_SLOTS;
+    ranges[at] = refine_lights(slot);
 }
 
 fn in_blocks(b: vec2<u32>) -> bool {

@@ -14,7 +14,7 @@ fn light_list_range(frag: vec2<f32>, d: f32) -> vec2<u32> {
     let blocks = vec2<u32>(cluster_params.refine_blocks_x, cluster_params.refine_blocks_y);
     if blocks.x != 0u {
         let b = min(vec2<u32>(max(frag, vec2<f32>(0.0))) / REFINE_EDGE, blocks - 1u);
-        let r = cluster_ranges[cluster_params.refined_first + b.x + b.y * blocks.x];
+        let r = cluster_ranges[refined_range_index(cluster_params, b)];
         if r.y != REFINED_FALLBACK {
             return r;
         }

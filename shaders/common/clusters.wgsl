@@ -61,13 +61,29 @@ fn cluster_slice(p: ClusterParams, d: f32) -> u32 {
     return u32(clamped);
 }
 
+// Tile x, y and slice of a fragment at framebuffer position `frag` (pixels) and view distance
+// `d` (ClusterGrid::tile_of_pixel, slice_of_depth).
+fn cluster_coords(p: ClusterParams, frag: vec2<f32>, d: f32) -> vec3<u32> {
+    let tile_f = floor(frag * vec2<f32>(p.dims.xy) / p.viewport.xy);
+    let tile = vec2<u32>(clamp(tile_f, vec2<f32>(0.0), vec2<f32>(p.dims.xy - vec2<u32>(1u))));
+    return vec3<u32>(tile, cluster_slice(p, d));
+}
+
+// The index of the cluster at tile x, y and slice `c` (ClusterGrid::index).
+fn cluster_at(p: ClusterParams, c: vec3<u32>) -> u32 {
+    return c.x + c.y * p.dims.x + c.z * p.dims.x * p.dims.y;
+}
+
 // Cluster of a fragment at framebuffer position `frag` (pixels) and view distance `d`
 // (ClusterGrid::cluster_of).
 fn cluster_index(p: ClusterParams, frag: vec2<f32>, d: f32) -> u32 {
-    let tile_f = floor(frag * vec2<f32>(p.dims.xy) / p.viewport.xy);
-    let tile = vec2<u32>(clamp(tile_f, vec2<f32>(0.0), vec2<f32>(p.dims.xy - vec2<u32>(1u))));
-    let z = cluster_slice(p, d);
-    return tile.x + tile.y * p.dims.x + z * p.dims.x * p.dims.y;
+    return cluster_at(p, cluster_coords(p, frag, d));
+}
+
+// Where refined lists are on (`p.refine_blocks_x` > 0): the index in the ranges buffer of
+// pixel block `b`'s range (light_refine.wgsl writes it, the shading passes read it).
+fn refined_range_index(p: ClusterParams, b: vec2<u32>) -> u32 {
+    return p.refined_first + b.x + b.y * p.refine_blocks_x;
 }
 
 // Conservative sphere–box test (manylight_core::cluster::sphere_intersects_aabb): spheres of
