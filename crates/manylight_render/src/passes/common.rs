@@ -1,5 +1,5 @@
-//! What the passes share: pipeline construction for mesh and full-screen passes, the attachments
-//! they use, and bind-group-layout entries.
+//! What the passes share: pipeline construction for mesh, full-screen and compute passes, the
+//! attachments they use, and bind-group-layout entries.
 
 use crate::context::RenderError;
 use crate::resources::{DEPTH_FORMAT, SurfaceVariant};
@@ -18,6 +18,28 @@ fn pipeline_layout(
         bind_group_layouts: &layouts,
         immediate_size: 0,
     })
+}
+
+/// The compute pipeline of `shader`'s `entry` over the bind groups `layouts` (group 0 first),
+/// with its `override` constants (`label` names the layout and the pipeline).
+pub fn compute_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    shader: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+    entry: &str,
+    constants: &[(&str, f64)],
+) -> Result<wgpu::ComputePipeline, RenderError> {
+    let module = crate::shaders::create_module(device, shader)?;
+    let layout = pipeline_layout(device, label, layouts);
+    Ok(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(label),
+        layout: Some(&layout),
+        module: &module,
+        entry_point: Some(entry),
+        compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
+        cache: None,
+    }))
 }
 
 fn color_targets(

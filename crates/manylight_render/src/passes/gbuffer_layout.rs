@@ -5,7 +5,7 @@
 //! each pixel's shading distance before shading (`cluster_depth`, `light_refine`) read it:
 //! [`DistanceSource`].
 
-use super::common::{texture_entry, uniform_entry};
+use super::common::{compute_pipeline, texture_entry, uniform_entry};
 use super::{DEPTH, SHADING_DISTANCE};
 use super::{
     GBUFFER_ALBEDO, GBUFFER_COMPACT, GBUFFER_EMISSIVE, GBUFFER_NORMAL, GBUFFER_PACKED_ALBEDO,
@@ -52,6 +52,16 @@ pub fn fragment_entry(layout: GBufferLayout) -> &'static str {
         GBufferLayout::Full => "fs_full",
         GBufferLayout::Packed => "fs_packed",
         GBufferLayout::Compact => "fs_compact",
+    }
+}
+
+/// The compute entry point reading a layout's G-buffer, in `tiled_deferred.wgsl`,
+/// `cluster_depth.wgsl` and `light_refine.wgsl`.
+pub fn compute_entry(layout: GBufferLayout) -> &'static str {
+    match layout {
+        GBufferLayout::Full => "cs_full",
+        GBufferLayout::Packed => "cs_packed",
+        GBufferLayout::Compact => "cs_compact",
     }
 }
 
@@ -156,12 +166,7 @@ impl DistanceSource {
                 (layout, "cs_forward", codec_constants(NormalCodec::Octa16))
             }
             DistanceSource::GBuffer(layout, codec) => {
-                let entry = match layout {
-                    GBufferLayout::Full => "cs_full",
-                    GBufferLayout::Packed => "cs_packed",
-                    GBufferLayout::Compact => "cs_compact",
-                };
-                (gbuffer_read_layout(device, layout), entry, codec_constants(codec))
+                (gbuffer_read_layout(device, layout), compute_entry(layout), codec_constants(codec))
             }
         }
     }
@@ -205,23 +210,8 @@ impl DistancePipeline {
         source: DistanceSource,
     ) -> Result<Self, RenderError> {
         let (source_layout, entry, constants) = source.layout(device);
-        let module = crate::shaders::create_module(device, shader)?;
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(label),
-            bind_group_layouts: &[Some(view_layout), Some(&source_layout), Some(pass_layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(label),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some(entry),
-            compilation_options: wgpu::PipelineCompilationOptions {
-                constants: &constants,
-                ..Default::default()
-            },
-            cache: None,
-        });
+        let layouts = [view_layout, &source_layout, pass_layout];
+        let pipeline = compute_pipeline(device, label, shader, &layouts, entry, &constants)?;
         Ok(DistancePipeline { pipeline, source_layout })
     }
 }

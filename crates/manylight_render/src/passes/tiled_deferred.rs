@@ -2,7 +2,10 @@
 //! of the light grid cuts the tile's list to its pixels' depths (range and 2.5D mask) in
 //! workgroup memory and shades its pixels from it into [`HDR`].
 
-use super::gbuffer_layout::{codec_constants, gbuffer_read_bind_group, gbuffer_read_layout, gbuffer_reads};
+use super::common::compute_pipeline;
+use super::gbuffer_layout::{
+    codec_constants, compute_entry, gbuffer_read_bind_group, gbuffer_read_layout, gbuffer_reads,
+};
 use super::{CLUSTERS, HDR};
 use crate::bindings::Binding;
 use crate::context::RenderError;
@@ -33,15 +36,6 @@ pub struct TiledDeferredPipeline {
     output_layout: wgpu::BindGroupLayout,
 }
 
-/// The compute entry point of `tiled_deferred.wgsl` for a layout.
-fn compute_entry(layout: GBufferLayout) -> &'static str {
-    match layout {
-        GBufferLayout::Full => "cs_full",
-        GBufferLayout::Packed => "cs_packed",
-        GBufferLayout::Compact => "cs_compact",
-    }
-}
-
 impl TiledDeferredPipeline {
     fn new(
         device: &wgpu::Device,
@@ -64,25 +58,10 @@ impl TiledDeferredPipeline {
                 count: None,
             }],
         });
-        let module = crate::shaders::create_module(device, "tiled_deferred.wgsl")?;
-        let layouts = [Some(view_layout), Some(&gbuffer_layout), Some(cluster_layout), Some(&output_layout)];
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("tiled_deferred"),
-            bind_group_layouts: &layouts,
-            immediate_size: 0,
-        });
-        let constants = codec_constants(codec);
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("tiled_deferred"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some(compute_entry(layout)),
-            compilation_options: wgpu::PipelineCompilationOptions {
-                constants: &constants,
-                ..Default::default()
-            },
-            cache: None,
-        });
+        let layouts = [view_layout, &gbuffer_layout, cluster_layout, &output_layout];
+        let (entry, constants) = (compute_entry(layout), codec_constants(codec));
+        let pipeline =
+            compute_pipeline(device, "tiled_deferred", "tiled_deferred.wgsl", &layouts, entry, &constants)?;
         Ok(TiledDeferredPipeline { pipeline, gbuffer_layout, output_layout })
     }
 }
