@@ -123,18 +123,28 @@ pub fn exact_pixel_lists(
     lights: &[ViewSphere],
     depth: &[f32],
 ) -> ClusterAssignment {
+    filtered_pixel_lists(grid, projection, assignment, depth, |l, q| {
+        lights.get(l as usize).is_some_and(|s| contributes(s, q))
+    })
+}
+
+/// Per covered pixel of a frame whose depth buffer is `depth`, the lights of its cluster's list
+/// in `assignment` that `keep(light, view_position)` keeps, in list order: an assignment over
+/// [`pixel_grid`] (`ranges[x + y * width]`, empty for background pixels, the offsets an
+/// exclusive prefix sum of the counts).
+fn filtered_pixel_lists(
+    grid: &ClusterGrid,
+    projection: &Projection,
+    assignment: &ClusterAssignment,
+    depth: &[f32],
+    mut keep: impl FnMut(u32, Vec3) -> bool,
+) -> ClusterAssignment {
     let pixels = grid.viewport.x.max(1) as usize * grid.viewport.y.max(1) as usize;
     let mut ranges = vec![[0u32; 2]; pixels];
     let mut indices: Vec<u32> = Vec::new();
     for_each_covered_pixel(grid, projection, depth, |index, q, cluster| {
         let offset = indices.len() as u32;
-        indices.extend(
-            assignment
-                .lights_of(cluster)
-                .iter()
-                .copied()
-                .filter(|&l| lights.get(l as usize).is_some_and(|s| contributes(s, q))),
-        );
+        indices.extend(assignment.lights_of(cluster).iter().copied().filter(|&l| keep(l, q)));
         ranges[index] = [offset, indices.len() as u32 - offset];
     });
     // Background pixels keep offset 0; give them the running offset so the offsets stay an
@@ -409,19 +419,11 @@ pub fn zbinned_lists(
             *r = (r.0.min(i as u32), r.1.max(i as u32));
         }
     }
-    let viewport = grid.viewport.max(glam::UVec2::ONE);
-    let mut ranges = vec![[0u32; 2]; (viewport.x * viewport.y) as usize];
-    let mut indices = Vec::new();
-    for_each_covered_pixel(grid, projection, depth, |index, q, cluster| {
+    filtered_pixel_lists(grid, projection, assignment, depth, |l, q| {
         let (first, last) = range[bin_of(-q.z) as usize];
-        let offset = indices.len() as u32;
-        indices.extend(assignment.lights_of(cluster).iter().copied().filter(|&l| {
-            let k = rank.get(l as usize).copied().unwrap_or(u32::MAX);
-            first <= k && k <= last
-        }));
-        ranges[index] = [offset, indices.len() as u32 - offset];
-    });
-    ClusterAssignment { ranges, indices, dropped_pairs: 0, clusters_overflowed: 0 }
+        let k = rank.get(l as usize).copied().unwrap_or(u32::MAX);
+        first <= k && k <= last
+    })
 }
 
 #[cfg(test)]
@@ -443,6 +445,13 @@ mod tests {
         );
         let depth_of = move |d: f32| projection.matrix(2.0).project_point3(glam::Vec3::new(0.0, 0.0, -d)).z;
         (grid, projection, depth_of)
+    }
+
+    /// [`small_view`] with one depth slice: its 4-px tiles.
+    fn small_tile_view() -> (ClusterGrid, Projection, impl Fn(f32) -> f32) {
+        let (grid, projection, depth_of) = small_view();
+        let config = GridConfig { tile_px: 4, z_slices: 1, ..GridConfig::default() };
+        (ClusterGrid::new(grid.viewport, &projection, &config), projection, depth_of)
     }
 
     /// Depth bounds cut the lights of a slice that miss the only depth its pixels have: a wall
@@ -484,12 +493,7 @@ mod tests {
     /// keeps, keeps lights reaching either surface, and misses no contributing pair.
     #[test]
     fn a_depth_mask_drops_lights_between_a_tiles_surfaces() {
-        let (grid, projection, depth_of) = small_view();
-        let grid = ClusterGrid::new(
-            grid.viewport,
-            &projection,
-            &GridConfig { tile_px: 4, z_slices: 1, ..GridConfig::default() },
-        );
+        let (grid, projection, depth_of) = small_tile_view();
         let mut depth = vec![depth_of(12.0); 32];
         for y in 0..4 {
             depth[y * 8] = depth_of(4.0);
@@ -518,12 +522,7 @@ mod tests {
     /// the same tiles; nothing that lights a pixel goes missing.
     #[test]
     fn zbinning_drops_lights_outside_the_pixels_depth_bin() {
-        let (grid, projection, depth_of) = small_view();
-        let grid = ClusterGrid::new(
-            grid.viewport,
-            &projection,
-            &GridConfig { tile_px: 4, z_slices: 1, ..GridConfig::default() },
-        );
+        let (grid, projection, depth_of) = small_tile_view();
         let depth = vec![depth_of(4.0); 32];
         let lights = [
             ViewSphere { center: glam::Vec3::new(0.0, 0.0, -4.5), radius: 1.0 },
