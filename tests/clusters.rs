@@ -715,9 +715,7 @@ fn depth_bounded_lists_keep_every_contributing_light() {
 #[test]
 fn refined_lists_keep_every_contributing_light() {
     use manylight::app::prelude::GBufferLayout;
-    use manylight::core::efficiency::{
-        Refinement, block_lists_per_pixel, culling_efficiency, pixel_grid, refined_lists,
-    };
+    use manylight::core::efficiency::{Refinement, culling_efficiency, pixel_grid, refined_lists};
     use manylight::render::gpu_types::{REFINE_EDGE, REFINED_FALLBACK, REFINED_LIST_SLOTS};
     let _gpu = gpu();
     let mut r = HeadlessRenderer::new().expect("adapter");
@@ -749,11 +747,7 @@ fn refined_lists_keep_every_contributing_light() {
         let refined = clusters.read_refined(&renderer.gpu).expect("readback").expect("refined lists");
         let (_, _, depth) = renderer.read_depth().expect("depth readback").expect("a depth buffer");
         let spheres = &clusters.view_spheres;
-        let blocks = ClusterAssignment {
-            ranges: refined.ranges.clone(),
-            indices: refined.indices.clone(),
-            ..Default::default()
-        };
+        let blocks = &refined.lists;
         let model = refined_lists(&clusters.grid, &projection, &lists, spheres, &depth, refinement);
         assert_eq!(model.ranges.len(), blocks.ranges.len(), "{what}: block count");
         for (b, r) in blocks.ranges.iter().enumerate() {
@@ -768,15 +762,7 @@ fn refined_lists_keep_every_contributing_light() {
                 assert!(!kept[..i].contains(l), "{what}: block {b} holds light {l} twice");
             }
         }
-        let per_pixel = block_lists_per_pixel(
-            &clusters.grid,
-            &projection,
-            &lists,
-            &depth,
-            REFINE_EDGE,
-            &blocks,
-            REFINED_FALLBACK,
-        );
+        let per_pixel = refined.per_pixel(&clusters.grid, &projection, &lists, &depth);
         let pixels = pixel_grid(clusters.grid.viewport, &projection);
         let e = culling_efficiency(&pixels, &projection, &per_pixel, spheres, &depth, stride);
         assert!(e.sampled_pixels > 0, "{what}: {e:?}");

@@ -6,10 +6,9 @@ use anyhow::{Context, Result};
 use glam::UVec2;
 use manylight_app::render_world::HeadlessRenderer;
 use manylight_app::scene::{extracted_light, scene_snapshot};
-use manylight_core::cluster::ClusterAssignment;
 use manylight_core::efficiency::{
-    CullingEfficiency, block_lists_per_pixel, culling_efficiency, depth_bounded_lists, depth_masked_lists,
-    exact_pixel_lists, pixel_grid, zbinned_lists,
+    CullingEfficiency, culling_efficiency, depth_bounded_lists, depth_masked_lists, exact_pixel_lists,
+    pixel_grid, zbinned_lists,
 };
 use manylight_render::{FrameReport, FrameSettings, FrameSnapshot, PipelineKind};
 use manylight_scene::{AnimatedLight, Scene};
@@ -89,21 +88,7 @@ pub fn measure_culling(
         let masked = depth_masked_lists(&f.grid, &f.projection, &f.assignment, &f.spheres, &f.depth, cells);
         culling_efficiency(&f.grid, &f.projection, &masked, &f.spheres, &f.depth, 64)
     } else if let Some(refined) = &f.refined {
-        use manylight_render::gpu_types::{REFINE_EDGE, REFINED_FALLBACK};
-        let blocks = ClusterAssignment {
-            ranges: refined.ranges.clone(),
-            indices: refined.indices.clone(),
-            ..Default::default()
-        };
-        let per_pixel = block_lists_per_pixel(
-            &f.grid,
-            &f.projection,
-            &f.assignment,
-            &f.depth,
-            REFINE_EDGE,
-            &blocks,
-            REFINED_FALLBACK,
-        );
+        let per_pixel = refined.per_pixel(&f.grid, &f.projection, &f.assignment, &f.depth);
         let pixels = pixel_grid(f.grid.viewport, &f.projection);
         culling_efficiency(&pixels, &f.projection, &per_pixel, &f.spheres, &f.depth, 64)
     } else {

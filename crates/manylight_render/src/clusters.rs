@@ -103,18 +103,38 @@ pub struct ListOptions {
     pub refined_lists: bool,
 }
 
-/// The refined lists of a frame, read back (`ClusterResources::read_refined`): per block of
-/// `REFINE_EDGE` × `REFINE_EDGE` pixels (row-major, `blocks` across and down) its
-/// `(offset, count)` into `indices`, or a count of `REFINED_FALLBACK` when its pixels shade
-/// from their cluster lists.
+/// The refined lists of a frame, read back (`ClusterResources::read_refined`).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct RefinedLists {
     /// Blocks across and down.
     pub blocks: glam::UVec2,
-    /// Per block `(offset, count)`, offsets into `indices`.
-    pub ranges: Vec<[u32; 2]>,
-    /// The blocks' light indices.
-    pub indices: Vec<u32>,
+    /// Per block of `REFINE_EDGE` × `REFINE_EDGE` pixels (row-major) its list, or a count of
+    /// `REFINED_FALLBACK` when its pixels shade from their cluster lists.
+    pub lists: ClusterAssignment,
+}
+
+impl RefinedLists {
+    /// The list each pixel of the frame shades from: its block's, or its cluster's in
+    /// `clusters` where the block fell back (`efficiency::block_lists_per_pixel`, over
+    /// `efficiency::pixel_grid`). `grid`, `projection` and `depth` are the frame's.
+    pub fn per_pixel(
+        &self,
+        grid: &ClusterGrid,
+        projection: &Projection,
+        clusters: &ClusterAssignment,
+        depth: &[f32],
+    ) -> ClusterAssignment {
+        use crate::gpu_types::REFINED_FALLBACK;
+        manylight_core::efficiency::block_lists_per_pixel(
+            grid,
+            projection,
+            clusters,
+            depth,
+            REFINE_EDGE,
+            &self.lists,
+            REFINED_FALLBACK,
+        )
+    }
 }
 
 /// GPU buffers and bind groups of the cluster build and of clustered shading.
@@ -738,7 +758,7 @@ impl ClusterResources {
                 r[0] = r[0].saturating_sub(base as u32);
             }
         }
-        Ok(Some(RefinedLists { blocks, ranges, indices }))
+        Ok(Some(RefinedLists { blocks, lists: ClusterAssignment { ranges, indices, ..Default::default() } }))
     }
 
     /// Reads the GPU's assignment back into the CPU structure (tests compare it with
