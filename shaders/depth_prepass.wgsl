@@ -1,8 +1,9 @@
 // Depth pre-pass: depth only, so the lighting pass shades each pixel once. Opaque surfaces run
 // no fragment stage; alpha-masked ones (`fs_mask`) discard where the base colour's alpha is below
-// the material's cutoff, as the shading passes do. With per-cluster depth bounds it also writes
-// the view distance clustered forward shades each pixel at (`fs_distance`, `fs_mask_distance`,
-// r32float), which cluster_depth.wgsl reads.
+// the material's cutoff, as the shading passes do. With per-cluster depth bounds or refined
+// light lists it also writes the view distance clustered forward shades each pixel at
+// (`fs_distance`, `fs_mask_distance`, r32float), which cluster_depth.wgsl and light_refine.wgsl
+// read.
 //!include common/mesh_pass.wgsl
 
 @fragment

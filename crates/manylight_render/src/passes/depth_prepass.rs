@@ -11,7 +11,7 @@ use crate::resources::{DEPTH_FORMAT, SceneResources, SurfaceVariant};
 
 /// The depth pre-pass's pipeline: one per surface variant (alpha-masked ones run a fragment
 /// stage that discards, the others none) and per whether it writes the shading distance for
-/// per-cluster depth bounds (then every variant runs a fragment stage).
+/// per-cluster depth bounds and refined light lists (then every variant runs a fragment stage).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct DepthPrepassKey {
     /// Culling and alpha masking.
@@ -66,7 +66,7 @@ impl ScenePipeline for DepthPrepassPipeline {
 pub const SHADING_DISTANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 
 /// Writes [`DEPTH`] for every drawn instance, and with `distance` each pixel's shading distance
-/// ([`SHADING_DISTANCE`], for per-cluster depth bounds).
+/// ([`SHADING_DISTANCE`], for per-cluster depth bounds and refined light lists).
 pub struct DepthPrepass {
     /// Also writes [`SHADING_DISTANCE`].
     pub distance: bool,

@@ -63,7 +63,7 @@ pub const LIGHT_ACCUM: crate::graph::ResourceName = "light_accum";
 /// Graph resource: the cluster light lists (persistent buffers, ordered through the graph).
 pub const CLUSTERS: crate::graph::ResourceName = "clusters";
 /// Graph resource: each pixel's view distance as forward shading computes it (the depth
-/// pre-pass writes it for per-cluster depth bounds).
+/// pre-pass writes it for per-cluster depth bounds and refined light lists).
 pub const SHADING_DISTANCE: crate::graph::ResourceName = "shading_distance";
 /// Graph resource: the depth range of every cluster's pixels (after the cluster ranges, in the
 /// same buffer), which the cluster build cuts clusters to.
