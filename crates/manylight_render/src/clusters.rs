@@ -391,7 +391,7 @@ impl ClusterResources {
         let depth_bounds = options.depth_bounds;
         self.depth_bounds = depth_bounds;
         self.refine_blocks =
-            options.refined_lists.then(|| view.size.max(glam::UVec2::ONE).map(|v| v.div_ceil(REFINE_EDGE)));
+            options.refined_lists.then(|| manylight_core::efficiency::block_dims(view.size, REFINE_EDGE));
         let grid_config = settings.grid_for(view.settings.pipeline);
         let projection = self.place_lights(view, view_from_world, lights);
         self.grid = ClusterGrid::new(view.size, &projection, &grid_config);
