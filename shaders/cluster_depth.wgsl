@@ -18,7 +18,7 @@
 //!include common/brdf.wgsl
 //!include common/clusters.wgsl
 
-// group 0, binding 0: `view`, declared in common/gbuffer_read.wgsl; group 1: the G-buffer
+// group 0, binding 0: `view` (common/view_binding.wgsl, through common/gbuffer_read.wgsl); group 1: the G-buffer
 //!include common/gbuffer_read.wgsl
 
 // A storage binding of the params uniform's buffer: lavapipe (Mesa 22.3) compiles a new

@@ -8,8 +8,7 @@
 
 @fragment
 fn fs_mask(in: SurfaceVertexOut) {
-    let uv = texture_uv(material, TEXTURE_SLOT_BASE_COLOR, in.uv);
-    alpha_test(surface_albedo(material, base_color_texture, base_color_sampler, uv));
+    alpha_test(surface_albedo(material, base_color_texel(in)));
 }
 
 @fragment
@@ -20,7 +19,6 @@ fn fs_distance(in: SurfaceVertexOut) -> @location(0) f32 {
 @fragment
 fn fs_mask_distance(in: SurfaceVertexOut) -> @location(0) f32 {
     let p = surface_point(view, in.clip_position.xy, in.camera_offset);
-    let uv = texture_uv(material, TEXTURE_SLOT_BASE_COLOR, in.uv);
-    alpha_test(surface_albedo(material, base_color_texture, base_color_sampler, uv));
+    alpha_test(surface_albedo(material, base_color_texel(in)));
     return p.view_depth;
 }

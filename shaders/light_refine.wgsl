@@ -24,7 +24,7 @@
 //!include common/brdf.wgsl
 //!include common/clusters.wgsl
 
-// group 0, binding 0: `view`, declared in common/gbuffer_read.wgsl; group 1: the G-buffer
+// group 0, binding 0: `view` (common/view_binding.wgsl, through common/gbuffer_read.wgsl); group 1: the G-buffer
 //!include common/gbuffer_read.wgsl
 
 // Storage, not uniform: see cluster_depth.wgsl (lavapipe recompiles small shaders whose

@@ -17,7 +17,7 @@
 //!include common/brdf.wgsl
 //!include common/clusters.wgsl
 
-// group 0, binding 0: `view`, declared in common/gbuffer_read.wgsl
+// group 0, binding 0: `view` (common/view_binding.wgsl, through common/gbuffer_read.wgsl)
 @group(0) @binding(1) var<storage, read> lights: array<GpuPointLight>;
 
 //!include common/gbuffer_read.wgsl
@@ -147,7 +147,7 @@ fn cull_tile(tile: vec2<u32>, li: u32) {
 
 fn shade(g: GSurface, tile: vec2<u32>) -> vec4<f32> {
     let view_dir = direction_to_eye(view, g.world_position);
-    var color = gbuffer_base_radiance(g) + shade_directional_lights(view, g.params, view_dir);
+    var color = gbuffer_base_radiance(g) + shade_directional_lights(g.params, view_dir);
     let count = atomicLoad(&list_count);
     if count <= TILED_LIST_CAPACITY {
         for (var i = 0u; i < count; i++) {

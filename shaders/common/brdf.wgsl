@@ -67,17 +67,6 @@ fn reflected(s: SurfaceParams, l: vec3<f32>, view_dir: vec3<f32>) -> vec3<f32> {
     return result;
 }
 
-// Radiance the view's directional lights add (`ViewUniform::directional`, at most
-// MAX_DIRECTIONAL_LIGHTS, not clustered: each reaches every pixel).
-fn shade_directional_lights(v: ViewUniform, s: SurfaceParams, view_dir: vec3<f32>) -> vec3<f32> {
-    var color = vec3<f32>(0.0);
-    for (var i = 0u; i < min(v.directional_count, MAX_DIRECTIONAL_LIGHTS); i++) {
-        let light = v.directional[i];
-        color += reflected(s, -light.direction.xyz, view_dir) * light.color.rgb;
-    }
-    return color;
-}
-
 // Toon (cel) shading of one light: the diffuse term in TOON_BANDS flat bands (the light's
 // attenuation stays smooth, so many overlapping lights do not stack into hard rings), plus a rim
 // on silhouettes where the light reaches the surface or grazes it from behind.

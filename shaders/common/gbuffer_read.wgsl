@@ -1,10 +1,9 @@
 // Reading the G-buffer back (clustered deferred lighting and light volumes). Group 1 holds the
 // targets of the pipeline's layout; each entry point touches only its own layout's bindings.
-// Declares the view uniform (group 0, binding 0) too, which decoding needs.
-//!include common/view.wgsl
+// Includes the view uniform (group 0, binding 0) too, which decoding needs.
+//!include common/view_binding.wgsl
 //!include common/gbuffer_codec.wgsl
-
-@group(0) @binding(0) var<uniform> view: ViewUniform;
+//!include common/directional_lights.wgsl
 
 // Full layout
 @group(1) @binding(0) var gb_position: texture_2d<f32>;

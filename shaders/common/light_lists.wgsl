@@ -3,6 +3,7 @@
 // then the point and spot lights it sums, either every light or its cluster's list.
 //!include common/mesh_pass.wgsl
 //!include common/brdf.wgsl
+//!include common/directional_lights.wgsl
 // The light lists (group 2), bound only by the pipelines whose entry point calls
 // `add_cluster_lights`.
 //!include common/cluster_lists.wgsl
@@ -23,7 +24,7 @@ fn forward_fragment(in: SurfaceVertexOut, front_facing: bool) -> ForwardFragment
     alpha_test(m.base_color);
     let view_dir = direction_to_eye(view, p.world_position);
     var color = surface_base_radiance(m.params.albedo, view.params.w, m.occlusion, m.emissive);
-    color += shade_directional_lights(view, m.params, view_dir);
+    color += shade_directional_lights(m.params, view_dir);
     return ForwardFragment(p, m, view_dir, color);
 }
 

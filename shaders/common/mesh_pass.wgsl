@@ -5,8 +5,8 @@
 //!include common/lights.wgsl
 //!include common/mesh.wgsl
 //!include common/surface.wgsl
+//!include common/view_binding.wgsl
 
-@group(0) @binding(0) var<uniform> view: ViewUniform;
 @group(0) @binding(1) var<storage, read> lights: array<GpuPointLight>;
 @group(0) @binding(2) var<storage, read> instances: array<GpuInstance>;
 
@@ -36,25 +36,48 @@ struct MaterialSample {
     occlusion: f32,
 };
 
-// Samples every texture of the material (in uniform control flow: no texture sample sits
-// behind a branch) and builds the surface: normal map, occlusion, emissive, and the normal
-// turned towards the viewer on the back faces of double-sided materials.
+// The base colour texture's texel at the fragment, 1 where the pipeline does not sample it.
+fn base_color_texel(in: SurfaceVertexOut) -> vec4<f32> {
+    var texel = vec4<f32>(1.0);
+    if BASE_COLOR_TEXTURE {
+        let uv = texture_uv(material, TEXTURE_SLOT_BASE_COLOR, in.uv);
+        texel = textureSample(base_color_texture, base_color_sampler, uv);
+    }
+    return texel;
+}
+
+// Samples the textures of the material that the pipeline samples (the `*_TEXTURE` override
+// constants; their branches are uniform and fold away when the pipeline is made) and builds
+// the surface: normal map, occlusion, emissive, and the normal turned towards the viewer on
+// the back faces of double-sided materials.
 fn sample_material(in: SurfaceVertexOut, front_facing: bool) -> MaterialSample {
     var out: MaterialSample;
-    let base_uv = texture_uv(material, TEXTURE_SLOT_BASE_COLOR, in.uv);
-    out.base_color = surface_albedo(material, base_color_texture, base_color_sampler, base_uv);
-    let metal_rough_uv = texture_uv(material, TEXTURE_SLOT_METALLIC_ROUGHNESS, in.uv);
-    let metal_rough =
-        surface_metal_rough(material, metallic_roughness_texture, metallic_roughness_sampler, metal_rough_uv);
-    let normal_uv = texture_uv(material, TEXTURE_SLOT_NORMAL, in.uv);
-    let normal_texel = textureSample(normal_texture, normal_sampler, normal_uv);
-    let n = surface_normal(material, normal_texel.xyz, in, front_facing);
+    out.base_color = surface_albedo(material, base_color_texel(in));
+    var metal_rough_texel = vec4<f32>(1.0);
+    if METALLIC_ROUGHNESS_TEXTURE {
+        let uv = texture_uv(material, TEXTURE_SLOT_METALLIC_ROUGHNESS, in.uv);
+        metal_rough_texel = textureSample(metallic_roughness_texture, metallic_roughness_sampler, uv);
+    }
+    let metal_rough = surface_metal_rough(material, metal_rough_texel);
+    // a flat normal where the pipeline has no normal map
+    var normal_texel = vec3<f32>(0.5, 0.5, 1.0);
+    if NORMAL_TEXTURE {
+        let uv = texture_uv(material, TEXTURE_SLOT_NORMAL, in.uv);
+        normal_texel = textureSample(normal_texture, normal_sampler, uv).xyz;
+    }
+    let n = surface_normal(material, normal_texel, in, front_facing);
     out.params = surface_params(material, view.shading_model, out.base_color.rgb, metal_rough, n);
-    let occlusion_uv = texture_uv(material, TEXTURE_SLOT_OCCLUSION, in.uv);
-    let occlusion_texel = textureSample(occlusion_texture, occlusion_sampler, occlusion_uv).r;
+    var occlusion_texel = 1.0;
+    if OCCLUSION_TEXTURE {
+        let uv = texture_uv(material, TEXTURE_SLOT_OCCLUSION, in.uv);
+        occlusion_texel = textureSample(occlusion_texture, occlusion_sampler, uv).r;
+    }
     out.occlusion = surface_occlusion(material, occlusion_texel);
-    let emissive_uv = texture_uv(material, TEXTURE_SLOT_EMISSIVE, in.uv);
-    let emissive_texel = textureSample(emissive_texture, emissive_sampler, emissive_uv).rgb;
+    var emissive_texel = vec3<f32>(1.0);
+    if EMISSIVE_TEXTURE {
+        let uv = texture_uv(material, TEXTURE_SLOT_EMISSIVE, in.uv);
+        emissive_texel = textureSample(emissive_texture, emissive_sampler, uv).rgb;
+    }
     out.emissive = material.emissive * select(vec3<f32>(1.0), emissive_texel, material.has_emissive_texture != 0u);
     return out;
 }

@@ -20,6 +20,17 @@ struct SurfaceVertexOut {
 // True in the pipelines of alpha-masked materials (Rust: `SurfaceVariant::alpha_mask`).
 override ALPHA_MASK: bool = false;
 
+// The texture slots the pipeline samples (Rust: `SurfaceVariant::textures`): each material's
+// draws use the pipeline of its own slots, and a slot left out costs nothing. A branch on the
+// material's flag would not do: lavapipe runs both sides of it, so every pixel paid for all
+// five samples (a quarter of the untextured sphere-shell scene's shading). True by default,
+// so a pipeline that sets none samples every slot its material flags.
+override BASE_COLOR_TEXTURE: bool = true;
+override METALLIC_ROUGHNESS_TEXTURE: bool = true;
+override NORMAL_TEXTURE: bool = true;
+override OCCLUSION_TEXTURE: bool = true;
+override EMISSIVE_TEXTURE: bool = true;
+
 fn surface_vertex(v: VertexIn, inst: GpuInstance, clip_from_world: mat4x4<f32>, camera: vec3<f32>) -> SurfaceVertexOut {
     let world = inst.world_from_local * vec4<f32>(v.position, 1.0);
     let m = mat3x3<f32>(inst.world_from_local[0].xyz, inst.world_from_local[1].xyz, inst.world_from_local[2].xyz);
@@ -34,17 +45,19 @@ fn surface_vertex(v: VertexIn, inst: GpuInstance, clip_from_world: mat4x4<f32>, 
     return out;
 }
 
-// Sampled always and chosen by select, never behind a branch on the material: lavapipe (Mesa
-// 22.3) compiles a shader again at every draw when it can fold a uniform-buffer branch away, and
+// The material's base colour times its texture's `texel` where it has one. The texels reach
+// these functions already sampled (`sample_material`, 1 where the pipeline does not sample the
+// slot) and are chosen by select, never by a branch on the material: lavapipe (Mesa 22.3)
+// compiles a shader again at every draw when it can fold a uniform-buffer branch away, and
 // keeps every copy (about 9 MB per frame in the Packed and Compact G-buffer passes).
-fn surface_albedo(m: GpuMaterial, t: texture_2d<f32>, smp: sampler, uv: vec2<f32>) -> vec4<f32> {
-    return m.base_color * select(vec4<f32>(1.0), textureSample(t, smp, uv), m.has_texture != 0u);
+fn surface_albedo(m: GpuMaterial, texel: vec4<f32>) -> vec4<f32> {
+    return m.base_color * select(vec4<f32>(1.0), texel, m.has_texture != 0u);
 }
 
-// Metalness and roughness of the material at `uv` (factors times the texture's blue and green).
-fn surface_metal_rough(m: GpuMaterial, t: texture_2d<f32>, smp: sampler, uv: vec2<f32>) -> vec2<f32> {
-    let texel = select(vec4<f32>(1.0), textureSample(t, smp, uv), m.has_metallic_roughness_texture != 0u);
-    return vec2<f32>(m.metallic * texel.b, m.roughness * texel.g);
+// Metalness and roughness of the material (factors times the texture `texel`'s blue and green).
+fn surface_metal_rough(m: GpuMaterial, texel: vec4<f32>) -> vec2<f32> {
+    let t = select(vec4<f32>(1.0), texel, m.has_metallic_roughness_texture != 0u);
+    return vec2<f32>(m.metallic * t.b, m.roughness * t.g);
 }
 
 // The shading normal of a fragment: the interpolated normal, turned to the side the camera

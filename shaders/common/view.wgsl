@@ -51,34 +51,38 @@ fn frag_ndc(v: ViewUniform, frag: vec2<f32>) -> vec2<f32> {
     return vec2<f32>(frag.x * v.viewport.z * 2.0 - 1.0, 1.0 - frag.y * v.viewport.w * 2.0);
 }
 
+// x and y of the view-space point at z = -1 (perspective) or 0 (orthographic) that the
+// framebuffer position `frag` sees.
+fn frag_view_xy(v: ViewUniform, frag: vec2<f32>) -> vec2<f32> {
+    let ndc = frag_ndc(v, frag);
+    return vec2<f32>(ndc.x / v.clip_from_view[0][0], ndc.y / v.clip_from_view[1][1]);
+}
+
+// The functions below choose between perspective and orthographic with `select`, never a
+// branch: lavapipe (Mesa 22.3) folds a branch that depends only on a uniform buffer into a
+// copy of the shader compiled at draw time, and never frees it (the Compact G-buffer pass grew
+// by about 15 MB a frame through `surface_point`; docs/reliability.md).
+
 // Direction of the ray through the framebuffer position `frag`, in world axes, scaled so that
 // its view-space z is -1: the point `camera + view_ray_origin + t * ray` lies at view depth t.
 // Perspective rays leave the camera; orthographic rays are parallel.
 fn view_ray(v: ViewUniform, frag: vec2<f32>) -> vec3<f32> {
-    if is_orthographic(v) {
-        return view_to_world_vector(v, vec3<f32>(0.0, 0.0, -1.0));
-    }
-    let ndc = frag_ndc(v, frag);
-    return view_to_world_vector(v, vec3<f32>(ndc.x / v.clip_from_view[0][0], ndc.y / v.clip_from_view[1][1], -1.0));
+    let xy = select(frag_view_xy(v, frag), vec2<f32>(0.0), is_orthographic(v));
+    return view_to_world_vector(v, vec3<f32>(xy, -1.0));
 }
 
 // Where the ray through `frag` starts, relative to the camera position: 0 in perspective; on
 // the camera's plane, beside it, in orthographic.
 fn view_ray_origin(v: ViewUniform, frag: vec2<f32>) -> vec3<f32> {
-    if !is_orthographic(v) {
-        return vec3<f32>(0.0);
-    }
-    let ndc = frag_ndc(v, frag);
-    return view_to_world_vector(v, vec3<f32>(ndc.x / v.clip_from_view[0][0], ndc.y / v.clip_from_view[1][1], 0.0));
+    let xy = select(vec2<f32>(0.0), frag_view_xy(v, frag), is_orthographic(v));
+    return view_to_world_vector(v, vec3<f32>(xy, 0.0));
 }
 
 // Unit direction from the surface point `p` (world) towards the eye: to the camera position in
 // perspective, against the view direction in orthographic.
 fn direction_to_eye(v: ViewUniform, p: vec3<f32>) -> vec3<f32> {
-    if is_orthographic(v) {
-        return normalize(view_to_world_vector(v, vec3<f32>(0.0, 0.0, 1.0)));
-    }
-    return normalize(v.camera_position.xyz - p);
+    let orthographic = normalize(view_to_world_vector(v, vec3<f32>(0.0, 0.0, 1.0)));
+    return select(normalize(v.camera_position.xyz - p), orthographic, is_orthographic(v));
 }
 
 // View distance (positive) of a reverse-Z depth value, through the projection's depth terms
@@ -87,10 +91,8 @@ fn direction_to_eye(v: ViewUniform, p: vec3<f32>) -> vec3<f32> {
 fn view_distance_of_depth(v: ViewUniform, depth: f32) -> f32 {
     let a = v.clip_from_view[2][2];
     let b = v.clip_from_view[3][2];
-    if is_orthographic(v) {
-        return (b - depth) / a;
-    }
     let near = v.params.x;
     let near_over_far = v.params.y;
-    return near / (depth * (1.0 - near_over_far) + near_over_far);
+    let perspective = near / (depth * (1.0 - near_over_far) + near_over_far);
+    return select(perspective, (b - depth) / a, is_orthographic(v));
 }

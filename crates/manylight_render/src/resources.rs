@@ -7,7 +7,8 @@
 use crate::context::{GpuContext, RenderError};
 use crate::gpu_types::{
     GpuDirectionalLight, GpuInstance, GpuMaterial, GpuPointLight, GpuTextureUv, MAX_DIRECTIONAL_LIGHTS,
-    SHADING_GLOBAL, ViewUniform,
+    SHADING_GLOBAL, TEXTURE_SLOT_BASE_COLOR, TEXTURE_SLOT_EMISSIVE, TEXTURE_SLOT_METALLIC_ROUGHNESS,
+    TEXTURE_SLOT_NORMAL, TEXTURE_SLOT_OCCLUSION, ViewUniform,
 };
 use crate::pool::GrowableBuffer;
 use crate::snapshot::{FrameSnapshot, RenderView, aspect};
@@ -80,6 +81,12 @@ pub struct SurfaceVariant {
     /// Blended over what is behind it (glTF `BLEND`): drawn only by the transparent pass, back
     /// to front, never by the opaque passes.
     pub blend: bool,
+    /// The material's texture slots, one bit per `TEXTURE_SLOT_*` (bit 0: base colour): the
+    /// pipeline samples only these (`BASE_COLOR_TEXTURE` … `EMISSIVE_TEXTURE` in
+    /// `shaders/common/surface.wgsl`). lavapipe runs both sides of every branch, so a slot the
+    /// shader could sample costs its sample at every pixel whether the material has the
+    /// texture or not.
+    pub textures: u8,
 }
 
 impl SurfaceVariant {
@@ -91,6 +98,12 @@ impl SurfaceVariant {
             cull_back: !material.double_sided,
             alpha_mask: material.alpha_mode.cutoff().is_some(),
             blend: material.alpha_mode == manylight_core::AlphaMode::Blend,
+            textures: material
+                .texture_slots()
+                .iter()
+                .enumerate()
+                .filter(|(_, t)| t.is_some())
+                .fold(0, |bits, (slot, _)| bits | 1 << slot),
         }
     }
 
@@ -103,9 +116,19 @@ impl SurfaceVariant {
         }
     }
 
-    /// The shader's `override` constants for the variant.
-    pub fn constants(self) -> [(&'static str, f64); 1] {
-        [("ALPHA_MASK", if self.alpha_mask { 1.0 } else { 0.0 })]
+    /// The shader's `override` constants for the variant: `ALPHA_MASK`, then one flag per
+    /// texture slot in `TEXTURE_SLOT_*` order.
+    pub fn constants(self) -> [(&'static str, f64); 6] {
+        let flag = |on: bool| if on { 1.0 } else { 0.0 };
+        let slot = |name, slot: u32| (name, flag(self.textures & 1 << slot != 0));
+        [
+            ("ALPHA_MASK", flag(self.alpha_mask)),
+            slot("BASE_COLOR_TEXTURE", TEXTURE_SLOT_BASE_COLOR),
+            slot("METALLIC_ROUGHNESS_TEXTURE", TEXTURE_SLOT_METALLIC_ROUGHNESS),
+            slot("NORMAL_TEXTURE", TEXTURE_SLOT_NORMAL),
+            slot("OCCLUSION_TEXTURE", TEXTURE_SLOT_OCCLUSION),
+            slot("EMISSIVE_TEXTURE", TEXTURE_SLOT_EMISSIVE),
+        ]
     }
 }
 
@@ -851,4 +874,38 @@ fn downsample(src: &[u8], w: u32, h: u32, srgb: bool) -> Vec<u8> {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use manylight_core::material::{MaterialTexture, TextureData};
+
+    #[test]
+    fn a_surface_variant_samples_exactly_its_materials_texture_slots() {
+        let image = Arc::new(TextureData {
+            label: "t".into(),
+            width: 1,
+            height: 1,
+            rgba8: vec![255; 4],
+            srgb: false,
+        });
+        let plain = MaterialData::default();
+        let v = SurfaceVariant::of(&plain, false);
+        assert_eq!(v.textures, 0);
+        assert!(v.constants()[1..].iter().all(|&(_, value)| value == 0.0), "{:?}", v.constants());
+
+        let mapped = MaterialData {
+            normal_texture: Some(MaterialTexture::new(image.clone())),
+            emissive_texture: Some(MaterialTexture::new(image)),
+            ..MaterialData::default()
+        };
+        let v = SurfaceVariant::of(&mapped, false);
+        assert_eq!(v.textures, 1 << TEXTURE_SLOT_NORMAL | 1 << TEXTURE_SLOT_EMISSIVE);
+        let on: Vec<&str> =
+            v.constants().iter().filter(|&&(_, value)| value == 1.0).map(|&(n, _)| n).collect();
+        assert_eq!(on, ["NORMAL_TEXTURE", "EMISSIVE_TEXTURE"]);
+        // Materials with other slots draw with other pipelines.
+        assert_ne!(v, SurfaceVariant::of(&plain, false));
+    }
 }

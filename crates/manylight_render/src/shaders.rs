@@ -20,6 +20,8 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("common/packing.wgsl", include_str!("../../../shaders/common/packing.wgsl")),
     ("common/gbuffer_codec.wgsl", include_str!("../../../shaders/common/gbuffer_codec.wgsl")),
     ("common/gbuffer_read.wgsl", include_str!("../../../shaders/common/gbuffer_read.wgsl")),
+    ("common/view_binding.wgsl", include_str!("../../../shaders/common/view_binding.wgsl")),
+    ("common/directional_lights.wgsl", include_str!("../../../shaders/common/directional_lights.wgsl")),
     ("common/cluster_lists.wgsl", include_str!("../../../shaders/common/cluster_lists.wgsl")),
     ("common/light_lists.wgsl", include_str!("../../../shaders/common/light_lists.wgsl")),
     ("light_volumes.wgsl", include_str!("../../../shaders/light_volumes.wgsl")),

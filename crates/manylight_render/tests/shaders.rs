@@ -5,6 +5,7 @@ use manylight_render::gpu_types::{
     GpuClusterBounds, GpuClusterCounters, GpuClusterParams, GpuDirectionalLight, GpuInstance, GpuMaterial,
     GpuPointLight, GpuTextureUv, ViewUniform,
 };
+use manylight_render::resources::SurfaceVariant;
 use manylight_render::shaders::{SOURCES, compose};
 use std::mem::{offset_of, size_of};
 
@@ -236,12 +237,30 @@ fn every_entry_point_compiles_to_spirv() {
         )
         .validate(&module)
         .unwrap_or_else(|e| panic!("{path}: {e}"));
-        let has_codec = module.overrides.iter().any(|(_, o)| o.name.as_deref() == Some("NORMAL_CODEC"));
-        let variants: Vec<naga::back::PipelineConstants> = if has_codec {
+        let declares = |name: &str| module.overrides.iter().any(|(_, o)| o.name.as_deref() == Some(name));
+        let mut variants: Vec<naga::back::PipelineConstants> = if declares("NORMAL_CODEC") {
             codecs.iter().map(|&c| [("NORMAL_CODEC".to_string(), c)].into_iter().collect()).collect()
         } else {
             vec![Default::default()]
         };
+        // Mesh passes: every surface variant's constants (no texture, each slot alone, all five;
+        // masked or not) on top of each codec's.
+        if declares("ALPHA_MASK") {
+            let texture_sets = [0u8, 1, 2, 4, 8, 16, 31];
+            variants = variants
+                .iter()
+                .flat_map(|base| {
+                    texture_sets.iter().flat_map(move |&textures| {
+                        [false, true].map(|alpha_mask| {
+                            let v = SurfaceVariant { alpha_mask, textures, ..Default::default() };
+                            let mut c = base.clone();
+                            c.extend(v.constants().map(|(name, value)| (name.to_string(), value)));
+                            c
+                        })
+                    })
+                })
+                .collect();
+        }
         for constants in &variants {
             for ep in &module.entry_points {
                 let (module, info) = naga::back::pipeline_constants::process_overrides(

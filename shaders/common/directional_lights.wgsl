@@ -1,0 +1,19 @@
+// The view's directional lights (`ViewUniform::directional`; not clustered: each reaches every
+// pixel), read from the pass's view uniform in place.
+//!include common/view_binding.wgsl
+//!include common/brdf.wgsl
+
+// Radiance the view's directional lights add to a surface seen from `view_dir`.
+//
+// It indexes the uniform buffer itself rather than a `ViewUniform` passed by value: lavapipe
+// copies a struct argument, array and all, into every invocation before a dynamic index can
+// read it, which made this loop about 40 % of the sphere-shell scene's shading at 1 024
+// lights, a scene with no directional light at all (docs/benchmarks.md, "Per-pixel cost").
+fn shade_directional_lights(s: SurfaceParams, view_dir: vec3<f32>) -> vec3<f32> {
+    var color = vec3<f32>(0.0);
+    for (var i = 0u; i < min(view.directional_count, MAX_DIRECTIONAL_LIGHTS); i++) {
+        let light = view.directional[i];
+        color += reflected(s, -light.direction.xyz, view_dir) * light.color.rgb;
+    }
+    return color;
+}
