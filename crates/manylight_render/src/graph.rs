@@ -77,6 +77,12 @@ pub struct PassContext<'a> {
 }
 
 impl<'a> PassContext<'a> {
+    /// The frame's cluster buffers, which pass `pass` needs: an error naming it when the frame
+    /// has none (the plan added the pass without the clusters it reads).
+    pub fn require_clusters(&self, pass: &str) -> Result<&'a crate::clusters::ClusterResources, RenderError> {
+        self.clusters.ok_or_else(|| RenderError::Graph(format!("{pass} needs cluster resources")))
+    }
+
     /// The bind group of `layout` with `bindings` (binding `i` is `bindings[i]`), kept across
     /// frames while its resources live ([`crate::bindings::BindingCache::bind_group`]).
     pub fn bind_group(

@@ -121,8 +121,7 @@ impl Pass for ClusterBuildPass {
         true
     }
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
-        let clusters =
-            ctx.clusters.ok_or_else(|| RenderError::Graph("cluster_build needs cluster resources".into()))?;
+        let clusters = ctx.require_clusters("cluster_build")?;
         let wg = self.workgroup_size.clamp(1, 1024);
         let layout = &clusters.build_layout;
         let pipelines = ctx.pipelines.get_or_create(ClusterBuildKey { workgroup_size: wg }, |k| {
@@ -199,9 +198,7 @@ impl Pass for PixelListsPass {
         vec![CLUSTERS]
     }
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
-        ctx.clusters
-            .map(|_| ())
-            .ok_or_else(|| RenderError::Graph("pixel_light_lists needs cluster resources".into()))
+        ctx.require_clusters("pixel_light_lists").map(|_| ())
     }
 }
 

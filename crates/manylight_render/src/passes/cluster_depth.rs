@@ -43,8 +43,7 @@ impl Pass for ClusterDepthPass {
         true
     }
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
-        let clusters =
-            ctx.clusters.ok_or_else(|| RenderError::Graph("cluster_depth needs cluster resources".into()))?;
+        let clusters = ctx.require_clusters("cluster_depth")?;
         let scene = ctx.scene;
         let device = &ctx.gpu.device;
         let pipeline =

@@ -142,9 +142,7 @@ impl Pass for DebugViewPass {
         ];
         match family {
             Family::Clusters => {
-                let clusters = ctx
-                    .clusters
-                    .ok_or_else(|| RenderError::Graph("debug_view needs cluster resources".into()))?;
+                let clusters = ctx.require_clusters("debug_view")?;
                 bindings.extend([
                     (2, Binding::Buffer(&clusters.params_buffer)),
                     (3, Binding::Buffer(clusters.ranges.buffer())),

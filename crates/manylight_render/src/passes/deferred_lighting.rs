@@ -86,9 +86,7 @@ impl Pass for DeferredLightingPass {
         vec![TextureSpec { name: HDR, format: HDR_FORMAT, usage, scale: 1.0 }]
     }
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
-        let clusters = ctx
-            .clusters
-            .ok_or_else(|| RenderError::Graph("deferred_lighting needs cluster resources".into()))?;
+        let clusters = ctx.require_clusters("deferred_lighting")?;
         let device = &ctx.gpu.device;
         let (layout, codec) = (self.layout, self.codec);
         let view_layout = &ctx.scene.view_layout;

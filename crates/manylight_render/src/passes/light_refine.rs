@@ -44,8 +44,7 @@ impl Pass for LightRefinePass {
         true
     }
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
-        let clusters =
-            ctx.clusters.ok_or_else(|| RenderError::Graph("light_refine needs cluster resources".into()))?;
+        let clusters = ctx.require_clusters("light_refine")?;
         let scene = ctx.scene;
         let device = &ctx.gpu.device;
         let pipeline = ctx.pipelines.get_or_create(RefineKey(self.source), |&RefineKey(source)| {

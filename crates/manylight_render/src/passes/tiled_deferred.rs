@@ -97,9 +97,7 @@ impl Pass for TiledDeferredPass {
         true
     }
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
-        let clusters = ctx
-            .clusters
-            .ok_or_else(|| RenderError::Graph("tiled_deferred needs cluster resources".into()))?;
+        let clusters = ctx.require_clusters("tiled_deferred")?;
         let [tiles_x, tiles_y, slices, _] = clusters.params.dims;
         if slices != 1 {
             return Err(RenderError::Graph(format!(

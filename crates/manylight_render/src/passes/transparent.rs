@@ -80,9 +80,7 @@ impl Pass for TransparentPass {
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
         let scene = ctx.scene;
         let clusters = if self.clustered {
-            let c = ctx
-                .clusters
-                .ok_or_else(|| RenderError::Graph("transparent needs cluster resources".into()))?;
+            let c = ctx.require_clusters("transparent")?;
             Some(c)
         } else {
             None
