@@ -1,21 +1,36 @@
-// Cluster light assignment on the GPU, in three levels of three dispatches each, in one compute
-// pass. Level 0 builds a list per coarse tile (span × span tiles); level 1 a list per screen
+// Cluster light assignment on the GPU, in three levels of three or four dispatches each, in one
+// compute pass. Level 0 builds a list per coarse tile (span × span tiles); level 1 a list per screen
 // tile (the column of clusters behind it) from its coarse tile's list; level 2 each cluster's
 // list from its tile's list. So no level tests every light against every tile: at 100 000
 // lights on 40 × 23 tiles, level 1 alone used to run 92 million sphere tests twice.
-// 0. `coarse_count`, `coarse_scan`, `coarse_fill`: one invocation per (coarse tile, chunk of
-//    TILE_LIGHT_CHUNK lights) counts, then writes, the chunk's lights that `touches_coarse`: a
-//    superset of what any of its columns accepts (manylight_core::cluster::coarse_tile_accepts;
-//    checked on the CPU by crates/manylight_core/tests/tile_prefilter.rs). Without a coarse level (`coarse_span` 0: the planes test, which is not
-//    monotone in the tile, or a span below 2) these steps are not dispatched and level 1 takes
-//    every light as a candidate;
+// 0. Level 0, per coarse tile, in one of two ways with the same lists:
+//    - from the lights' side, where its bits fit (ClusterResources::coarse_bits): `light_marks`
+//      runs one invocation per light, makes the light's rectangle of tiles (`light_rect`, a
+//      superset of the tiles whose column accepts it: manylight_core::cluster::RectGrid::light_tile_rect,
+//      checked on the CPU by crates/manylight_core/tests/tile_prefilter.rs) and sets the light's
+//      bit in each coarse tile of the rectangle that `touches_coarse`; `coarse_count_bits`
+//      counts, and `coarse_fill_bits` writes, the set bits of one (coarse tile, chunk of
+//      TILE_LIGHT_CHUNK lights) each, in ascending light order. Each light loops over its few
+//      coarse tiles, not each coarse tile over every light;
+//    - otherwise `coarse_count` and `coarse_fill`: one invocation per (coarse tile, chunk of
+//      TILE_LIGHT_CHUNK lights) counts, then writes, the chunk's lights that `touches_coarse`.
+//    `touches_coarse` accepts a superset of what any of its columns accepts
+//    (manylight_core::cluster::coarse_tile_accepts; checked by tile_prefilter.rs too), and
+//    `coarse_scan` makes the lists' offsets. Without a coarse level (`coarse_span` 0: the
+//    planes test, which is not monotone in the tile, or a span below 2) these steps are not
+//    dispatched and level 1 takes every light as a candidate;
 // 1. `tile_count`: one invocation per (tile, chunk of TILE_LIGHT_CHUNK candidates of its coarse
 //    tile's list; `chunk_of`) counts the chunk's lights whose sphere passes the chosen test against the
 //    tile's whole column, radius inflated a little more: the column's box contains each
 //    cluster's box and its planes are each cluster's side planes moved outwards, so this is a
 //    superset of what any cluster of the column accepts (checked on the CPU by
 //    crates/manylight_core/tests/tile_prefilter.rs). Chunks keep every invocation's loop short:
-//    lavapipe stops an invocation after 65 535 loop iterations (gpu_types::TILE_LIGHT_CHUNK);
+//    lavapipe stops an invocation after 65 535 loop iterations (gpu_types::TILE_LIGHT_CHUNK).
+//    With level 0's bits, level 1 runs from the coarse lists' side instead: `tile_marks` takes
+//    one invocation per position of the coarse lists and tests its light only against the tiles
+//    of its coarse tile inside its rectangle, marking a bit per (tile, position) where the
+//    column accepts it; `tile_count_bits` and `tile_fill_bits` then count and write the set
+//    bits of each (tile, chunk), in ascending position, so the same lists in the same order;
 // 2. `tile_scan`: one workgroup turns the (tile, chunk) counts, tile-major, into offsets
 //    (exclusive prefix sum), so a tile's chunks lie one after another;
 // 3. `tile_fill`: each (tile, chunk) writes its lights in ascending order, so each tile's
@@ -52,7 +67,18 @@ struct ClusterCounters {
 @group(0) @binding(2) var<storage, read> spheres: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> ranges: array<vec2<u32>>;
 @group(0) @binding(4) var<storage, read_write> indices: array<u32>;
-@group(0) @binding(5) var<storage, read_write> counters: ClusterCounters;
+// The counters, then, where levels 0 and 1 run from the lights' side, their bits (the build's
+// 8 storage bindings are taken, and atomics need an atomic binding): level 0's first
+// (`light_marks`: bit `l % 32` of word `c * coarse_words + l / 32` of `coarse_bits` is set when
+// coarse tile `c` keeps light `l`, `coarse_words` being `tile_chunks * CHUNK_WORDS`, a chunk of
+// TILE_LIGHT_CHUNK lights being CHUNK_WORDS words), then level 1's (`tile_marks`,
+// `tile_bits_first`). The renderer clears the bits before the build.
+struct ClusterBuildState {
+    counters: ClusterCounters,
+    coarse_bits: array<atomic<u32>>,
+};
+
+@group(0) @binding(5) var<storage, read_write> build: ClusterBuildState;
 @group(0) @binding(6) var<storage, read> tile_bounds: array<GpuClusterBounds>;
 @group(0) @binding(7) var<storage, read_write> tile_ranges: array<vec2<u32>>;
 @group(0) @binding(8) var<storage, read_write> tile_indices: array<u32>;
@@ -148,6 +174,100 @@ fn chunked_list(first: u32, capacity: u32) -> vec2<u32> {
     return select(vec2<u32>(0u), range, fits(range, capacity));
 }
 
+const RECT_NONE = vec2<u32>(0xffffu, 0xffffu);
+
+// Tiles `k` whose span [k, k + 1] (tile units) meets [lo, hi] padded by RECT_PAD, as (first,
+// last); `first > last` when none does, the whole axis for NaN (RectGrid::light_tile_rect's `tile_span`).
+fn rect_span(lo: f32, hi: f32, n: u32) -> vec2<u32> {
+    let last = f32(n - 1u);
+    let first = ceil(lo - RECT_PAD) - 1.0;
+    let end = floor(hi + RECT_PAD);
+    if first > last || end < 0.0 || first > end {
+        return vec2<u32>(0xffffu, 0u);
+    }
+    // NaN compares false both ways: the whole axis.
+    let a = select(0.0, min(first, last), first >= 0.0);
+    let b = select(last, max(end, 0.0), end <= last);
+    return vec2<u32>(u32(a), u32(b));
+}
+
+// Slopes a column's edges must reach for its box over depths [near, far] to meet [a - big,
+// a + big] (RectGrid::light_tile_rect's `box_slopes`).
+fn box_slopes(a: f32, big: f32, near: f32, far: f32) -> vec2<f32> {
+    let lo = a - big;
+    let hi = a + big;
+    return vec2<f32>(lo / select(far, near, lo <= 0.0), hi / select(far, near, hi >= 0.0));
+}
+
+// Slopes of the two lines through the eye tangent to the circle of radius `big` around (a, d),
+// den = (d - big)(d + big) > 0 (RectGrid::light_tile_rect's `tangent_slopes`).
+fn tangent_slopes(a: f32, d: f32, big: f32, den: f32) -> vec2<f32> {
+    let root = big * sqrt(a * a + den);
+    return vec2<f32>((a * d - root) / den, (a * d + root) / den);
+}
+
+// Whether some pair of tile edges in [-tan, tan] can have the sphere within reach of both side
+// planes (RectGrid::light_tile_rect's `within_side_planes`).
+fn within_side_planes(a: f32, d: f32, big: f32, tan: f32) -> bool {
+    return abs(a) <= abs(tan * d) + big * sqrt(1.0 + tan * tan);
+}
+
+// The tile rectangle of sphere `s` (manylight_core::cluster::RectGrid::light_tile_rect, step for step),
+// packed as (x0 | x1 << 16, y0 | y1 << 16), inclusive tile coordinates (a grid has at most 4096
+// tiles across); RECT_NONE when no tile can accept the light.
+fn light_rect(s: vec4<f32>) -> vec2<u32> {
+    let tiles = params.dims.xy;
+    let everything = vec2<u32>(((tiles.x - 1u) << 16u), ((tiles.y - 1u) << 16u));
+    // 1. `>` is false for NaN.
+    if !(s.w > 0.0) {
+        return RECT_NONE;
+    }
+    // 2. `<` is false for NaN and infinities.
+    let size = abs(s.x) + abs(s.y) + abs(s.z) + s.w;
+    if !(size < RECT_MAGNITUDE) {
+        return everything;
+    }
+    // 3.
+    let f = params.frustum;
+    let near = params.viewport.z;
+    let far = params.viewport.w;
+    let r = s.w * (TILE_PREFILTER_INFLATION * TILE_PREFILTER_INFLATION * RADIUS_INFLATION);
+    let big = r + 4.0 * f.w + RECT_SLACK * size;
+    // 4.
+    let d = -s.z;
+    if d + big < near || d - big > far {
+        return RECT_NONE;
+    }
+    // 5. Slope ranges in NDC units.
+    var x = vec2<f32>(s.x - big, s.x + big) / f.x;
+    var y = vec2<f32>(s.y - big, s.y + big) / f.y;
+    if f.z <= 0.5 {
+        let planes_only = params.cull_test == CULL_PLANES;
+        x = select(box_slopes(s.x, big, near, far), vec2<f32>(-3.0e38, 3.0e38), planes_only);
+        y = select(box_slopes(s.y, big, near, far), vec2<f32>(-3.0e38, 3.0e38), planes_only);
+        let den = (d - big) * (d + big);
+        if params.cull_test != CULL_AABB && d > 2.0 * big && den > 1e-30 {
+            let tx = tangent_slopes(s.x, d, big, den);
+            let ty = tangent_slopes(s.y, d, big, den);
+            x = vec2<f32>(max(x.x, tx.x), min(x.y, tx.y));
+            y = vec2<f32>(max(y.x, ty.x), min(y.y, ty.y));
+        } else if params.cull_test != CULL_AABB
+            && !(within_side_planes(s.x, d, big, f.x) && within_side_planes(s.y, d, big, f.y)) {
+            return RECT_NONE;
+        }
+        x /= f.x;
+        y /= f.y;
+    }
+    // 6. Tile x spans NDC [-1 + 2k/X, ...]; tile row 0 is at the top.
+    let n = vec2<f32>(tiles);
+    let xs = rect_span((x.x + 1.0) * 0.5 * n.x, (x.y + 1.0) * 0.5 * n.x, tiles.x);
+    let ys = rect_span((1.0 - y.y) * 0.5 * n.y, (1.0 - y.x) * 0.5 * n.y, tiles.y);
+    if xs.x > xs.y || ys.x > ys.y {
+        return RECT_NONE;
+    }
+    return vec2<u32>(xs.x | (xs.y << 16u), ys.x | (ys.y << 16u));
+}
+
 // Level 0's test (manylight_core::cluster::coarse_tile_accepts, where the proof is): the
 // sphere, radius inflated as for level 1, must reach the hull of the coarse tile's columns'
 // AABBs, and, unless the AABB test is chosen, its planes with the radius inflated once more,
@@ -207,6 +327,84 @@ fn coarse_fill(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgr
     }
 }
 
+// Words of `coarse_bits` per chunk of TILE_LIGHT_CHUNK lights.
+const CHUNK_WORDS: u32 = TILE_LIGHT_CHUNK / 32u;
+
+// The first word of coarse tile `c`'s chunk `chunk` in `coarse_bits`.
+fn coarse_word(c: u32, chunk: u32) -> u32 {
+    return (c * params.tile_chunks + chunk) * CHUNK_WORDS;
+}
+
+// Level 0 from the lights' side (where the coarse bits fit, `ClusterResources`): one invocation
+// per light makes its rectangle (`light_rect`) and sets its bit in each coarse tile of the
+// rectangle that `touches_coarse`. The loops run over the rectangle, at most
+// COARSE_SCATTER_TILES coarse tiles, not over the lights.
+@compute @workgroup_size(WORKGROUP_SIZE)
+fn light_marks(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let l = linear_index(id, groups);
+    if l >= params.light_count {
+        return;
+    }
+    let rect = light_rect(spheres[l]);
+    let span = params.coarse_span;
+    let lo = vec2<u32>(rect.x & 0xffffu, rect.y & 0xffffu) / span;
+    let hi = vec2<u32>(rect.x >> 16u, rect.y >> 16u) / span;
+    let word = l / 32u;
+    let bit = 1u << (l % 32u);
+    for (var y = lo.y; y <= hi.y; y++) {
+        for (var x = lo.x; x <= hi.x; x++) {
+            let c = x + y * params.coarse_dims.x;
+            if touches_coarse(tile_bounds[tile_count_total() + c], l) {
+                atomicOr(&build.coarse_bits[coarse_word(c, 0u) + word], bit);
+            }
+        }
+    }
+}
+
+// `coarse_count` from the bits: the chunk's lights are the set bits of its CHUNK_WORDS words.
+@compute @workgroup_size(WORKGROUP_SIZE)
+fn coarse_count_bits(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let e = linear_index(id, groups);
+    if e >= coarse_entry_total() {
+        return;
+    }
+    let c = chunk_of(e, coarse_count_total());
+    let first = coarse_word(c.x, c.y);
+    var n = 0u;
+    for (var i = 0u; i < CHUNK_WORDS; i++) {
+        n += countOneBits(atomicLoad(&build.coarse_bits[first + i]));
+    }
+    tile_ranges[tile_entry_total() + c.z] = vec2<u32>(0u, n);
+}
+
+// `coarse_fill` from the bits: the set bits in ascending order, so the coarse lists are in
+// ascending light order as before.
+@compute @workgroup_size(WORKGROUP_SIZE)
+fn coarse_fill_bits(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let e = linear_index(id, groups);
+    if e >= coarse_entry_total() {
+        return;
+    }
+    let c = chunk_of(e, coarse_count_total());
+    let range = tile_ranges[tile_entry_total() + c.z];
+    if !fits(range, params.coarse_index_capacity) {
+        return;
+    }
+    let first = coarse_word(c.x, c.y);
+    let base = params.tile_index_capacity + range.x;
+    var k = 0u;
+    for (var i = 0u; i < CHUNK_WORDS; i++) {
+        var bits = atomicLoad(&build.coarse_bits[first + i]);
+        let light0 = (c.y * CHUNK_WORDS + i) * 32u;
+        // One iteration per set bit; at most TILE_LIGHT_CHUNK in all.
+        while bits != 0u && k < range.y {
+            tile_indices[base + k] = light0 + firstTrailingBit(bits);
+            k += 1u;
+            bits &= bits - 1u;
+        }
+    }
+}
+
 // Level 1's candidates for tile `t`: its coarse tile's list (offset, count into the coarse
 // lists), or, without a coarse level, every light.
 fn tile_candidates(t: u32) -> vec2<u32> {
@@ -239,7 +437,8 @@ fn tile_count(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgro
     let part = chunk_range(t.y, list.y);
     var n = 0u;
     for (var i = part.x; i < part.y; i++) {
-        if touches_tile(b, candidate(list, i)) {
+        let l = candidate(list, i);
+        if touches_tile(b, l) {
             n += 1u;
         }
     }
@@ -266,6 +465,135 @@ fn tile_fill(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgrou
         if touches_tile(b, l) {
             tile_indices[range.x + k] = l;
             k += 1u;
+        }
+    }
+}
+
+// Level 1 from the coarse lists' side (with level 0's bits), after level 0's bits in
+// `coarse_bits`: bit `p % 32` of word `tile_bits_first() + k * tile_bit_words() + p / 32` is set
+// when the k-th tile of its coarse tile (`local_tile`) keeps the light at position `p` of the
+// coarse lists.
+fn tile_bits_first() -> u32 {
+    return coarse_count_total() * params.tile_chunks * CHUNK_WORDS;
+}
+
+fn tile_bit_words() -> u32 {
+    return (params.coarse_index_capacity + 31u) / 32u;
+}
+
+// The index of tile (x, y) among the span × span tiles of its coarse tile.
+fn local_tile(x: u32, y: u32) -> u32 {
+    let span = params.coarse_span;
+    return x % span + (y % span) * span;
+}
+
+// The (coarse tile, chunk) entry of level 0's ranges whose list holds position `p` of the coarse
+// lists: the last entry whose offset is at most `p` (offsets grow entry by entry, and an entry
+// with the offset of the next one is empty).
+fn coarse_entry_of(p: u32) -> u32 {
+    var lo = 0u;
+    var hi = coarse_entry_total();
+    while hi - lo > 1u {
+        let mid = (lo + hi) / 2u;
+        if tile_ranges[tile_entry_total() + mid].x <= p {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
+
+// One invocation per position of the coarse lists: the light there is tested against the tiles
+// of its coarse tile that lie in its rectangle (the others cannot accept it), and marked in
+// those whose column accepts it. Each entry loops over at most span × span tiles.
+@compute @workgroup_size(WORKGROUP_SIZE)
+fn tile_marks(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let p = linear_index(id, groups);
+    if p >= min(atomicLoad(&build.counters.coarse_entries), params.coarse_index_capacity) {
+        return;
+    }
+    let c = coarse_entry_of(p) / params.tile_chunks;
+    let l = tile_indices[params.tile_index_capacity + p];
+    let rect = light_rect(spheres[l]);
+    let span = params.coarse_span;
+    let origin = vec2<u32>(c % params.coarse_dims.x, c / params.coarse_dims.x) * span;
+    let lo = max(vec2<u32>(rect.x & 0xffffu, rect.y & 0xffffu), origin);
+    let hi = min(vec2<u32>(rect.x >> 16u, rect.y >> 16u), min(origin + vec2<u32>(span - 1u), params.dims.xy - vec2<u32>(1u)));
+    let word = tile_bits_first() + p / 32u;
+    let bit = 1u << (p % 32u);
+    for (var y = lo.y; y <= hi.y; y++) {
+        for (var x = lo.x; x <= hi.x; x++) {
+            if touches_tile(tile_bounds[x + y * params.dims.x], l) {
+                atomicOr(&build.coarse_bits[word + local_tile(x, y) * tile_bit_words()], bit);
+            }
+        }
+    }
+}
+
+// Word `w` of the tile bits from `row`, with only the bits of positions [first, end) kept.
+fn bits_between(row: u32, w: u32, first: u32, end: u32) -> u32 {
+    var bits = atomicLoad(&build.coarse_bits[row + w]);
+    let base = w * 32u;
+    if first > base {
+        bits &= ~0u << (first - base);
+    }
+    if end < base + 32u {
+        bits &= (1u << (end - base)) - 1u;
+    }
+    return bits;
+}
+
+// A (tile, chunk)'s row of tile bits and its positions [first, end) in the coarse lists.
+fn tile_bit_span(t: vec3<u32>) -> vec3<u32> {
+    let list = tile_candidates(t.x);
+    let part = chunk_range(t.y, list.y);
+    let row = tile_bits_first() + local_tile(t.x % params.dims.x, t.x / params.dims.x) * tile_bit_words();
+    return vec3<u32>(row, list.x + part.x, list.x + max(part.x, part.y));
+}
+
+// `tile_count` from the bits: the chunk's lights are the set bits of its positions.
+@compute @workgroup_size(WORKGROUP_SIZE)
+fn tile_count_bits(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let e = linear_index(id, groups);
+    if e >= tile_entry_total() {
+        return;
+    }
+    let t = chunk_of(e, tile_count_total());
+    let b = tile_bit_span(t);
+    var n = 0u;
+    if b.y < b.z {
+        for (var w = b.y / 32u; w <= (b.z - 1u) / 32u; w++) {
+            n += countOneBits(bits_between(b.x, w, b.y, b.z));
+        }
+    }
+    tile_ranges[t.z] = vec2<u32>(0u, n);
+}
+
+// `tile_fill` from the bits, in ascending position, so in ascending light order.
+@compute @workgroup_size(WORKGROUP_SIZE)
+fn tile_fill_bits(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let e = linear_index(id, groups);
+    if e >= tile_entry_total() {
+        return;
+    }
+    let t = chunk_of(e, tile_count_total());
+    let range = tile_ranges[t.z];
+    if !fits(range, params.tile_index_capacity) {
+        return;
+    }
+    let b = tile_bit_span(t);
+    var k = 0u;
+    if b.y < b.z {
+        for (var w = b.y / 32u; w <= (b.z - 1u) / 32u; w++) {
+            var bits = bits_between(b.x, w, b.y, b.z);
+            // One iteration per set bit; at most TILE_LIGHT_CHUNK in all.
+            while bits != 0u && k < range.y {
+                let p = w * 32u + firstTrailingBit(bits);
+                tile_indices[range.x + k] = tile_indices[params.tile_index_capacity + p];
+                k += 1u;
+                bits &= bits - 1u;
+            }
         }
     }
 }
@@ -346,7 +674,7 @@ fn count(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) 
     }
     // The longest tile list: the loops below run that often (lavapipe ends an invocation
     // after LAVAPIPE_LOOP_LIMIT iterations, so the renderer refuses longer lists there).
-    atomicMax(&counters.max_tile_lights, tile.y);
+    atomicMax(&build.counters.max_tile_lights, tile.y);
     var n = 0u;
     for (var i = 0u; i < tile.y; i++) {
         if touches(b, tile_indices[tile.x + i]) {
@@ -356,13 +684,13 @@ fn count(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) 
     let kept = min(n, params.cap);
     ranges[cluster] = vec2<u32>(0u, kept);
     if n > kept {
-        atomicAdd(&counters.dropped_pairs, n - kept);
-        atomicAdd(&counters.clusters_overflowed, 1u);
+        atomicAdd(&build.counters.dropped_pairs, n - kept);
+        atomicAdd(&build.counters.clusters_overflowed, 1u);
     }
     if n > 0u {
-        atomicAdd(&counters.non_empty, 1u);
+        atomicAdd(&build.counters.non_empty, 1u);
     }
-    atomicMax(&counters.max_count, n);
+    atomicMax(&build.counters.max_count, n);
 }
 
 var<workgroup> partial_sums: array<u32, SCAN_WORKGROUP_SIZE>;
@@ -412,7 +740,7 @@ fn scan_ranges(clusters: bool, first: u32, count: u32, t: u32) -> u32 {
 fn coarse_scan(@builtin(local_invocation_index) t: u32) {
     let total = scan_ranges(false, tile_entry_total(), coarse_entry_total(), t);
     if t == 0u {
-        atomicStore(&counters.coarse_entries, total);
+        atomicStore(&build.counters.coarse_entries, total);
     }
 }
 
@@ -420,7 +748,7 @@ fn coarse_scan(@builtin(local_invocation_index) t: u32) {
 fn tile_scan(@builtin(local_invocation_index) t: u32) {
     let total = scan_ranges(false, 0u, tile_entry_total(), t);
     if t == 0u {
-        atomicStore(&counters.tile_entries, total);
+        atomicStore(&build.counters.tile_entries, total);
     }
 }
 
@@ -428,7 +756,7 @@ fn tile_scan(@builtin(local_invocation_index) t: u32) {
 fn scan(@builtin(local_invocation_index) t: u32) {
     let total = scan_ranges(true, 0u, params.dims.w, t);
     if t == 0u {
-        atomicStore(&counters.total_entries, total);
+        atomicStore(&build.counters.total_entries, total);
     }
 }
 

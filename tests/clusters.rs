@@ -201,16 +201,24 @@ fn gpu_lists_equal_the_cpu_reference_on_the_sphere_shell() {
     let mut r = HeadlessRenderer::new().expect("adapter");
     let scene = manylight::scene::sphere_shell_scene();
     let lights = shell_lights();
-    for coarse_tiles in [2, 0] {
+    // Coarse tiles of 2 and 8 tiles: levels 0 and 1 from the lights' side; none: every light
+    // per tile; 520 × 130 tiles make more coarse tiles than the lights' side takes
+    // (COARSE_SCATTER_TILES), so each coarse tile loops over every light.
+    for (coarse_tiles, dims, from_lights) in
+        [(2, None, true), (8, None, true), (0, None, false), (2, Some(glam::UVec3::new(520, 130, 1)), false)]
+    {
         let mut settings = clustered(CullTest::Both, ZSlicing::Exponential, None);
         settings.clusters.coarse_tiles = coarse_tiles;
+        settings.clusters.grid.dims = dims;
         let snap = scene_snapshot(&scene, UVec2::new(256, 144), lights.clone(), settings);
         let (report, gpu, cpu) = gpu_and_cpu(&mut r, snap);
         let c = report.clusters.as_ref().expect("cluster report");
         assert!(c.total_entries > 0, "{c:?}");
-        assert_same_lists(&format!("sphere shell, coarse tiles {coarse_tiles}"), &gpu, &cpu);
+        assert_eq!(c.from_lights, from_lights, "{c:?}");
+        assert_same_lists(&format!("sphere shell, coarse tiles {coarse_tiles}, grid {dims:?}"), &gpu, &cpu);
         if coarse_tiles > 0 {
-            let coarse = u64::from(c.dims[0].div_ceil(2) * c.dims[1].div_ceil(2));
+            let span = coarse_tiles;
+            let coarse = u64::from(c.dims[0].div_ceil(span) * c.dims[1].div_ceil(span));
             assert!(c.coarse_entries < coarse * 20_000, "coarse lists barely cut: {c:?}");
         }
     }

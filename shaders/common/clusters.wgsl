@@ -28,6 +28,9 @@ struct ClusterParams {
     refine_blocks_y: u32,
     // index in the ranges of block 0's refined range; its lists follow `index_capacity` entries
     refined_first: u32,
+    // each light's tile rectangle (cluster_build.wgsl, `light_rects`): (tan_x, tan_y, 0,
+    // margin) in perspective, (half_x, half_y, 1, margin) orthographic
+    frustum: vec4<f32>,
 };
 
 // A u32 that orders as `d` does among floats (sign-magnitude to two's-complement order).

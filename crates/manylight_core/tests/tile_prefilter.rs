@@ -3,7 +3,9 @@
 //! the tile's whole column (one slice from near to far, radius × 1.001); then tests only those
 //! against each cluster. That is exact only if every light a cluster accepts is also accepted
 //! by its column, and every light a column accepts by its coarse tile; this checks both on
-//! random lights.
+//! random lights. Level 0 also keeps a light only for the coarse tiles of its screen rectangle
+//! (`RectGrid::light_tile_rect`), which must hold every tile whose column accepts it; the last test checks
+//! that.
 
 use glam::{UVec2, UVec3, Vec3};
 use manylight_core::Projection;
@@ -21,6 +23,15 @@ fn uniform(mut seed: u64) -> impl FnMut() -> f32 {
         seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         (seed >> 40) as f32 / (1u64 << 24) as f32
     }
+}
+
+/// The default grid of `viewport` and `projection`, and its one-slice grid of columns.
+fn grid_and_columns(viewport: UVec2, projection: &Projection) -> (ClusterGrid, ClusterGrid) {
+    let grid = ClusterGrid::new(viewport, projection, &GridConfig::default());
+    let dims = UVec3::new(grid.dims.x, grid.dims.y, 1);
+    let column =
+        ClusterGrid::new(viewport, projection, &GridConfig { dims: Some(dims), ..GridConfig::default() });
+    (grid, column)
 }
 
 #[test]
@@ -79,13 +90,8 @@ fn a_coarse_tile_accepts_every_light_its_columns_accept() {
         (UVec2::new(200, 120), Projection::orthographic(30.0, 0.5, 100.0)),
     ];
     for (viewport, projection) in cases {
-        let grid = ClusterGrid::new(viewport, &projection, &GridConfig::default());
-        let dims = UVec3::new(grid.dims.x, grid.dims.y, 1);
-        let column = ClusterGrid::new(
-            viewport,
-            &projection,
-            &GridConfig { dims: Some(dims), ..GridConfig::default() },
-        );
+        let (grid, column) = grid_and_columns(viewport, &projection);
+        let dims = column.dims;
         let extent = projection.far.min(100.0);
         // The planes must make the coarse test tighter than the hull alone (perspective).
         let mut planes_rejected = 0u32;
@@ -130,6 +136,102 @@ fn a_coarse_tile_accepts_every_light_its_columns_accept() {
         }
         if projection.orthographic_half_extent(1.0).is_none() {
             assert!(planes_rejected > 0, "the planes never cut: {viewport:?} {projection:?}");
+        }
+    }
+}
+
+/// Level 0 of the build marks a light only in the coarse tiles of its rectangle
+/// (`RectGrid::light_tile_rect`, computed once per light on the GPU): exact only if the rectangle holds
+/// every tile whose column accepts the light (each test, radius × 1.001); the coarse tile of
+/// such a column then lies in the rectangle divided by the span, and accepts the light (the
+/// test above). Checked on random lights in front of, around and behind
+/// the eye, huge and tiny ones, in wide, narrow, extreme and orthographic views; the rectangles
+/// must also be small where they can be, or the build gains nothing.
+#[test]
+fn a_light_rectangle_holds_every_tile_that_accepts_the_light() {
+    use manylight_core::cluster::{RectGrid, sphere_passes};
+    let mut rnd = uniform(0x51_7cc1_b727_220a);
+    let cases = [
+        (UVec2::new(1280, 720), Projection::perspective(0.8, 0.1, 1000.0)),
+        (UVec2::new(200, 120), Projection::perspective(1.0, 0.1, 200.0)),
+        (UVec2::new(96, 64), Projection::perspective(2.8, 0.01, 50.0)),
+        (UVec2::new(640, 17), Projection::perspective(0.01, 0.5, 50.0)),
+        (UVec2::new(1, 1), Projection::perspective(3.1, 1e-4, 1e6)),
+        (UVec2::new(200, 120), Projection::orthographic(30.0, 0.5, 100.0)),
+    ];
+    for (viewport, projection) in cases {
+        let (grid, column) = grid_and_columns(viewport, &projection);
+        let dims = column.dims;
+        let rects = RectGrid::of(&grid);
+        assert_eq!(rects, RectGrid::of(&column), "the grid and its columns share the rectangles");
+        let extent = projection.far.min(100.0);
+        let (mut area, mut in_view) = (0u64, 0u64);
+        for i in 0..800 {
+            // A third of the lights within a few radii of the eye, some behind it; some beside
+            // it, far off the axis (a shell of lights around the camera); a few huge.
+            let beside = i % 7 == 0;
+            let d = match () {
+                _ if beside => (rnd() - 0.5) * 0.5,
+                _ if i % 3 == 0 => (rnd() - 0.3) * 2.0,
+                _ => rnd() * extent,
+            };
+            let spread = if beside { extent } else { d.abs().max(1.0) * 2.0 };
+            let radius = match i % 50 {
+                0 => 1e6,
+                1 => 0.0,
+                2 => f32::NAN,
+                _ => rnd() * if i % 3 == 0 { 2.0 } else { extent * 0.05 },
+            };
+            let s =
+                ViewSphere { center: Vec3::new((rnd() - 0.5) * spread, (rnd() - 0.5) * spread, -d), radius };
+            for test in CullTest::ALL {
+                let rect = rects.light_tile_rect(s.center.extend(s.radius), test);
+                let inside = |x: u32, y: u32| {
+                    rect.is_some_and(|[x0, y0, x1, y1]| (x0..=x1).contains(&x) && (y0..=y1).contains(&y))
+                };
+                // The CPU bound's wider rectangle holds it.
+                let wider = rects.light_tile_rect_bound(s.center.extend(s.radius), test);
+                if let Some([x0, y0, x1, y1]) = rect {
+                    let [u0, v0, u1, v1] = wider.expect("the bound's rectangle is wider");
+                    assert!(
+                        u0 <= x0 && v0 <= y0 && u1 >= x1 && v1 >= y1,
+                        "{test:?}: {s:?}: {rect:?} not in {wider:?}"
+                    );
+                }
+                let wide = ViewSphere { radius: s.radius * INFLATION, ..s };
+                let mut accepted = false;
+                for t in 0..column.cluster_count() {
+                    let k = column.coords(t);
+                    let bounds = (column.cluster_aabb(k.x, k.y, 0), column.cluster_planes(k.x, k.y, 0));
+                    if sphere_passes(test, &wide, bounds.0, &bounds.1) {
+                        accepted = true;
+                        assert!(
+                            inside(k.x, k.y),
+                            "{test:?}: {s:?} in column {k:?} outside {rect:?}, {viewport:?} {projection:?}"
+                        );
+                    }
+                }
+                if test == CullTest::Both && accepted && d > 4.0 * s.radius {
+                    let [x0, y0, x1, y1] = rect.expect("accepted");
+                    area += u64::from(x1 - x0 + 1) * u64::from(y1 - y0 + 1);
+                    in_view += 1;
+                }
+            }
+        }
+        // A light beside the eye, off the screen, reaches no tile's planes.
+        if projection.orthographic_half_extent(1.0).is_none() && grid.fov_y < 3.0 {
+            let beside = Vec3::new(0.2, extent * 0.5, 0.1).extend(0.3);
+            for test in [CullTest::Planes, CullTest::Both] {
+                assert_eq!(rects.light_tile_rect(beside, test), None);
+            }
+        }
+        // Lights well in front of the eye cover a few tiles, not the screen (where it has many).
+        let tiles = u64::from(dims.x * dims.y);
+        if tiles >= 100 && projection.orthographic_half_extent(1.0).is_none() && in_view > 0 {
+            assert!(
+                area < in_view * tiles / 4,
+                "{area} tiles in {in_view} rectangles of {tiles}: {viewport:?} {projection:?}"
+            );
         }
     }
 }

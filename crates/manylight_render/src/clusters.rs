@@ -7,8 +7,8 @@
 
 use crate::context::{GpuContext, RenderError};
 use crate::gpu_types::{
-    CLUSTER_NO_CAP, CULL_AABB, CULL_BOTH, CULL_PLANES, GpuClusterBounds, GpuClusterCounters,
-    GpuClusterParams, REFINE_EDGE, REFINED_LIST_SLOTS, TILE_LIGHT_CHUNK,
+    CLUSTER_NO_CAP, COARSE_SCATTER_TILES, CULL_AABB, CULL_BOTH, CULL_PLANES, GpuClusterBounds,
+    GpuClusterCounters, GpuClusterParams, REFINE_EDGE, REFINED_LIST_SLOTS, TILE_LIGHT_CHUNK,
 };
 use crate::layouts::{storage_entry, uniform_entry};
 use crate::pool::GrowableBuffer;
@@ -72,6 +72,10 @@ pub struct ClusterReport {
     pub cull_test: String,
     /// Z slicing used.
     pub z_slicing: String,
+    /// Levels 0 and 1 of the build ran from the lights' side (each light marks the coarse
+    /// tiles of its rectangle, each coarse-list entry the tiles of its coarse tile), not each
+    /// (coarse) tile over its candidates; the lists are the same either way.
+    pub from_lights: bool,
 }
 
 impl ClusterReport {
@@ -176,12 +180,19 @@ pub struct ClusterResources {
     /// The per-tile lists (`GpuClusterParams::tile_index_capacity` entries), then the
     /// per-coarse-tile lists (`tile_list_split`).
     tile_indices: GrowableBuffer,
-    counters: wgpu::Buffer,
+    /// The counters (`GpuClusterCounters`), then the bits of levels 0 and 1 when the build sets
+    /// them from the lights' side this frame (`coarse_bits`).
+    counters: GrowableBuffer,
+    /// Bytes of the bits of levels 0 and 1 after the counters this frame (`size_bits`); `None`
+    /// when those levels test each (coarse) tile against its candidates instead.
+    coarse_bits: Option<u64>,
+    /// Levels 0 and 1 of the build run from the lights' side this frame (`levels_from_lights`).
+    from_lights: bool,
     /// The grid and coarse span the uploaded bounds are for.
     bounds_of: Option<(ClusterGrid, Option<u32>)>,
     /// Tiles per coarse-tile edge this frame, `None` without a coarse level.
     coarse: Option<u32>,
-    generations: [u64; 7],
+    generations: [u64; 8],
     /// The view-space spheres uploaded this frame (for the CPU reference in tests and stats).
     pub view_spheres: Vec<ViewSphere>,
     /// This frame's CPU bounds of the list sizes, which the lists were sized to before it was
@@ -194,6 +205,9 @@ pub struct ClusterResources {
     /// Blocks across and down of this frame's refined lists, `None` without them.
     refine_blocks: Option<glam::UVec2>,
 }
+
+/// Bytes of the build's counters (`GpuClusterCounters`), before level 0's bits.
+const COUNTER_BYTES: u64 = std::mem::size_of::<GpuClusterCounters>() as u64;
 
 /// Initial entries of the cluster light-index list (it grows as frames need).
 pub const INITIAL_INDEX_CAPACITY: u64 = 1 << 16;
@@ -263,20 +277,13 @@ impl ClusterResources {
         let tile_ranges = GrowableBuffer::new(gpu, "tile_ranges", storage, 8 * 256);
         let tile_indices =
             GrowableBuffer::new(gpu, "tile_light_index_list", storage, 4 * INITIAL_TILE_INDEX_CAPACITY);
-        let counters_size = std::mem::size_of::<GpuClusterCounters>() as u64;
-        let counters = gpu.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("cluster_counters"),
-            size: counters_size,
-            usage: storage | copy | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let counters = GrowableBuffer::new(gpu, "cluster_counters", storage | copy, COUNTER_BYTES + 4);
         let (build_bind_group, shading_bind_group) = Self::bind_groups(
             gpu,
             &build_layout,
             &shading_layout,
             &params_buffer,
-            [&bounds, &spheres, &ranges, &indices, &tile_bounds, &tile_ranges, &tile_indices],
-            &counters,
+            [&bounds, &spheres, &ranges, &indices, &tile_bounds, &tile_ranges, &tile_indices, &counters],
         );
         ClusterResources {
             grid: ClusterGrid::new(glam::UVec2::ONE, &Default::default(), &Default::default()),
@@ -296,9 +303,11 @@ impl ClusterResources {
             tile_ranges,
             tile_indices,
             counters,
+            coarse_bits: None,
+            from_lights: false,
             bounds_of: None,
             coarse: None,
-            generations: [0; 7],
+            generations: [0; 8],
             view_spheres: Vec::new(),
             bounds_estimate: ListBounds::default(),
             bound_cpu_ms: 0.0,
@@ -313,8 +322,8 @@ impl ClusterResources {
         build_layout: &wgpu::BindGroupLayout,
         shading_layout: &wgpu::BindGroupLayout,
         params: &wgpu::Buffer,
-        [bounds, spheres, ranges, indices, tile_bounds, tile_ranges, tile_indices]: [&GrowableBuffer; 7],
-        counters: &wgpu::Buffer,
+        [bounds, spheres, ranges, indices, tile_bounds, tile_ranges, tile_indices, counters]: [&GrowableBuffer;
+            8],
     ) -> (wgpu::BindGroup, wgpu::BindGroup) {
         fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
             wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() }
@@ -328,7 +337,7 @@ impl ClusterResources {
                 entry(2, spheres.buffer()),
                 entry(3, ranges.buffer()),
                 entry(4, indices.buffer()),
-                entry(5, counters),
+                entry(5, counters.buffer()),
                 entry(6, tile_bounds.buffer()),
                 entry(7, tile_ranges.buffer()),
                 entry(8, tile_indices.buffer()),
@@ -351,6 +360,7 @@ impl ClusterResources {
             self.tile_bounds.generation(),
             self.tile_ranges.generation(),
             self.tile_indices.generation(),
+            self.counters.generation(),
         ];
         if generations != self.generations {
             let (b, s) = Self::bind_groups(
@@ -366,8 +376,8 @@ impl ClusterResources {
                     &self.tile_bounds,
                     &self.tile_ranges,
                     &self.tile_indices,
+                    &self.counters,
                 ],
-                &self.counters,
             );
             self.build_bind_group = b;
             self.shading_bind_group = s;
@@ -462,7 +472,16 @@ impl ClusterResources {
         // twice. A bound beyond what the device can bind reserves what it can; then the build's
         // counters decide, after the frame, whether the real lists fit.
         let started = std::time::Instant::now();
-        self.bounds_estimate = list_bounds(&self.grid, &self.view_spheres, settings.cull, self.coarse);
+        let tile_chunks = (self.view_spheres.len() as u32).div_ceil(TILE_LIGHT_CHUNK).max(1);
+        // Levels 0 and 1 from the lights' side where the grid allows and their bits fit (a
+        // second bound, of level 0 per coarse tile, when they do not).
+        let (cull, coarse) = (settings.cull, self.coarse);
+        self.from_lights = self.grid_allows_bits();
+        self.bounds_estimate = list_bounds(&self.grid, &self.view_spheres, cull, coarse, self.from_lights);
+        if self.from_lights && !self.bits_fit(tile_chunks) {
+            self.from_lights = false;
+            self.bounds_estimate = list_bounds(&self.grid, &self.view_spheres, cull, coarse, false);
+        }
         self.bound_cpu_ms = started.elapsed().as_secs_f64() * 1e3;
         // A quarter of headroom: lights that move a little do not grow the lists every frame
         // (growing creates a buffer and rebinds), and the buffers grow in powers of two.
@@ -484,11 +503,9 @@ impl ClusterResources {
         self.tile_indices.reserve(gpu, with_headroom(tile_need + coarse_need, &self.tile_indices))?;
         let tiles = self.grid.dims.x as u64 * self.grid.dims.y as u64;
         let coarse_tiles = self.coarse_dims().map_or(0, |d| u64::from(d.x) * u64::from(d.y));
-        let tile_chunks = (spheres.len() as u32).div_ceil(TILE_LIGHT_CHUNK).max(1);
         self.tile_ranges.reserve(gpu, (tiles + coarse_tiles) * tile_chunks as u64 * 8)?;
         let cap = settings.cap.unwrap_or(CLUSTER_NO_CAP);
-        self.write_params(gpu, view, spheres.len() as u32, cap, tile_chunks);
-        Ok(())
+        self.write_params(gpu, view, spheres.len() as u32, cap, tile_chunks)
     }
 
     /// Blocks of this frame's refined lists (0 without them).
@@ -512,13 +529,20 @@ impl ClusterResources {
     }
 
     /// The entries of the tile-lists buffer for the per-tile lists (first) and the
-    /// per-coarse-tile lists: each gets what it needs and half the spare room (the coarse
-    /// lists what is left when the buffer could not grow to both).
+    /// per-coarse-tile lists: the coarse lists get what they need and a quarter more
+    /// (`coarse_room`; level 1 from the lights' side runs an invocation and keeps a bit per tile
+    /// for each of their entries), the tile lists the rest (and the coarse lists what is left
+    /// when the buffer could not grow to both).
     fn tile_list_split(&self, tile_need: u64, coarse_need: u64) -> (u32, u32) {
         let total = (self.tile_indices.capacity() / 4).min(u64::from(u32::MAX));
-        let spare = total.saturating_sub(tile_need + coarse_need);
-        let tiles = (tile_need + spare / 2).min(total);
-        (tiles as u32, (total - tiles) as u32)
+        let coarse = Self::coarse_room(coarse_need).min(total - tile_need.min(total));
+        ((total - coarse) as u32, coarse as u32)
+    }
+
+    /// Entries the coarse lists are given for `need`: a quarter more and 256, so lights that
+    /// move a little do not change the split every frame.
+    fn coarse_room(need: u64) -> u64 {
+        need + need / 4 + 256
     }
 
     /// Sets the lights' view-space spheres (`lights` in the order of the light buffer) and
@@ -535,8 +559,9 @@ impl ClusterResources {
         view.camera.map(|c| c.projection).unwrap_or_default().finite_for(reach)
     }
 
-    /// Fills the parameters from this frame's grid, culling test and list capacities, uploads
-    /// them, zeroes the counters and rebinds the buffers that grew.
+    /// Fills the parameters from this frame's grid, culling test and list capacities, sizes the
+    /// bits of levels 0 and 1, uploads the parameters, zeroes the counters and rebinds the
+    /// buffers that grew.
     fn write_params(
         &mut self,
         gpu: &GpuContext,
@@ -544,7 +569,7 @@ impl ClusterResources {
         light_count: u32,
         cap: u32,
         tile_chunks: u32,
-    ) {
+    ) -> Result<(), RenderError> {
         let (near, far) = (self.grid.near, self.grid.far);
         let count_ranges = self.grid.cluster_count() * if self.depth_bounds { 2 } else { 1 };
         let (tile_lists, coarse_lists) =
@@ -571,10 +596,57 @@ impl ClusterResources {
             refine_blocks_x: self.refine_blocks.map_or(0, |b| b.x),
             refine_blocks_y: self.refine_blocks.map_or(0, |b| b.y),
             refined_first: count_ranges,
+            frustum: manylight_core::cluster::rect_frustum(&self.grid).to_array(),
         };
+        self.size_bits(gpu)?;
         gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
-        gpu.queue.write_buffer(&self.counters, 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
+        gpu.queue.write_buffer(self.counters.buffer(), 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
         self.rebind_if_grown(gpu);
+        Ok(())
+    }
+
+    /// Whether the grid lets levels 0 and 1 of the build run from the lights' side: a coarse
+    /// level of at most [`COARSE_SCATTER_TILES`] coarse tiles of at most 64 × 64 tiles (the
+    /// loops over them stay short).
+    fn grid_allows_bits(&self) -> bool {
+        self.coarse.is_some_and(|span| {
+            let dims = coarse_dims(self.grid.dims.truncate(), span);
+            (1..=COARSE_SCATTER_TILES).contains(&(dims.x * dims.y)) && (2..=64).contains(&span)
+        })
+    }
+
+    /// Whether the bits of levels 0 and 1 (`bit_bytes`) fit in what the device binds, with as
+    /// many coarse-list positions as this frame's bound gives the coarse lists
+    /// (`tile_list_split`).
+    fn bits_fit(&self, tile_chunks: u32) -> bool {
+        let span = self.coarse.unwrap_or(0);
+        let dims = coarse_dims(self.grid.dims.truncate(), span.max(1));
+        let positions = Self::coarse_room(self.bounds_estimate.coarse_entries);
+        COUNTER_BYTES + Self::bit_bytes(dims, span, tile_chunks, positions) <= self.counters.max_bytes()
+    }
+
+    /// Bytes of the bits of levels 0 and 1: one per (coarse tile, light), then one per (tile of
+    /// a coarse tile, position of the coarse lists), each row whole words.
+    fn bit_bytes(coarse_dims: glam::UVec2, span: u32, tile_chunks: u32, positions: u64) -> u64 {
+        let words = |n: u64| n.div_ceil(32) * 4;
+        let coarse_tiles = u64::from(coarse_dims.x) * u64::from(coarse_dims.y);
+        let level0 = coarse_tiles * u64::from(tile_chunks) * words(u64::from(TILE_LIGHT_CHUNK));
+        level0 + u64::from(span) * u64::from(span) * words(positions)
+    }
+
+    /// Makes room after the counters for this frame's bits of levels 0 and 1 when they run from
+    /// the lights' side (`from_lights`), for the coarse lists' present capacity. Bits that do
+    /// not fit (only when the lists grew past the bound while the frame is checked) send the
+    /// levels back to testing each (coarse) tile against its candidates.
+    fn size_bits(&mut self, gpu: &GpuContext) -> Result<(), RenderError> {
+        let p = &self.params;
+        let dims = glam::UVec2::from_array(p.coarse_dims);
+        let bytes = Self::bit_bytes(dims, p.coarse_span, p.tile_chunks, u64::from(p.coarse_index_capacity));
+        self.from_lights &= COUNTER_BYTES + bytes <= self.counters.max_bytes();
+        self.coarse_bits = self.from_lights.then_some(bytes);
+        // The shader's bits array has at least one word.
+        self.counters.reserve(gpu, COUNTER_BYTES + self.coarse_bits.unwrap_or(0).max(4))?;
+        Ok(())
     }
 
     /// Uploads per-pixel light lists made outside the renderer (`FrameSnapshot::pixel_light_lists`)
@@ -616,19 +688,26 @@ impl ClusterResources {
         self.bound_cpu_ms = 0.0;
         self.depth_bounds = false;
         self.refine_blocks = None;
-        self.write_params(gpu, view, lights.len() as u32, CLUSTER_NO_CAP, 1);
-        Ok(())
+        self.from_lights = false;
+        self.write_params(gpu, view, lights.len() as u32, CLUSTER_NO_CAP, 1)
     }
 
     /// The buffer the build writes its counters into (the renderer copies it into the frame's
     /// read-back slot after the view's passes).
     pub fn counters_buffer(&self) -> &wgpu::Buffer {
-        &self.counters
+        self.counters.buffer()
+    }
+
+    /// Where the bits of levels 0 and 1 lie this frame, `(offset, bytes)` in
+    /// [`Self::counters_buffer`] (the build clears them first); `None` when those levels test
+    /// each (coarse) tile against its candidates.
+    pub fn coarse_bits(&self) -> Option<(u64, u64)> {
+        self.coarse_bits.map(|bytes| (COUNTER_BYTES, bytes))
     }
 
     /// Reads the counters of the last submitted view (waits for the GPU).
     pub fn read_counters(&self, gpu: &GpuContext) -> Result<GpuClusterCounters, RenderError> {
-        let bytes = read_buffer(gpu, &self.counters, 0, self.counters.size())?;
+        let bytes = read_buffer(gpu, self.counters.buffer(), 0, COUNTER_BYTES)?;
         Ok(bytemuck::pod_read_unaligned(&bytes[..std::mem::size_of::<GpuClusterCounters>()]))
     }
 
@@ -679,13 +758,14 @@ impl ClusterResources {
             self.tile_indices.reserve(gpu, (tiles + coarse) * 4)?;
             (self.params.tile_index_capacity, self.params.coarse_index_capacity) =
                 self.tile_list_split(tiles, coarse);
+            self.size_bits(gpu)?;
         }
         if clusters_short {
             self.indices.reserve(gpu, (counters.total_entries as u64 + self.refined_entries()) * 4)?;
             self.params.index_capacity = self.cluster_index_capacity();
         }
         gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
-        gpu.queue.write_buffer(&self.counters, 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
+        gpu.queue.write_buffer(self.counters.buffer(), 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
         self.rebind_if_grown(gpu);
         Ok(true)
     }
@@ -705,6 +785,7 @@ impl ClusterResources {
             buffer_bytes: self.buffer_bytes(),
             cull_test: self.cull.name().to_string(),
             z_slicing: self.grid.slicing.name().to_string(),
+            from_lights: self.coarse_bits.is_some(),
             ..Default::default()
         };
         report.apply_counters(c);
@@ -732,8 +813,9 @@ impl ClusterResources {
             &self.tile_bounds,
             &self.tile_ranges,
             &self.tile_indices,
+            &self.counters,
         ];
-        growable.iter().map(|b| b.capacity()).sum::<u64>() + self.params_buffer.size() + self.counters.size()
+        growable.iter().map(|b| b.capacity()).sum::<u64>() + self.params_buffer.size()
     }
 
     /// Reads the refined lists of the last submitted view back (waits for the GPU); `None` when

@@ -20,6 +20,12 @@ pub const CLUSTER_NO_CAP: u32 = 0xffff_ffff;
 /// lights lost every light past the ~16 000th. 4096 iterations (the plane test has no loop)
 /// stay well below that.
 pub const TILE_LIGHT_CHUNK: u32 = 4096;
+/// Most coarse tiles for which level 0 of the cluster build runs from the lights' side (each
+/// light loops over the coarse tiles of its rectangle, `light_marks` in
+/// `shaders/cluster_build.wgsl`), which keeps that loop far below [`LAVAPIPE_LOOP_LIMIT`]; a
+/// grid with more (only with very small coarse tiles on a huge view) tests every light per
+/// coarse tile instead.
+pub const COARSE_SCATTER_TILES: u32 = 16_384;
 /// The value the cluster build's saturating sums stop at: a total of light–cluster (or
 /// light–tile) pairs that reaches it did not fit in the u32 counters, and the frame is refused
 /// ([`crate::RenderError::TooManyPairs`]) instead of being built from a wrapped total.
@@ -345,6 +351,9 @@ pub fn shared_f32_constants() -> Vec<(&'static str, f32)> {
         ("REFINE_SLACK", REFINE_SLACK),
         ("LIGHT_MIN_DISTANCE", manylight_core::attenuation::LIGHT_MIN_DISTANCE),
         ("TILE_PREFILTER_INFLATION", manylight_core::cluster::TILE_PREFILTER_INFLATION),
+        ("RECT_SLACK", manylight_core::cluster::RECT_SLACK),
+        ("RECT_PAD", manylight_core::cluster::RECT_PAD),
+        ("RECT_MAGNITUDE", manylight_core::cluster::RECT_MAGNITUDE),
         ("TOON_RIM_STRENGTH", manylight_core::material::TOON_RIM_STRENGTH),
         ("PBR_MIN_ROUGHNESS", manylight_core::brdf::PBR_MIN_ROUGHNESS),
         ("PBR_MIN_N_DOT_V", manylight_core::brdf::PBR_MIN_N_DOT_V),
@@ -397,6 +406,10 @@ pub struct GpuClusterParams {
     /// with depth bounds, their depth ranges); the blocks' lists follow the `index_capacity`
     /// entries of the cluster lists, [`REFINED_LIST_SLOTS`] entries each.
     pub refined_first: u32,
+    /// What each light's tile rectangle needs of the grid (`light_rect` in
+    /// `shaders/cluster_build.wgsl`; `manylight_core::cluster::rect_frustum`): `(tan_x, tan_y,
+    /// 0, margin)` in perspective, `(half_x, half_y, 1, margin)` orthographic.
+    pub frustum: [f32; 4],
 }
 
 /// Bounds of one cluster in view space (`GpuClusterBounds` in `shaders/common/clusters.wgsl`).

@@ -203,6 +203,7 @@ fn shared_structs_match_rust() {
             ("refine_blocks_x", offset_of!(GpuClusterParams, refine_blocks_x)),
             ("refine_blocks_y", offset_of!(GpuClusterParams, refine_blocks_y)),
             ("refined_first", offset_of!(GpuClusterParams, refined_first)),
+            ("frustum", offset_of!(GpuClusterParams, frustum)),
         ],
     );
 }

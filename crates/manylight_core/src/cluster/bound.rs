@@ -19,6 +19,10 @@
 //!    range), and the test's per-axis distances to it are those to one of the columns, bit for
 //!    bit, so a coarse tile accepts a light only if one of its columns' AABBs does: the light's
 //!    AABB candidate tiles, counted per coarse tile they meet, bound the coarse lists.
+//!    Where the build marks level 0 from the lights' side (`coarse_from_lights`), a light is
+//!    kept only in the coarse tiles of its rectangle ([`super::RectGrid::light_tile_rect`]): the coarse
+//!    tiles that [`super::RectGrid::light_tile_rect_bound`]'s wider rectangle meets bound those lists
+//!    instead, much more tightly (the hull is no filter for deep columns).
 //! 5. The cost is one candidate search per light and level (two binary searches over the
 //!    slices and a few divisions), no per-cluster work: linear in the light count.
 
@@ -140,12 +144,14 @@ pub fn coarse_tile_accepts(tile: &CoarseTile, light: &ViewSphere, test: CullTest
 }
 
 /// Bounds of the lists that `lights` give in `grid` under `test` (module docs), with a coarse
-/// level of `coarse` tiles per edge when [`coarse_span`] gives one.
+/// level of `coarse` tiles per edge when [`coarse_span`] gives one, marked from the lights' side
+/// when `coarse_from_lights` (each light in the coarse tiles of its rectangle).
 pub fn list_bounds(
     grid: &ClusterGrid,
     lights: &[ViewSphere],
     test: CullTest,
     coarse: Option<u32>,
+    coarse_from_lights: bool,
 ) -> ListBounds {
     let clusters = ClusterTables::new(grid);
     let columns = ClusterGrid { dims: glam::UVec3::new(grid.dims.x, grid.dims.y, 1), ..*grid };
@@ -154,15 +160,22 @@ pub fn list_bounds(
     // Difference array of the tile boxes, one row and column wider than the grid.
     let (w, h) = (grid.dims.x as usize + 1, grid.dims.y as usize + 1);
     let mut starts = vec![0i64; w * h];
+    let rects = super::RectGrid::of(grid);
     for light in lights {
         bounds.cluster_pairs += clusters.candidates(light, test).map_or(0, |c| c.size());
         let inflated = ViewSphere { radius: light.radius * TILE_PREFILTER_INFLATION, ..*light };
         let tile_box = tiles.candidates(&inflated, test);
         if let Some(span) = coarse {
-            let aabb_box =
-                if test == CullTest::Aabb { tile_box } else { tiles.candidates(&inflated, CullTest::Aabb) };
-            if let Some(c) = aabb_box {
-                let n = |r: [u32; 2]| u64::from(r[1] / span - r[0] / span) + 1;
+            let n = |r: [u32; 2]| u64::from(r[1] / span - r[0] / span) + 1;
+            if coarse_from_lights {
+                let sphere = light.center.extend(light.radius);
+                let rect = rects.light_tile_rect_bound(sphere, test);
+                if let Some([x0, y0, x1, y1]) = rect {
+                    bounds.coarse_entries += n([x0, x1]) * n([y0, y1]);
+                }
+            } else if let Some(c) =
+                if test == CullTest::Aabb { tile_box } else { tiles.candidates(&inflated, CullTest::Aabb) }
+            {
                 bounds.coarse_entries += n(c.x) * n(c.y);
             }
         }

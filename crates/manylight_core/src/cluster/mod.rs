@@ -19,8 +19,11 @@
 //! 5. **List sizes** ([`list_bounds`], `bound.rs`): upper bounds of the cluster, tile and
 //!    coarse-tile lists, from each light's candidate ranges, so the GPU lists are sized before
 //!    a frame is submitted.
-//! 6. **Shading lookup** ([`ClusterGrid::cluster_of`]): pixel + view distance → cluster index.
-//! 7. **Measurement** ([`false_positive_counts`], `exact.rs`): how many accepted pairs an exact
+//! 6. **Light rectangles** ([`RectGrid::light_tile_rect`], `rect.rs`): each light's screen rectangle of
+//!    tiles, a superset of the tiles and coarse tiles that accept it, so the GPU build's tile
+//!    levels run the sphere test only for lights near the tile.
+//! 7. **Shading lookup** ([`ClusterGrid::cluster_of`]): pixel + view distance → cluster index.
+//! 8. **Measurement** ([`false_positive_counts`], `exact.rs`): how many accepted pairs an exact
 //!    sphere–frustum-piece distance rejects.
 
 mod assign;
@@ -29,6 +32,7 @@ mod candidates;
 mod cull;
 mod exact;
 mod grid;
+mod rect;
 
 #[cfg(test)]
 mod tests;
@@ -46,6 +50,9 @@ pub use cull::{
 };
 pub use exact::{false_positive_counts, sphere_touches_cluster_exact};
 pub use grid::{CLUSTER_MARGIN, ClusterGrid, GridConfig, MAX_CLUSTERS, MAX_GRID_DIM};
+pub use rect::{
+    RECT_BOUND_PAD, RECT_BOUND_SCALE, RECT_MAGNITUDE, RECT_PAD, RECT_SLACK, RectGrid, rect_frustum,
+};
 
 /// How depth slice boundaries are spread between the near and far planes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]

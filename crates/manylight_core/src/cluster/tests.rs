@@ -185,7 +185,9 @@ proptest! {
         let coarse_list = coarse_tiles(&columns, span);
         let coarse = coarse_dims(columns.dims.truncate(), span);
         for test in CullTest::ALL {
-            let bounds = list_bounds(&grid, &lights, test, coarse_span(span, test));
+            let bounds = list_bounds(&grid, &lights, test, coarse_span(span, test), false);
+            let marked = list_bounds(&grid, &lights, test, coarse_span(span, test), true);
+            prop_assert_eq!(ListBounds { coarse_entries: bounds.coarse_entries, ..marked }, bounds);
             let pairs = assign_lights_brute_force(&grid, &lights, test, None).indices.len() as u64;
             let tile_lists = assign_lights_brute_force(&columns, &inflated, test, None);
             let tiles = tile_lists.indices.len() as u64;
@@ -201,14 +203,22 @@ proptest! {
             // column accepts is in its coarse tile's list.
             if coarse_span(span, test).is_none() {
                 prop_assert_eq!(bounds.coarse_entries, 0);
+                prop_assert_eq!(marked.coarse_entries, 0);
                 continue;
             }
-            let mut coarse_pairs = 0u64;
+            let (mut coarse_pairs, mut marked_pairs) = (0u64, 0u64);
+            let rects = RectGrid::of(&grid);
             for (c, tile) in coarse_list.iter().enumerate() {
                 let (cx, cy) = (c as u32 % coarse.x, c as u32 / coarse.x);
                 for (l, s) in lights.iter().enumerate() {
                     let hit = coarse_tile_accepts(tile, s, test);
                     coarse_pairs += u64::from(hit);
+                    // From the lights' side: accepted and in the light's rectangle.
+                    let rect = rects.light_tile_rect(s.center.extend(s.radius), test);
+                    let inside = rect.is_some_and(|[x0, y0, x1, y1]| {
+                        (x0 / span..=x1 / span).contains(&cx) && (y0 / span..=y1 / span).contains(&cy)
+                    });
+                    marked_pairs += u64::from(hit && inside);
                     for t in 0..columns.cluster_count() {
                         let k = columns.coords(t);
                         if (k.x / span, k.y / span) == (cx, cy) && tile_lists.lights_of(t).contains(&(l as u32)) {
@@ -218,6 +228,10 @@ proptest! {
                 }
             }
             prop_assert!(bounds.coarse_entries >= coarse_pairs, "{test:?}: {bounds:?} < {coarse_pairs} coarse entries");
+            prop_assert!(
+                marked.coarse_entries >= marked_pairs,
+                "{test:?}: {bounds:?} < {marked_pairs} coarse entries from the lights' side"
+            );
         }
     }
 

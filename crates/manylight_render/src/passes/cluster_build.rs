@@ -1,4 +1,5 @@
-//! The `cluster_build` compute pass: per-coarse-tile lists, per-tile lists from them, then
+//! The `cluster_build` compute pass: per-coarse-tile lists (from each light's rectangle of
+//! tiles where their bits fit), per-tile lists from them, then
 //! per-cluster lists from those, each by count → prefix sum → fill (see
 //! `shaders/cluster_build.wgsl`), producing per-cluster `(offset, count)` ranges into one
 //! light-index list.
@@ -20,8 +21,15 @@ impl PipelineKey for ClusterBuildKey {
     type Pipeline = ClusterBuildPipelines;
 }
 
-/// The nine compute pipelines of the build (three per level), for one workgroup size.
+/// The compute pipelines of the build, for one workgroup size: three per level, and levels 0
+/// and 1 from the lights' side (`light_marks`, `tile_marks` and the `_bits` steps).
 pub struct ClusterBuildPipelines {
+    light_marks: wgpu::ComputePipeline,
+    coarse_count_bits: wgpu::ComputePipeline,
+    coarse_fill_bits: wgpu::ComputePipeline,
+    tile_marks: wgpu::ComputePipeline,
+    tile_count_bits: wgpu::ComputePipeline,
+    tile_fill_bits: wgpu::ComputePipeline,
     coarse_count: wgpu::ComputePipeline,
     coarse_scan: wgpu::ComputePipeline,
     coarse_fill: wgpu::ComputePipeline,
@@ -60,6 +68,12 @@ impl ClusterBuildPipelines {
             })
         };
         Ok(ClusterBuildPipelines {
+            light_marks: make("light_marks"),
+            coarse_count_bits: make("coarse_count_bits"),
+            coarse_fill_bits: make("coarse_fill_bits"),
+            tile_marks: make("tile_marks"),
+            tile_count_bits: make("tile_count_bits"),
+            tile_fill_bits: make("tile_fill_bits"),
             coarse_count: make("coarse_count"),
             coarse_scan: make("coarse_scan"),
             coarse_fill: make("coarse_fill"),
@@ -141,11 +155,17 @@ impl Pass for ClusterBuildPass {
         };
         let tile_groups =
             dispatch_size(entries(u64::from(p.dims[0]) * u64::from(p.dims[1]))?, wg, max_groups)?;
+        let light_groups = dispatch_size(p.light_count, wg, max_groups)?;
+        let position_groups = dispatch_size(p.coarse_index_capacity, wg, max_groups)?;
         let coarse_groups = dispatch_size(
             entries(u64::from(p.coarse_dims[0]) * u64::from(p.coarse_dims[1]))?,
             wg,
             max_groups,
         )?;
+        // The bits of levels 0 and 1 start clear (`light_marks` and `tile_marks` only set them).
+        if let Some((offset, bytes)) = clusters.coarse_bits() {
+            ctx.encoder.clear_buffer(clusters.counters_buffer(), offset, Some(bytes));
+        }
         let timestamps = ctx.compute_timestamps(true, true);
         {
             let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -154,22 +174,39 @@ impl Pass for ClusterBuildPass {
             });
             pass.set_bind_group(0, &clusters.build_bind_group, &[]);
             // The steps of the build (shaders/cluster_build.wgsl), in order; the scans run as
-            // one workgroup. Level 0 only with a coarse level.
-            let coarse = [
-                (&pipelines.coarse_count, coarse_groups),
-                (&pipelines.coarse_scan, [1, 1]),
-                (&pipelines.coarse_fill, coarse_groups),
-            ];
-            let levels = [
+            // one workgroup.
+            let no_coarse = [
                 (&pipelines.tile_count, tile_groups),
                 (&pipelines.tile_scan, [1, 1]),
                 (&pipelines.tile_fill, tile_groups),
-                (&pipelines.count, groups),
-                (&pipelines.scan, [1, 1]),
-                (&pipelines.fill, groups),
             ];
-            let coarse = if p.coarse_span > 0 { &coarse[..] } else { &[] };
-            for &(pipeline, workgroups) in coarse.iter().chain(&levels) {
+            let gather = [
+                (&pipelines.coarse_count, coarse_groups),
+                (&pipelines.coarse_scan, [1, 1]),
+                (&pipelines.coarse_fill, coarse_groups),
+                (&pipelines.tile_count, tile_groups),
+                (&pipelines.tile_scan, [1, 1]),
+                (&pipelines.tile_fill, tile_groups),
+            ];
+            let scatter = [
+                (&pipelines.light_marks, light_groups),
+                (&pipelines.coarse_count_bits, coarse_groups),
+                (&pipelines.coarse_scan, [1, 1]),
+                (&pipelines.coarse_fill_bits, coarse_groups),
+                (&pipelines.tile_marks, position_groups),
+                (&pipelines.tile_count_bits, tile_groups),
+                (&pipelines.tile_scan, [1, 1]),
+                (&pipelines.tile_fill_bits, tile_groups),
+            ];
+            let levels = [(&pipelines.count, groups), (&pipelines.scan, [1, 1]), (&pipelines.fill, groups)];
+            // Levels 0 and 1: level 0 only with a coarse level, both from the lights' side where
+            // their bits fit.
+            let first = match (p.coarse_span > 0, clusters.coarse_bits().is_some()) {
+                (false, _) => &no_coarse[..],
+                (true, false) => &gather[..],
+                (true, true) => &scatter[..],
+            };
+            for &(pipeline, workgroups) in first.iter().chain(&levels) {
                 pass.set_pipeline(pipeline);
                 pass.dispatch_workgroups(workgroups[0], workgroups[1], 1);
             }
