@@ -90,7 +90,7 @@ fn a_coarse_tile_accepts_every_light_its_columns_accept() {
         (UVec2::new(200, 120), Projection::orthographic(30.0, 0.5, 100.0)),
     ];
     for (viewport, projection) in cases {
-        let (grid, column) = grid_and_columns(viewport, &projection);
+        let (_, column) = grid_and_columns(viewport, &projection);
         let dims = column.dims;
         let extent = projection.far.min(100.0);
         // The planes must make the coarse test tighter than the hull alone (perspective).
