@@ -43,7 +43,7 @@ pub const RECT_SLACK: f32 = 1e-4;
 /// Tiles added on each side of the rectangle for the rounding of its edges (step 6).
 pub const RECT_PAD: f32 = 0.125;
 /// Factor on the radius `R` of the wider rectangle a CPU bound counts
-/// ([`light_tile_rect_bound`]).
+/// ([`RectGrid::light_tile_rect_bound`]).
 pub const RECT_BOUND_SCALE: f32 = 1.001;
 /// Pad, in tiles, of the wider rectangle a CPU bound counts.
 pub const RECT_BOUND_PAD: f32 = 0.25;
