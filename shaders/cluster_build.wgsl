@@ -268,6 +268,15 @@ fn light_rect(s: vec4<f32>) -> vec2<u32> {
     return vec2<u32>(xs.x | (xs.y << 16u), ys.x | (ys.y << 16u));
 }
 
+// The first (x0, y0) and last (x1, y1) tile of a rectangle from `light_rect`.
+fn rect_first(rect: vec2<u32>) -> vec2<u32> {
+    return rect & vec2<u32>(0xffffu);
+}
+
+fn rect_last(rect: vec2<u32>) -> vec2<u32> {
+    return rect >> vec2<u32>(16u);
+}
+
 // Level 0's test (manylight_core::cluster::coarse_tile_accepts, where the proof is): the
 // sphere, radius inflated as for level 1, must reach the hull of the coarse tile's columns'
 // AABBs, and, unless the AABB test is chosen, its planes with the radius inflated once more,
@@ -335,6 +344,31 @@ fn coarse_word(c: u32, chunk: u32) -> u32 {
     return (c * params.tile_chunks + chunk) * CHUNK_WORDS;
 }
 
+// Word `w` of the bits from `row` (level 0's of a coarse tile, or level 1's of a tile), with
+// only the bits of positions [first, end) kept.
+fn bits_between(row: u32, w: u32, first: u32, end: u32) -> u32 {
+    var bits = atomicLoad(&build.coarse_bits[row + w]);
+    let base = w * 32u;
+    if first > base {
+        bits &= ~0u << (first - base);
+    }
+    if end < base + 32u {
+        bits &= (1u << (end - base)) - 1u;
+    }
+    return bits;
+}
+
+// The set bits of positions [first, end) of the bits from `row`.
+fn count_bits(row: u32, first: u32, end: u32) -> u32 {
+    var n = 0u;
+    if first < end {
+        for (var w = first / 32u; w <= (end - 1u) / 32u; w++) {
+            n += countOneBits(bits_between(row, w, first, end));
+        }
+    }
+    return n;
+}
+
 // Level 0 from the lights' side (where the coarse bits fit, `ClusterResources`): one invocation
 // per light makes its rectangle (`light_rect`) and sets its bit in each coarse tile of the
 // rectangle that `touches_coarse`. The loops run over the rectangle, at most
@@ -347,8 +381,8 @@ fn light_marks(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgr
     }
     let rect = light_rect(spheres[l]);
     let span = params.coarse_span;
-    let lo = vec2<u32>(rect.x & 0xffffu, rect.y & 0xffffu) / span;
-    let hi = vec2<u32>(rect.x >> 16u, rect.y >> 16u) / span;
+    let lo = rect_first(rect) / span;
+    let hi = rect_last(rect) / span;
     let word = l / 32u;
     let bit = 1u << (l % 32u);
     for (var y = lo.y; y <= hi.y; y++) {
@@ -369,12 +403,8 @@ fn coarse_count_bits(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_
         return;
     }
     let c = chunk_of(e, coarse_count_total());
-    let first = coarse_word(c.x, c.y);
-    var n = 0u;
-    for (var i = 0u; i < CHUNK_WORDS; i++) {
-        n += countOneBits(atomicLoad(&build.coarse_bits[first + i]));
-    }
-    tile_ranges[tile_entry_total() + c.z] = vec2<u32>(0u, n);
+    let lights = chunk_range(c.y, params.light_count);
+    tile_ranges[tile_entry_total() + c.z] = vec2<u32>(0u, count_bits(coarse_word(c.x, 0u), lights.x, lights.y));
 }
 
 // `coarse_fill` from the bits: the set bits in ascending order, so the coarse lists are in
@@ -437,8 +467,7 @@ fn tile_count(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgro
     let part = chunk_range(t.y, list.y);
     var n = 0u;
     for (var i = part.x; i < part.y; i++) {
-        let l = candidate(list, i);
-        if touches_tile(b, l) {
+        if touches_tile(b, candidate(list, i)) {
             n += 1u;
         }
     }
@@ -518,8 +547,8 @@ fn tile_marks(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgro
     let rect = light_rect(spheres[l]);
     let span = params.coarse_span;
     let origin = vec2<u32>(c % params.coarse_dims.x, c / params.coarse_dims.x) * span;
-    let lo = max(vec2<u32>(rect.x & 0xffffu, rect.y & 0xffffu), origin);
-    let hi = min(vec2<u32>(rect.x >> 16u, rect.y >> 16u), min(origin + vec2<u32>(span - 1u), params.dims.xy - vec2<u32>(1u)));
+    let lo = max(rect_first(rect), origin);
+    let hi = min(rect_last(rect), min(origin + vec2<u32>(span - 1u), params.dims.xy - vec2<u32>(1u)));
     let word = tile_bits_first() + p / 32u;
     let bit = 1u << (p % 32u);
     for (var y = lo.y; y <= hi.y; y++) {
@@ -529,19 +558,6 @@ fn tile_marks(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgro
             }
         }
     }
-}
-
-// Word `w` of the tile bits from `row`, with only the bits of positions [first, end) kept.
-fn bits_between(row: u32, w: u32, first: u32, end: u32) -> u32 {
-    var bits = atomicLoad(&build.coarse_bits[row + w]);
-    let base = w * 32u;
-    if first > base {
-        bits &= ~0u << (first - base);
-    }
-    if end < base + 32u {
-        bits &= (1u << (end - base)) - 1u;
-    }
-    return bits;
 }
 
 // A (tile, chunk)'s row of tile bits and its positions [first, end) in the coarse lists.
@@ -561,13 +577,7 @@ fn tile_count_bits(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_wo
     }
     let t = chunk_of(e, tile_count_total());
     let b = tile_bit_span(t);
-    var n = 0u;
-    if b.y < b.z {
-        for (var w = b.y / 32u; w <= (b.z - 1u) / 32u; w++) {
-            n += countOneBits(bits_between(b.x, w, b.y, b.z));
-        }
-    }
-    tile_ranges[t.z] = vec2<u32>(0u, n);
+    tile_ranges[t.z] = vec2<u32>(0u, count_bits(b.x, b.y, b.z));
 }
 
 // `tile_fill` from the bits, in ascending position, so in ascending light order.

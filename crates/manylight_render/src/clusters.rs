@@ -183,10 +183,8 @@ pub struct ClusterResources {
     /// The counters (`GpuClusterCounters`), then the bits of levels 0 and 1 when the build sets
     /// them from the lights' side this frame (`coarse_bits`).
     counters: GrowableBuffer,
-    /// Bytes of the bits of levels 0 and 1 after the counters this frame (`size_bits`); `None`
-    /// when those levels test each (coarse) tile against its candidates instead.
-    coarse_bits: Option<u64>,
-    /// Levels 0 and 1 of the build run from the lights' side this frame (`levels_from_lights`).
+    /// Levels 0 and 1 of the build run from the lights' side this frame (`grid_allows_bits`,
+    /// `bits_fit`, `size_bits`).
     from_lights: bool,
     /// The grid and coarse span the uploaded bounds are for.
     bounds_of: Option<(ClusterGrid, Option<u32>)>,
@@ -303,7 +301,6 @@ impl ClusterResources {
             tile_ranges,
             tile_indices,
             counters,
-            coarse_bits: None,
             from_lights: false,
             bounds_of: None,
             coarse: None,
@@ -639,14 +636,19 @@ impl ClusterResources {
     /// not fit (only when the lists grew past the bound while the frame is checked) send the
     /// levels back to testing each (coarse) tile against its candidates.
     fn size_bits(&mut self, gpu: &GpuContext) -> Result<(), RenderError> {
+        self.from_lights &= COUNTER_BYTES + self.params_bit_bytes() <= self.counters.max_bytes();
+        // The shader's bits array has at least one word.
+        let bits = self.coarse_bits().map_or(0, |(_, bytes)| bytes);
+        self.counters.reserve(gpu, COUNTER_BYTES + bits.max(4))?;
+        Ok(())
+    }
+
+    /// [`Self::bit_bytes`] for this frame's parameters: as many coarse-list positions as the
+    /// coarse lists can hold.
+    fn params_bit_bytes(&self) -> u64 {
         let p = &self.params;
         let dims = glam::UVec2::from_array(p.coarse_dims);
-        let bytes = Self::bit_bytes(dims, p.coarse_span, p.tile_chunks, u64::from(p.coarse_index_capacity));
-        self.from_lights &= COUNTER_BYTES + bytes <= self.counters.max_bytes();
-        self.coarse_bits = self.from_lights.then_some(bytes);
-        // The shader's bits array has at least one word.
-        self.counters.reserve(gpu, COUNTER_BYTES + self.coarse_bits.unwrap_or(0).max(4))?;
-        Ok(())
+        Self::bit_bytes(dims, p.coarse_span, p.tile_chunks, u64::from(p.coarse_index_capacity))
     }
 
     /// Uploads per-pixel light lists made outside the renderer (`FrameSnapshot::pixel_light_lists`)
@@ -702,7 +704,7 @@ impl ClusterResources {
     /// [`Self::counters_buffer`] (the build clears them first); `None` when those levels test
     /// each (coarse) tile against its candidates.
     pub fn coarse_bits(&self) -> Option<(u64, u64)> {
-        self.coarse_bits.map(|bytes| (COUNTER_BYTES, bytes))
+        self.from_lights.then(|| (COUNTER_BYTES, self.params_bit_bytes()))
     }
 
     /// Reads the counters of the last submitted view (waits for the GPU).
@@ -785,7 +787,7 @@ impl ClusterResources {
             buffer_bytes: self.buffer_bytes(),
             cull_test: self.cull.name().to_string(),
             z_slicing: self.grid.slicing.name().to_string(),
-            from_lights: self.coarse_bits.is_some(),
+            from_lights: self.from_lights,
             ..Default::default()
         };
         report.apply_counters(c);

@@ -175,12 +175,8 @@ impl Pass for ClusterBuildPass {
             pass.set_bind_group(0, &clusters.build_bind_group, &[]);
             // The steps of the build (shaders/cluster_build.wgsl), in order; the scans run as
             // one workgroup.
-            let no_coarse = [
-                (&pipelines.tile_count, tile_groups),
-                (&pipelines.tile_scan, [1, 1]),
-                (&pipelines.tile_fill, tile_groups),
-            ];
-            let gather = [
+            // Levels 0 and 1 per (coarse) tile, or from the lights' side where their bits fit.
+            let per_tile = [
                 (&pipelines.coarse_count, coarse_groups),
                 (&pipelines.coarse_scan, [1, 1]),
                 (&pipelines.coarse_fill, coarse_groups),
@@ -188,7 +184,7 @@ impl Pass for ClusterBuildPass {
                 (&pipelines.tile_scan, [1, 1]),
                 (&pipelines.tile_fill, tile_groups),
             ];
-            let scatter = [
+            let from_lights = [
                 (&pipelines.light_marks, light_groups),
                 (&pipelines.coarse_count_bits, coarse_groups),
                 (&pipelines.coarse_scan, [1, 1]),
@@ -199,12 +195,11 @@ impl Pass for ClusterBuildPass {
                 (&pipelines.tile_fill_bits, tile_groups),
             ];
             let levels = [(&pipelines.count, groups), (&pipelines.scan, [1, 1]), (&pipelines.fill, groups)];
-            // Levels 0 and 1: level 0 only with a coarse level, both from the lights' side where
-            // their bits fit.
+            // Without a coarse level, level 1 alone (every light a candidate).
             let first = match (p.coarse_span > 0, clusters.coarse_bits().is_some()) {
-                (false, _) => &no_coarse[..],
-                (true, false) => &gather[..],
-                (true, true) => &scatter[..],
+                (false, _) => &per_tile[3..],
+                (true, false) => &per_tile[..],
+                (true, true) => &from_lights[..],
             };
             for &(pipeline, workgroups) in first.iter().chain(&levels) {
                 pass.set_pipeline(pipeline);
