@@ -20,7 +20,8 @@
 //    planes test, which is not monotone in the tile, or a span below 2) these steps are not
 //    dispatched and level 1 takes every light as a candidate;
 // 1. `tile_count`: one invocation per (tile, chunk of TILE_LIGHT_CHUNK candidates of its coarse
-//    tile's list; `chunk_of`) counts the chunk's lights whose sphere passes the chosen test against the
+//    tile's list; `chunk_of`; `tile_chunks` chunks per tile, enough for the longest coarse list
+//    the CPU bound allows, so far fewer than level 0's chunks of all lights) counts the chunk's lights whose sphere passes the chosen test against the
 //    tile's whole column, radius inflated a little more: the column's box contains each
 //    cluster's box and its planes are each cluster's side planes moved outwards, so this is a
 //    superset of what any cluster of the column accepts (checked on the CPU by
@@ -70,7 +71,7 @@ struct ClusterCounters {
 // The counters, then, where levels 0 and 1 run from the lights' side, their bits (the build's
 // 8 storage bindings are taken, and atomics need an atomic binding): level 0's first
 // (`light_marks`: bit `l % 32` of word `c * coarse_words + l / 32` of `coarse_bits` is set when
-// coarse tile `c` keeps light `l`, `coarse_words` being `tile_chunks * CHUNK_WORDS`, a chunk of
+// coarse tile `c` keeps light `l`, `coarse_words` being `light_chunks * CHUNK_WORDS`, a chunk of
 // TILE_LIGHT_CHUNK lights being CHUNK_WORDS words), then level 1's (`tile_marks`,
 // `tile_bits_first`). The renderer clears the bits before the build.
 struct ClusterBuildState {
@@ -144,7 +145,7 @@ fn coarse_count_total() -> u32 {
 
 // Entries of `tile_ranges` for level 0, after level 1's: one per (coarse tile, chunk).
 fn coarse_entry_total() -> u32 {
-    return select(0u, coarse_count_total() * params.tile_chunks, params.coarse_span > 0u);
+    return select(0u, coarse_count_total() * params.light_chunks, params.coarse_span > 0u);
 }
 
 // The positions [first, end) of chunk `chunk` in a list of `n` candidates.
@@ -158,18 +159,18 @@ fn chunk_range(chunk: u32, n: u32) -> vec2<u32> {
 // wait for its longest loop, take the same chunk of different tiles, so a group is either all
 // at work or all past the end of its lists. Returns (tile, chunk, entry): `entry` indexes the
 // tile-major ranges, where a tile's chunks lie one after another.
-fn chunk_of(e: u32, tiles: u32) -> vec3<u32> {
+fn chunk_of(e: u32, tiles: u32, chunks: u32) -> vec3<u32> {
     let tile = e % tiles;
     let chunk = e / tiles;
-    return vec3<u32>(tile, chunk, tile * params.tile_chunks + chunk);
+    return vec3<u32>(tile, chunk, tile * chunks + chunk);
 }
 
-// The list (offset, count) made of the `tile_chunks` consecutive entries from `first` of
+// The list (offset, count) made of the `chunks` consecutive entries from `first` of
 // `tile_ranges`, or empty when it does not fit in `capacity` entries this frame (the frame is
 // rendered again).
-fn chunked_list(first: u32, capacity: u32) -> vec2<u32> {
+fn chunked_list(first: u32, chunks: u32, capacity: u32) -> vec2<u32> {
     let a = tile_ranges[first];
-    let z = tile_ranges[first + params.tile_chunks - 1u];
+    let z = tile_ranges[first + chunks - 1u];
     let range = vec2<u32>(a.x, add_saturating(z.x, z.y) - a.x);
     return select(vec2<u32>(0u), range, fits(range, capacity));
 }
@@ -301,7 +302,7 @@ fn coarse_count(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workg
     if e >= coarse_entry_total() {
         return;
     }
-    let c = chunk_of(e, coarse_count_total());
+    let c = chunk_of(e, coarse_count_total(), params.light_chunks);
     let b = tile_bounds[tile_count_total() + c.x];
     let lights = chunk_range(c.y, params.light_count);
     var n = 0u;
@@ -319,7 +320,7 @@ fn coarse_fill(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgr
     if e >= coarse_entry_total() {
         return;
     }
-    let c = chunk_of(e, coarse_count_total());
+    let c = chunk_of(e, coarse_count_total(), params.light_chunks);
     let range = tile_ranges[tile_entry_total() + c.z];
     if !fits(range, params.coarse_index_capacity) {
         return;
@@ -341,7 +342,7 @@ const CHUNK_WORDS: u32 = TILE_LIGHT_CHUNK / 32u;
 
 // The first word of coarse tile `c`'s chunk `chunk` in `coarse_bits`.
 fn coarse_word(c: u32, chunk: u32) -> u32 {
-    return (c * params.tile_chunks + chunk) * CHUNK_WORDS;
+    return (c * params.light_chunks + chunk) * CHUNK_WORDS;
 }
 
 // Word `w` of the bits from `row` (level 0's of a coarse tile, or level 1's of a tile), with
@@ -402,7 +403,7 @@ fn coarse_count_bits(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_
     if e >= coarse_entry_total() {
         return;
     }
-    let c = chunk_of(e, coarse_count_total());
+    let c = chunk_of(e, coarse_count_total(), params.light_chunks);
     let lights = chunk_range(c.y, params.light_count);
     tile_ranges[tile_entry_total() + c.z] = vec2<u32>(0u, count_bits(coarse_word(c.x, 0u), lights.x, lights.y));
 }
@@ -415,7 +416,7 @@ fn coarse_fill_bits(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_w
     if e >= coarse_entry_total() {
         return;
     }
-    let c = chunk_of(e, coarse_count_total());
+    let c = chunk_of(e, coarse_count_total(), params.light_chunks);
     let range = tile_ranges[tile_entry_total() + c.z];
     if !fits(range, params.coarse_index_capacity) {
         return;
@@ -444,7 +445,8 @@ fn tile_candidates(t: u32) -> vec2<u32> {
     let x = (t % params.dims.x) / params.coarse_span;
     let y = (t / params.dims.x) / params.coarse_span;
     let c = x + y * params.coarse_dims.x;
-    return chunked_list(tile_entry_total() + c * params.tile_chunks, params.coarse_index_capacity);
+    let chunks = params.light_chunks;
+    return chunked_list(tile_entry_total() + c * chunks, chunks, params.coarse_index_capacity);
 }
 
 // Candidate `i` of a list from `tile_candidates`.
@@ -461,7 +463,7 @@ fn tile_count(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgro
     if e >= tile_entry_total() {
         return;
     }
-    let t = chunk_of(e, tile_count_total());
+    let t = chunk_of(e, tile_count_total(), params.tile_chunks);
     let b = tile_bounds[t.x];
     let list = tile_candidates(t.x);
     let part = chunk_range(t.y, list.y);
@@ -480,7 +482,7 @@ fn tile_fill(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgrou
     if e >= tile_entry_total() {
         return;
     }
-    let t = chunk_of(e, tile_count_total());
+    let t = chunk_of(e, tile_count_total(), params.tile_chunks);
     let range = tile_ranges[t.z];
     if !fits(range, params.tile_index_capacity) {
         return;
@@ -503,7 +505,7 @@ fn tile_fill(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgrou
 // when the k-th tile of its coarse tile (`local_tile`) keeps the light at position `p` of the
 // coarse lists.
 fn tile_bits_first() -> u32 {
-    return coarse_count_total() * params.tile_chunks * CHUNK_WORDS;
+    return coarse_count_total() * params.light_chunks * CHUNK_WORDS;
 }
 
 fn tile_bit_words() -> u32 {
@@ -542,7 +544,7 @@ fn tile_marks(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgro
     if p >= min(atomicLoad(&build.counters.coarse_entries), params.coarse_index_capacity) {
         return;
     }
-    let c = coarse_entry_of(p) / params.tile_chunks;
+    let c = coarse_entry_of(p) / params.light_chunks;
     let l = tile_indices[params.tile_index_capacity + p];
     let rect = light_rect(spheres[l]);
     let span = params.coarse_span;
@@ -575,7 +577,7 @@ fn tile_count_bits(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_wo
     if e >= tile_entry_total() {
         return;
     }
-    let t = chunk_of(e, tile_count_total());
+    let t = chunk_of(e, tile_count_total(), params.tile_chunks);
     let b = tile_bit_span(t);
     tile_ranges[t.z] = vec2<u32>(0u, count_bits(b.x, b.y, b.z));
 }
@@ -587,7 +589,7 @@ fn tile_fill_bits(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_wor
     if e >= tile_entry_total() {
         return;
     }
-    let t = chunk_of(e, tile_count_total());
+    let t = chunk_of(e, tile_count_total(), params.tile_chunks);
     let range = tile_ranges[t.z];
     if !fits(range, params.tile_index_capacity) {
         return;
@@ -611,7 +613,8 @@ fn tile_fill_bits(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_wor
 // The lights of the cluster's tile: (offset, count) into `tile_indices`, from its first and
 // last chunk's ranges.
 fn tile_lights(cluster: u32) -> vec2<u32> {
-    return chunked_list((cluster % tile_count_total()) * params.tile_chunks, params.tile_index_capacity);
+    let chunks = params.tile_chunks;
+    return chunked_list((cluster % tile_count_total()) * chunks, chunks, params.tile_index_capacity);
 }
 
 // The coordinate (x for planes 0 and 1, y for 2 and 3: `along` is the plane's normal along

@@ -220,6 +220,13 @@ fn gpu_lists_equal_the_cpu_reference_on_the_sphere_shell() {
             let span = coarse_tiles;
             let coarse = u64::from(c.dims[0].div_ceil(span) * c.dims[1].div_ceil(span));
             assert!(c.coarse_entries < coarse * 20_000, "coarse lists barely cut: {c:?}");
+            // Level 1 takes as many chunks per tile as the longest coarse list needs, not one
+            // per chunk of all lights.
+            let [light_chunks, tile_chunks] = c.chunks;
+            assert_eq!(light_chunks, 100_000u32.div_ceil(4096), "{c:?}");
+            assert!(tile_chunks < light_chunks, "{c:?}");
+        } else {
+            assert_eq!(c.chunks[0], c.chunks[1], "{c:?}");
         }
     }
 }
@@ -360,7 +367,12 @@ fn gpu_lists_keep_every_light_of_a_large_rig() {
     let scene = default_scene();
     let settings = clustered(CullTest::Both, ZSlicing::Exponential, None);
     let snap = scene_snapshot(&scene, UVec2::new(128, 72), rig(&scene, 70_000, 5), settings);
-    let (_, gpu, cpu) = gpu_and_cpu(&mut r, snap);
+    let (report, gpu, cpu) = gpu_and_cpu(&mut r, snap);
+    let c = report.clusters.as_ref().expect("cluster report");
+    // Levels 0 and 1 from the lights' side, level 1 over several chunks of its coarse lists
+    // but fewer than level 0's chunks of all lights.
+    let [light_chunks, tile_chunks] = c.chunks;
+    assert!(c.from_lights && (2..light_chunks).contains(&tile_chunks), "{c:?}");
     assert_same_lists("70 000 lights", &gpu, &cpu);
     let last = (0..gpu.ranges.len() as u32).flat_map(|c| gpu.lights_of(c).to_vec()).max().unwrap_or(0);
     assert!(last >= 65_536, "lights past index 65 535 must be assigned (largest: {last})");

@@ -12,7 +12,8 @@ struct ClusterParams {
     slicing: u32,
     log_far_over_near: f32,
     tile_index_capacity: u32,
-    // light chunks of levels 0 and 1 (TILE_LIGHT_CHUNK lights each), at least 1
+    // candidate chunks (TILE_LIGHT_CHUNK each) of level 1 per tile, at least 1: enough for the
+    // longest coarse list, or light_chunks without a coarse level
     tile_chunks: u32,
     // coarse tiles across and down (level 0 of the build)
     coarse_dims: vec2<u32>,
@@ -31,6 +32,11 @@ struct ClusterParams {
     // each light's tile rectangle (cluster_build.wgsl, `light_rects`): (tan_x, tan_y, 0,
     // margin) in perspective, (half_x, half_y, 1, margin) orthographic
     frustum: vec4<f32>,
+    // light chunks (TILE_LIGHT_CHUNK lights each) of level 0 per coarse tile, at least 1
+    light_chunks: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 };
 
 // A u32 that orders as `d` does among floats (sign-magnitude to two's-complement order).

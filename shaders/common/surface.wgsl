@@ -31,6 +31,12 @@ override NORMAL_TEXTURE: bool = true;
 override OCCLUSION_TEXTURE: bool = true;
 override EMISSIVE_TEXTURE: bool = true;
 
+// The shading model of the pipeline's draws (Rust: `SurfaceVariant::shading`, resolved against
+// the view's), or SHADING_GLOBAL where each fragment reads its material's and the view's. A
+// constant model leaves the other models' code out of the loop over lights, which lavapipe
+// would run for every light whatever the branch decided.
+override SHADING_MODEL: u32 = SHADING_GLOBAL;
+
 fn surface_vertex(v: VertexIn, inst: GpuInstance, clip_from_world: mat4x4<f32>, camera: vec3<f32>) -> SurfaceVertexOut {
     let world = inst.world_from_local * vec4<f32>(v.position, 1.0);
     let m = mat3x3<f32>(inst.world_from_local[0].xyz, inst.world_from_local[1].xyz, inst.world_from_local[2].xyz);
@@ -103,6 +109,9 @@ fn surface_params(m: GpuMaterial, global_model: u32, albedo: vec3<f32>, metal_ro
     s.metallic = saturate(metal_rough.x);
     s.roughness = clamp(metal_rough.y, PBR_MIN_ROUGHNESS, 1.0);
     s.model = select(m.shading_model, global_model, m.shading_model == SHADING_GLOBAL);
+    if SHADING_MODEL != SHADING_GLOBAL {
+        s.model = SHADING_MODEL;
+    }
     return s;
 }
 

@@ -76,6 +76,9 @@ pub struct ClusterReport {
     /// tiles of its rectangle, each coarse-list entry the tiles of its coarse tile), not each
     /// (coarse) tile over its candidates; the lists are the same either way.
     pub from_lights: bool,
+    /// Invocations of level 0 per coarse tile (chunks of `TILE_LIGHT_CHUNK` lights) and of
+    /// level 1 per tile (chunks of its candidates: as many as the longest coarse list can need).
+    pub chunks: [u32; 2],
 }
 
 impl ClusterReport {
@@ -469,17 +472,26 @@ impl ClusterResources {
         // twice. A bound beyond what the device can bind reserves what it can; then the build's
         // counters decide, after the frame, whether the real lists fit.
         let started = std::time::Instant::now();
-        let tile_chunks = (self.view_spheres.len() as u32).div_ceil(TILE_LIGHT_CHUNK).max(1);
+        let light_chunks = (self.view_spheres.len() as u32).div_ceil(TILE_LIGHT_CHUNK).max(1);
         // Levels 0 and 1 from the lights' side where the grid allows and their bits fit (a
         // second bound, of level 0 per coarse tile, when they do not).
         let (cull, coarse) = (settings.cull, self.coarse);
         self.from_lights = self.grid_allows_bits();
         self.bounds_estimate = list_bounds(&self.grid, &self.view_spheres, cull, coarse, self.from_lights);
-        if self.from_lights && !self.bits_fit(tile_chunks) {
+        if self.from_lights && !self.bits_fit(light_chunks) {
             self.from_lights = false;
             self.bounds_estimate = list_bounds(&self.grid, &self.view_spheres, cull, coarse, false);
         }
         self.bound_cpu_ms = started.elapsed().as_secs_f64() * 1e3;
+        // Level 1 loops over each tile's coarse list (every light without a coarse level) in
+        // chunks: as many as the longest list the bound allows, so a coarse list never runs
+        // past its tile's last chunk.
+        let tile_chunks = match self.coarse {
+            Some(_) => {
+                self.bounds_estimate.max_coarse_lights.div_ceil(TILE_LIGHT_CHUNK).clamp(1, light_chunks)
+            }
+            None => light_chunks,
+        };
         // A quarter of headroom: lights that move a little do not grow the lists every frame
         // (growing creates a buffer and rebinds), and the buffers grow in powers of two.
         let bytes =
@@ -500,9 +512,10 @@ impl ClusterResources {
         self.tile_indices.reserve(gpu, with_headroom(tile_need + coarse_need, &self.tile_indices))?;
         let tiles = self.grid.dims.x as u64 * self.grid.dims.y as u64;
         let coarse_tiles = self.coarse_dims().map_or(0, |d| u64::from(d.x) * u64::from(d.y));
-        self.tile_ranges.reserve(gpu, (tiles + coarse_tiles) * tile_chunks as u64 * 8)?;
+        let ranges = tiles * u64::from(tile_chunks) + coarse_tiles * u64::from(light_chunks);
+        self.tile_ranges.reserve(gpu, ranges * 8)?;
         let cap = settings.cap.unwrap_or(CLUSTER_NO_CAP);
-        self.write_params(gpu, view, spheres.len() as u32, cap, tile_chunks)
+        self.write_params(gpu, view, spheres.len() as u32, cap, [light_chunks, tile_chunks])
     }
 
     /// Blocks of this frame's refined lists (0 without them).
@@ -565,7 +578,7 @@ impl ClusterResources {
         view: &RenderView,
         light_count: u32,
         cap: u32,
-        tile_chunks: u32,
+        [light_chunks, tile_chunks]: [u32; 2],
     ) -> Result<(), RenderError> {
         let (near, far) = (self.grid.near, self.grid.far);
         let count_ranges = self.grid.cluster_count() * if self.depth_bounds { 2 } else { 1 };
@@ -594,6 +607,8 @@ impl ClusterResources {
             refine_blocks_y: self.refine_blocks.map_or(0, |b| b.y),
             refined_first: count_ranges,
             frustum: manylight_core::cluster::rect_frustum(&self.grid).to_array(),
+            light_chunks,
+            _pad: [0; 3],
         };
         self.size_bits(gpu)?;
         gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
@@ -615,19 +630,19 @@ impl ClusterResources {
     /// Whether the bits of levels 0 and 1 (`bit_bytes`) fit in what the device binds, with as
     /// many coarse-list positions as this frame's bound gives the coarse lists
     /// (`tile_list_split`).
-    fn bits_fit(&self, tile_chunks: u32) -> bool {
+    fn bits_fit(&self, light_chunks: u32) -> bool {
         let span = self.coarse.unwrap_or(0);
         let dims = coarse_dims(self.grid.dims.truncate(), span.max(1));
         let positions = Self::coarse_room(self.bounds_estimate.coarse_entries);
-        COUNTER_BYTES + Self::bit_bytes(dims, span, tile_chunks, positions) <= self.counters.max_bytes()
+        COUNTER_BYTES + Self::bit_bytes(dims, span, light_chunks, positions) <= self.counters.max_bytes()
     }
 
     /// Bytes of the bits of levels 0 and 1: one per (coarse tile, light), then one per (tile of
     /// a coarse tile, position of the coarse lists), each row whole words.
-    fn bit_bytes(coarse_dims: glam::UVec2, span: u32, tile_chunks: u32, positions: u64) -> u64 {
+    fn bit_bytes(coarse_dims: glam::UVec2, span: u32, light_chunks: u32, positions: u64) -> u64 {
         let words = |n: u64| n.div_ceil(32) * 4;
         let coarse_tiles = u64::from(coarse_dims.x) * u64::from(coarse_dims.y);
-        let level0 = coarse_tiles * u64::from(tile_chunks) * words(u64::from(TILE_LIGHT_CHUNK));
+        let level0 = coarse_tiles * u64::from(light_chunks) * words(u64::from(TILE_LIGHT_CHUNK));
         level0 + u64::from(span) * u64::from(span) * words(positions)
     }
 
@@ -648,7 +663,7 @@ impl ClusterResources {
     fn params_bit_bytes(&self) -> u64 {
         let p = &self.params;
         let dims = glam::UVec2::from_array(p.coarse_dims);
-        Self::bit_bytes(dims, p.coarse_span, p.tile_chunks, u64::from(p.coarse_index_capacity))
+        Self::bit_bytes(dims, p.coarse_span, p.light_chunks, u64::from(p.coarse_index_capacity))
     }
 
     /// Uploads per-pixel light lists made outside the renderer (`FrameSnapshot::pixel_light_lists`)
@@ -691,7 +706,7 @@ impl ClusterResources {
         self.depth_bounds = false;
         self.refine_blocks = None;
         self.from_lights = false;
-        self.write_params(gpu, view, lights.len() as u32, CLUSTER_NO_CAP, 1)
+        self.write_params(gpu, view, lights.len() as u32, CLUSTER_NO_CAP, [1, 1])
     }
 
     /// The buffer the build writes its counters into (the renderer copies it into the frame's
@@ -788,6 +803,7 @@ impl ClusterResources {
             cull_test: self.cull.name().to_string(),
             z_slicing: self.grid.slicing.name().to_string(),
             from_lights: self.from_lights,
+            chunks: [self.params.light_chunks, self.params.tile_chunks],
             ..Default::default()
         };
         report.apply_counters(c);

@@ -385,7 +385,9 @@ pub struct GpuClusterParams {
     pub log_far_over_near: f32,
     /// Entries the per-tile light lists (first level of the build) can hold.
     pub tile_index_capacity: u32,
-    /// Light chunks of levels 0 and 1: `ceil(light_count / TILE_LIGHT_CHUNK)`, at least 1.
+    /// Candidate chunks of level 1 (its invocations per tile), at least 1: with a coarse level,
+    /// `ceil(longest coarse list / TILE_LIGHT_CHUNK)` from the CPU bound
+    /// (`ListBounds::max_coarse_lights`), else `light_chunks`.
     pub tile_chunks: u32,
     /// Coarse tiles across and down (level 0 of the build).
     pub coarse_dims: [u32; 2],
@@ -410,6 +412,11 @@ pub struct GpuClusterParams {
     /// `shaders/cluster_build.wgsl`; `manylight_core::cluster::rect_frustum`): `(tan_x, tan_y,
     /// 0, margin)` in perspective, `(half_x, half_y, 1, margin)` orthographic.
     pub frustum: [f32; 4],
+    /// Light chunks of level 0 (its invocations per coarse tile):
+    /// `ceil(light_count / TILE_LIGHT_CHUNK)`, at least 1.
+    pub light_chunks: u32,
+    /// Padding to 16 bytes.
+    pub _pad: [u32; 3],
 }
 
 /// Bounds of one cluster in view space (`GpuClusterBounds` in `shaders/common/clusters.wgsl`).

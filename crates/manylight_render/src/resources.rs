@@ -87,6 +87,12 @@ pub struct SurfaceVariant {
     /// shader could sample costs its sample at every pixel whether the material has the
     /// texture or not.
     pub textures: u8,
+    /// The material's shading model (`ShadingModel::gpu_id`), or [`SHADING_GLOBAL`] for the
+    /// view's. The mesh passes make their pipelines with it [`resolved`](Self::resolved)
+    /// against the view's model, so the shaders' model is the constant `SHADING_MODEL` and
+    /// lavapipe does not run the other models' code for every light (it runs both sides of a
+    /// branch on the material's model).
+    pub shading: u32,
 }
 
 impl SurfaceVariant {
@@ -104,7 +110,14 @@ impl SurfaceVariant {
                 .enumerate()
                 .filter(|(_, t)| t.is_some())
                 .fold(0, |bits, (slot, _)| bits | 1 << slot),
+            shading: material.shading.map_or(SHADING_GLOBAL, |s| s.gpu_id()),
         }
+    }
+
+    /// The variant with the view's model `global` (`ShadingModel::gpu_id`) where the material
+    /// has none of its own.
+    pub fn resolved(self, global: u32) -> SurfaceVariant {
+        SurfaceVariant { shading: if self.shading == SHADING_GLOBAL { global } else { self.shading }, ..self }
     }
 
     /// Rasteriser state: triangle lists, winding and culling as the variant says.
@@ -116,9 +129,10 @@ impl SurfaceVariant {
         }
     }
 
-    /// The shader's `override` constants for the variant: `ALPHA_MASK`, then one flag per
-    /// texture slot in `TEXTURE_SLOT_*` order.
-    pub fn constants(self) -> [(&'static str, f64); 6] {
+    /// The shader's `override` constants for the variant: `ALPHA_MASK`, one flag per texture
+    /// slot in `TEXTURE_SLOT_*` order, then `SHADING_MODEL` (`SHADING_GLOBAL` when not
+    /// [`resolved`](Self::resolved): each fragment reads its material's and the view's).
+    pub fn constants(self) -> [(&'static str, f64); 7] {
         let flag = |on: bool| if on { 1.0 } else { 0.0 };
         let slot = |name, slot: u32| (name, flag(self.textures & 1 << slot != 0));
         [
@@ -128,6 +142,7 @@ impl SurfaceVariant {
             slot("NORMAL_TEXTURE", TEXTURE_SLOT_NORMAL),
             slot("OCCLUSION_TEXTURE", TEXTURE_SLOT_OCCLUSION),
             slot("EMISSIVE_TEXTURE", TEXTURE_SLOT_EMISSIVE),
+            ("SHADING_MODEL", f64::from(self.shading)),
         ]
     }
 }
@@ -879,7 +894,7 @@ fn downsample(src: &[u8], w: u32, h: u32, srgb: bool) -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use manylight_core::material::{MaterialTexture, TextureData};
+    use manylight_core::material::{MaterialTexture, ShadingModel, TextureData};
 
     #[test]
     fn a_surface_variant_samples_exactly_its_materials_texture_slots() {
@@ -893,7 +908,7 @@ mod tests {
         let plain = MaterialData::default();
         let v = SurfaceVariant::of(&plain, false);
         assert_eq!(v.textures, 0);
-        assert!(v.constants()[1..].iter().all(|&(_, value)| value == 0.0), "{:?}", v.constants());
+        assert!(v.constants()[1..6].iter().all(|&(_, value)| value == 0.0), "{:?}", v.constants());
 
         let mapped = MaterialData {
             normal_texture: Some(MaterialTexture::new(image.clone())),
@@ -903,9 +918,27 @@ mod tests {
         let v = SurfaceVariant::of(&mapped, false);
         assert_eq!(v.textures, 1 << TEXTURE_SLOT_NORMAL | 1 << TEXTURE_SLOT_EMISSIVE);
         let on: Vec<&str> =
-            v.constants().iter().filter(|&&(_, value)| value == 1.0).map(|&(n, _)| n).collect();
+            v.constants()[1..6].iter().filter(|&&(_, value)| value == 1.0).map(|&(n, _)| n).collect();
         assert_eq!(on, ["NORMAL_TEXTURE", "EMISSIVE_TEXTURE"]);
         // Materials with other slots draw with other pipelines.
         assert_ne!(v, SurfaceVariant::of(&plain, false));
+    }
+
+    #[test]
+    fn a_surface_variant_fixes_its_materials_shading_model_or_the_views() {
+        let model =
+            |v: SurfaceVariant| v.constants().into_iter().find(|&(n, _)| n == "SHADING_MODEL").map(|c| c.1);
+        let own = MaterialData { shading: Some(ShadingModel::Toon), ..MaterialData::default() };
+        let v = SurfaceVariant::of(&own, false);
+        let toon = f64::from(ShadingModel::Toon.gpu_id());
+        assert_eq!(model(v), Some(toon));
+        // The material's own model wins over the view's.
+        assert_eq!(model(v.resolved(ShadingModel::Pbr.gpu_id())), Some(toon));
+        // Without one, each fragment reads the view's, until resolved against it.
+        let plain = SurfaceVariant::of(&MaterialData::default(), false);
+        assert_eq!(model(plain), Some(f64::from(SHADING_GLOBAL)));
+        let lambert = plain.resolved(ShadingModel::Lambert.gpu_id());
+        assert_eq!(model(lambert), Some(f64::from(ShadingModel::Lambert.gpu_id())));
+        assert_ne!(plain, v);
     }
 }

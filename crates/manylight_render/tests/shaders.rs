@@ -204,6 +204,7 @@ fn shared_structs_match_rust() {
             ("refine_blocks_y", offset_of!(GpuClusterParams, refine_blocks_y)),
             ("refined_first", offset_of!(GpuClusterParams, refined_first)),
             ("frustum", offset_of!(GpuClusterParams, frustum)),
+            ("light_chunks", offset_of!(GpuClusterParams, light_chunks)),
         ],
     );
 }

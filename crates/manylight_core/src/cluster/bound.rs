@@ -23,7 +23,15 @@
 //!    kept only in the coarse tiles of its rectangle ([`super::RectGrid::light_tile_rect`]): the coarse
 //!    tiles that [`super::RectGrid::light_tile_rect_bound`]'s wider rectangle meets bound those lists
 //!    instead, much more tightly (the hull is no filter for deep columns).
-//! 5. The cost is one candidate search per light and level (two binary searches over the
+//! 5. **Longest coarse list**: the coarse tiles of step 4 are counted per coarse tile with a
+//!    difference array as in step 3; level 1 gives each tile as many chunks of candidates as
+//!    that count needs (`GpuClusterParams::tile_chunks` in `manylight_render`).
+//! 6. A light whose bound rectangle ([`super::RectGrid::light_tile_rect_bound`]) is empty is
+//!    left out of steps 1–3: the rectangle holds every tile whose column accepts the light, so
+//!    no tile list, and no cluster list (made from the tile lists), holds it. Most lights of a
+//!    scene that surrounds the camera are such lights, and the rectangle costs a few
+//!    operations.
+//! 7. The cost is one candidate search per light and level (two binary searches over the
 //!    slices and a few divisions), no per-cluster work: linear in the light count.
 
 use glam::{UVec2, Vec3, Vec4};
@@ -47,6 +55,54 @@ pub struct ListBounds {
     pub max_tile_lights: u32,
     /// At least the (light, coarse tile) entries level 0 writes (0 without a coarse level).
     pub coarse_entries: u64,
+    /// At least the longest coarse-tile list (the candidates level 1 loops over for each of
+    /// its tiles; 0 without a coarse level).
+    pub max_coarse_lights: u32,
+}
+
+/// How many rectangles cover each cell of a `w × h` grid, the longest count being what is
+/// wanted: a two-dimensional difference array, one row and column wider than the grid, summed
+/// once.
+struct Coverage {
+    w: usize,
+    h: usize,
+    starts: Vec<i64>,
+}
+
+impl Coverage {
+    fn new(dims: UVec2) -> Coverage {
+        let (w, h) = (dims.x as usize + 1, dims.y as usize + 1);
+        Coverage { w, h, starts: vec![0; w * h] }
+    }
+
+    /// Adds the cells `[x0, x1] × [y0, y1]`.
+    fn add(&mut self, [x0, x1]: [u32; 2], [y0, y1]: [u32; 2]) {
+        let w = self.w;
+        let (x0, x1) = (x0 as usize, x1 as usize + 1);
+        let (y0, y1) = (y0 as usize, y1 as usize + 1);
+        self.starts[y0 * w + x0] += 1;
+        self.starts[y0 * w + x1] -= 1;
+        self.starts[y1 * w + x0] -= 1;
+        self.starts[y1 * w + x1] += 1;
+    }
+
+    /// The largest count of rectangles over one cell.
+    fn longest(mut self) -> u32 {
+        let (w, h) = (self.w, self.h);
+        // Prefix sums over rows, then columns.
+        for y in 0..h {
+            for x in 1..w {
+                self.starts[y * w + x] += self.starts[y * w + x - 1];
+            }
+        }
+        for y in 1..h {
+            for x in 0..w {
+                self.starts[y * w + x] += self.starts[(y - 1) * w + x];
+            }
+        }
+        let cells = (0..h - 1).flat_map(|y| (0..w - 1).map(move |x| y * w + x));
+        cells.map(|i| self.starts[i]).max().unwrap_or(0).clamp(0, i64::from(u32::MAX)) as u32
+    }
 }
 
 /// Tiles per coarse-tile edge of the build's level 0 for a requested `span` and culling test,
@@ -157,50 +213,42 @@ pub fn list_bounds(
     let columns = ClusterGrid { dims: glam::UVec3::new(grid.dims.x, grid.dims.y, 1), ..*grid };
     let tiles = ClusterTables::new(&columns);
     let mut bounds = ListBounds::default();
-    // Difference array of the tile boxes, one row and column wider than the grid.
-    let (w, h) = (grid.dims.x as usize + 1, grid.dims.y as usize + 1);
-    let mut starts = vec![0i64; w * h];
+    let mut tile_cover = Coverage::new(grid.dims.truncate());
+    let mut coarse_cover = coarse.map(|span| Coverage::new(super::coarse_dims(grid.dims.truncate(), span)));
     let rects = super::RectGrid::of(grid);
     for light in lights {
-        bounds.cluster_pairs += clusters.candidates(light, test).map_or(0, |c| c.size());
+        // A light no tile's column accepts is in no tile or cluster list: most of a scene's
+        // lights when they surround the camera, and the rectangle costs a few operations.
+        let rect = rects.light_tile_rect_bound(light.center.extend(light.radius), test);
         let inflated = ViewSphere { radius: light.radius * TILE_PREFILTER_INFLATION, ..*light };
-        let tile_box = tiles.candidates(&inflated, test);
-        if let Some(span) = coarse {
-            let n = |r: [u32; 2]| u64::from(r[1] / span - r[0] / span) + 1;
-            if coarse_from_lights {
-                let sphere = light.center.extend(light.radius);
-                let rect = rects.light_tile_rect_bound(sphere, test);
-                if let Some([x0, y0, x1, y1]) = rect {
-                    bounds.coarse_entries += n([x0, x1]) * n([y0, y1]);
-                }
-            } else if let Some(c) =
-                if test == CullTest::Aabb { tile_box } else { tiles.candidates(&inflated, CullTest::Aabb) }
-            {
-                bounds.coarse_entries += n(c.x) * n(c.y);
+        let tile_box = rect.and_then(|_| tiles.candidates(&inflated, test));
+        if let (Some(span), Some(cover)) = (coarse, coarse_cover.as_mut()) {
+            // The light's tiles (inclusive x and y ranges) whose coarse tiles can list it: those
+            // of its rectangle from the lights' side, else those of its AABB candidates (the
+            // hull test can take a light no column accepts).
+            let reach = if coarse_from_lights {
+                rect.map(|[x0, y0, x1, y1]| ([x0, x1], [y0, y1]))
+            } else if test == CullTest::Aabb && rect.is_some() {
+                tile_box.map(|c| (c.x, c.y))
+            } else {
+                tiles.candidates(&inflated, CullTest::Aabb).map(|c| (c.x, c.y))
+            };
+            if let Some((x, y)) = reach {
+                let (x, y) = ([x[0] / span, x[1] / span], [y[0] / span, y[1] / span]);
+                bounds.coarse_entries += u64::from(x[1] - x[0] + 1) * u64::from(y[1] - y[0] + 1);
+                cover.add(x, y);
             }
         }
+        if rect.is_none() {
+            continue;
+        }
+        bounds.cluster_pairs += clusters.candidates(light, test).map_or(0, |c| c.size());
         if let Some(c) = tile_box {
             bounds.tile_entries += c.size();
-            let (x0, x1) = (c.x[0] as usize, c.x[1] as usize + 1);
-            let (y0, y1) = (c.y[0] as usize, c.y[1] as usize + 1);
-            starts[y0 * w + x0] += 1;
-            starts[y0 * w + x1] -= 1;
-            starts[y1 * w + x0] -= 1;
-            starts[y1 * w + x1] += 1;
+            tile_cover.add(c.x, c.y);
         }
     }
-    // Prefix sums over rows, then columns: the count of boxes covering each tile.
-    for y in 0..h {
-        for x in 1..w {
-            starts[y * w + x] += starts[y * w + x - 1];
-        }
-    }
-    for y in 1..h {
-        for x in 0..w {
-            starts[y * w + x] += starts[(y - 1) * w + x];
-        }
-    }
-    let longest = (0..h - 1).flat_map(|y| (0..w - 1).map(move |x| y * w + x)).map(|i| starts[i]).max();
-    bounds.max_tile_lights = longest.unwrap_or(0).clamp(0, i64::from(u32::MAX)) as u32;
+    bounds.max_tile_lights = tile_cover.longest();
+    bounds.max_coarse_lights = coarse_cover.map_or(0, Coverage::longest);
     bounds
 }

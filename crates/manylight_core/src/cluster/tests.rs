@@ -187,7 +187,10 @@ proptest! {
         for test in CullTest::ALL {
             let bounds = list_bounds(&grid, &lights, test, coarse_span(span, test), false);
             let marked = list_bounds(&grid, &lights, test, coarse_span(span, test), true);
-            prop_assert_eq!(ListBounds { coarse_entries: bounds.coarse_entries, ..marked }, bounds);
+            prop_assert_eq!(
+                ListBounds { coarse_entries: bounds.coarse_entries, max_coarse_lights: bounds.max_coarse_lights, ..marked },
+                bounds
+            );
             let pairs = assign_lights_brute_force(&grid, &lights, test, None).indices.len() as u64;
             let tile_lists = assign_lights_brute_force(&columns, &inflated, test, None);
             let tiles = tile_lists.indices.len() as u64;
@@ -204,21 +207,25 @@ proptest! {
             if coarse_span(span, test).is_none() {
                 prop_assert_eq!(bounds.coarse_entries, 0);
                 prop_assert_eq!(marked.coarse_entries, 0);
+                prop_assert_eq!((bounds.max_coarse_lights, marked.max_coarse_lights), (0, 0));
                 continue;
             }
             let (mut coarse_pairs, mut marked_pairs) = (0u64, 0u64);
             let rects = RectGrid::of(&grid);
             for (c, tile) in coarse_list.iter().enumerate() {
                 let (cx, cy) = (c as u32 % coarse.x, c as u32 / coarse.x);
+                let (mut list, mut marked_list) = (0u32, 0u32);
                 for (l, s) in lights.iter().enumerate() {
                     let hit = coarse_tile_accepts(tile, s, test);
                     coarse_pairs += u64::from(hit);
+                    list += u32::from(hit);
                     // From the lights' side: accepted and in the light's rectangle.
                     let rect = rects.light_tile_rect(s.center.extend(s.radius), test);
                     let inside = rect.is_some_and(|[x0, y0, x1, y1]| {
                         (x0 / span..=x1 / span).contains(&cx) && (y0 / span..=y1 / span).contains(&cy)
                     });
                     marked_pairs += u64::from(hit && inside);
+                    marked_list += u32::from(hit && inside);
                     for t in 0..columns.cluster_count() {
                         let k = columns.coords(t);
                         if (k.x / span, k.y / span) == (cx, cy) && tile_lists.lights_of(t).contains(&(l as u32)) {
@@ -226,6 +233,12 @@ proptest! {
                         }
                     }
                 }
+                // Level 1 loops over each coarse list in chunks sized by the longest bound.
+                prop_assert!(bounds.max_coarse_lights >= list, "{test:?}: {bounds:?} < coarse list {c} of {list}");
+                prop_assert!(
+                    marked.max_coarse_lights >= marked_list,
+                    "{test:?}: {marked:?} < coarse list {c} of {marked_list} from the lights' side"
+                );
             }
             prop_assert!(bounds.coarse_entries >= coarse_pairs, "{test:?}: {bounds:?} < {coarse_pairs} coarse entries");
             prop_assert!(

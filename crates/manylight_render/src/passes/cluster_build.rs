@@ -145,23 +145,19 @@ impl Pass for ClusterBuildPass {
         let groups = dispatch_size(clusters.params.dims[3], wg, max_groups)?;
         // Levels 0 and 1 run one invocation per (coarse tile or tile, chunk of candidates).
         let p = &clusters.params;
-        let entries = |tiles: u64| {
-            u32::try_from(tiles * u64::from(p.tile_chunks)).map_err(|_| {
+        let entries = |tiles: u64, chunks: u32| {
+            u32::try_from(tiles * u64::from(chunks)).map_err(|_| {
                 RenderError::UnsupportedSettings(format!(
-                    "{tiles} tiles × {} light chunks exceed 2^32 cluster-build invocations",
-                    p.tile_chunks
+                    "{tiles} tiles × {chunks} light chunks exceed 2^32 cluster-build invocations"
                 ))
             })
         };
-        let tile_groups =
-            dispatch_size(entries(u64::from(p.dims[0]) * u64::from(p.dims[1]))?, wg, max_groups)?;
+        let tiles = u64::from(p.dims[0]) * u64::from(p.dims[1]);
+        let tile_groups = dispatch_size(entries(tiles, p.tile_chunks)?, wg, max_groups)?;
         let light_groups = dispatch_size(p.light_count, wg, max_groups)?;
         let position_groups = dispatch_size(p.coarse_index_capacity, wg, max_groups)?;
-        let coarse_groups = dispatch_size(
-            entries(u64::from(p.coarse_dims[0]) * u64::from(p.coarse_dims[1]))?,
-            wg,
-            max_groups,
-        )?;
+        let coarse_tiles = u64::from(p.coarse_dims[0]) * u64::from(p.coarse_dims[1]);
+        let coarse_groups = dispatch_size(entries(coarse_tiles, p.light_chunks)?, wg, max_groups)?;
         // The bits of levels 0 and 1 start clear (`light_marks` and `tile_marks` only set them).
         if let Some((offset, bytes)) = clusters.coarse_bits() {
             ctx.encoder.clear_buffer(clusters.counters_buffer(), offset, Some(bytes));

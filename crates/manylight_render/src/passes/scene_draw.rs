@@ -43,8 +43,10 @@ fn pipelines_where<K: PipelineKey>(
     key: impl Fn(SurfaceVariant) -> K,
     create: impl Fn(&K) -> Result<K::Pipeline, RenderError>,
 ) -> Result<VariantPipelines<K::Pipeline>, RenderError> {
+    // Each variant's pipeline has the view's shading model where its material has none.
+    let global = ctx.scene.view.shading_model;
     let variants = ctx.scene.variants.iter().filter(|v| filter(v));
-    variants.map(|&v| Ok((v, ctx.pipelines.get_or_create(key(v), &create)?))).collect()
+    variants.map(|&v| Ok((v, ctx.pipelines.get_or_create(key(v.resolved(global)), &create)?))).collect()
 }
 
 /// Records the graph pass as one timed wgpu render pass that draws every scene instance with
