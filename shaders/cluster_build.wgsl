@@ -20,11 +20,12 @@
 //    planes test, which is not monotone in the tile, or a span below 2) these steps are not
 //    dispatched and level 1 takes every light as a candidate;
 // 1. `tile_count`: one invocation per (tile, chunk of TILE_LIGHT_CHUNK candidates of its coarse
-//    tile's list; `chunk_of`; `tile_chunks` chunks per tile, enough for the longest coarse list
-//    the CPU bound allows, so far fewer than level 0's chunks of all lights) counts the chunk's lights whose sphere passes the chosen test against the
-//    tile's whole column, radius inflated a little more: the column's box contains each
-//    cluster's box and its planes are each cluster's side planes moved outwards, so this is a
-//    superset of what any cluster of the column accepts (checked on the CPU by
+//    tile's list; `tile_chunk`: `tile_chunks` chunks per tile, enough for the longest coarse
+//    list the CPU bound allows, so far fewer than level 0's chunks of all lights) counts the
+//    chunk's lights whose sphere passes the chosen test against the tile's whole column,
+//    radius inflated a little more: the column's box contains each cluster's box and its
+//    planes are each cluster's side planes moved outwards, so this is a superset of what any
+//    cluster of the column accepts (checked on the CPU by
 //    crates/manylight_core/tests/tile_prefilter.rs). Chunks keep every invocation's loop short:
 //    lavapipe stops an invocation after 65 535 loop iterations (gpu_types::TILE_LIGHT_CHUNK).
 //    With level 0's bits, level 1 runs from the coarse lists' side instead: `tile_marks` takes
@@ -165,6 +166,16 @@ fn chunk_of(e: u32, tiles: u32, chunks: u32) -> vec3<u32> {
     return vec3<u32>(tile, chunk, tile * chunks + chunk);
 }
 
+// Invocation `e` of level 0: (coarse tile, chunk of `light_chunks` chunks of all lights, entry).
+fn coarse_chunk(e: u32) -> vec3<u32> {
+    return chunk_of(e, coarse_count_total(), params.light_chunks);
+}
+
+// Invocation `e` of level 1: (tile, chunk of `tile_chunks` chunks of its candidates, entry).
+fn tile_chunk(e: u32) -> vec3<u32> {
+    return chunk_of(e, tile_count_total(), params.tile_chunks);
+}
+
 // The list (offset, count) made of the `chunks` consecutive entries from `first` of
 // `tile_ranges`, or empty when it does not fit in `capacity` entries this frame (the frame is
 // rendered again).
@@ -302,7 +313,7 @@ fn coarse_count(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workg
     if e >= coarse_entry_total() {
         return;
     }
-    let c = chunk_of(e, coarse_count_total(), params.light_chunks);
+    let c = coarse_chunk(e);
     let b = tile_bounds[tile_count_total() + c.x];
     let lights = chunk_range(c.y, params.light_count);
     var n = 0u;
@@ -320,7 +331,7 @@ fn coarse_fill(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgr
     if e >= coarse_entry_total() {
         return;
     }
-    let c = chunk_of(e, coarse_count_total(), params.light_chunks);
+    let c = coarse_chunk(e);
     let range = tile_ranges[tile_entry_total() + c.z];
     if !fits(range, params.coarse_index_capacity) {
         return;
@@ -403,7 +414,7 @@ fn coarse_count_bits(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_
     if e >= coarse_entry_total() {
         return;
     }
-    let c = chunk_of(e, coarse_count_total(), params.light_chunks);
+    let c = coarse_chunk(e);
     let lights = chunk_range(c.y, params.light_count);
     tile_ranges[tile_entry_total() + c.z] = vec2<u32>(0u, count_bits(coarse_word(c.x, 0u), lights.x, lights.y));
 }
@@ -416,7 +427,7 @@ fn coarse_fill_bits(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_w
     if e >= coarse_entry_total() {
         return;
     }
-    let c = chunk_of(e, coarse_count_total(), params.light_chunks);
+    let c = coarse_chunk(e);
     let range = tile_ranges[tile_entry_total() + c.z];
     if !fits(range, params.coarse_index_capacity) {
         return;
@@ -463,7 +474,7 @@ fn tile_count(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgro
     if e >= tile_entry_total() {
         return;
     }
-    let t = chunk_of(e, tile_count_total(), params.tile_chunks);
+    let t = tile_chunk(e);
     let b = tile_bounds[t.x];
     let list = tile_candidates(t.x);
     let part = chunk_range(t.y, list.y);
@@ -482,7 +493,7 @@ fn tile_fill(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgrou
     if e >= tile_entry_total() {
         return;
     }
-    let t = chunk_of(e, tile_count_total(), params.tile_chunks);
+    let t = tile_chunk(e);
     let range = tile_ranges[t.z];
     if !fits(range, params.tile_index_capacity) {
         return;
@@ -577,7 +588,7 @@ fn tile_count_bits(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_wo
     if e >= tile_entry_total() {
         return;
     }
-    let t = chunk_of(e, tile_count_total(), params.tile_chunks);
+    let t = tile_chunk(e);
     let b = tile_bit_span(t);
     tile_ranges[t.z] = vec2<u32>(0u, count_bits(b.x, b.y, b.z));
 }
@@ -589,7 +600,7 @@ fn tile_fill_bits(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_wor
     if e >= tile_entry_total() {
         return;
     }
-    let t = chunk_of(e, tile_count_total(), params.tile_chunks);
+    let t = tile_chunk(e);
     let range = tile_ranges[t.z];
     if !fits(range, params.tile_index_capacity) {
         return;
