@@ -66,15 +66,17 @@ struct ClusterCounters {
 
 @group(0) @binding(0) var<uniform> params: ClusterParams;
 @group(0) @binding(1) var<storage, read> bounds: array<GpuClusterBounds>;
+// The lights' view-space spheres (centre, radius), then the indices of the lights level 0 from
+// the lights' side marks, four to an element (`listed_light`).
 @group(0) @binding(2) var<storage, read> spheres: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> ranges: array<vec2<u32>>;
 @group(0) @binding(4) var<storage, read_write> indices: array<u32>;
 // The counters, then, where levels 0 and 1 run from the lights' side, their bits (the build's
 // 8 storage bindings are taken, and atomics need an atomic binding): level 0's first
-// (`light_marks`: bit `l % 32` of word `c * coarse_words + l / 32` of `coarse_bits` is set when
-// coarse tile `c` keeps light `l`, `coarse_words` being `light_chunks * CHUNK_WORDS`, a chunk of
-// TILE_LIGHT_CHUNK lights being CHUNK_WORDS words), then level 1's (`tile_marks`,
-// `tile_bits_first`). The renderer clears the bits before the build.
+// (`light_marks`: bit `e % 32` of word `c * coarse_words + e / 32` of `coarse_bits` is set when
+// coarse tile `c` keeps the `e`-th listed light, `coarse_words` being `light_chunks *
+// CHUNK_WORDS`, a chunk of TILE_LIGHT_CHUNK listed lights being CHUNK_WORDS words), then level
+// 1's (`tile_marks`, `tile_bits_first`). The renderer clears the bits before the build.
 struct ClusterBuildState {
     counters: ClusterCounters,
     coarse_bits: array<atomic<u32>>,
@@ -166,7 +168,8 @@ fn chunk_of(e: u32, tiles: u32, chunks: u32) -> vec3<u32> {
     return vec3<u32>(tile, chunk, tile * chunks + chunk);
 }
 
-// Invocation `e` of level 0: (coarse tile, chunk of `light_chunks` chunks of all lights, entry).
+// Invocation `e` of level 0: (coarse tile, chunk of its `light_chunks` chunks of candidates,
+// entry).
 fn coarse_chunk(e: u32) -> vec3<u32> {
     return chunk_of(e, coarse_count_total(), params.light_chunks);
 }
@@ -381,22 +384,31 @@ fn count_bits(row: u32, first: u32, end: u32) -> u32 {
     return n;
 }
 
+// The `e`-th of the lights level 0 from the lights' side marks (`params.listed_lights` of them,
+// ascending): those whose rectangle the CPU's bound leaves non-empty, which holds the GPU's
+// (`manylight_core::cluster::list_bounds`); no other light is in any list. Most lights of a
+// scene that surrounds the camera are not, and marking them cost an invocation each.
+fn listed_light(e: u32) -> u32 {
+    return bitcast<u32>(spheres[params.light_count + e / 4u][e % 4u]);
+}
+
 // Level 0 from the lights' side (where the coarse bits fit, `ClusterResources`): one invocation
-// per light makes its rectangle (`light_rect`) and sets its bit in each coarse tile of the
-// rectangle that `touches_coarse`. The loops run over the rectangle, at most
+// per listed light makes its rectangle (`light_rect`) and sets its bit in each coarse tile of
+// the rectangle that `touches_coarse`. The loops run over the rectangle, at most
 // COARSE_SCATTER_TILES coarse tiles, not over the lights.
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn light_marks(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
-    let l = linear_index(id, groups);
-    if l >= params.light_count {
+    let e = linear_index(id, groups);
+    if e >= params.listed_lights {
         return;
     }
+    let l = listed_light(e);
     let rect = light_rect(spheres[l]);
     let span = params.coarse_span;
     let lo = rect_first(rect) / span;
     let hi = rect_last(rect) / span;
-    let word = l / 32u;
-    let bit = 1u << (l % 32u);
+    let word = e / 32u;
+    let bit = 1u << (e % 32u);
     for (var y = lo.y; y <= hi.y; y++) {
         for (var x = lo.x; x <= hi.x; x++) {
             let c = x + y * params.coarse_dims.x;
@@ -415,12 +427,12 @@ fn coarse_count_bits(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_
         return;
     }
     let c = coarse_chunk(e);
-    let lights = chunk_range(c.y, params.light_count);
+    let lights = chunk_range(c.y, params.listed_lights);
     tile_ranges[tile_entry_total() + c.z] = vec2<u32>(0u, count_bits(coarse_word(c.x, 0u), lights.x, lights.y));
 }
 
-// `coarse_fill` from the bits: the set bits in ascending order, so the coarse lists are in
-// ascending light order as before.
+// `coarse_fill` from the bits: the set bits in ascending order, and the listed lights are
+// ascending, so the coarse lists are in ascending light order as before.
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn coarse_fill_bits(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let e = linear_index(id, groups);
@@ -437,10 +449,10 @@ fn coarse_fill_bits(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_w
     var k = 0u;
     for (var i = 0u; i < CHUNK_WORDS; i++) {
         var bits = atomicLoad(&build.coarse_bits[first + i]);
-        let light0 = (c.y * CHUNK_WORDS + i) * 32u;
+        let listed0 = (c.y * CHUNK_WORDS + i) * 32u;
         // One iteration per set bit; at most TILE_LIGHT_CHUNK in all.
         while bits != 0u && k < range.y {
-            tile_indices[base + k] = light0 + firstTrailingBit(bits);
+            tile_indices[base + k] = listed_light(listed0 + firstTrailingBit(bits));
             k += 1u;
             bits &= bits - 1u;
         }

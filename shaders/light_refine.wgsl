@@ -47,6 +47,8 @@ var<private> clusters_min: vec3<u32>;
 var<private> clusters_max: vec3<u32>;
 var<private> covered: bool;
 var<private> unbounded: bool;
+// The largest view distance of the block's pixels.
+var<private> farthest: f32;
 
 fn begin_block() {
     box_min = vec3<f32>(3.0e38);
@@ -55,6 +57,7 @@ fn begin_block() {
     pixels_max = vec2<u32>(0u);
     covered = false;
     unbounded = false;
+    farthest = 0.0;
 }
 
 // Pixel `i` (row-major) of block `b`.
@@ -64,17 +67,25 @@ fn block_pixel(b: vec2<u32>, i: u32) -> vec2<u32> {
 
 // Adds the pixel `px` whose surface lies at view-space `q`.
 fn add_pixel(px: vec2<u32>, q: vec3<f32>) {
-    let d = -q.z;
     if !all(abs(q) <= vec3<f32>(3.0e38)) {
         unbounded = true;
         return;
     }
-    let s = REFINE_SLACK * (abs(d) + length(view.camera_position.xyz));
-    box_min = min(box_min, q - s);
-    box_max = max(box_max, q + s);
+    box_min = min(box_min, q);
+    box_max = max(box_max, q);
+    farthest = max(farthest, abs(q.z));
     pixels_min = min(pixels_min, px);
     pixels_max = max(pixels_max, px);
     covered = true;
+}
+
+// Widens the box around the block's surface positions by REFINE_SLACK × (distance + the
+// camera's distance from the origin) on every side, with the block's largest distance: at
+// least each pixel's own widening, once per block rather than per pixel.
+fn widen_box() {
+    let s = REFINE_SLACK * (farthest + length(view.camera_position.xyz));
+    box_min -= vec3<f32>(s);
+    box_max += vec3<f32>(s);
 }
 
 // The box of clusters the block's pixels fall in with their widened distances: tiles grow with
@@ -122,6 +133,7 @@ fn refine_lights(slot: u32) -> vec2<u32> {
     if unbounded {
         return fallback;
     }
+    widen_box();
     find_clusters();
     let n3 = clusters_max - clusters_min + 1u;
     let n = n3.x * n3.y * n3.z;
@@ -190,14 +202,13 @@ fn cs_forward(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     begin_block();
-    let size = textureDimensions(shading_distance);
+    // A pixel past the image's edge reads the edge's (in the same block) instead.
+    let last = textureDimensions(shading_distance) - 1u;
     for (var i = 0u; i < REFINE_EDGE * REFINE_EDGE; i++) {
-        let px = block_pixel(id.xy, i);
-        if all(px < size) {
-            let d = textureLoad(shading_distance, vec2<i32>(px), 0).r;
-            if d > 0.0 || !(abs(d) <= 3.0e38) {
-                add_pixel(px, forward_position(px, d));
-            }
+        let px = min(block_pixel(id.xy, i), last);
+        let d = textureLoad(shading_distance, vec2<i32>(px), 0).r;
+        if d > 0.0 || !(abs(d) <= 3.0e38) {
+            add_pixel(px, forward_position(px, d));
         }
     }
     finish_block(id.xy);

@@ -220,11 +220,18 @@ fn gpu_lists_equal_the_cpu_reference_on_the_sphere_shell() {
             let span = coarse_tiles;
             let coarse = u64::from(c.dims[0].div_ceil(span) * c.dims[1].div_ceil(span));
             assert!(c.coarse_entries < coarse * 20_000, "coarse lists barely cut: {c:?}");
-            // Level 1 takes as many chunks per tile as the longest coarse list needs, not one
-            // per chunk of all lights.
+            // Level 0 from the lights' side marks only the lights some tile can list (a shell
+            // around the camera: a small part), per coarse tile over all; level 1 takes as many
+            // chunks per tile as the longest coarse list needs.
             let [light_chunks, tile_chunks] = c.chunks;
-            assert_eq!(light_chunks, 100_000u32.div_ceil(4096), "{c:?}");
-            assert!(tile_chunks < light_chunks, "{c:?}");
+            let all_chunks = 100_000u32.div_ceil(4096);
+            if from_lights {
+                assert!((1..30_000).contains(&c.listed_lights), "{c:?}");
+                assert_eq!(light_chunks, c.listed_lights.div_ceil(4096), "{c:?}");
+            } else {
+                assert_eq!((light_chunks, c.listed_lights), (all_chunks, 0), "{c:?}");
+            }
+            assert!(tile_chunks <= light_chunks && tile_chunks < all_chunks, "{c:?}");
         } else {
             assert_eq!(c.chunks[0], c.chunks[1], "{c:?}");
         }
@@ -369,10 +376,11 @@ fn gpu_lists_keep_every_light_of_a_large_rig() {
     let snap = scene_snapshot(&scene, UVec2::new(128, 72), rig(&scene, 70_000, 5), settings);
     let (report, gpu, cpu) = gpu_and_cpu(&mut r, snap);
     let c = report.clusters.as_ref().expect("cluster report");
-    // Levels 0 and 1 from the lights' side, level 1 over several chunks of its coarse lists
-    // but fewer than level 0's chunks of all lights.
+    // Levels 0 and 1 from the lights' side, level 0 over the listed lights' chunks, level 1
+    // over several chunks of its coarse lists but fewer than there are chunks of all lights.
     let [light_chunks, tile_chunks] = c.chunks;
-    assert!(c.from_lights && (2..light_chunks).contains(&tile_chunks), "{c:?}");
+    assert!(c.from_lights && light_chunks == c.listed_lights.div_ceil(4096), "{c:?}");
+    assert!((2..=light_chunks).contains(&tile_chunks) && tile_chunks < 70_000u32.div_ceil(4096), "{c:?}");
     assert_same_lists("70 000 lights", &gpu, &cpu);
     let last = (0..gpu.ranges.len() as u32).flat_map(|c| gpu.lights_of(c).to_vec()).max().unwrap_or(0);
     assert!(last >= 65_536, "lights past index 65 535 must be assigned (largest: {last})");

@@ -32,11 +32,14 @@ struct ClusterParams {
     // each light's tile rectangle (cluster_build.wgsl, `light_rects`): (tan_x, tan_y, 0,
     // margin) in perspective, (half_x, half_y, 1, margin) orthographic
     frustum: vec4<f32>,
-    // light chunks (TILE_LIGHT_CHUNK lights each) of level 0 per coarse tile, at least 1
+    // chunks (TILE_LIGHT_CHUNK lights each) of level 0 per coarse tile, at least 1: of the
+    // listed lights from the lights' side, else of all lights
     light_chunks: u32,
+    // level 0 from the lights' side: the lights it marks, listed after the spheres
+    // (cluster_build.wgsl, `listed_light`)
+    listed_lights: u32,
     _pad0: u32,
     _pad1: u32,
-    _pad2: u32,
 };
 
 // A u32 that orders as `d` does among floats (sign-magnitude to two's-complement order).

@@ -76,9 +76,13 @@ pub struct ClusterReport {
     /// tiles of its rectangle, each coarse-list entry the tiles of its coarse tile), not each
     /// (coarse) tile over its candidates; the lists are the same either way.
     pub from_lights: bool,
-    /// Invocations of level 0 per coarse tile (chunks of `TILE_LIGHT_CHUNK` lights) and of
-    /// level 1 per tile (chunks of its candidates: as many as the longest coarse list can need).
+    /// Invocations of level 0 per coarse tile (chunks of `TILE_LIGHT_CHUNK` lights: of the
+    /// listed ones from the lights' side, else of all) and of level 1 per tile (chunks of its
+    /// candidates: as many as the longest coarse list can need).
     pub chunks: [u32; 2],
+    /// From the lights' side: the lights level 0 marks, those some tile can list (the CPU's
+    /// rectangle bound is not empty); 0 per coarse tile.
+    pub listed_lights: u32,
 }
 
 impl ClusterReport {
@@ -196,6 +200,12 @@ pub struct ClusterResources {
     generations: [u64; 8],
     /// The view-space spheres uploaded this frame (for the CPU reference in tests and stats).
     pub view_spheres: Vec<ViewSphere>,
+    /// The lights some tile can list this frame, ascending (`list_bounds`): level 0 from the
+    /// lights' side marks these only. Uploaded after the spheres.
+    listed: Vec<u32>,
+    /// What this frame uploads to the spheres buffer: the spheres, then `listed` (four to an
+    /// element); kept between frames so that it is not allocated again.
+    sphere_upload: Vec<[f32; 4]>,
     /// This frame's CPU bounds of the list sizes, which the lists were sized to before it was
     /// submitted.
     pub bounds_estimate: ListBounds,
@@ -205,6 +215,11 @@ pub struct ClusterResources {
     depth_bounds: bool,
     /// Blocks across and down of this frame's refined lists, `None` without them.
     refine_blocks: Option<glam::UVec2>,
+}
+
+/// Chunks of [`TILE_LIGHT_CHUNK`] lights that `lights` lights take, at least 1.
+fn light_chunks_of(lights: usize) -> u32 {
+    u32::try_from(lights).unwrap_or(u32::MAX).div_ceil(TILE_LIGHT_CHUNK).max(1)
 }
 
 /// Bytes of the build's counters (`GpuClusterCounters`), before level 0's bits.
@@ -309,6 +324,8 @@ impl ClusterResources {
             coarse: None,
             generations: [0; 8],
             view_spheres: Vec::new(),
+            listed: Vec::new(),
+            sphere_upload: Vec::new(),
             bounds_estimate: ListBounds::default(),
             bound_cpu_ms: 0.0,
             cull: CullTest::default(),
@@ -456,13 +473,6 @@ impl ClusterResources {
             self.tile_bounds.write(gpu, bytemuck::cast_slice(&tiles))?;
             self.bounds_of = Some((self.grid, self.coarse));
         }
-        let spheres: Vec<[f32; 4]> =
-            self.view_spheres.iter().map(|s| s.center.extend(s.radius).to_array()).collect();
-        if spheres.is_empty() {
-            self.spheres.write(gpu, &[0u8; 16])?;
-        } else {
-            self.spheres.write(gpu, bytemuck::cast_slice(&spheres))?;
-        }
         // The cluster ranges, then (with depth bounds) the depth ranges of the clusters, then
         // (with refined lists) the blocks' ranges.
         let cluster_ranges = count as u64 * if depth_bounds { 16 } else { 8 };
@@ -472,17 +482,22 @@ impl ClusterResources {
         // twice. A bound beyond what the device can bind reserves what it can; then the build's
         // counters decide, after the frame, whether the real lists fit.
         let started = std::time::Instant::now();
-        let light_chunks = (self.view_spheres.len() as u32).div_ceil(TILE_LIGHT_CHUNK).max(1);
+        let all_chunks = light_chunks_of(self.view_spheres.len());
         // Levels 0 and 1 from the lights' side where the grid allows and their bits fit (a
         // second bound, of level 0 per coarse tile, when they do not).
         let (cull, coarse) = (settings.cull, self.coarse);
         self.from_lights = self.grid_allows_bits();
-        self.bounds_estimate = list_bounds(&self.grid, &self.view_spheres, cull, coarse, self.from_lights);
-        if self.from_lights && !self.bits_fit(light_chunks) {
+        let spheres = &self.view_spheres;
+        self.bounds_estimate =
+            list_bounds(&self.grid, spheres, cull, coarse, self.from_lights, &mut self.listed);
+        if self.from_lights && !self.bits_fit(light_chunks_of(self.listed.len())) {
             self.from_lights = false;
-            self.bounds_estimate = list_bounds(&self.grid, &self.view_spheres, cull, coarse, false);
+            self.bounds_estimate = list_bounds(&self.grid, spheres, cull, coarse, false, &mut self.listed);
         }
         self.bound_cpu_ms = started.elapsed().as_secs_f64() * 1e3;
+        // Level 0 from the lights' side runs over the listed lights, per tile over all.
+        let light_chunks = if self.from_lights { light_chunks_of(self.listed.len()) } else { all_chunks };
+        self.upload_spheres(gpu)?;
         // Level 1 loops over each tile's coarse list (every light without a coarse level) in
         // chunks: as many as the longest list the bound allows, so a coarse list never runs
         // past its tile's last chunk.
@@ -512,10 +527,32 @@ impl ClusterResources {
         self.tile_indices.reserve(gpu, with_headroom(tile_need + coarse_need, &self.tile_indices))?;
         let tiles = self.grid.dims.x as u64 * self.grid.dims.y as u64;
         let coarse_tiles = self.coarse_dims().map_or(0, |d| u64::from(d.x) * u64::from(d.y));
-        let ranges = tiles * u64::from(tile_chunks) + coarse_tiles * u64::from(light_chunks);
+        // Room for level 0's ranges over all lights, should the bits not fit after all (`size_bits`).
+        let ranges = tiles * u64::from(tile_chunks) + coarse_tiles * u64::from(all_chunks);
         self.tile_ranges.reserve(gpu, ranges * 8)?;
         let cap = settings.cap.unwrap_or(CLUSTER_NO_CAP);
-        self.write_params(gpu, view, spheres.len() as u32, cap, [light_chunks, tile_chunks])
+        let light_count = self.view_spheres.len() as u32;
+        self.write_params(gpu, view, light_count, cap, [light_chunks, tile_chunks])
+    }
+
+    /// Uploads the view spheres, then the listed lights' indices (their bits, four to a sphere
+    /// element: `listed_light` in `shaders/cluster_build.wgsl`).
+    fn upload_spheres(&mut self, gpu: &GpuContext) -> Result<(), RenderError> {
+        let upload = &mut self.sphere_upload;
+        upload.clear();
+        upload.extend(self.view_spheres.iter().map(|s| s.center.extend(s.radius).to_array()));
+        upload.extend(self.listed.chunks(4).map(|c| {
+            let mut four = [0.0f32; 4];
+            for (slot, &light) in four.iter_mut().zip(c) {
+                *slot = f32::from_bits(light);
+            }
+            four
+        }));
+        if upload.is_empty() {
+            upload.push([0.0; 4]);
+        }
+        self.spheres.write(gpu, bytemuck::cast_slice(upload))?;
+        Ok(())
     }
 
     /// Blocks of this frame's refined lists (0 without them).
@@ -608,7 +645,8 @@ impl ClusterResources {
             refined_first: count_ranges,
             frustum: manylight_core::cluster::rect_frustum(&self.grid).to_array(),
             light_chunks,
-            _pad: [0; 3],
+            listed_lights: if self.from_lights { self.listed.len() as u32 } else { 0 },
+            _pad: [0; 2],
         };
         self.size_bits(gpu)?;
         gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
@@ -651,7 +689,12 @@ impl ClusterResources {
     /// not fit (only when the lists grew past the bound while the frame is checked) send the
     /// levels back to testing each (coarse) tile against its candidates.
     fn size_bits(&mut self, gpu: &GpuContext) -> Result<(), RenderError> {
-        self.from_lights &= COUNTER_BYTES + self.params_bit_bytes() <= self.counters.max_bytes();
+        if self.from_lights && COUNTER_BYTES + self.params_bit_bytes() > self.counters.max_bytes() {
+            // Level 0 per coarse tile loops over all lights.
+            self.from_lights = false;
+            self.params.light_chunks = light_chunks_of(self.params.light_count as usize);
+            self.params.listed_lights = 0;
+        }
         // The shader's bits array has at least one word.
         let bits = self.coarse_bits().map_or(0, |(_, bytes)| bytes);
         self.counters.reserve(gpu, COUNTER_BYTES + bits.max(4))?;
@@ -804,6 +847,7 @@ impl ClusterResources {
             z_slicing: self.grid.slicing.name().to_string(),
             from_lights: self.from_lights,
             chunks: [self.params.light_chunks, self.params.tile_chunks],
+            listed_lights: self.params.listed_lights,
             ..Default::default()
         };
         report.apply_counters(c);

@@ -412,11 +412,16 @@ pub struct GpuClusterParams {
     /// `shaders/cluster_build.wgsl`; `manylight_core::cluster::rect_frustum`): `(tan_x, tan_y,
     /// 0, margin)` in perspective, `(half_x, half_y, 1, margin)` orthographic.
     pub frustum: [f32; 4],
-    /// Light chunks of level 0 (its invocations per coarse tile):
-    /// `ceil(light_count / TILE_LIGHT_CHUNK)`, at least 1.
+    /// Light chunks of level 0 (its invocations per coarse tile), at least 1: of the listed
+    /// lights, `ceil(listed_lights / TILE_LIGHT_CHUNK)`, from the lights' side, else of all,
+    /// `ceil(light_count / TILE_LIGHT_CHUNK)`.
     pub light_chunks: u32,
+    /// Level 0 from the lights' side: how many lights it marks, those whose CPU rectangle bound
+    /// is not empty (`manylight_core::cluster::list_bounds`), listed after the spheres (0 per
+    /// coarse tile).
+    pub listed_lights: u32,
     /// Padding to 16 bytes.
-    pub _pad: [u32; 3],
+    pub _pad: [u32; 2],
 }
 
 /// Bounds of one cluster in view space (`GpuClusterBounds` in `shaders/common/clusters.wgsl`).

@@ -205,6 +205,7 @@ fn shared_structs_match_rust() {
             ("refined_first", offset_of!(GpuClusterParams, refined_first)),
             ("frustum", offset_of!(GpuClusterParams, frustum)),
             ("light_chunks", offset_of!(GpuClusterParams, light_chunks)),
+            ("listed_lights", offset_of!(GpuClusterParams, listed_lights)),
         ],
     );
 }

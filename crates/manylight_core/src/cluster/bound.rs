@@ -202,13 +202,20 @@ pub fn coarse_tile_accepts(tile: &CoarseTile, light: &ViewSphere, test: CullTest
 /// Bounds of the lists that `lights` give in `grid` under `test` (module docs), with a coarse
 /// level of `coarse` tiles per edge when [`coarse_span`] gives one, marked from the lights' side
 /// when `coarse_from_lights` (each light in the coarse tiles of its rectangle).
+///
+/// `listed` is cleared and given, in ascending order, the index of every light whose rectangle
+/// bound ([`super::RectGrid::light_tile_rect_bound`]) is not empty: the only lights a tile or
+/// cluster can list, and the only ones level 0 from the lights' side needs to mark (the bound
+/// holds the GPU's rectangle).
 pub fn list_bounds(
     grid: &ClusterGrid,
     lights: &[ViewSphere],
     test: CullTest,
     coarse: Option<u32>,
     coarse_from_lights: bool,
+    listed: &mut Vec<u32>,
 ) -> ListBounds {
+    listed.clear();
     let clusters = ClusterTables::new(grid);
     let columns = ClusterGrid { dims: glam::UVec3::new(grid.dims.x, grid.dims.y, 1), ..*grid };
     let tiles = ClusterTables::new(&columns);
@@ -216,7 +223,7 @@ pub fn list_bounds(
     let mut tile_cover = Coverage::new(grid.dims.truncate());
     let mut coarse_cover = coarse.map(|span| Coverage::new(super::coarse_dims(grid.dims.truncate(), span)));
     let rects = super::RectGrid::of(grid);
-    for light in lights {
+    for (index, light) in (0u32..).zip(lights) {
         // A light no tile's column accepts is in no tile or cluster list: most of a scene's
         // lights when they surround the camera, and the rectangle costs a few operations.
         let rect = rects.light_tile_rect_bound(light.center.extend(light.radius), test);
@@ -242,6 +249,7 @@ pub fn list_bounds(
         if rect.is_none() {
             continue;
         }
+        listed.push(index);
         bounds.cluster_pairs += clusters.candidates(light, test).map_or(0, |c| c.size());
         if let Some(c) = tile_box {
             bounds.tile_entries += c.size();

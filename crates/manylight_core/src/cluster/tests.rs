@@ -185,8 +185,11 @@ proptest! {
         let coarse_list = coarse_tiles(&columns, span);
         let coarse = coarse_dims(columns.dims.truncate(), span);
         for test in CullTest::ALL {
-            let bounds = list_bounds(&grid, &lights, test, coarse_span(span, test), false);
-            let marked = list_bounds(&grid, &lights, test, coarse_span(span, test), true);
+            let (mut listed, mut listed_marked) = (Vec::new(), Vec::new());
+            let bounds = list_bounds(&grid, &lights, test, coarse_span(span, test), false, &mut listed);
+            let marked = list_bounds(&grid, &lights, test, coarse_span(span, test), true, &mut listed_marked);
+            prop_assert_eq!(&listed, &listed_marked);
+            prop_assert!(listed.windows(2).all(|w| w[0] < w[1]), "ascending: {listed:?}");
             prop_assert_eq!(
                 ListBounds { coarse_entries: bounds.coarse_entries, max_coarse_lights: bounds.max_coarse_lights, ..marked },
                 bounds
@@ -202,6 +205,12 @@ proptest! {
                 "{test:?}: {bounds:?} < a tile list of {longest}, {grid:?}"
             );
             prop_assert!(u64::from(bounds.max_tile_lights) <= bounds.tile_entries);
+            // Every light a tile lists is listed (level 0 from the lights' side marks no other).
+            for t in 0..columns.cluster_count() {
+                for l in tile_lists.lights_of(t) {
+                    prop_assert!(listed.binary_search(l).is_ok(), "{test:?}: light {l} of tile {t} not in {listed:?}");
+                }
+            }
             // Level 0: every (light, coarse tile) pair the hull test accepts, and every light a
             // column accepts is in its coarse tile's list.
             if coarse_span(span, test).is_none() {

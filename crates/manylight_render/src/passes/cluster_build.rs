@@ -154,7 +154,7 @@ impl Pass for ClusterBuildPass {
         };
         let tiles = u64::from(p.dims[0]) * u64::from(p.dims[1]);
         let tile_groups = dispatch_size(entries(tiles, p.tile_chunks)?, wg, max_groups)?;
-        let light_groups = dispatch_size(p.light_count, wg, max_groups)?;
+        let light_groups = dispatch_size(p.listed_lights, wg, max_groups)?;
         let position_groups = dispatch_size(p.coarse_index_capacity, wg, max_groups)?;
         let coarse_tiles = u64::from(p.coarse_dims[0]) * u64::from(p.coarse_dims[1]);
         let coarse_groups = dispatch_size(entries(coarse_tiles, p.light_chunks)?, wg, max_groups)?;
