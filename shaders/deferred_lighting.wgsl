@@ -8,7 +8,7 @@
 //!include common/fullscreen.wgsl
 
 // group 0, binding 0: `view` (common/view_binding.wgsl, through common/gbuffer_read.wgsl)
-@group(0) @binding(1) var<storage, read> lights: array<GpuPointLight>;
+//!include common/point_lights.wgsl
 
 //!include common/gbuffer_read.wgsl
 
@@ -20,7 +20,7 @@ fn shade(g: GSurface, frag: vec2<f32>) -> vec4<f32> {
     let range = light_list_range(frag, gbuffer_view_distance(g.world_position));
     var color = gbuffer_base_radiance(g) + shade_directional_lights(g.params, view_dir);
     for (var i = 0u; i < range.y; i++) {
-        color += shade_point_light(g.params, g.world_position, view_dir, lights[cluster_indices[range.x + i]]);
+        color += shade_light(g.params, g.world_position, view_dir, cluster_indices[range.x + i]);
     }
     return vec4<f32>(color, 1.0);
 }

@@ -18,7 +18,7 @@
 //!include common/fullscreen.wgsl
 
 // group 0, binding 0: `view` (common/view_binding.wgsl, through common/gbuffer_read.wgsl)
-@group(0) @binding(1) var<storage, read> lights: array<GpuPointLight>;
+//!include common/point_lights.wgsl
 
 //!include common/gbuffer_read.wgsl
 
@@ -54,7 +54,7 @@ fn ambient(g: GSurface) -> vec4<f32> {
 
 fn one_light(g: GSurface, light_index: u32) -> vec4<f32> {
     let view_dir = direction_to_eye(view, g.world_position);
-    return vec4<f32>(shade_point_light(g.params, g.world_position, view_dir, lights[light_index]), 0.0);
+    return vec4<f32>(shade_light(g.params, g.world_position, view_dir, light_index), 0.0);
 }
 
 @fragment

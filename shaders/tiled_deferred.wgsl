@@ -18,7 +18,7 @@
 //!include common/clusters.wgsl
 
 // group 0, binding 0: `view` (common/view_binding.wgsl, through common/gbuffer_read.wgsl)
-@group(0) @binding(1) var<storage, read> lights: array<GpuPointLight>;
+//!include common/point_lights.wgsl
 
 //!include common/gbuffer_read.wgsl
 
@@ -151,13 +151,13 @@ fn shade(g: GSurface, tile: vec2<u32>) -> vec4<f32> {
     let count = atomicLoad(&list_count);
     if count <= TILED_LIST_CAPACITY {
         for (var i = 0u; i < count; i++) {
-            color += shade_point_light(g.params, g.world_position, view_dir, lights[tile_list[i]]);
+            color += shade_light(g.params, g.world_position, view_dir, tile_list[i]);
         }
     } else {
         // More lights than workgroup memory holds: the column's whole list.
         let range = cluster_ranges[tile.x + tile.y * cluster_params.dims.x];
         for (var i = 0u; i < range.y; i++) {
-            color += shade_point_light(g.params, g.world_position, view_dir, lights[cluster_indices[range.x + i]]);
+            color += shade_light(g.params, g.world_position, view_dir, cluster_indices[range.x + i]);
         }
     }
     return vec4<f32>(color, 1.0);

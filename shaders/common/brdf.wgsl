@@ -32,15 +32,35 @@ fn with_material_slots(s: SurfaceParams, slots: vec2<f32>) -> SurfaceParams {
 
 // Radiance a point or spot light adds at `position` seen from `view_dir` (unit, towards the eye).
 fn shade_point_light(s: SurfaceParams, position: vec3<f32>, view_dir: vec3<f32>, light: GpuPointLight) -> vec3<f32> {
-    let to_light = light.position_radius.xyz - position;
-    let distance = length(to_light);
-    let att = attenuation(distance, light.position_radius.w);
-    if att <= 0.0 {
+    let reach = light_reach(light.position_radius, position);
+    if reach.attenuation <= 0.0 {
         return vec3<f32>(0.0);
     }
-    let l = to_light / max(distance, 1e-6);
-    let cone = spot_attenuation(dot(light.spot.xyz, -l), light.spot.w, light.color.a);
-    return reflected(s, l, view_dir) * light.color.rgb * (att * cone);
+    return shade_reached_light(s, reach, view_dir, light.color, light.spot);
+}
+
+// How a light (`position_radius`: `GpuPointLight::position_radius`) reaches `position`: the
+// vector to it, its distance and the distance attenuation (0: the light adds nothing).
+struct LightReach {
+    to_light: vec3<f32>,
+    distance: f32,
+    attenuation: f32,
+};
+
+fn light_reach(position_radius: vec4<f32>, position: vec3<f32>) -> LightReach {
+    let to_light = position_radius.xyz - position;
+    let distance = length(to_light);
+    return LightReach(to_light, distance, attenuation(distance, position_radius.w));
+}
+
+// `shade_point_light` past its range test, for a light that reaches the point (`reach`), with
+// the light's `color` and `spot` fields. Passes that loop over light lists read those two only
+// here: on a CPU rasteriser every field read is a gather, and most listed lights end at the
+// range test.
+fn shade_reached_light(s: SurfaceParams, reach: LightReach, view_dir: vec3<f32>, color: vec4<f32>, spot: vec4<f32>) -> vec3<f32> {
+    let l = reach.to_light / max(reach.distance, 1e-6);
+    let cone = spot_attenuation(dot(spot.xyz, -l), spot.w, color.a);
+    return reflected(s, l, view_dir) * color.rgb * (reach.attenuation * cone);
 }
 
 // What a surface reflects towards `view_dir` of unit light arriving from unit direction `l`

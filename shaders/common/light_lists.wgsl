@@ -36,13 +36,13 @@ fn add_every_light(f: ForwardFragment) -> vec3<f32> {
     let n = view.light_count;
     var i = 0u;
     for (; i + 4u <= n; i += 4u) {
-        color += shade_point_light(f.m.params, f.p.world_position, f.view_dir, lights[i]);
-        color += shade_point_light(f.m.params, f.p.world_position, f.view_dir, lights[i + 1u]);
-        color += shade_point_light(f.m.params, f.p.world_position, f.view_dir, lights[i + 2u]);
-        color += shade_point_light(f.m.params, f.p.world_position, f.view_dir, lights[i + 3u]);
+        color += shade_light(f.m.params, f.p.world_position, f.view_dir, i);
+        color += shade_light(f.m.params, f.p.world_position, f.view_dir, i + 1u);
+        color += shade_light(f.m.params, f.p.world_position, f.view_dir, i + 2u);
+        color += shade_light(f.m.params, f.p.world_position, f.view_dir, i + 3u);
     }
     for (; i < n; i++) {
-        color += shade_point_light(f.m.params, f.p.world_position, f.view_dir, lights[i]);
+        color += shade_light(f.m.params, f.p.world_position, f.view_dir, i);
     }
     return color;
 }
@@ -53,7 +53,7 @@ fn add_cluster_lights(f: ForwardFragment, frag: vec2<f32>) -> vec3<f32> {
     var color = f.color;
     let range = light_list_range(frag, f.p.view_depth);
     for (var i = 0u; i < range.y; i++) {
-        color += shade_point_light(f.m.params, f.p.world_position, f.view_dir, lights[cluster_indices[range.x + i]]);
+        color += shade_light(f.m.params, f.p.world_position, f.view_dir, cluster_indices[range.x + i]);
     }
     return color;
 }

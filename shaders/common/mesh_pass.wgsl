@@ -7,7 +7,7 @@
 //!include common/surface.wgsl
 //!include common/view_binding.wgsl
 
-@group(0) @binding(1) var<storage, read> lights: array<GpuPointLight>;
+//!include common/point_lights.wgsl
 @group(0) @binding(2) var<storage, read> instances: array<GpuInstance>;
 
 @group(1) @binding(0) var<uniform> material: GpuMaterial;

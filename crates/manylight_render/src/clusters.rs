@@ -18,7 +18,7 @@ use glam::Mat4;
 use manylight_core::Projection;
 use manylight_core::cluster::{
     ClusterAssignment, ClusterGrid, CullTest, ListBounds, ViewSphere, coarse_dims, coarse_span, coarse_tiles,
-    list_bounds, view_spheres,
+    list_bounds, to_view_space,
 };
 use serde::Serialize;
 
@@ -601,7 +601,8 @@ impl ClusterResources {
         view_from_world: &Mat4,
         lights: &[(glam::Vec3, f32)],
     ) -> Projection {
-        self.view_spheres = view_spheres(view_from_world, lights.iter().copied());
+        self.view_spheres.clear();
+        self.view_spheres.extend(to_view_space(*view_from_world, lights.iter().copied()));
         let reach = manylight_core::cluster::farthest_reach(self.view_spheres.iter().copied());
         view.camera.map(|c| c.projection).unwrap_or_default().finite_for(reach)
     }

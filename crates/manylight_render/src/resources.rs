@@ -209,6 +209,8 @@ pub struct SceneResources {
     /// (centre, radius) of the sphere bounding what each uploaded light can reach (a spot
     /// light's is the smaller sphere around its cone), in light-buffer order.
     pub light_spheres: Vec<(glam::Vec3, f32)>,
+    /// The frame's valid point and spot lights as uploaded (kept for its allocation).
+    gpu_lights: Vec<GpuPointLight>,
     /// The tone map's count of non-finite HDR pixels.
     pub nonfinite: NonFiniteCounter,
     meshes: HashMap<usize, GpuMesh>,
@@ -370,6 +372,7 @@ impl SceneResources {
             invalid_instances: 0,
             collapsed_instances: 0,
             light_spheres: Vec::new(),
+            gpu_lights: Vec::new(),
             nonfinite: NonFiniteCounter::new(gpu),
             meshes: HashMap::new(),
             materials: HashMap::new(),
@@ -454,26 +457,24 @@ impl SceneResources {
         self.frame += 1;
 
         // Lights: invalid ones (NaN, inf, negative) are dropped and counted, never uploaded.
-        let gpu_lights: Vec<GpuPointLight> = snapshot
-            .lights
-            .iter()
-            .filter(|l| l.is_valid())
-            .map(|l| {
-                // A point light: no direction, falloff scale 0 and offset 1 (1 everywhere).
-                let (direction, scale, offset) = match &l.spot {
-                    Some(cone) => {
-                        let (scale, offset) = cone.scale_offset();
-                        (cone.sanitized().direction, scale, offset)
-                    }
-                    None => (glam::Vec3::ZERO, 0.0, 1.0),
-                };
-                GpuPointLight {
-                    position_radius: l.position.extend(l.radius).to_array(),
-                    color: (l.color * l.intensity).extend(offset).to_array(),
-                    spot: direction.extend(scale).to_array(),
+        // Both light Vecs keep their allocation from frame to frame.
+        let mut gpu_lights = std::mem::take(&mut self.gpu_lights);
+        gpu_lights.clear();
+        gpu_lights.extend(snapshot.lights.iter().filter(|l| l.is_valid()).map(|l| {
+            // A point light: no direction, falloff scale 0 and offset 1 (1 everywhere).
+            let (direction, scale, offset) = match &l.spot {
+                Some(cone) => {
+                    let (scale, offset) = cone.scale_offset();
+                    (cone.sanitized().direction, scale, offset)
                 }
-            })
-            .collect();
+                None => (glam::Vec3::ZERO, 0.0, 1.0),
+            };
+            GpuPointLight {
+                position_radius: l.position.extend(l.radius).to_array(),
+                color: (l.color * l.intensity).extend(offset).to_array(),
+                spot: direction.extend(scale).to_array(),
+            }
+        }));
         self.invalid_lights = (snapshot.lights.len() - gpu_lights.len()) as u32;
         // Directional lights: the first MAX_DIRECTIONAL_LIGHTS valid ones, in the view uniform.
         let valid = snapshot.directional_lights.iter().filter(|l| l.is_valid());
@@ -498,13 +499,16 @@ impl SceneResources {
                 self.dropped_directional_lights
             );
         }
-        self.light_spheres =
-            snapshot.lights.iter().filter(|l| l.is_valid()).map(|l| l.bounding_sphere()).collect();
+        self.light_spheres.clear();
+        self.light_spheres
+            .extend(snapshot.lights.iter().filter(|l| l.is_valid()).map(|l| l.bounding_sphere()));
         self.light_count = gpu_lights.len() as u32;
         let light_bytes: &[u8] =
             if gpu_lights.is_empty() { PLACEHOLDER_LIGHT } else { bytemuck::cast_slice(&gpu_lights) };
-        self.lights.write(gpu, light_bytes)?;
+        let written = self.lights.write(gpu, light_bytes);
         self.light_upload_bytes = light_bytes.len() as u64;
+        self.gpu_lights = gpu_lights;
+        written?;
 
         // Meshes, materials, instances.
         let mut instance_data = Vec::with_capacity(snapshot.instances.len());

@@ -24,6 +24,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("common/directional_lights.wgsl", include_str!("../../../shaders/common/directional_lights.wgsl")),
     ("common/cluster_lists.wgsl", include_str!("../../../shaders/common/cluster_lists.wgsl")),
     ("common/light_lists.wgsl", include_str!("../../../shaders/common/light_lists.wgsl")),
+    ("common/point_lights.wgsl", include_str!("../../../shaders/common/point_lights.wgsl")),
     ("light_volumes.wgsl", include_str!("../../../shaders/light_volumes.wgsl")),
     ("forward.wgsl", include_str!("../../../shaders/forward.wgsl")),
     ("depth_prepass.wgsl", include_str!("../../../shaders/depth_prepass.wgsl")),
