@@ -1,7 +1,8 @@
-// Refined light lists: one compute pass after the cluster build, one invocation per block of
-// REFINE_EDGE × REFINE_EDGE pixels. A cluster is a whole tile deep in a depth slice; the lights
-// of a tile that reach a block's few surface points are far fewer when lights are small (a
-// light a few pixels wide on a 16-pixel tile). Each block:
+// Refined light lists: one compute pass after the cluster build, one invocation per group of
+// REFINE_GROUP_EDGE × REFINE_GROUP_EDGE blocks of REFINE_EDGE × REFINE_EDGE pixels. A cluster
+// is a whole tile deep in a depth slice; the lights of a tile that reach a block's few surface
+// points are far fewer when lights are small (a light a few pixels wide on a 16-pixel tile).
+// Each block:
 // 1. reads its pixels' shading distances (the depth pre-pass's `shading_distance`, or the
 //    G-buffer's stored position as deferred lighting reads it) and makes the view-space box
 //    around their surface positions, widened on every axis by REFINE_SLACK × (distance +
@@ -17,6 +18,13 @@
 //    REFINED_LIST_SLOTS lights kept, more than REFINE_MAX_CLUSTERS clusters or
 //    REFINE_CANDIDATE_LIMIT list entries to test (which keeps the invocation far inside
 //    lavapipe's loop limit), or a distance that is not finite.
+// When every block of the group that has surface points falls in one and the same cluster
+// (most groups at 16-px tiles), step 2 reads that cluster's list once for all of them and tests
+// each light against each block's box, which gives each block the list it would get alone; the
+// other groups refine their blocks one after the other within one budget of
+// REFINE_CANDIDATE_LIMIT × REFINE_MAX_CLUSTERS list entries × clusters (which keeps the
+// invocation, dedup loops included, as far inside lavapipe's loop limit as one block was; a
+// block past the budget shades from its cluster lists).
 // Exact as the cluster lists are: a light that lights a pixel reaches the pixel's position,
 // which lies in the block's box, and is in the list of the pixel's cluster.
 //!include common/view.wgsl
@@ -49,6 +57,21 @@ var<private> covered: bool;
 var<private> unbounded: bool;
 // The largest view distance of the block's pixels.
 var<private> farthest: f32;
+
+// A block of the group, once its pixels are read (`close_block`).
+const BLOCK_OUTSIDE: u32 = 0u; // past the image's blocks
+const BLOCK_EMPTY: u32 = 1u; // no surface: an empty list
+const BLOCK_UNBOUNDED: u32 = 2u; // a distance that is not finite: shades from its clusters
+const BLOCK_OPEN: u32 = 3u; // its box and cluster box are known
+struct GroupBlock {
+    box_min: vec3<f32>,
+    box_max: vec3<f32>,
+    clusters_min: vec3<u32>,
+    clusters_max: vec3<u32>,
+    state: u32,
+};
+const GROUP_BLOCKS: u32 = REFINE_GROUP_EDGE * REFINE_GROUP_EDGE;
+var<private> group: array<GroupBlock, GROUP_BLOCKS>;
 
 fn begin_block() {
     box_min = vec3<f32>(3.0e38);
@@ -124,17 +147,11 @@ fn list_holds(r: vec2<u32>, l: u32) -> bool {
     return false;
 }
 
-// The block's list (steps 2 and 3 above), written at `slot`: its range.
-fn refine_lights(slot: u32) -> vec2<u32> {
+// The list (steps 2 and 3 above) of the open block whose box and cluster box are in
+// `box_min`.. `clusters_max`, written at `slot`: its range. Takes its list entries × clusters
+// from `budget`.
+fn refine_lights(slot: u32, budget: ptr<function, u32>) -> vec2<u32> {
     let fallback = vec2<u32>(0u, REFINED_FALLBACK);
-    if !covered {
-        return vec2<u32>(slot, 0u);
-    }
-    if unbounded {
-        return fallback;
-    }
-    widen_box();
-    find_clusters();
     let n3 = clusters_max - clusters_min + 1u;
     let n = n3.x * n3.y * n3.z;
     if n > REFINE_MAX_CLUSTERS {
@@ -144,9 +161,10 @@ fn refine_lights(slot: u32) -> vec2<u32> {
     for (var k = 0u; k < n; k++) {
         candidates += min(ranges[box_cluster(k)].y, REFINE_CANDIDATE_LIMIT + 1u);
     }
-    if candidates > REFINE_CANDIDATE_LIMIT {
+    if candidates > REFINE_CANDIDATE_LIMIT || candidates * n > *budget {
         return fallback;
     }
+    *budget -= candidates * n;
     var count = 0u;
     for (var k = 0u; k < n; k++) {
         let r = ranges[box_cluster(k)];
@@ -173,15 +191,106 @@ fn refine_lights(slot: u32) -> vec2<u32> {
     return vec2<u32>(slot, count);
 }
 
-// Writes block `b`'s range from the pixels added since `begin_block`.
-fn finish_block(b: vec2<u32>) {
-    let at = refined_range_index(cluster_params, b);
-    let slot = cluster_params.index_capacity + (at - cluster_params.refined_first) * REFINED_LIST_SLOTS;
-    ranges[at] = refine_lights(slot);
-}
-
 fn in_blocks(b: vec2<u32>) -> bool {
     return b.x < cluster_params.refine_blocks_x && b.y < cluster_params.refine_blocks_y;
+}
+
+// Block `q` (row-major) of the group `g`.
+fn group_block(g: vec2<u32>, q: u32) -> vec2<u32> {
+    return g * REFINE_GROUP_EDGE + vec2<u32>(q % REFINE_GROUP_EDGE, q / REFINE_GROUP_EDGE);
+}
+
+// Keeps block `q` of the group from the pixels added since `begin_block` (`inside`: the block
+// is one of the image's).
+fn close_block(q: u32, inside: bool) {
+    var state = BLOCK_OPEN;
+    if !inside {
+        state = BLOCK_OUTSIDE;
+    } else if unbounded {
+        state = BLOCK_UNBOUNDED;
+    } else if !covered {
+        state = BLOCK_EMPTY;
+    } else {
+        widen_box();
+        find_clusters();
+    }
+    group[q] = GroupBlock(box_min, box_max, clusters_min, clusters_max, state);
+}
+
+// Where block `b`'s range and list slots are.
+fn range_at(b: vec2<u32>) -> u32 {
+    return refined_range_index(cluster_params, b);
+}
+
+fn slot_of(at: u32) -> u32 {
+    return cluster_params.index_capacity + (at - cluster_params.refined_first) * REFINED_LIST_SLOTS;
+}
+
+// The one cluster every open block of the group falls in, or 0xffffffff when they fall in
+// more than one (or none is open).
+fn shared_cluster() -> u32 {
+    var lead = 0xffffffffu;
+    var one = true;
+    for (var q = 0u; q < GROUP_BLOCKS; q++) {
+        let blk = group[q];
+        if blk.state == BLOCK_OPEN {
+            let c = cluster_at(cluster_params, blk.clusters_min);
+            one = one && all(blk.clusters_min == blk.clusters_max) && (lead == 0xffffffffu || c == lead);
+            lead = c;
+        }
+    }
+    return select(0xffffffffu, lead, one);
+}
+
+// Writes the ranges of the group `g`'s blocks (closed with `close_block`).
+fn finish_group(g: vec2<u32>) {
+    let fallback = vec2<u32>(0u, REFINED_FALLBACK);
+    let lead = shared_cluster();
+    if lead != 0xffffffffu {
+        // Step 2 once for the group: the shared cluster's list against every open block's box.
+        let r = ranges[lead];
+        var counts = array<u32, GROUP_BLOCKS>();
+        if r.y <= REFINE_CANDIDATE_LIMIT {
+            for (var j = 0u; j < r.y; j++) {
+                let l = indices[r.x + j];
+                let s = spheres[l];
+                for (var q = 0u; q < GROUP_BLOCKS; q++) {
+                    let blk = group[q];
+                    if blk.state == BLOCK_OPEN && sphere_intersects_aabb(s.xyz, s.w, blk.box_min, blk.box_max) {
+                        if counts[q] < REFINED_LIST_SLOTS {
+                            indices[slot_of(range_at(group_block(g, q))) + counts[q]] = l;
+                        }
+                        counts[q] += 1u;
+                    }
+                }
+            }
+        }
+        for (var q = 0u; q < GROUP_BLOCKS; q++) {
+            let blk = group[q];
+            let at = range_at(group_block(g, q));
+            if blk.state == BLOCK_OPEN {
+                let fits = r.y <= REFINE_CANDIDATE_LIMIT && counts[q] <= REFINED_LIST_SLOTS;
+                ranges[at] = select(fallback, vec2<u32>(slot_of(at), counts[q]), fits);
+            } else if blk.state != BLOCK_OUTSIDE {
+                ranges[at] = select(fallback, vec2<u32>(slot_of(at), 0u), blk.state == BLOCK_EMPTY);
+            }
+        }
+        return;
+    }
+    var budget = REFINE_CANDIDATE_LIMIT * REFINE_MAX_CLUSTERS;
+    for (var q = 0u; q < GROUP_BLOCKS; q++) {
+        let blk = group[q];
+        let at = range_at(group_block(g, q));
+        if blk.state == BLOCK_OPEN {
+            box_min = blk.box_min;
+            box_max = blk.box_max;
+            clusters_min = blk.clusters_min;
+            clusters_max = blk.clusters_max;
+            ranges[at] = refine_lights(slot_of(at), &budget);
+        } else if blk.state != BLOCK_OUTSIDE {
+            ranges[at] = select(fallback, vec2<u32>(slot_of(at), 0u), blk.state == BLOCK_EMPTY);
+        }
+    }
 }
 
 // The view-space position forward shading computes for a pixel at view distance `d`
@@ -198,66 +307,72 @@ fn gbuffer_position(p: vec3<f32>) -> vec3<f32> {
 
 @compute @workgroup_size(8, 8)
 fn cs_forward(@builtin(global_invocation_id) id: vec3<u32>) {
-    if !in_blocks(id.xy) {
-        return;
-    }
-    begin_block();
     // A pixel past the image's edge reads the edge's (in the same block) instead.
     let last = textureDimensions(shading_distance) - 1u;
-    for (var i = 0u; i < REFINE_EDGE * REFINE_EDGE; i++) {
-        let px = min(block_pixel(id.xy, i), last);
-        let d = textureLoad(shading_distance, vec2<i32>(px), 0).r;
-        if d > 0.0 || !(abs(d) <= 3.0e38) {
-            add_pixel(px, forward_position(px, d));
+    for (var q = 0u; q < GROUP_BLOCKS; q++) {
+        let b = group_block(id.xy, q);
+        begin_block();
+        if in_blocks(b) {
+            for (var i = 0u; i < REFINE_EDGE * REFINE_EDGE; i++) {
+                let px = min(block_pixel(b, i), last);
+                let d = textureLoad(shading_distance, vec2<i32>(px), 0).r;
+                if d > 0.0 || !(abs(d) <= 3.0e38) {
+                    add_pixel(px, forward_position(px, d));
+                }
+            }
         }
+        close_block(q, in_blocks(b));
     }
-    finish_block(id.xy);
+    finish_group(id.xy);
 }
 
 @compute @workgroup_size(8, 8)
 fn cs_full(@builtin(global_invocation_id) id: vec3<u32>) {
-    if !in_blocks(id.xy) {
-        return;
-    }
-    begin_block();
     let size = textureDimensions(gb_depth);
-    for (var i = 0u; i < REFINE_EDGE * REFINE_EDGE; i++) {
-        let px = block_pixel(id.xy, i);
-        if all(px < size) && gbuffer_depth(vec2<i32>(px)) > 0.0 {
-            add_pixel(px, gbuffer_position(gbuffer_read_full(vec2<i32>(px)).world_position));
+    for (var q = 0u; q < GROUP_BLOCKS; q++) {
+        let b = group_block(id.xy, q);
+        begin_block();
+        for (var i = 0u; i < REFINE_EDGE * REFINE_EDGE && in_blocks(b); i++) {
+            let px = block_pixel(b, i);
+            if all(px < size) && gbuffer_depth(vec2<i32>(px)) > 0.0 {
+                add_pixel(px, gbuffer_position(gbuffer_read_full(vec2<i32>(px)).world_position));
+            }
         }
+        close_block(q, in_blocks(b));
     }
-    finish_block(id.xy);
+    finish_group(id.xy);
 }
 
 @compute @workgroup_size(8, 8)
 fn cs_packed(@builtin(global_invocation_id) id: vec3<u32>) {
-    if !in_blocks(id.xy) {
-        return;
-    }
-    begin_block();
     let size = textureDimensions(gb_depth);
-    for (var i = 0u; i < REFINE_EDGE * REFINE_EDGE; i++) {
-        let px = block_pixel(id.xy, i);
-        if all(px < size) && gbuffer_depth(vec2<i32>(px)) > 0.0 {
-            add_pixel(px, gbuffer_position(gbuffer_read_packed(vec2<i32>(px)).world_position));
+    for (var q = 0u; q < GROUP_BLOCKS; q++) {
+        let b = group_block(id.xy, q);
+        begin_block();
+        for (var i = 0u; i < REFINE_EDGE * REFINE_EDGE && in_blocks(b); i++) {
+            let px = block_pixel(b, i);
+            if all(px < size) && gbuffer_depth(vec2<i32>(px)) > 0.0 {
+                add_pixel(px, gbuffer_position(gbuffer_read_packed(vec2<i32>(px)).world_position));
+            }
         }
+        close_block(q, in_blocks(b));
     }
-    finish_block(id.xy);
+    finish_group(id.xy);
 }
 
 @compute @workgroup_size(8, 8)
 fn cs_compact(@builtin(global_invocation_id) id: vec3<u32>) {
-    if !in_blocks(id.xy) {
-        return;
-    }
-    begin_block();
     let size = textureDimensions(gb_depth);
-    for (var i = 0u; i < REFINE_EDGE * REFINE_EDGE; i++) {
-        let px = block_pixel(id.xy, i);
-        if all(px < size) && gbuffer_depth(vec2<i32>(px)) > 0.0 {
-            add_pixel(px, gbuffer_position(gbuffer_read_compact(vec2<i32>(px)).world_position));
+    for (var q = 0u; q < GROUP_BLOCKS; q++) {
+        let b = group_block(id.xy, q);
+        begin_block();
+        for (var i = 0u; i < REFINE_EDGE * REFINE_EDGE && in_blocks(b); i++) {
+            let px = block_pixel(b, i);
+            if all(px < size) && gbuffer_depth(vec2<i32>(px)) > 0.0 {
+                add_pixel(px, gbuffer_position(gbuffer_read_compact(vec2<i32>(px)).world_position));
+            }
         }
+        close_block(q, in_blocks(b));
     }
-    finish_block(id.xy);
+    finish_group(id.xy);
 }

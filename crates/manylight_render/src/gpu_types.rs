@@ -62,6 +62,11 @@ pub const REFINE_EDGE: u32 = 4;
 /// Refined light lists: the most lights a block's list holds; a block whose pixels need more
 /// shades from its pixels' cluster lists ([`REFINED_FALLBACK`]).
 pub const REFINED_LIST_SLOTS: u32 = 16;
+/// Refined light lists: blocks along each axis that one `light_refine` invocation refines.
+/// Blocks of a group whose pixels all fall in one cluster, the same for all, read its list
+/// once (at 16-px tiles most groups); the others are refined one after the other within one
+/// budget of [`REFINE_CANDIDATE_LIMIT`] × [`REFINE_MAX_CLUSTERS`] list entries × clusters.
+pub const REFINE_GROUP_EDGE: u32 = 2;
 /// Refined light lists: the most cluster-list entries a block tests (all the clusters its
 /// pixels fall in together); a block with more shades from its cluster lists. Keeps an
 /// invocation well inside lavapipe's loop limit ([`LAVAPIPE_LOOP_LIMIT`]) with the duplicate
@@ -119,6 +124,7 @@ pub fn shared_u32_constants() -> Vec<(&'static str, u32)> {
         ("TILED_DEPTH_CELLS", TILED_DEPTH_CELLS),
         ("REFINE_EDGE", REFINE_EDGE),
         ("REFINED_LIST_SLOTS", REFINED_LIST_SLOTS),
+        ("REFINE_GROUP_EDGE", REFINE_GROUP_EDGE),
         ("REFINE_CANDIDATE_LIMIT", REFINE_CANDIDATE_LIMIT),
         ("REFINE_MAX_CLUSTERS", REFINE_MAX_CLUSTERS),
         ("REFINED_FALLBACK", REFINED_FALLBACK),

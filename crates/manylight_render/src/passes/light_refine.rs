@@ -8,6 +8,7 @@ use super::CLUSTERS;
 use super::gbuffer_layout::{DistancePipeline, DistanceSource};
 use crate::bindings::Binding;
 use crate::context::RenderError;
+use crate::gpu_types::REFINE_GROUP_EDGE;
 use crate::graph::{Pass, PassContext, ResourceName};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
@@ -68,7 +69,9 @@ impl Pass for LightRefinePass {
             ],
         );
         let p = &clusters.params;
-        let groups = [p.refine_blocks_x.div_ceil(8), p.refine_blocks_y.div_ceil(8)];
+        // Workgroups of 8 × 8 invocations, each refining REFINE_GROUP_EDGE² blocks.
+        let per_workgroup = 8 * REFINE_GROUP_EDGE;
+        let groups = [p.refine_blocks_x.div_ceil(per_workgroup), p.refine_blocks_y.div_ceil(per_workgroup)];
         let timestamps = ctx.compute_timestamps(true, true);
         let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("light_refine"),
