@@ -180,7 +180,44 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
         rows.push(Row { pipeline, gbuffer, lights, frame_ms, last, culling, depth_bounded, zbinned, oracle });
     }
     progress.finish();
+    warn_unlike_oracle_frames(&rows);
     Ok(csv(&rows, scene_name, sweep.size, &adapter))
+}
+
+/// How far a pass of the same work may take longer or shorter in one frame than in another
+/// before their timings are not comparable.
+const LIKE_FRAMES_TOLERANCE: f64 = 1.25;
+
+/// The tone map does the same work in an oracle's frame as in the pipelines' frames of the same
+/// size: where its time differs by more than [`LIKE_FRAMES_TOLERANCE`], the oracle's frames were
+/// not timed in the same state of the GPU (seen on an H200: every pass of the oracle's frames up
+/// to 5.7 times slower), and its `shading_vs_oracle` says nothing. Warns of each such oracle;
+/// `render --oracle` interleaves the two frame by frame instead.
+fn warn_unlike_oracle_frames(rows: &[Row]) {
+    let tonemap = |r: &Row| r.last.passes.iter().find(|p| p.name == "tonemap").and_then(|p| p.gpu_ms);
+    for o in rows.iter().filter(|r| r.oracle) {
+        let theirs: Vec<f64> =
+            rows.iter().filter(|r| !r.oracle && r.lights == o.lights).filter_map(tonemap).collect();
+        if let (Some(ours), false) = (tonemap(o), theirs.is_empty())
+            && let Some(ratio) = unlike(ours, median(&theirs))
+        {
+            tracing::warn!(
+                "the {} oracle at {} lights: its tone map took {ratio:.2} times the pipelines' \
+                 ({ours:.3} ms against {:.3} ms), so its frames were not timed like theirs and \
+                 shading_vs_oracle is not comparable at this light count; `manylight render \
+                 --oracle` times the two frame by frame",
+                if o.pipeline.is_deferred() { "deferred" } else { "forward" },
+                o.lights,
+                median(&theirs)
+            );
+        }
+    }
+}
+
+/// `a / b` where it lies outside [`LIKE_FRAMES_TOLERANCE`] either way.
+fn unlike(a: f64, b: f64) -> Option<f64> {
+    let ratio = a / b;
+    (b > 0.0 && !(1.0 / LIKE_FRAMES_TOLERANCE..=LIKE_FRAMES_TOLERANCE).contains(&ratio)).then_some(ratio)
 }
 
 /// The scene lit by `count` lights: the sphere-shell preset (`shell_lattice`) gets its lattice of
@@ -337,4 +374,19 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
         );
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::unlike;
+
+    #[test]
+    fn frames_are_unlike_only_past_the_tolerance() {
+        assert_eq!(unlike(0.131, 0.131), None);
+        assert_eq!(unlike(0.150, 0.131), None);
+        assert_eq!(unlike(0.110, 0.131), None);
+        assert!(unlike(0.752, 0.131).is_some_and(|r| (r - 5.74).abs() < 0.01));
+        assert!(unlike(0.05, 0.131).is_some_and(|r| r < 0.5));
+        assert_eq!(unlike(0.1, 0.0), None);
+    }
 }
