@@ -17,8 +17,8 @@ use crate::snapshot::RenderView;
 use glam::Mat4;
 use manylight_core::Projection;
 use manylight_core::cluster::{
-    ClusterAssignment, ClusterGrid, CullTest, ListBounds, ViewSphere, coarse_dims, coarse_span, coarse_tiles,
-    list_bounds, to_view_space,
+    ClusterAssignment, ClusterGrid, CullTest, ListBounder, ListBounds, ViewSphere, coarse_dims, coarse_span,
+    coarse_tiles, to_view_space,
 };
 use serde::Serialize;
 
@@ -203,6 +203,8 @@ pub struct ClusterResources {
     /// The lights some tile can list this frame, ascending (`list_bounds`): level 0 from the
     /// lights' side marks these only. Uploaded after the spheres.
     listed: Vec<u32>,
+    /// Computes the list bounds on all cores, its parts' storage kept between frames.
+    bounder: ListBounder,
     /// What this frame uploads to the spheres buffer: the spheres, then `listed` (four to an
     /// element); kept between frames so that it is not allocated again.
     sphere_upload: Vec<[f32; 4]>,
@@ -325,6 +327,7 @@ impl ClusterResources {
             generations: [0; 8],
             view_spheres: Vec::new(),
             listed: Vec::new(),
+            bounder: ListBounder::default(),
             sphere_upload: Vec::new(),
             bounds_estimate: ListBounds::default(),
             bound_cpu_ms: 0.0,
@@ -478,9 +481,9 @@ impl ClusterResources {
         let cluster_ranges = count as u64 * if depth_bounds { 16 } else { 8 };
         self.ranges.reserve(gpu, cluster_ranges + self.refined_blocks() * 8)?;
         // Lists sized before the frame is submitted, from a CPU bound of what the build can
-        // write (`list_bounds`): the GPU lists cannot overflow, so the frame is never rendered
-        // twice. A bound beyond what the device can bind reserves what it can; then the build's
-        // counters decide, after the frame, whether the real lists fit.
+        // write (`ListBounder`, on all cores): the GPU lists cannot overflow, so the frame is
+        // never rendered twice. A bound beyond what the device can bind reserves what it can;
+        // then the build's counters decide, after the frame, whether the real lists fit.
         let started = std::time::Instant::now();
         let all_chunks = light_chunks_of(self.view_spheres.len());
         // Levels 0 and 1 from the lights' side where the grid allows and their bits fit (a
@@ -489,10 +492,11 @@ impl ClusterResources {
         self.from_lights = self.grid_allows_bits();
         let spheres = &self.view_spheres;
         self.bounds_estimate =
-            list_bounds(&self.grid, spheres, cull, coarse, self.from_lights, &mut self.listed);
+            self.bounder.bound(&self.grid, spheres, cull, coarse, self.from_lights, &mut self.listed);
         if self.from_lights && !self.bits_fit(light_chunks_of(self.listed.len())) {
             self.from_lights = false;
-            self.bounds_estimate = list_bounds(&self.grid, spheres, cull, coarse, false, &mut self.listed);
+            self.bounds_estimate =
+                self.bounder.bound(&self.grid, spheres, cull, coarse, false, &mut self.listed);
         }
         self.bound_cpu_ms = started.elapsed().as_secs_f64() * 1e3;
         // Level 0 from the lights' side runs over the listed lights, per tile over all.

@@ -32,7 +32,9 @@
 //!    scene that surrounds the camera are such lights, and the rectangle costs a few
 //!    operations.
 //! 7. The cost is one candidate search per light and level (two binary searches over the
-//!    slices and a few divisions), no per-cluster work: linear in the light count.
+//!    slices and a few divisions), no per-cluster work: linear in the light count, and spread
+//!    over all cores in parts of lights whose sums and difference arrays add up
+//!    ([`ListBounder`]).
 
 use glam::{UVec2, Vec3, Vec4};
 
@@ -62,7 +64,9 @@ pub struct ListBounds {
 
 /// How many rectangles cover each cell of a `w × h` grid, the longest count being what is
 /// wanted: a two-dimensional difference array, one row and column wider than the grid, summed
-/// once.
+/// once. Kept between frames (`reset` reuses its storage), and the arrays of several parts of
+/// the lights add up to the array of all of them.
+#[derive(Default)]
 struct Coverage {
     w: usize,
     h: usize,
@@ -70,9 +74,11 @@ struct Coverage {
 }
 
 impl Coverage {
-    fn new(dims: UVec2) -> Coverage {
-        let (w, h) = (dims.x as usize + 1, dims.y as usize + 1);
-        Coverage { w, h, starts: vec![0; w * h] }
+    /// Empties the array for a grid of `dims` cells.
+    fn reset(&mut self, dims: UVec2) {
+        (self.w, self.h) = (dims.x as usize + 1, dims.y as usize + 1);
+        self.starts.clear();
+        self.starts.resize(self.w * self.h, 0);
     }
 
     /// Adds the cells `[x0, x1] × [y0, y1]`.
@@ -86,8 +92,15 @@ impl Coverage {
         self.starts[y1 * w + x1] += 1;
     }
 
-    /// The largest count of rectangles over one cell.
-    fn longest(mut self) -> u32 {
+    /// Adds the rectangles of `other` (an array of the same grid).
+    fn merge(&mut self, other: &Coverage) {
+        for (a, b) in self.starts.iter_mut().zip(&other.starts) {
+            *a += b;
+        }
+    }
+
+    /// The largest count of rectangles over one cell (the array holds the counts after).
+    fn longest(&mut self) -> u32 {
         let (w, h) = (self.w, self.h);
         // Prefix sums over rows, then columns.
         for y in 0..h {
@@ -100,7 +113,7 @@ impl Coverage {
                 self.starts[y * w + x] += self.starts[(y - 1) * w + x];
             }
         }
-        let cells = (0..h - 1).flat_map(|y| (0..w - 1).map(move |x| y * w + x));
+        let cells = (0..h.saturating_sub(1)).flat_map(|y| (0..w - 1).map(move |x| y * w + x));
         cells.map(|i| self.starts[i]).max().unwrap_or(0).clamp(0, i64::from(u32::MAX)) as u32
     }
 }
@@ -207,6 +220,9 @@ pub fn coarse_tile_accepts(tile: &CoarseTile, light: &ViewSphere, test: CullTest
 /// bound ([`super::RectGrid::light_tile_rect_bound`]) is not empty: the only lights a tile or
 /// cluster can list, and the only ones level 0 from the lights' side needs to mark (the bound
 /// holds the GPU's rectangle).
+///
+/// A [`ListBounder`] kept between frames does the same without allocating once its parts have
+/// grown, on all cores.
 pub fn list_bounds(
     grid: &ClusterGrid,
     lights: &[ViewSphere],
@@ -215,48 +231,143 @@ pub fn list_bounds(
     coarse_from_lights: bool,
     listed: &mut Vec<u32>,
 ) -> ListBounds {
-    listed.clear();
-    let clusters = ClusterTables::new(grid);
-    let columns = ClusterGrid { dims: glam::UVec3::new(grid.dims.x, grid.dims.y, 1), ..*grid };
-    let tiles = ClusterTables::new(&columns);
-    let mut bounds = ListBounds::default();
-    let mut tile_cover = Coverage::new(grid.dims.truncate());
-    let mut coarse_cover = coarse.map(|span| Coverage::new(super::coarse_dims(grid.dims.truncate(), span)));
-    let rects = super::RectGrid::of(grid);
-    for (index, light) in (0u32..).zip(lights) {
-        // A light no tile's column accepts is in no tile or cluster list: most of a scene's
-        // lights when they surround the camera, and the rectangle costs a few operations.
-        let rect = rects.light_tile_rect_bound(light.center.extend(light.radius), test);
-        let inflated = ViewSphere { radius: light.radius * TILE_PREFILTER_INFLATION, ..*light };
-        let tile_box = rect.and_then(|_| tiles.candidates(&inflated, test));
-        if let (Some(span), Some(cover)) = (coarse, coarse_cover.as_mut()) {
-            // The light's tiles (inclusive x and y ranges) whose coarse tiles can list it: those
-            // of its rectangle from the lights' side, else those of its AABB candidates (the
-            // hull test can take a light no column accepts).
-            let reach = if coarse_from_lights {
-                rect.map(|[x0, y0, x1, y1]| ([x0, x1], [y0, y1]))
-            } else if test == CullTest::Aabb && rect.is_some() {
-                tile_box.map(|c| (c.x, c.y))
-            } else {
-                tiles.candidates(&inflated, CullTest::Aabb).map(|c| (c.x, c.y))
-            };
-            if let Some((x, y)) = reach {
-                let (x, y) = ([x[0] / span, x[1] / span], [y[0] / span, y[1] / span]);
-                bounds.coarse_entries += u64::from(x[1] - x[0] + 1) * u64::from(y[1] - y[0] + 1);
-                cover.add(x, y);
-            }
+    ListBounder::default().bound(grid, lights, test, coarse, coarse_from_lights, listed)
+}
+
+/// Lights per part of [`ListBounder::bound`]: each part is bounded on its own, on any core, and
+/// the parts' sums and coverage arrays add up (a part costs its coverage arrays' size to merge,
+/// a few thousand cells at 1280×720).
+pub const BOUND_PART_LIGHTS: usize = 4096;
+
+/// [`list_bounds`] over parts of [`BOUND_PART_LIGHTS`] lights on all cores (rayon's pool), the
+/// parts' storage kept from frame to frame. The result is the same, bit for bit: sums and
+/// difference arrays add in any order, the longest lists are taken from the merged arrays, and
+/// the listed lights are joined in the parts' order.
+#[derive(Default)]
+pub struct ListBounder {
+    parts: Vec<BoundPart>,
+}
+
+/// One part's share of a frame's bounds.
+#[derive(Default)]
+struct BoundPart {
+    sums: ListBounds,
+    tile_cover: Coverage,
+    coarse_cover: Coverage,
+    listed: Vec<u32>,
+}
+
+/// What every part reads.
+struct BoundInputs<'a> {
+    clusters: ClusterTables,
+    tiles: ClusterTables,
+    rects: super::RectGrid,
+    test: CullTest,
+    coarse: Option<u32>,
+    coarse_from_lights: bool,
+    lights: &'a [ViewSphere],
+}
+
+impl ListBounder {
+    /// [`list_bounds`] of `lights`.
+    pub fn bound(
+        &mut self,
+        grid: &ClusterGrid,
+        lights: &[ViewSphere],
+        test: CullTest,
+        coarse: Option<u32>,
+        coarse_from_lights: bool,
+        listed: &mut Vec<u32>,
+    ) -> ListBounds {
+        use rayon::prelude::*;
+        let columns = ClusterGrid { dims: glam::UVec3::new(grid.dims.x, grid.dims.y, 1), ..*grid };
+        let inputs = BoundInputs {
+            clusters: ClusterTables::new(grid),
+            tiles: ClusterTables::new(&columns),
+            rects: super::RectGrid::of(grid),
+            test,
+            coarse,
+            coarse_from_lights,
+            lights,
+        };
+        let parts = lights.len().div_ceil(BOUND_PART_LIGHTS).max(1);
+        if self.parts.len() < parts {
+            self.parts.resize_with(parts, BoundPart::default);
         }
-        if rect.is_none() {
-            continue;
+        let tile_dims = grid.dims.truncate();
+        let coarse_dims = coarse.map_or(UVec2::ZERO, |span| super::coarse_dims(tile_dims, span));
+        let fill = |(p, part): (usize, &mut BoundPart)| {
+            part.tile_cover.reset(tile_dims);
+            part.coarse_cover.reset(coarse_dims);
+            let first = p * BOUND_PART_LIGHTS;
+            let last = (first + BOUND_PART_LIGHTS).min(lights.len());
+            part.fill(&inputs, first..last.max(first));
+        };
+        if parts == 1 {
+            self.parts.iter_mut().take(1).enumerate().for_each(fill);
+        } else {
+            self.parts[..parts].par_iter_mut().enumerate().for_each(fill);
         }
-        listed.push(index);
-        bounds.cluster_pairs += clusters.candidates(light, test).map_or(0, |c| c.size());
-        if let Some(c) = tile_box {
-            bounds.tile_entries += c.size();
-            tile_cover.add(c.x, c.y);
+        let (head, rest) = self.parts[..parts].split_at_mut(1);
+        let all = &mut head[0];
+        listed.clear();
+        listed.extend_from_slice(&all.listed);
+        for part in rest.iter() {
+            all.sums.cluster_pairs += part.sums.cluster_pairs;
+            all.sums.tile_entries += part.sums.tile_entries;
+            all.sums.coarse_entries += part.sums.coarse_entries;
+            all.tile_cover.merge(&part.tile_cover);
+            all.coarse_cover.merge(&part.coarse_cover);
+            listed.extend_from_slice(&part.listed);
+        }
+        ListBounds {
+            max_tile_lights: all.tile_cover.longest(),
+            max_coarse_lights: if coarse.is_some() { all.coarse_cover.longest() } else { 0 },
+            ..all.sums
         }
     }
-    bounds.max_tile_lights = tile_cover.longest();
-    bounds.max_coarse_lights = coarse_cover.map_or(0, Coverage::longest);
-    bounds
+}
+
+impl BoundPart {
+    /// The bounds of the lights `range` of `inputs.lights` (their sums, coverage and listed
+    /// lights; the longest lists are left to the merged arrays).
+    fn fill(&mut self, inputs: &BoundInputs<'_>, range: std::ops::Range<usize>) {
+        let BoundInputs { clusters, tiles, rects, test, coarse, coarse_from_lights, lights } = inputs;
+        let (test, coarse_from_lights) = (*test, *coarse_from_lights);
+        self.sums = ListBounds::default();
+        self.listed.clear();
+        for (index, light) in (range.start as u32..).zip(&lights[range]) {
+            // A light no tile's column accepts is in no tile or cluster list: most of a scene's
+            // lights when they surround the camera, and the rectangle costs a few operations.
+            let rect = rects.light_tile_rect_bound(light.center.extend(light.radius), test);
+            let inflated = ViewSphere { radius: light.radius * TILE_PREFILTER_INFLATION, ..*light };
+            let tile_box = rect.and_then(|_| tiles.candidates(&inflated, test));
+            if let Some(span) = *coarse {
+                // The light's tiles (inclusive x and y ranges) whose coarse tiles can list it:
+                // those of its rectangle from the lights' side, else those of its AABB
+                // candidates (the hull test can take a light no column accepts).
+                let reach = if coarse_from_lights {
+                    rect.map(|[x0, y0, x1, y1]| ([x0, x1], [y0, y1]))
+                } else if test == CullTest::Aabb && rect.is_some() {
+                    tile_box.map(|c| (c.x, c.y))
+                } else {
+                    tiles.candidates(&inflated, CullTest::Aabb).map(|c| (c.x, c.y))
+                };
+                if let Some((x, y)) = reach {
+                    let (x, y) = ([x[0] / span, x[1] / span], [y[0] / span, y[1] / span]);
+                    self.sums.coarse_entries += u64::from(x[1] - x[0] + 1) * u64::from(y[1] - y[0] + 1);
+                    self.coarse_cover.add(x, y);
+                }
+            }
+            if rect.is_none() {
+                continue;
+            }
+            self.listed.push(index);
+            self.sums.cluster_pairs += clusters.candidates(light, test).map_or(0, |c| c.size());
+            if let Some(c) = tile_box {
+                self.sums.tile_entries += c.size();
+                self.tile_cover.add(c.x, c.y);
+            }
+        }
+    }
 }

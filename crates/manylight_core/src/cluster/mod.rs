@@ -41,8 +41,8 @@ mod tests_edge;
 
 pub use assign::{ClusterAssignment, ClusterStats, assign_lights};
 pub use bound::{
-    CoarseTile, ListBounds, TILE_PREFILTER_INFLATION, coarse_dims, coarse_span, coarse_tile_accepts,
-    coarse_tiles, list_bounds,
+    BOUND_PART_LIGHTS, CoarseTile, ListBounder, ListBounds, TILE_PREFILTER_INFLATION, coarse_dims,
+    coarse_span, coarse_tile_accepts, coarse_tiles, list_bounds,
 };
 pub use cull::{
     RADIUS_INFLATION, ViewSphere, farthest_reach, inflated_radius, sphere_intersects_aabb,

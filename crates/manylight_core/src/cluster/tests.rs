@@ -376,3 +376,57 @@ proptest! {
         prop_assert!(grid.cluster_planes(c.x, c.y, c.z).iter().all(|p| p.is_finite()));
     }
 }
+
+/// Many lights bounded in parts on all cores give what one part gives: the sums and listed
+/// lights of the parts bounded one by one, and the longest tile list counted tile by tile.
+#[test]
+fn list_bounds_in_parts_equal_one_part() {
+    let mut rng = Rng::new(11);
+    for _ in 0..3 {
+        let grid = random_grid(&mut rng);
+        let n = 2 * BOUND_PART_LIGHTS + 1 + rng.below(BOUND_PART_LIGHTS as u32) as usize;
+        let lights = random_lights(&mut rng, &grid, n);
+        let span = 2 + rng.below(3);
+        let columns = ClusterGrid { dims: UVec3::new(grid.dims.x, grid.dims.y, 1), ..grid };
+        let (tiles, rects) = (candidates::ClusterTables::new(&columns), RectGrid::of(&grid));
+        let mut bounder = ListBounder::default();
+        for test in CullTest::ALL {
+            for from_lights in [false, true] {
+                let coarse = coarse_span(span, test);
+                let mut listed = Vec::new();
+                let all = bounder.bound(&grid, &lights, test, coarse, from_lights, &mut listed);
+                let (mut sums, mut joined) = (ListBounds::default(), Vec::new());
+                for (p, part) in lights.chunks(BOUND_PART_LIGHTS).enumerate() {
+                    let mut part_listed = Vec::new();
+                    let b = list_bounds(&grid, part, test, coarse, from_lights, &mut part_listed);
+                    sums.cluster_pairs += b.cluster_pairs;
+                    sums.tile_entries += b.tile_entries;
+                    sums.coarse_entries += b.coarse_entries;
+                    sums.max_coarse_lights += b.max_coarse_lights;
+                    joined.extend(part_listed.iter().map(|&i| i + (p * BOUND_PART_LIGHTS) as u32));
+                }
+                assert_eq!(listed, joined, "{test:?}");
+                assert_eq!(
+                    (all.cluster_pairs, all.tile_entries, all.coarse_entries),
+                    (sums.cluster_pairs, sums.tile_entries, sums.coarse_entries),
+                    "{test:?} {grid:?}"
+                );
+                assert!(all.max_coarse_lights <= sums.max_coarse_lights);
+                let mut counts = vec![0u32; (grid.dims.x * grid.dims.y) as usize];
+                for light in &lights {
+                    let inflated = ViewSphere { radius: light.radius * TILE_PREFILTER_INFLATION, ..*light };
+                    let rect = rects.light_tile_rect_bound(light.center.extend(light.radius), test);
+                    if let Some(c) = rect.and_then(|_| tiles.candidates(&inflated, test)) {
+                        for y in c.y[0]..=c.y[1] {
+                            for x in c.x[0]..=c.x[1] {
+                                counts[(y * grid.dims.x + x) as usize] += 1;
+                            }
+                        }
+                    }
+                }
+                let longest = counts.iter().copied().max().unwrap_or(0);
+                assert_eq!(all.max_tile_lights, longest, "{test:?} {grid:?}");
+            }
+        }
+    }
+}
