@@ -30,15 +30,6 @@ fn with_material_slots(s: SurfaceParams, slots: vec2<f32>) -> SurfaceParams {
     return out;
 }
 
-// Radiance a point or spot light adds at `position` seen from `view_dir` (unit, towards the eye).
-fn shade_point_light(s: SurfaceParams, position: vec3<f32>, view_dir: vec3<f32>, light: GpuPointLight) -> vec3<f32> {
-    let reach = light_reach(light.position_radius, position);
-    if reach.attenuation <= 0.0 {
-        return vec3<f32>(0.0);
-    }
-    return shade_reached_light(s, reach, view_dir, light.color, light.spot);
-}
-
 // How a light (`position_radius`: `GpuPointLight::position_radius`) reaches `position`: the
 // vector to it, its distance and the distance attenuation (0: the light adds nothing).
 struct LightReach {
@@ -53,10 +44,10 @@ fn light_reach(position_radius: vec4<f32>, position: vec3<f32>) -> LightReach {
     return LightReach(to_light, distance, attenuation(distance, position_radius.w));
 }
 
-// `shade_point_light` past its range test, for a light that reaches the point (`reach`), with
-// the light's `color` and `spot` fields. Passes that loop over light lists read those two only
-// here: on a CPU rasteriser every field read is a gather, and most listed lights end at the
-// range test.
+// Radiance a point or spot light that reaches the point (`reach`, attenuation above 0) adds,
+// seen from `view_dir` (unit, towards the eye), with the light's `color` and `spot` fields
+// (`shade_light` in `point_lights.wgsl` reads those two only here: on a CPU rasteriser every
+// field read is a gather, and most listed lights end at the range test).
 fn shade_reached_light(s: SurfaceParams, reach: LightReach, view_dir: vec3<f32>, color: vec4<f32>, spot: vec4<f32>) -> vec3<f32> {
     let l = reach.to_light / max(reach.distance, 1e-6);
     let cone = spot_attenuation(dot(spot.xyz, -l), spot.w, color.a);

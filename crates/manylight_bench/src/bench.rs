@@ -198,17 +198,17 @@ fn warn_unlike_oracle_frames(rows: &[Row]) {
     for o in rows.iter().filter(|r| r.oracle) {
         let theirs: Vec<f64> =
             rows.iter().filter(|r| !r.oracle && r.lights == o.lights).filter_map(tonemap).collect();
-        if let (Some(ours), false) = (tonemap(o), theirs.is_empty())
-            && let Some(ratio) = unlike(ours, median(&theirs))
+        let theirs = median(&theirs);
+        if let Some(ours) = tonemap(o)
+            && let Some(ratio) = unlike(ours, theirs)
         {
             tracing::warn!(
                 "the {} oracle at {} lights: its tone map took {ratio:.2} times the pipelines' \
-                 ({ours:.3} ms against {:.3} ms), so its frames were not timed like theirs and \
-                 shading_vs_oracle is not comparable at this light count; `manylight render \
+                 ({ours:.3} ms against {theirs:.3} ms), so its frames were not timed like theirs \
+                 and shading_vs_oracle is not comparable at this light count; `manylight render \
                  --oracle` times the two frame by frame",
                 if o.pipeline.is_deferred() { "deferred" } else { "forward" },
                 o.lights,
-                median(&theirs)
             );
         }
     }

@@ -11,7 +11,7 @@ pub enum ShadingModel {
     /// Diffuse plus a Blinn-Phong specular lobe.
     BlinnPhong,
     /// Cel shading: each light's diffuse term in [`TOON_BANDS`] flat bands, plus a rim light
-    /// on silhouettes the light reaches (`shade_point_light` in `shaders/common/brdf.wgsl`).
+    /// on silhouettes the light reaches (`shade_reached_light` in `shaders/common/brdf.wgsl`).
     Toon,
     /// glTF 2.0 metallic-roughness: GGX distribution, height-correlated Smith visibility,
     /// Schlick Fresnel and Lambert diffuse, split by metallic ([`crate::brdf`]).

@@ -6,7 +6,7 @@
 //! axis and the direction from the light to the surface; `scale` and `offset` come from the
 //! inner and outer cone angles ([`SpotCone::scale_offset`]). A point light is the same
 //! expression with `scale = 0`, `offset = 1`, so the shaders have no branch for the kind of
-//! light (`shade_point_light` in `shaders/common/brdf.wgsl` and [`crate::brdf`]).
+//! light (`shade_reached_light` in `shaders/common/brdf.wgsl` and [`crate::brdf`]).
 
 use glam::Vec3;
 

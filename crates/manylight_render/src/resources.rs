@@ -458,9 +458,8 @@ impl SceneResources {
 
         // Lights: invalid ones (NaN, inf, negative) are dropped and counted, never uploaded.
         // Both light Vecs keep their allocation from frame to frame.
-        let mut gpu_lights = std::mem::take(&mut self.gpu_lights);
-        gpu_lights.clear();
-        gpu_lights.extend(snapshot.lights.iter().filter(|l| l.is_valid()).map(|l| {
+        self.gpu_lights.clear();
+        self.gpu_lights.extend(snapshot.lights.iter().filter(|l| l.is_valid()).map(|l| {
             // A point light: no direction, falloff scale 0 and offset 1 (1 everywhere).
             let (direction, scale, offset) = match &l.spot {
                 Some(cone) => {
@@ -475,7 +474,7 @@ impl SceneResources {
                 spot: direction.extend(scale).to_array(),
             }
         }));
-        self.invalid_lights = (snapshot.lights.len() - gpu_lights.len()) as u32;
+        self.invalid_lights = (snapshot.lights.len() - self.gpu_lights.len()) as u32;
         // Directional lights: the first MAX_DIRECTIONAL_LIGHTS valid ones, in the view uniform.
         let valid = snapshot.directional_lights.iter().filter(|l| l.is_valid());
         let (mut count, mut valid_count) = (0usize, 0u32);
@@ -502,13 +501,14 @@ impl SceneResources {
         self.light_spheres.clear();
         self.light_spheres
             .extend(snapshot.lights.iter().filter(|l| l.is_valid()).map(|l| l.bounding_sphere()));
-        self.light_count = gpu_lights.len() as u32;
-        let light_bytes: &[u8] =
-            if gpu_lights.is_empty() { PLACEHOLDER_LIGHT } else { bytemuck::cast_slice(&gpu_lights) };
-        let written = self.lights.write(gpu, light_bytes);
+        self.light_count = self.gpu_lights.len() as u32;
+        let light_bytes: &[u8] = if self.gpu_lights.is_empty() {
+            PLACEHOLDER_LIGHT
+        } else {
+            bytemuck::cast_slice(&self.gpu_lights)
+        };
+        self.lights.write(gpu, light_bytes)?;
         self.light_upload_bytes = light_bytes.len() as u64;
-        self.gpu_lights = gpu_lights;
-        written?;
 
         // Meshes, materials, instances.
         let mut instance_data = Vec::with_capacity(snapshot.instances.len());

@@ -301,7 +301,7 @@ impl ListBounder {
             part.coarse_cover.reset(coarse_dims);
             let first = p * BOUND_PART_LIGHTS;
             let last = (first + BOUND_PART_LIGHTS).min(lights.len());
-            part.fill(&inputs, first..last.max(first));
+            part.fill(&inputs, first..last);
         };
         if parts == 1 {
             self.parts.iter_mut().take(1).enumerate().for_each(fill);
