@@ -15,7 +15,7 @@ use manylight::prelude::*;
 fn setup(mut commands: Commands) {
     let scene = default_scene();
     spawn_scene(&mut commands, &scene, true, 16.0 / 9.0);
-    spawn_light_rig(&mut commands, 256, scene.bounds(), 1);
+    spawn_light_rig(&mut commands, 256, scene.bounds(), 1).expect("256 lights fit");
 }
 
 /// Reads the keys pressed this frame and changes the `DebugView` resource and the camera's

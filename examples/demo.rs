@@ -13,6 +13,7 @@ use manylight::app::RenderFailure;
 use manylight::app::cli::parse_pipeline;
 use manylight::app::headless::save_png;
 use manylight::app::window::WindowConfig;
+use manylight::core::light_count::{APP_BYTES_PER_LIGHT, LightLimit, check_light_count};
 use manylight::prelude::*;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -46,7 +47,7 @@ fn scene_setup(lights: usize) -> impl FnMut(Commands) {
     let scene = default_scene();
     move |mut commands: Commands| {
         spawn_scene(&mut commands, &scene, true, SIZE.x as f32 / SIZE.y as f32);
-        spawn_light_rig(&mut commands, lights, scene.bounds(), 1);
+        spawn_light_rig(&mut commands, lights, scene.bounds(), 1).expect("--lights was checked in main");
     }
 }
 
@@ -133,6 +134,10 @@ fn run_headless(lights: usize, settings: RenderSettings, out_dir: PathBuf) -> an
 fn main() -> ExitCode {
     tracing_subscriber::fmt().with_env_filter("warn,winit=error,manylight_app=info").init();
     let args = Args::parse();
+    if let Err(e) = check_light_count(args.lights, LightLimit::INDICES, APP_BYTES_PER_LIGHT) {
+        eprintln!("error: --lights: {e}");
+        return ExitCode::FAILURE;
+    }
     let mut settings = RenderSettings::default();
     if let Some(pipeline) = args.pipeline {
         settings.pipeline = pipeline;

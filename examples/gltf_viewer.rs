@@ -12,6 +12,7 @@
 use clap::Parser;
 use manylight::app::window::WindowConfig;
 use manylight::core::Aabb;
+use manylight::core::light_count::{APP_BYTES_PER_LIGHT, LightLimit, check_light_count};
 use manylight::prelude::*;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -58,10 +59,15 @@ fn main() -> ExitCode {
         scene.cameras.clear();
     }
     if scene.lights.is_empty() && args.lights.is_none() {
-        let studio = manylight::scene::studio_lights(STUDIO_LIGHTS, scene.bounds());
+        let studio =
+            manylight::scene::studio_lights(STUDIO_LIGHTS, scene.bounds()).expect("the studio's lights fit");
         scene.lights.extend(studio);
     }
     let lights = args.lights.unwrap_or(0);
+    if let Err(e) = check_light_count(lights, LightLimit::INDICES, APP_BYTES_PER_LIGHT) {
+        eprintln!("error: --lights: {e}");
+        return ExitCode::FAILURE;
+    }
     println!(
         "{}: {} meshes, {} instances, {} lights{}, {}",
         args.path.display(),
@@ -88,7 +94,8 @@ fn main() -> ExitCode {
         .add_systems(Startup, move |mut commands: Commands| {
             spawn_scene(&mut commands, &scene, true, aspect);
             if lights > 0 {
-                spawn_light_rig(&mut commands, lights, rig_bounds(scene.bounds()), 1);
+                spawn_light_rig(&mut commands, lights, rig_bounds(scene.bounds()), 1)
+                    .expect("--lights was checked before the app was built");
             }
         })
         .run();

@@ -29,7 +29,7 @@ const FEED: UVec2 = UVec2::new(320, 180);
 fn setup(mut commands: Commands) {
     let scene = default_scene();
     spawn_scene(&mut commands, &scene, true, 16.0 / 9.0);
-    spawn_light_rig(&mut commands, 256, scene.bounds(), 3);
+    spawn_light_rig(&mut commands, 256, scene.bounds(), 3).expect("256 lights fit");
     let feed = RenderImage::new(FEED.x, FEED.y);
     commands.insert_resource(SecurityFeed(feed));
     // Rendered before the main camera, into its image.

@@ -26,7 +26,7 @@ struct Circling;
 fn setup(mut commands: Commands) {
     let scene = default_scene();
     spawn_scene(&mut commands, &scene, false, 16.0 / 9.0);
-    spawn_light_rig(&mut commands, 512, scene.bounds(), 7);
+    spawn_light_rig(&mut commands, 512, scene.bounds(), 7).expect("512 lights fit");
     let entrance = Transform::from_xyz(-18.0, 1.7, 0.0).looking_at(Vec3::new(0.0, 1.2, 0.0), Vec3::Y);
     let above = Transform::from_xyz(0.0, 14.0, 0.1).looking_at(Vec3::ZERO, Vec3::Y);
     commands.spawn((entrance, Camera3d, Camera { order: 0, ..default() }, Quarter(0, 0)));

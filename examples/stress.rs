@@ -174,7 +174,10 @@ pub fn sync_light_count(
     let count = controls.count as usize;
     let scale = controls.radius_scale;
     if layout.shell {
-        let lights = sphere_shell_lights(count, SHELL_RADIUS, SHELL_LIGHT_RANGE, layout.seed);
+        let lights = match sphere_shell_lights(count, SHELL_RADIUS, SHELL_LIGHT_RANGE, layout.seed) {
+            Ok(lights) => lights,
+            Err(e) => return eprintln!("error: {e}"),
+        };
         commands.spawn_batch(lights.into_iter().map(move |l| {
             (
                 Transform::from_translation(l.position),
@@ -188,7 +191,10 @@ pub fn sync_light_count(
             )
         }));
     } else {
-        let rig = light_rig(count, layout.bounds, layout.seed);
+        let rig = match light_rig(count, layout.bounds, layout.seed) {
+            Ok(rig) => rig,
+            Err(e) => return eprintln!("error: {e}"),
+        };
         commands.spawn_batch(rig.into_iter().map(move |a| {
             (
                 Transform::from_translation(a.position_at(0.0)),

@@ -16,7 +16,7 @@ fn scene_app(plugin: ManyLightPlugin, lights: usize) -> App {
     app.add_plugins(plugin).add_systems(Startup, move |mut commands: Commands| {
         let scene = default_scene();
         spawn_scene(&mut commands, &scene, true, 1.5);
-        spawn_light_rig(&mut commands, lights, scene.bounds(), 7);
+        spawn_light_rig(&mut commands, lights, scene.bounds(), 7).expect("the rig's lights fit");
     });
     app
 }
@@ -320,7 +320,7 @@ fn an_invalid_camera_renders_nothing_and_is_counted() {
             move |mut commands: Commands| {
                 let scene = default_scene();
                 spawn_scene(&mut commands, &scene, false, 1.5);
-                spawn_light_rig(&mut commands, 8, scene.bounds(), 1);
+                spawn_light_rig(&mut commands, 8, scene.bounds(), 1).expect("the rig's lights fit");
                 commands.spawn((camera, Camera3d));
             },
         );
@@ -352,7 +352,7 @@ fn extreme_projections_render_finite_images() {
             app.add_systems(Startup, move |mut commands: Commands| {
                 let scene = default_scene();
                 spawn_scene(&mut commands, &scene, false, 1.5);
-                spawn_light_rig(&mut commands, 8, scene.bounds(), 1);
+                spawn_light_rig(&mut commands, 8, scene.bounds(), 1).expect("the rig's lights fit");
                 commands.spawn((
                     Transform::from_xyz(0.0, 2.0, 8.0).looking_at(Vec3::ZERO, Vec3::Y),
                     Camera3d,

@@ -23,6 +23,7 @@ fn scene_snapshot(
 
 fn rig(scene: &Scene, count: usize, seed: u64) -> Vec<ExtractedPointLight> {
     manylight::scene::light_rig(count, scene.bounds(), seed)
+        .expect("the rig's lights fit")
         .iter()
         .map(|a| extracted_light(&a.at(0.0)))
         .collect()
@@ -36,6 +37,7 @@ fn shell_lights() -> Vec<ExtractedPointLight> {
         manylight::scene::SHELL_LIGHT_RANGE,
         7,
     )
+    .expect("100 000 lights")
     .iter()
     .map(extracted_light)
     .collect()

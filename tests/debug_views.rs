@@ -64,7 +64,7 @@ fn render(debug: DebugView, settings: RenderSettings) -> HeadlessFrame {
             Startup,
             move |mut commands: Commands| {
                 spawn_scene(&mut commands, &scene, true, aspect);
-                spawn_light_rig(&mut commands, 64, bounds, 1);
+                spawn_light_rig(&mut commands, 64, bounds, 1).expect("the rig's lights fit");
             },
         );
     })
@@ -155,7 +155,7 @@ fn heat(t: f32) -> [f32; 3] {
 fn count_views_show_the_cpu_reference_of_each_pixels_cluster() {
     let _gpu = gpu();
     let scene = default_scene();
-    let rig = manylight::scene::light_rig(64, scene.bounds(), 1);
+    let rig = manylight::scene::light_rig(64, scene.bounds(), 1).expect("64 lights");
     let lights: Vec<_> = scene
         .lights
         .iter()
@@ -247,7 +247,7 @@ fn count_views_show_the_cpu_reference_of_each_pixels_cluster() {
 fn the_depth_view_scales_to_the_far_plane_or_to_the_lights_reach() {
     let _gpu = gpu();
     let mut scene = default_scene();
-    let rig = manylight::scene::light_rig(64, scene.bounds(), 1);
+    let rig = manylight::scene::light_rig(64, scene.bounds(), 1).expect("64 lights");
     let lights: Vec<_> = rig.iter().map(|a| extracted_light(&a.at(0.0))).collect();
     let camera = scene.camera_or_fit(SIZE.x as f32 / SIZE.y as f32);
     let mut renderer = HeadlessRenderer::new().expect("adapter");

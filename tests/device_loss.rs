@@ -24,7 +24,7 @@ fn app(pipelined: bool, pipeline: PipelineKind) -> App {
             let scene = default_scene();
             spawn_scene(&mut commands, &scene, true, SIZE.x as f32 / SIZE.y as f32);
             // A light rig without animation: every frame shows the same image.
-            spawn_light_rig(&mut commands, 64, scene.bounds(), 7);
+            spawn_light_rig(&mut commands, 64, scene.bounds(), 7).expect("the rig's lights fit");
         });
     finish_plugins(&mut app);
     app
@@ -52,32 +52,47 @@ fn captured(app: &App) -> image::RgbaImage {
     app.world().resource::<HeadlessCapture>().image.clone().expect("a captured frame")
 }
 
+/// Runs `frames` frames with the device lost as `losses` says and checks the recovery against a
+/// run without losses: no failure, each loss counted once, `rendered` frames rendered, and the
+/// last image the same (FLIP within the strict tolerance; `name` names the failure images).
+fn assert_recovers(
+    name: &str,
+    pipelined: bool,
+    pipeline: PipelineKind,
+    frames: u64,
+    losses: &[(u64, DeviceLoss)],
+    rendered: u64,
+) {
+    let what = format!("pipelined {pipelined}, {}", pipeline.name());
+    let mut reference = app(pipelined, pipeline);
+    assert!(run(&mut reference, frames, &[]).is_none(), "{what}");
+    let mut lossy = app(pipelined, pipeline);
+    assert!(run(&mut lossy, frames, losses).is_none(), "{what}");
+    assert!(lossy.world().resource::<RenderFailure>().0.is_none(), "{what}");
+    let stats = lossy.world().resource::<FrameStats>();
+    assert_eq!(stats.device_recoveries, losses.len() as u64, "{what}: each loss is counted once");
+    assert_eq!(stats.frames_rendered, rendered, "{what}: frames rendered");
+    let last = stats.last.as_ref().expect("a report");
+    assert_eq!(last.device_recoveries, 0, "{what}");
+    assert_eq!(last.nonfinite_pixels.unwrap_or(0), 0, "{what}");
+    assert_similar(
+        &format!("{name}_{pipelined}_{}", pipeline.name()),
+        &captured(&reference),
+        &captured(&lossy),
+        STRICT,
+    );
+}
+
 #[test]
 fn a_lost_device_is_recreated_and_the_next_frame_is_the_same_image() {
     let _gpu = gpu();
     for pipelined in [false, true] {
         for pipeline in PipelineKind::ALL {
-            let what = format!("pipelined {pipelined}, {}", pipeline.name());
-            let mut reference = app(pipelined, pipeline);
-            assert!(run(&mut reference, 6, &[]).is_none(), "{what}");
-            let mut lossy = app(pipelined, pipeline);
             // Lost between frames 1 and 2 (frame 2 renders on a new device), then during
-            // frame 4 (which renders nothing; frame 5 renders on a third device).
+            // frame 4 (which renders nothing; frame 5 renders on a third device): only the
+            // frame of the in-frame loss is missing.
             let losses = [(2, DeviceLoss::BetweenFrames), (4, DeviceLoss::InFrame)];
-            assert!(run(&mut lossy, 6, &losses).is_none(), "{what}");
-            assert!(lossy.world().resource::<RenderFailure>().0.is_none(), "{what}");
-            let stats = lossy.world().resource::<FrameStats>();
-            assert_eq!(stats.device_recoveries, 2, "{what}: each loss is counted once");
-            assert_eq!(stats.frames_rendered, 5, "{what}: only the frame of the in-frame loss is missing");
-            let last = stats.last.as_ref().expect("a report");
-            assert_eq!(last.device_recoveries, 0, "{what}");
-            assert_eq!(last.nonfinite_pixels.unwrap_or(0), 0, "{what}");
-            assert_similar(
-                &format!("device_loss_{pipelined}_{}", pipeline.name()),
-                &captured(&reference),
-                &captured(&lossy),
-                STRICT,
-            );
+            assert_recovers("device_loss", pipelined, pipeline, 6, &losses, 5);
         }
     }
 }
@@ -103,5 +118,20 @@ fn a_device_lost_again_and_again_ends_the_app_with_a_typed_error() {
         );
         let message = app.world().resource::<RenderFailure>().0.clone().unwrap_or_default();
         assert!(message.contains("MAX_DEVICE_LOSSES"), "pipelined {pipelined}: {message}");
+    }
+}
+
+/// A device lost at the start of a frame, before its uploads: every mesh, texture and light
+/// buffer of that frame is created on the lost device (wgpu's `create_buffer_init` panics there).
+/// The frame is reported with no passes, and the frames after it render the same image as a
+/// run without a loss — in the first frame (everything uploads) and in a later one.
+#[test]
+fn a_device_lost_before_the_frames_uploads_recovers() {
+    let _gpu = gpu();
+    for pipelined in [false, true] {
+        for pipeline in [PipelineKind::ClusteredForward, PipelineKind::LightVolumes] {
+            let losses = [(0, DeviceLoss::BeforeUploads), (2, DeviceLoss::BeforeUploads)];
+            assert_recovers("device_loss_uploads", pipelined, pipeline, 5, &losses, 3);
+        }
     }
 }

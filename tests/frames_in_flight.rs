@@ -33,7 +33,7 @@ fn setup(app: &mut App, seen: Arc<Mutex<Seen>>, exit_after: Option<u64>) {
     app.add_systems(Startup, |mut commands: Commands| {
         let scene = manylight::scene::default_scene();
         spawn_scene(&mut commands, &scene, true, 4.0 / 3.0);
-        spawn_light_rig(&mut commands, LIGHTS, scene.bounds(), 7);
+        spawn_light_rig(&mut commands, LIGHTS, scene.bounds(), 7).expect("the rig's lights fit");
     })
     .insert_resource(RenderSettings { pipeline: PipelineKind::ClusteredForward, ..default() })
     .add_systems(Last, move |stats: Res<FrameStats>, mut exit: MessageWriter<AppExit>| {

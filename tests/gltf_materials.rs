@@ -58,7 +58,7 @@ fn khronos_material_assets_match_their_references() {
     let _gpu = gpu();
     for (name, rel) in ASSETS {
         let mut scene = load(rel);
-        scene.lights.extend(studio_lights(LIGHTS, scene.bounds()));
+        scene.lights.extend(studio_lights(LIGHTS, scene.bounds()).expect("studio lights"));
         let frame = render_scene(scene, SIZE, 0, settings(PipelineKind::NaiveForward));
         assert_matches_reference(&format!("{name}_naive"), &frame.image, STRICT);
     }

@@ -250,3 +250,391 @@ fn check_spawned_tree(asset: &str) -> (bool, usize) {
     assert_eq!(lights, expected.lights.len(), "{asset}");
     (expected.nodes.iter().any(|n| n.parent.is_some()), lights)
 }
+
+// --- Visibility propagation without rendering: `propagate_visibility` alone in a bare world.
+
+use manylight::app::visibility::{VisibilityUpdateStats, propagate_visibility};
+
+/// A bare world running `propagate_visibility` as its only system, one frame per `frame()`,
+/// with the system's [`VisibilityUpdateStats`] recorded.
+struct VisWorld {
+    world: World,
+    schedule: Schedule,
+}
+
+impl VisWorld {
+    fn new() -> Self {
+        let mut world = World::new();
+        world.init_resource::<VisibilityUpdateStats>();
+        let mut schedule = Schedule::default();
+        schedule.add_systems(propagate_visibility);
+        VisWorld { world, schedule }
+    }
+
+    /// Runs one frame and checks that every `InheritedVisibility` it wrote changed value;
+    /// returns what the system reported.
+    fn frame(&mut self) -> VisibilityUpdateStats {
+        let mut values = self.world.query::<(Entity, &InheritedVisibility)>();
+        let before: std::collections::HashMap<Entity, bool> =
+            values.iter(&self.world).map(|(e, v)| (e, v.0)).collect();
+        // The edits made so far carry this tick; the system's writes a later one.
+        let edits = self.world.increment_change_tick();
+        self.schedule.run(&mut self.world);
+        let now = self.world.change_tick();
+        let mut written = 0;
+        let mut refs = self.world.query::<(Entity, Ref<InheritedVisibility>)>();
+        for (e, v) in refs.iter(&self.world) {
+            if v.last_changed().is_newer_than(edits, now) {
+                written += 1;
+                assert_ne!(before.get(&e), Some(&v.0), "{e} was written without changing");
+            }
+        }
+        self.world.clear_trackers();
+        let stats = *self.world.resource::<VisibilityUpdateStats>();
+        assert_eq!(stats.written, written, "the system's count of writes");
+        stats
+    }
+
+    /// The stored value of `entity`.
+    fn shown(&self, entity: Entity) -> bool {
+        self.world.get::<InheritedVisibility>(entity).expect("an InheritedVisibility").0
+    }
+
+    /// Checks every entity with a `Visibility` against [`reference_visibility`].
+    fn check(&mut self, context: &str) {
+        let mut q = self.world.query_filtered::<(Entity, &InheritedVisibility), With<Visibility>>();
+        for (e, v) in q.iter(&self.world) {
+            assert_eq!(v.0, reference_visibility(&self.world, e), "{context}: {e}");
+        }
+    }
+}
+
+/// The brute-force value: walk the ancestors until one decides (`Hidden`, `Visible`) or the
+/// root (visible); an entity without a `Visibility` counts as `Inherited`.
+fn reference_visibility(world: &World, entity: Entity) -> bool {
+    let mut current = entity;
+    loop {
+        match world.get::<Visibility>(current).copied().unwrap_or_default() {
+            Visibility::Hidden => return false,
+            Visibility::Visible => return true,
+            Visibility::Inherited => {}
+        }
+        match world.get::<ChildOf>(current) {
+            Some(child_of) => current = child_of.parent(),
+            None => return true,
+        }
+    }
+}
+
+/// A small deterministic generator (xorshift64*), so that a failing seed reproduces.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+    }
+
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n.max(1) as u64) as usize
+    }
+
+    /// A random `Visibility`, or none.
+    fn visibility(&mut self) -> Option<Visibility> {
+        [None, Some(Visibility::Inherited), Some(Visibility::Hidden), Some(Visibility::Visible)]
+            [self.below(4)]
+    }
+}
+
+/// Spawns an entity with `visibility` (or none) under `parent` (or as a root).
+fn spawn_node(world: &mut World, visibility: Option<Visibility>, parent: Option<Entity>) -> Entity {
+    let mut entity = world.spawn_empty();
+    if let Some(v) = visibility {
+        entity.insert(v);
+    }
+    if let Some(p) = parent {
+        entity.insert(ChildOf(p));
+    }
+    entity.id()
+}
+
+/// Whether `ancestor` is `entity` or one of its ancestors.
+fn is_ancestor(world: &World, ancestor: Entity, entity: Entity) -> bool {
+    let mut current = Some(entity);
+    while let Some(e) = current {
+        if e == ancestor {
+            return true;
+        }
+        current = world.get::<ChildOf>(e).map(ChildOf::parent);
+    }
+    false
+}
+
+/// Random forests with random `Visibility` values, edited at random over many frames (every
+/// kind of change: `Visibility` set, touched, added and removed; reparenting; becoming a root;
+/// children spawned under existing and new parents, children before parents; despawns;
+/// `InheritedVisibility` overwritten by someone else), match the brute-force reference after
+/// every frame, write only values that change, and a frame without edits does nothing.
+#[test]
+fn visibility_propagation_matches_the_reference_under_random_edits() {
+    for seed in 1..=32u64 {
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15 ^ seed.wrapping_mul(0x1000_0000_01b3));
+        let mut vis = VisWorld::new();
+        let mut live: Vec<Entity> = Vec::new();
+        for _ in 0..80 {
+            let parent =
+                if live.is_empty() || rng.below(6) == 0 { None } else { Some(live[rng.below(live.len())]) };
+            let v = rng.visibility();
+            live.push(spawn_node(&mut vis.world, v, parent));
+        }
+        vis.frame();
+        vis.check(&format!("seed {seed}, first frame"));
+        for frame in 0..60 {
+            for _ in 0..1 + rng.below(6) {
+                live.retain(|&e| vis.world.get_entity(e).is_ok());
+                if live.is_empty() {
+                    live.push(spawn_node(&mut vis.world, rng.visibility(), None));
+                }
+                let e = live[rng.below(live.len())];
+                let world = &mut vis.world;
+                match rng.below(11) {
+                    0 | 1 => match rng.visibility() {
+                        Some(v) => {
+                            world.entity_mut(e).insert(v);
+                        }
+                        None => {
+                            world.entity_mut(e).remove::<Visibility>();
+                        }
+                    },
+                    2 => {
+                        let p = live[rng.below(live.len())];
+                        if !is_ancestor(world, e, p) {
+                            world.entity_mut(e).insert(ChildOf(p));
+                        }
+                    }
+                    3 => {
+                        world.entity_mut(e).remove::<ChildOf>();
+                    }
+                    4 => {
+                        world.entity_mut(e).remove::<Visibility>();
+                    }
+                    5 => {
+                        let v = rng.visibility();
+                        live.push(spawn_node(world, v, Some(e)));
+                    }
+                    6 if live.len() > 10 => world.entity_mut(e).despawn(),
+                    7 => {
+                        // Written with the same value: changed, not different.
+                        if let Some(mut v) = world.get_mut::<Visibility>(e) {
+                            v.set_changed();
+                        }
+                    }
+                    8 => {
+                        if let Some(mut v) = world.get_mut::<InheritedVisibility>(e) {
+                            v.0 = !v.0;
+                        }
+                    }
+                    9 => {
+                        // A child spawned before its new parent, the parent under `e`.
+                        let (cv, pv) = (rng.visibility(), rng.visibility());
+                        let child = spawn_node(world, cv, None);
+                        let parent = spawn_node(world, pv, Some(e));
+                        world.entity_mut(child).insert(ChildOf(parent));
+                        live.extend([child, parent]);
+                    }
+                    _ => {
+                        // A parent and one of its descendants both changed in one frame.
+                        let v = rng.visibility().unwrap_or(Visibility::Hidden);
+                        world.entity_mut(e).insert(v);
+                        if let Some(parent) = world.get::<ChildOf>(e).map(ChildOf::parent) {
+                            let v = rng.visibility().unwrap_or(Visibility::Visible);
+                            world.entity_mut(parent).insert(v);
+                        }
+                    }
+                }
+            }
+            vis.frame();
+            vis.check(&format!("seed {seed}, frame {frame}"));
+            if frame % 8 == 0 {
+                let idle = vis.frame();
+                assert_eq!(
+                    idle,
+                    VisibilityUpdateStats::default(),
+                    "seed {seed}, frame {frame}: an idle frame"
+                );
+            }
+        }
+    }
+}
+
+/// A change at the top of a chain and a change below a clean entity whose stored value is
+/// about to go stale, in one frame: the lower one must not trust the stale value.
+#[test]
+fn a_changed_child_under_a_stale_clean_parent_ends_correct() {
+    let mut vis = VisWorld::new();
+    let top = spawn_node(&mut vis.world, Some(Visibility::Inherited), None);
+    let middle = spawn_node(&mut vis.world, Some(Visibility::Inherited), Some(top));
+    let bottom = spawn_node(&mut vis.world, Some(Visibility::Inherited), Some(middle));
+    let leaves: Vec<Entity> =
+        (0..4).map(|_| spawn_node(&mut vis.world, Some(Visibility::Inherited), Some(bottom))).collect();
+    vis.frame();
+    assert!(vis.shown(bottom));
+    vis.world.entity_mut(top).insert(Visibility::Hidden);
+    vis.world.entity_mut(bottom).insert(Visibility::Inherited);
+    vis.world.entity_mut(leaves[0]).insert(Visibility::Inherited);
+    vis.frame();
+    vis.check("top hidden");
+    assert!(!vis.shown(middle) && !vis.shown(bottom) && leaves.iter().all(|&l| !vis.shown(l)));
+}
+
+/// An entity without a `Visibility` passes its parent's value through; when it gains one that
+/// equals its left-over `InheritedVisibility`, its children still get the new value.
+#[test]
+fn gaining_visibility_over_a_left_over_value_reaches_the_children() {
+    let mut vis = VisWorld::new();
+    let group = spawn_node(&mut vis.world, Some(Visibility::Hidden), None);
+    let child = spawn_node(&mut vis.world, Some(Visibility::Inherited), Some(group));
+    vis.frame();
+    assert!(!vis.shown(child));
+    // Without a `Visibility` the group counts as `Inherited` (its own stored value stays).
+    vis.world.entity_mut(group).remove::<Visibility>();
+    vis.frame();
+    assert!(vis.shown(child), "the group passes the root's visible through");
+    assert!(!vis.shown(group), "an entity without Visibility keeps its InheritedVisibility");
+    vis.world.entity_mut(group).insert(Visibility::Hidden);
+    vis.frame();
+    assert!(!vis.shown(child), "hidden again, though the group's stored value did not change");
+    // Becoming a root, and a despawned parent's messages, leave the rest consistent.
+    vis.world.entity_mut(child).remove::<ChildOf>();
+    vis.frame();
+    assert!(vis.shown(child));
+    vis.world.entity_mut(group).despawn();
+    assert_eq!(vis.frame().dirty, 0, "a despawned entity has nothing to update");
+    vis.check("after the despawn");
+}
+
+/// A chain of 1,023 `Inherited` nodes above 100,000 instances settles in one pass on its first
+/// frame (each entity resolved once, not once per ancestor), and later frames cost what
+/// changed: nothing when nothing did, one entity for one instance, the subtree whose value
+/// changes when the top of the chain hides it (not what a `Visible` entity shields).
+#[test]
+fn a_deep_chain_above_many_instances_settles_in_one_pass() {
+    const DEPTH: usize = 1023;
+    const INSTANCES: usize = 100_000;
+    let mut vis = VisWorld::new();
+    let top = spawn_node(&mut vis.world, Some(Visibility::Inherited), None);
+    let mut leaf = top;
+    for _ in 1..DEPTH {
+        leaf = spawn_node(&mut vis.world, Some(Visibility::Inherited), Some(leaf));
+    }
+    let instances: Vec<Entity> =
+        vis.world.spawn_batch((0..INSTANCES).map(move |_| (Visibility::Inherited, ChildOf(leaf)))).collect();
+    let all = DEPTH + INSTANCES;
+    // Beside the chain: a `Visible` entity with instances of its own, kept visible.
+    let shield = spawn_node(&mut vis.world, Some(Visibility::Visible), Some(top));
+    for _ in 0..1000 {
+        spawn_node(&mut vis.world, Some(Visibility::Inherited), Some(shield));
+    }
+
+    let first = vis.frame();
+    assert_eq!(first.dirty, all + 1001);
+    assert!(first.resolved <= all + 1001, "{first:?}");
+    // The freshly added values are not trusted: each parent looks at its children once.
+    assert!(first.propagated <= all + 1001, "{first:?}");
+    assert_eq!(first.written, 0, "everything is visible, as the default");
+    assert!(instances.iter().all(|&i| vis.shown(i)));
+
+    assert_eq!(vis.frame(), VisibilityUpdateStats::default(), "nothing changed");
+
+    vis.world.entity_mut(top).insert(Visibility::Hidden);
+    let hidden = vis.frame();
+    assert_eq!((hidden.dirty, hidden.resolved, hidden.written), (1, 1, all), "{hidden:?}");
+    // Below the top: the rest of the chain, its instances and the shield, not what it shields.
+    assert_eq!(hidden.propagated, (DEPTH - 1) + INSTANCES + 1, "{hidden:?}");
+    assert!(instances.iter().all(|&i| !vis.shown(i)) && vis.shown(shield));
+
+    vis.world.entity_mut(instances[7]).insert(Visibility::Visible);
+    let one = vis.frame();
+    assert_eq!(one, VisibilityUpdateStats { dirty: 1, resolved: 1, propagated: 0, written: 1 });
+
+    // A new instance resolves through the chain (memoised: each ancestor once) up to the
+    // hidden top.
+    let late = vis.world.spawn((Visibility::Inherited, ChildOf(leaf))).id();
+    let spawned = vis.frame();
+    assert_eq!((spawned.dirty, spawned.written), (1, 1), "{spawned:?}");
+    assert!(spawned.resolved <= DEPTH + 1, "{spawned:?}");
+    assert!(!vis.shown(late));
+    // The bottom of the chain made `Visible` shows every instance below it, nothing above.
+    vis.world.entity_mut(leaf).insert(Visibility::Visible);
+    let shown = vis.frame();
+    assert_eq!(shown.written, 1 + INSTANCES, "{shown:?}");
+    assert!(vis.shown(late) && vis.shown(instances[0]) && !vis.shown(top));
+}
+
+/// Through the plugin, frame by frame: hiding a group hides its lights in the next frame, a
+/// frame without edits writes no `InheritedVisibility`, and a subgroup without a `Visibility`
+/// moved to the top level shows again.
+#[test]
+fn visibility_changes_reach_the_extracted_lights_frame_by_frame() {
+    let _gpu = gpu();
+    #[derive(Component)]
+    struct Group;
+    #[derive(Component)]
+    struct Subgroup;
+    let mut app = App::new();
+    app.add_plugins(ManyLightPlugin::headless(UVec2::new(32, 32))).add_systems(
+        Startup,
+        |mut commands: Commands| {
+            commands.spawn((Transform::from_xyz(0.0, 1.0, 5.0), Camera3d));
+            let group = commands.spawn((Transform::IDENTITY, Visibility::Inherited, Group)).id();
+            for x in 0..3 {
+                commands.spawn((Transform::from_xyz(x as f32, 0.0, 0.0), spot_light(), ChildOf(group)));
+            }
+            // No `Visibility`: it passes the group's through.
+            let sub = commands.spawn((Transform::IDENTITY, Subgroup, ChildOf(group))).id();
+            for x in 0..2 {
+                commands.spawn((Transform::from_xyz(x as f32, 1.0, 0.0), spot_light(), ChildOf(sub)));
+            }
+        },
+    );
+    let lights = |app: &mut App| {
+        app.update();
+        app.world().resource::<FrameStats>().last.as_ref().expect("a report").light_count
+    };
+    assert_eq!(lights(&mut app), 5);
+    let group = app.world_mut().query_filtered::<Entity, With<Group>>().single(app.world()).expect("a group");
+    app.world_mut().entity_mut(group).insert(Visibility::Hidden);
+    assert_eq!(lights(&mut app), 0, "the hidden group's lights, its subgroup's included");
+    // One more frame without edits: no `InheritedVisibility` written in it.
+    let before = app.world_mut().increment_change_tick();
+    assert_eq!(lights(&mut app), 0);
+    let now = app.world_mut().change_tick();
+    let mut values = app.world_mut().query::<Ref<InheritedVisibility>>();
+    let written = values.iter(app.world()).filter(|v| v.last_changed().is_newer_than(before, now)).count();
+    assert_eq!(written, 0, "a frame without edits writes nothing");
+    let sub =
+        app.world_mut().query_filtered::<Entity, With<Subgroup>>().single(app.world()).expect("a subgroup");
+    app.world_mut().entity_mut(sub).remove::<ChildOf>();
+    assert_eq!(lights(&mut app), 2, "the subgroup, now a root, shows");
+    app.world_mut().entity_mut(group).insert(Visibility::Visible);
+    assert_eq!(lights(&mut app), 5);
+}
+
+/// A `ChildOf` cycle (which Bevy does not refuse) ends the walk at the number of entities
+/// instead of looping forever.
+#[test]
+fn a_childof_cycle_does_not_hang_the_update() {
+    let mut vis = VisWorld::new();
+    let a = spawn_node(&mut vis.world, Some(Visibility::Inherited), None);
+    let b = spawn_node(&mut vis.world, None, Some(a));
+    let c = spawn_node(&mut vis.world, Some(Visibility::Hidden), Some(b));
+    vis.frame();
+    vis.world.entity_mut(a).insert(ChildOf(b));
+    vis.frame();
+    assert!(vis.shown(a), "at the end of the walk, visible like a root");
+    vis.world.entity_mut(a).insert(Visibility::Hidden);
+    vis.frame();
+    assert!(!vis.shown(a) && !vis.shown(c));
+}

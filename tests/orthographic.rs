@@ -80,6 +80,7 @@ fn orthographic_gpu_lists_equal_the_cpu_reference() {
     let mut r = HeadlessRenderer::new().expect("adapter");
     let scene = scene(orthographic());
     let mut lights: Vec<_> = manylight::scene::light_rig(300, scene.bounds(), 5)
+        .expect("300 lights")
         .iter()
         .map(|a| extracted_light(&a.at(0.0)))
         .collect();

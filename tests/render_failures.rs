@@ -55,7 +55,7 @@ fn failing_app(pipelined: bool, frames: u32, fail_at: u32, failure: Failure, out
         |mut commands: Commands| {
             let scene = default_scene();
             spawn_scene(&mut commands, &scene, true, SIZE.x as f32 / SIZE.y as f32);
-            spawn_light_rig(&mut commands, 8, scene.bounds(), 1);
+            spawn_light_rig(&mut commands, 8, scene.bounds(), 1).expect("the rig's lights fit");
         },
     );
     let sink = FailingSink { inner: HeadlessRenderer::new().expect("adapter"), frames: 0, fail_at, failure };

@@ -16,7 +16,7 @@ const SIZE: UVec2 = UVec2::new(160, 96);
 /// which way (some at the camera, some away; one cone is a hemisphere, one a hair).
 fn spot_scene(count: usize) -> Scene {
     let mut scene = default_scene();
-    for (i, anim) in light_rig(count, scene.bounds(), 7).iter().enumerate() {
+    for (i, anim) in light_rig(count, scene.bounds(), 7).expect("the rig's lights fit").iter().enumerate() {
         let a = i as f32 * 2.399;
         let outer = [0.05, 0.35, 0.7, 1.2, std::f32::consts::FRAC_PI_2][i % 5];
         let mut light = anim.at(0.0);

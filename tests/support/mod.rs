@@ -134,7 +134,7 @@ pub fn try_render_scene(
     manylight::app::headless::render_headless(size, 1, move |app| {
         app.insert_resource(settings).add_systems(Startup, move |mut commands: Commands| {
             spawn_scene(&mut commands, &scene, true, aspect);
-            spawn_light_rig(&mut commands, lights, bounds, 1);
+            spawn_light_rig(&mut commands, lights, bounds, 1).expect("the rig's lights fit");
         });
     })
     .map_err(|e| e.to_string())

@@ -89,7 +89,7 @@ impl FrameSink for crate::render_world::HeadlessRenderer {
 }
 
 /// The message of a panic payload (`panic!` with a string or a formatted message).
-fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+pub(crate) fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
     payload
         .downcast_ref::<&str>()
         .map(|s| s.to_string())

@@ -76,6 +76,27 @@ pub fn parse_size(s: &str) -> Result<UVec2, String> {
     Ok(UVec2::new(w, h))
 }
 
+/// A finite number in `range`, for the flag `what`.
+fn finite_in(s: &str, what: &str, range: std::ops::RangeInclusive<f32>, rule: &str) -> Result<f32, String> {
+    let v: f32 = s.trim().parse().map_err(|e| format!("{what} `{s}`: {e}"))?;
+    if v.is_finite() && range.contains(&v) { Ok(v) } else { Err(format!("{what} `{s}`: must be {rule}")) }
+}
+
+/// An exposure multiplier: finite and positive.
+pub fn parse_exposure(s: &str) -> Result<f32, String> {
+    finite_in(s, "exposure", f32::MIN_POSITIVE..=f32::MAX, "a finite number above 0")
+}
+
+/// An exposure value at ISO 100: finite, in `-100..=100` (the range `Exposure::multiplier` keeps).
+pub fn parse_ev100(s: &str) -> Result<f32, String> {
+    finite_in(s, "ev100", -100.0..=100.0, "a finite number in -100..=100")
+}
+
+/// An ambient term (fraction of albedo): finite and non-negative.
+pub fn parse_ambient(s: &str) -> Result<f32, String> {
+    finite_in(s, "ambient", 0.0..=f32::MAX, "a finite number of at least 0")
+}
+
 /// `XxYxZ` cluster-grid dimensions, each in `1..=MAX_GRID_DIM`.
 pub fn parse_grid(s: &str) -> Result<UVec3, String> {
     let parts: Vec<&str> = s.split(['x', 'X']).collect();
@@ -93,6 +114,23 @@ pub fn parse_grid(s: &str) -> Result<UVec3, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn exposure_and_ambient_refuse_non_finite_and_out_of_range_values() {
+        for bad in ["NaN", "inf", "-inf", "0", "-1", "x"] {
+            assert!(parse_exposure(bad).is_err(), "{bad}");
+        }
+        for bad in ["NaN", "inf", "101", "-100.5"] {
+            assert!(parse_ev100(bad).is_err(), "{bad}");
+        }
+        for bad in ["NaN", "inf", "-0.1"] {
+            assert!(parse_ambient(bad).is_err(), "{bad}");
+        }
+        assert_eq!(parse_exposure("2.5"), Ok(2.5));
+        assert_eq!(parse_ev100("-3"), Ok(-3.0));
+        assert_eq!(parse_ambient("0"), Ok(0.0));
+        assert!(parse_exposure("NaN").unwrap_err().contains("exposure"));
+    }
 
     #[test]
     fn example_args_read_headless_output_and_frames() {

@@ -64,6 +64,6 @@ pub mod prelude {
     pub use glam::{Quat, UVec2, Vec2, Vec3};
     pub use manylight_core::cluster::{CullTest, GridConfig, ZSlicing};
     pub use manylight_core::codec::NormalCodec;
-    pub use manylight_core::{MaterialData, MeshData, ShadingModel};
+    pub use manylight_core::{LightCountError, MaterialData, MeshData, ShadingModel};
     pub use manylight_render::{BloomChain, ClusterSettings, DebugViewMode, GBufferLayout, PipelineKind};
 }

@@ -10,7 +10,7 @@ use crate::window::WindowConfig;
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
 use bevy_time::{TimePlugin, TimeUpdateStrategy};
-use bevy_transform::{TransformPlugin, TransformSystems};
+use bevy_transform::{StaticTransformOptimizations, TransformPlugin, TransformSystems};
 use glam::UVec2;
 use std::path::PathBuf;
 use std::time::Duration;
@@ -126,6 +126,12 @@ impl Plugin for ManyLightPlugin {
         // PostUpdate) and clock, unless the app brought them already.
         if !app.is_plugin_added::<TransformPlugin>() {
             app.add_plugins(TransformPlugin);
+            // bevy_transform's serial "static scene" pass marks dirty trees by walking up from
+            // every changed entity until it meets an ancestor changed but not newly added: on
+            // the frame a hierarchy is spawned that is entities × depth (a million instances
+            // under a 1 023-deep glTF chain took 54 s), and the serial propagation it feeds
+            // visits every entity with a parent anyway, so it saves nothing here.
+            app.insert_resource(StaticTransformOptimizations::Disabled);
         }
         if !app.is_plugin_added::<TimePlugin>() {
             app.add_plugins(TimePlugin);

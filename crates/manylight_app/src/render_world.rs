@@ -147,6 +147,11 @@ pub enum DeviceLoss {
     /// frame's read-back and presentation meet a lost device, the frame is reported with no
     /// passes, and the frame after it renders on a new device.
     InFrame,
+    /// The device is destroyed at the start of the next frame, after the check for a lost
+    /// device and before the frame uploads its meshes, textures and lights: every buffer and
+    /// texture of that frame is created on a lost device. The frame is reported with no
+    /// passes, and the frame after it renders on a new device.
+    BeforeUploads,
 }
 
 /// A render world with its schedule.
@@ -155,7 +160,9 @@ pub struct RenderWorld {
     pub world: World,
     schedule: Schedule,
     losses: LossHistory,
-    lose_in_frame: bool,
+    /// An injected loss waiting for the next frame ([`DeviceLoss::InFrame`] or
+    /// [`DeviceLoss::BeforeUploads`]).
+    lose_in_frame: Option<DeviceLoss>,
     /// Render-to-texture targets, by id (dropped when no view draws into them).
     textures: HashMap<RenderTextureId, HeadlessTarget>,
     /// Images of the view rectangles, copied into their targets, by size and format (only the
@@ -193,7 +200,7 @@ impl RenderWorld {
             world,
             schedule,
             losses: LossHistory::default(),
-            lose_in_frame: false,
+            lose_in_frame: None,
             textures: HashMap::new(),
             view_images: HashMap::new(),
             texture_images: Vec::new(),
@@ -206,7 +213,7 @@ impl RenderWorld {
     pub fn lose_device(&mut self, when: DeviceLoss) {
         match when {
             DeviceLoss::BetweenFrames => self.gpu().device.destroy(),
-            DeviceLoss::InFrame => self.lose_in_frame = true,
+            DeviceLoss::InFrame | DeviceLoss::BeforeUploads => self.lose_in_frame = Some(when),
         }
     }
 
@@ -298,11 +305,15 @@ impl RenderWorld {
         let sanitized_cameras = snapshot.sanitized_cameras();
         self.last_passes.clear();
         self.texture_images.clear();
+        if self.lose_in_frame == Some(DeviceLoss::BeforeUploads) {
+            self.lose_in_frame = None;
+            self.gpu().device.destroy();
+        }
         self.world.resource_mut::<RendererResource>().0.prepare(&snapshot)?;
         let light_upload_bytes = self.world.resource::<RendererResource>().0.scene.light_upload_bytes;
         self.world.insert_resource(CurrentSnapshot(snapshot));
         let result = self.render_views(output, format);
-        if std::mem::take(&mut self.lose_in_frame) {
+        if self.lose_in_frame.take() == Some(DeviceLoss::InFrame) {
             self.gpu().device.destroy();
         }
         let views = result?;
@@ -711,12 +722,24 @@ pub(crate) trait DeviceSink {
             self.recover(reason, frame)?;
         }
         let (viewport, pipeline) = (snapshot.viewport, snapshot.settings.pipeline);
-        let result = self.render_on_device(snapshot, readback);
-        let result = result.and_then(|(empty, image)| {
-            let mut reports = self.render_world().take_reports(readback)?;
-            reports.extend(empty);
-            Ok(SinkFrame { reports, image })
-        });
+        // The frame boundary: a wgpu call that panics because the device was lost during the
+        // frame (a third-party pass, a helper outside `GpuContext`) ends the frame here, where
+        // the loss can be recovered from; a panic on a device that is not lost goes on
+        // unwinding to the caller.
+        let rendered = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            self.render_on_device(snapshot, readback).and_then(|(empty, image)| {
+                let mut reports = self.render_world().take_reports(readback)?;
+                reports.extend(empty);
+                Ok(SinkFrame { reports, image })
+            })
+        }));
+        let result = match rendered {
+            Ok(result) => result,
+            Err(panic) if self.gpu().lost().is_some() => {
+                Err(RenderError::Device(format!("panicked: {}", crate::backend::panic_message(&*panic))))
+            }
+            Err(panic) => std::panic::resume_unwind(panic),
+        };
         match self.gpu().lost() {
             Some(reason) => {
                 if let Err(e) = &result {

@@ -7,7 +7,7 @@ use crate::components::{
 use bevy_ecs::name::Name;
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
-use manylight_core::{Aabb, lumens_from_candela};
+use manylight_core::{Aabb, LightCountError, LightLimit, check_light_count, lumens_from_candela};
 use manylight_render::{
     ExtractedCamera, ExtractedDirectionalLight, ExtractedInstance, ExtractedPointLight, ExtractedView,
     FrameSettings, FrameSnapshot,
@@ -150,8 +150,19 @@ pub struct SceneNodeIndex(pub usize);
 pub struct SceneRoot(pub String);
 
 /// Spawns `count` animated lights inside `bounds` (deterministic for a `seed`).
-pub fn spawn_light_rig(commands: &mut Commands, count: usize, bounds: Aabb, seed: u64) {
-    for anim in light_rig(count, bounds, seed) {
+///
+/// A `count` past [`manylight_core::MAX_LIGHTS`], or whose entities would not fit the memory
+/// available ([`manylight_core::light_count::APP_BYTES_PER_LIGHT`] each), is refused before
+/// anything is spawned or allocated. A device holds fewer lights than `MAX_LIGHTS`
+/// (`GpuContext::light_limit`): past that, frames fail with `RenderError::BufferTooLarge`.
+pub fn spawn_light_rig(
+    commands: &mut Commands,
+    count: usize,
+    bounds: Aabb,
+    seed: u64,
+) -> Result<(), LightCountError> {
+    check_light_count(count, LightLimit::INDICES, manylight_core::light_count::APP_BYTES_PER_LIGHT)?;
+    for anim in light_rig(count, bounds, seed)? {
         commands.spawn((
             Transform::from_translation(anim.position_at(0.0)),
             PointLight {
@@ -163,6 +174,7 @@ pub fn spawn_light_rig(commands: &mut Commands, count: usize, bounds: Aabb, seed
             LightAnimation(anim),
         ));
     }
+    Ok(())
 }
 
 /// A scene light as the render side sees it.

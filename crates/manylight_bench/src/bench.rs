@@ -155,7 +155,7 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
             (false, None) => format!("{}, {lights} lights", pipeline.name()),
         };
         progress.set_message(label.clone());
-        let (lit, rig) = lights_of(scene, sweep.shell_lattice, lights);
+        let (lit, rig) = lights_of(scene, sweep.shell_lattice, lights)?;
         let settings = FrameSettings {
             render: RenderSettings {
                 pipeline,
@@ -222,12 +222,12 @@ fn unlike(a: f64, b: f64) -> Option<f64> {
 
 /// The scene lit by `count` lights: the sphere-shell preset (`shell_lattice`) gets its lattice of
 /// static lights, every other scene `count` animated rig lights over its own.
-fn lights_of(scene: &Scene, shell_lattice: bool, count: usize) -> (Scene, Vec<AnimatedLight>) {
+fn lights_of(scene: &Scene, shell_lattice: bool, count: usize) -> Result<(Scene, Vec<AnimatedLight>)> {
     if shell_lattice {
-        let lights = sphere_shell_lights(count, SHELL_RADIUS, SHELL_LIGHT_RANGE, 1);
-        (Scene { lights, ..scene.clone() }, Vec::new())
+        let lights = sphere_shell_lights(count, SHELL_RADIUS, SHELL_LIGHT_RANGE, 1)?;
+        Ok((Scene { lights, ..scene.clone() }, Vec::new()))
     } else {
-        (scene.clone(), light_rig(count, scene.bounds(), 1))
+        Ok((scene.clone(), light_rig(count, scene.bounds(), 1)?))
     }
 }
 

@@ -10,8 +10,9 @@ use glam::{UVec2, UVec3};
 use manylight_app::FrameStats;
 use manylight_app::RenderSettings;
 use manylight_app::cli::{
-    parse_bloom_chain, parse_cull, parse_debug_view, parse_gbuffer, parse_grid, parse_normal_codec,
-    parse_on_off, parse_pipeline, parse_shading, parse_size, parse_slicing,
+    parse_ambient, parse_bloom_chain, parse_cull, parse_debug_view, parse_ev100, parse_exposure,
+    parse_gbuffer, parse_grid, parse_normal_codec, parse_on_off, parse_pipeline, parse_shading, parse_size,
+    parse_slicing,
 };
 use manylight_app::headless::{render_headless, save_png};
 use manylight_app::scene::{spawn_light_rig, spawn_scene};
@@ -226,16 +227,16 @@ struct RenderArgs {
     #[arg(long, default_value_t = 1)]
     frames: u32,
     /// Exposure multiplier before tone mapping.
-    #[arg(long, default_value_t = 1.0, conflicts_with = "ev100")]
+    #[arg(long, default_value_t = 1.0, conflicts_with = "ev100", allow_hyphen_values = true, value_parser = parse_exposure)]
     exposure: f32,
     /// Photographic exposure value at ISO 100 instead of `--exposure` (multiplier
     /// 1 / (1.2 · 2^EV100)): about 15 for sunlight, 7 for a lamp-lit room, with lights in
     /// physical units.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_ev100)]
     ev100: Option<f32>,
     /// Constant ambient light, as a fraction of albedo (default: 0.03, or 0.2 for a scene
     /// that brings no lights of its own, so its shapes read).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_ambient)]
     ambient: Option<f32>,
     /// Seed of the light placement.
     #[arg(long, default_value_t = 1)]
@@ -387,8 +388,10 @@ fn render_scene(
             Startup,
             move |mut commands: Commands| {
                 spawn_scene(&mut commands, &scene, true, aspect);
-                if lights > 0 {
-                    spawn_light_rig(&mut commands, lights, bounds, seed);
+                // The count was checked before the app was built; memory taken since then fails
+                // the run with the error instead of a frame without the lights.
+                if let Err(e) = spawn_light_rig(&mut commands, lights, bounds, seed) {
+                    commands.insert_resource(manylight_app::RenderFailure(Some(format!("--lights: {e}"))));
                 }
             },
         );
@@ -416,6 +419,15 @@ fn render_scene(
     })
     .map_err(anyhow::Error::msg)?;
     Ok((frame.image, frame.stats))
+}
+
+/// Refuses `count` lights — all the lights a command would create, named by `flags` — past the
+/// light limit of the adapter the command renders with, or past the memory available, before
+/// any light is created.
+fn check_lights(count: usize, flags: &str) -> Result<()> {
+    use manylight_core::light_count::{APP_BYTES_PER_LIGHT, check_light_count};
+    let limit = manylight_render::context::adapter_light_limit()?;
+    check_light_count(count, limit, APP_BYTES_PER_LIGHT).with_context(|| flags.to_string())
 }
 
 /// Reorders or clears the scene's cameras so the chosen one comes first.
@@ -474,25 +486,27 @@ fn render(args: RenderArgs) -> Result<()> {
     // The sphere-shell preset is lit by its own lattice (`--lights`, default 100 000 of range
     // 0.3 just inside the radius-50 sphere), not by the animated rig.
     let shell = args.scene == "sphere-shell";
+    let shell_lights = if shell { args.lights.unwrap_or(100_000) } else { 0 };
+    let unlit = if shell { shell_lights == 0 } else { scene.lights.is_empty() };
+    let lights = if shell { 0 } else { args.lights.unwrap_or(0) };
+    let studio = args.studio_lights.unwrap_or(if unlit && args.lights.is_none() { 32 } else { 0 });
+    let total = [scene.lights.len(), shell_lights, lights, studio].into_iter().fold(0, usize::saturating_add);
+    check_lights(total, "--lights and --studio-lights (with the scene's own lights)")?;
     if shell {
-        let n = args.lights.unwrap_or(100_000);
         scene.lights = manylight_scene::sphere_shell_lights(
-            n,
+            shell_lights,
             manylight_scene::SHELL_RADIUS,
             manylight_scene::SHELL_LIGHT_RANGE,
             args.seed,
-        );
+        )?;
     }
-    let unlit = scene.lights.is_empty();
-    let lights = if shell { 0 } else { args.lights.unwrap_or(0) };
-    let studio = args.studio_lights.unwrap_or(if unlit && args.lights.is_none() { 32 } else { 0 });
-    let studio = manylight_scene::studio_lights(studio, scene.bounds());
+    let studio = manylight_scene::studio_lights(studio, scene.bounds())?;
     scene.lights.extend(studio);
     let ambient = args.ambient.unwrap_or(if unlit { 0.2 } else { RenderSettings::default().ambient });
     // The measured frame of `--culling-efficiency` and `--oracle`: the last frame's animation
     // time, rendered straight from the scene (no app).
-    let measured = (args.culling_efficiency || args.oracle).then(|| {
-        let rig = manylight_scene::light_rig(lights, scene.bounds(), args.seed);
+    let measured = (args.culling_efficiency || args.oracle).then(|| -> Result<_> {
+        let rig = manylight_scene::light_rig(lights, scene.bounds(), args.seed)?;
         let t = args.frames.max(1).saturating_sub(1) as f32 / 60.0;
         let settings = manylight_render::FrameSettings {
             render: manylight_render::RenderSettings {
@@ -505,8 +519,9 @@ fn render(args: RenderArgs) -> Result<()> {
             },
             ..Default::default()
         };
-        direct::snapshot(&scene, &rig, t, args.size, settings, 0)
+        Ok(direct::snapshot(&scene, &rig, t, args.size, settings, 0))
     });
+    let measured = measured.transpose()?;
     let culling = match &measured {
         Some(snap) if args.culling_efficiency => {
             let mut renderer = manylight_app::render_world::HeadlessRenderer::new()?;
@@ -665,6 +680,7 @@ fn report_base(args: &ReportArgs) -> manylight_render::FrameSettings {
 
 fn rangeless_lights_cmd(args: ReportArgs) -> Result<()> {
     let scene = args.clusters.load(&args.scene)?;
+    check_lights(scene.lights.len().saturating_add(args.lights), "--lights")?;
     let mut renderer = manylight_app::render_world::HeadlessRenderer::new()?;
     let (lights, size, frames) = (args.lights, args.size, args.frames.max(1));
     print!("{}", report::rangeless_lights(&mut renderer, &scene, lights, size, frames, report_base(&args))?);
@@ -673,6 +689,7 @@ fn rangeless_lights_cmd(args: ReportArgs) -> Result<()> {
 
 fn report_cmd(args: ReportArgs) -> Result<()> {
     let scene = args.clusters.load(&args.scene)?;
+    check_lights(scene.lights.len().saturating_add(args.lights), "--lights")?;
     let base = report_base(&args);
     let name = scene_name(&args.scene);
     let report = report::run(&scene, &name, args.lights, args.size, args.frames.max(1), base)?;
@@ -685,6 +702,7 @@ fn report_cmd(args: ReportArgs) -> Result<()> {
 
 fn post_cmd(args: ReportArgs) -> Result<()> {
     let scene = args.clusters.load(&args.scene)?;
+    check_lights(scene.lights.len().saturating_add(args.lights), "--lights")?;
     let base = manylight_render::FrameSettings {
         render: manylight_render::RenderSettings {
             clusters: args.clusters.settings(&args.scene),
@@ -703,6 +721,7 @@ fn post_cmd(args: ReportArgs) -> Result<()> {
 
 fn views_cmd(args: ViewsArgs) -> Result<()> {
     let scene = args.clusters.load(&args.scene)?;
+    check_lights(scene.lights.len().saturating_add(args.lights), "--lights")?;
     let base = manylight_render::FrameSettings {
         render: manylight_render::RenderSettings {
             clusters: args.clusters.settings(&args.scene),
@@ -734,6 +753,8 @@ fn codec_accuracy_cmd(samples: usize) -> Result<()> {
 
 fn bench_cmd(args: BenchArgs) -> Result<()> {
     let scene = args.clusters.load(&args.scene)?;
+    let most = args.lights.iter().copied().max().unwrap_or(0);
+    check_lights(scene.lights.len().saturating_add(most), "--lights")?;
     let sweep = bench::Sweep {
         pipelines: args.pipelines,
         lights: args.lights,
@@ -796,8 +817,10 @@ fn main() -> ExitCode {
         }
         Command::CodecAccuracy { samples } => codec_accuracy_cmd(samples.max(1)),
         Command::CullingTests { lights, seed } => {
-            print!("{}", culling_tests::table(lights, seed));
-            Ok(())
+            use manylight_core::light_count::{APP_BYTES_PER_LIGHT, LightLimit, check_light_count};
+            check_light_count(lights, LightLimit::INDICES, APP_BYTES_PER_LIGHT)
+                .map_err(anyhow::Error::from)
+                .map(|()| print!("{}", culling_tests::table(lights, seed)))
         }
     };
     match result {

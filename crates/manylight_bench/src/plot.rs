@@ -264,6 +264,26 @@ pub fn pareto_front(points: &[AccuracyPoint]) -> Vec<usize> {
     front
 }
 
+/// Tallest figure drawn, in pixels: a 1900-pixel-wide RGB buffer of this height takes 93 MB.
+pub const MAX_FIGURE_HEIGHT: u32 = 16_384;
+
+/// Height of a figure with `rows` rows of `per_row` pixels under a `base` of titles and axes,
+/// at least `min`; refused, naming the row count, past [`MAX_FIGURE_HEIGHT`].
+fn figure_height(base: u32, per_row: u32, rows: usize, min: u32) -> Result<u32> {
+    let height = u32::try_from(rows)
+        .ok()
+        .and_then(|rows| rows.checked_mul(per_row))
+        .and_then(|h| h.checked_add(base))
+        .filter(|&h| h <= MAX_FIGURE_HEIGHT);
+    match height {
+        Some(h) => Ok(h.max(min)),
+        None => bail!(
+            "{rows} rows would make a figure more than MAX_FIGURE_HEIGHT ({MAX_FIGURE_HEIGHT} px) tall: at most {} rows fit",
+            (MAX_FIGURE_HEIGHT - base) / per_row
+        ),
+    }
+}
+
 /// Renders into an RGB buffer of `size` and saves it as PNG at `path`.
 fn save(
     path: &Path,
@@ -381,7 +401,7 @@ where
 /// written under the chart.
 fn stacked_bars(path: &Path, title: &str, x_desc: &str, bars: &[Bar], note: Option<&str>) -> Result<()> {
     let n = bars.len().max(1);
-    let height = (200 + 44 * n as u32).max(450);
+    let height = figure_height(200, 44, n, 450)?;
     save(path, (1400, height), |root| {
         if let Some(note) = note {
             root.draw(&Text::new(note.to_string(), (20, height as i32 - 28), (FONT, 16).into_font()))
@@ -471,7 +491,7 @@ fn stacked_bars(path: &Path, title: &str, x_desc: &str, bars: &[Bar], note: Opti
 fn accuracy_chart(path: &Path, title: &str, points: &[AccuracyPoint]) -> Result<()> {
     // A zero error (the reference itself) is drawn on the bottom of the log axis.
     const FLOOR: f64 = 1e-5;
-    let height = (200 + 26 * points.len() as u32).max(800);
+    let height = figure_height(200, 26, points.len(), 800)?;
     save(path, (1900, height), |root| {
         let (left, right) = root.split_horizontally(1000);
         let xs = log_range(points.iter().map(|p| p.frame_ms));
@@ -573,6 +593,12 @@ pub fn figures(csv: &str, dir: &Path) -> Result<Vec<PathBuf>> {
         bail!("the CSV has no rows to plot");
     }
     let kind = Kind::of(&table)?;
+    // The tallest figures grow with the rows they show (one bar per configuration, one key
+    // line per point): checked before anything is drawn.
+    figure_height(200, 44, bar_rows(&table).0.len(), 450)?;
+    if kind == Kind::Report {
+        figure_height(200, 26, table.rows.len(), 800)?;
+    }
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let setting = table.setting();
     let file = |name: &str| dir.join(format!("{}_{name}.png", kind.prefix()));
@@ -666,6 +692,26 @@ mod tests {
             vec![("frame textures".to_string(), 0.07), ("cluster buffers".to_string(), 0.60)]
         );
         assert_eq!(t.setting(), "default, 96×64, llvmpipe (LLVM 15, 256 bits)");
+    }
+
+    /// A CSV of 200 000 configurations at one light count would ask for a figure 8.8 million
+    /// pixels tall (and, with `u32` sizes, wrap past 2^32 at larger counts): refused, naming
+    /// the limit, before any buffer is allocated.
+    #[test]
+    fn figures_too_tall_for_their_rows_are_refused() {
+        let mut csv = BENCH.lines().next().expect("header").to_string();
+        for i in 0..200_000 {
+            csv.push_str(&format!(
+                "\n\"llvmpipe\",default,clustered-forward-{i},,64,96,64,20.0,,0.03,false,1.2,0.07,0.60"
+            ));
+        }
+        let dir = std::env::temp_dir().join(format!("manylight_plot_rows_{}", std::process::id()));
+        let error = figures(&csv, &dir).expect_err("too many rows for one figure");
+        let _ = std::fs::remove_dir_all(&dir);
+        assert!(format!("{error:#}").contains("MAX_FIGURE_HEIGHT"), "{error:#}");
+        assert!(figure_height(200, 44, usize::MAX, 450).is_err());
+        assert!(figure_height(200, 26, (u32::MAX / 26) as usize + 1, 800).is_err());
+        assert_eq!(figure_height(200, 44, 1, 450).expect("fits"), 450);
     }
 
     #[test]

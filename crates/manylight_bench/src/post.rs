@@ -99,7 +99,7 @@ pub fn run(
     frames: u32,
     base: FrameSettings,
 ) -> Result<Report> {
-    let rig = light_rig(lights, scene.bounds(), 1);
+    let rig = light_rig(lights, scene.bounds(), 1)?;
     let configs = configurations();
     let names: Vec<String> = configs.iter().map(|c| c.name.to_string()).collect();
     let (adapter, timed) = interleaved(&names, frames, "rounds of every configuration", |i, f| {

@@ -30,7 +30,7 @@ fn measure(
     settings: FrameSettings,
     frames: u32,
 ) -> Result<(f64, FrameReport, image::RgbaImage)> {
-    let rig = light_rig(lights, scene.bounds(), 1);
+    let rig = light_rig(lights, scene.bounds(), 1)?;
     measure_rig(renderer, scene, &rig, size, settings, frames)
 }
 
@@ -185,7 +185,7 @@ pub fn run(
     // The oracles: the same frame shaded from exact per-pixel lists (built from a clustered
     // frame's depth before the timed frames), by clustered forward and by clustered deferred
     // with the base G-buffer layout.
-    let rig = light_rig(lights, scene.bounds(), 1);
+    let rig = light_rig(lights, scene.bounds(), 1)?;
     for (name, pipeline) in
         [(FORWARD_ORACLE, PipelineKind::ClusteredForward), (DEFERRED_ORACLE, PipelineKind::ClusteredDeferred)]
     {
@@ -253,7 +253,7 @@ pub fn rangeless_lights(
     frames: u32,
     base: FrameSettings,
 ) -> Result<String> {
-    let rig = light_rig(lights, scene.bounds(), 1);
+    let rig = light_rig(lights, scene.bounds(), 1)?;
     let with_range = |range: &dyn Fn(&AnimatedLight) -> f32| -> Vec<AnimatedLight> {
         rig.iter().map(|l| AnimatedLight { radius: range(l), ..*l }).collect()
     };

@@ -24,8 +24,10 @@ mod plan;
 
 use crate::progress::Progress;
 use anyhow::{Context, Result, bail};
-use bevy_app::{App, Startup, Update};
-use bevy_ecs::prelude::{Commands, Entity, IntoScheduleConfigs, Local, Query, Res, ResMut, Resource, With};
+use bevy_app::{App, AppExit, Startup, Update};
+use bevy_ecs::prelude::{
+    Commands, Entity, IntoScheduleConfigs, Local, MessageWriter, Query, Res, ResMut, Resource, With,
+};
 use glam::{Quat, UVec2};
 use manylight_app::cli::parse_size;
 use manylight_app::scene::{spawn_light_rig, spawn_scene};
@@ -126,6 +128,7 @@ fn drive(
     lights: Query<Entity, With<LightAnimation>>,
     mut debug: ResMut<DebugView>,
     mut requests: ResMut<WindowRequests>,
+    mut exit: MessageWriter<AppExit>,
 ) {
     let f = frame.0;
     let now = soak.plan.at(f);
@@ -140,7 +143,11 @@ fn drive(
         for light in &lights {
             commands.entity(light).despawn();
         }
-        spawn_light_rig(&mut commands, now.lights, soak.bounds, soak.seed);
+        // `Plan::validate` checked every count; memory taken since then ends the run here.
+        if let Err(e) = spawn_light_rig(&mut commands, now.lights, soak.bounds, soak.seed) {
+            tracing::error!("--lights: {e}");
+            exit.write(AppExit::error());
+        }
     }
     for (entity, mut transform) in &mut cameras {
         let base = *base_rotation.get_or_insert(transform.rotation);

@@ -59,7 +59,7 @@ pub fn run(
     frames: u32,
     base: FrameSettings,
 ) -> Result<String> {
-    let rig = light_rig(lights, scene.bounds(), 1);
+    let rig = light_rig(lights, scene.bounds(), 1)?;
     let names: Vec<String> = VIEW_COUNTS.iter().map(|n| format!("{n} view(s)")).collect();
     let (adapter, timed) = interleaved(&names, frames, "rounds of 1, 2 and 4 views", |i, f| {
         split(snapshot(scene, &rig, 0.0, size, base, f), VIEW_COUNTS[i])

@@ -296,3 +296,75 @@ fn report_writes_csv_and_figures() {
         assert!(a == b, "{name}: the figure drawn from the CSV differs from the one drawn with it");
     }
 }
+
+/// Arguments that used to allocate before any limit was checked (`--lights 4294967295` aborted
+/// on a 240 GB allocation, `--lights 18446744073709551615` panicked with "capacity overflow",
+/// `--lights 10000000` reached 2.9 GB spawning entities past lavapipe's 2 796 202-light
+/// buffer) or rendered a black image and exited 0 (`--exposure NaN`): each exits 1 or 2 with a
+/// message naming the limit, in seconds and without its resident memory reaching 256 MiB.
+#[test]
+fn arguments_past_a_limit_exit_with_a_message_before_allocating() {
+    let _gpu = GPU.lock().unwrap_or_else(|e| e.into_inner());
+    let out = root().join("target/cli-tests/refused.png");
+    let out = out.to_str().expect("utf-8 path");
+    let cases: [(&[&str], &str); 9] = [
+        (&["--lights", "4294967295"], "lights"),
+        (&["--lights", "18446744073709551615"], "lights"),
+        (&["--studio-lights", "4294967295"], "lights"),
+        (&["--lights", "10000000"], "max_storage_buffer_binding_size"),
+        (&["--scene", "sphere-shell", "--lights", "4294967295"], "lights"),
+        (&["--exposure", "NaN"], "exposure"),
+        (&["--ev100", "inf"], "ev100"),
+        (&["--ambient", "-1"], "ambient"),
+        (&["--exposure", "-2"], "exposure"),
+    ];
+    for (flags, named) in cases {
+        let mut args = vec!["render", "--size", "64x32", "--out", out];
+        args.extend_from_slice(flags);
+        let run = run_watched(&args);
+        let stderr = String::from_utf8_lossy(&run.output.stderr);
+        let code = run.output.status.code();
+        assert!(matches!(code, Some(1 | 2)), "{flags:?}: exit {:?}\n{stderr}", run.output.status);
+        assert!(stderr.contains(named), "{flags:?}: the message does not name `{named}`:\n{stderr}");
+        assert!(!stderr.contains("panicked") && !stderr.contains("memory allocation"), "{flags:?}: {stderr}");
+        // Finding the adapter takes a fraction of a second on lavapipe.
+        assert!(run.seconds < 10.0, "{flags:?}: took {:.1} s", run.seconds);
+        assert!(run.peak_rss < 256 << 20, "{flags:?}: resident memory reached {} MiB", run.peak_rss >> 20);
+    }
+}
+
+/// A finished run of the binary with its wall time and the largest resident set seen.
+struct WatchedRun {
+    output: Output,
+    seconds: f64,
+    peak_rss: u64,
+}
+
+/// Runs the binary with `args`, reading its peak resident set (`VmHWM`) from `/proc` until it
+/// exits (0 where `/proc` cannot be read).
+fn run_watched(args: &[&str]) -> WatchedRun {
+    use std::process::Stdio;
+    let start = std::time::Instant::now();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_manylight"))
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the binary runs");
+    let status_path = format!("/proc/{}/status", child.id());
+    let mut peak_rss = 0u64;
+    while child.try_wait().expect("wait").is_none() {
+        if let Ok(status) = std::fs::read_to_string(&status_path)
+            && let Some(kib) = status
+                .lines()
+                .find_map(|l| l.strip_prefix("VmHWM:"))
+                .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok())
+        {
+            peak_rss = peak_rss.max(kib * 1024);
+        }
+        assert!(start.elapsed().as_secs() < 120, "{args:?} still runs after 120 s");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let output = child.wait_with_output().expect("output");
+    WatchedRun { output, seconds: start.elapsed().as_secs_f64(), peak_rss }
+}

@@ -4,6 +4,14 @@
 
 use glam::{Mat4, Vec2, Vec3};
 
+/// Smallest orthographic view height [`Projection::sanitized`] keeps (its half-extent's
+/// reciprocal stays finite).
+pub const MIN_ORTHOGRAPHIC_HEIGHT: f32 = 1e-30;
+
+/// Largest orthographic view height [`Projection::sanitized`] keeps; taller ones are clamped
+/// to it, and the glTF loader refuses cameras whose `ymag` asks for more.
+pub const MAX_ORTHOGRAPHIC_HEIGHT: f32 = 1e30;
+
 /// Smallest field of view a projection keeps (radians); smaller ones are raised to it.
 pub const MIN_FOV_Y: f32 = 1e-6;
 
@@ -99,8 +107,10 @@ impl Projection {
     /// near plane, or so close to a huge near plane that the depth terms overflow is dropped:
     /// the projection becomes infinite. `+∞` stays infinite.
     ///
-    /// Orthographic: a height that is not finite and positive becomes 1 (and one whose
-    /// half-extent overflows or underflows is clamped into `[1e-30, 1e30]`), and a far plane
+    /// Orthographic: a height that is NaN or not positive becomes 1, and one outside
+    /// [`MIN_ORTHOGRAPHIC_HEIGHT`, `MAX_ORTHOGRAPHIC_HEIGHT`] (`+∞` included) is clamped into
+    /// it (an infinite height used to become 1, shrinking the view by 38 orders of magnitude
+    /// without a word), and a far plane
     /// that is missing, infinite, not beyond the near plane or too close to it for the linear
     /// depth scale to be finite becomes `near + ORTHOGRAPHIC_FALLBACK_DEPTH` (or the near
     /// plane is moved back from a far plane at `f32::MAX`).
@@ -108,7 +118,11 @@ impl Projection {
         let fov_y = if self.fov_y.is_finite() { self.fov_y.clamp(MIN_FOV_Y, MAX_FOV_Y) } else { 1.0 };
         let near = if self.near.is_finite() && self.near > 0.0 { self.near } else { 0.1 };
         if let ProjectionKind::Orthographic { height } = self.kind {
-            let height = if height.is_finite() && height > 0.0 { height.clamp(1e-30, 1e30) } else { 1.0 };
+            let height = if height > 0.0 {
+                height.clamp(MIN_ORTHOGRAPHIC_HEIGHT, MAX_ORTHOGRAPHIC_HEIGHT)
+            } else {
+                1.0 // NaN or not positive
+            };
             let fits =
                 |near: f32, far: f32| far.is_finite() && far > near && (1.0 / (far - near)).is_finite();
             let (near, far) = if fits(near, self.far) {
@@ -352,6 +366,21 @@ mod tests {
         assert_eq!(p.finite_for(3.0).near, 0.1);
         assert_eq!(Projection::default().finite_for(1e9), Projection::default());
         assert!(Projection::infinite(1.0, f32::MAX).finite_for(0.0).far.is_finite());
+    }
+
+    #[test]
+    fn an_infinite_orthographic_height_is_clamped_not_replaced() {
+        for (height, kept) in [
+            (f32::INFINITY, MAX_ORTHOGRAPHIC_HEIGHT),
+            (3e38, MAX_ORTHOGRAPHIC_HEIGHT),
+            (1e-40, MIN_ORTHOGRAPHIC_HEIGHT),
+            (f32::NAN, 1.0),
+            (-2.0, 1.0),
+        ] {
+            let p = Projection::orthographic(height, 0.1, 100.0).sanitized();
+            assert_eq!(p.kind, ProjectionKind::Orthographic { height: kept }, "{height}");
+            assert!(p.matrix(1.5).is_finite(), "{height}");
+        }
     }
 
     /// Orthographic: near maps to 1 and far to 0 linearly, x and y by the half-extents at every

@@ -12,6 +12,7 @@ pub mod codec;
 pub mod efficiency;
 pub mod icosphere;
 pub mod image_metrics;
+pub mod light_count;
 pub mod material;
 pub mod mesh;
 pub mod spot;
@@ -21,6 +22,7 @@ pub use attenuation::{
     LIGHT_MIN_DISTANCE, attenuation, candela_from_lumens, lumens_from_candela, radius_for_intensity,
 };
 pub use camera::{Projection, ProjectionKind, linearize_depth_reverse_z};
+pub use light_count::{LightCountError, LightLimit, MAX_LIGHTS, check_light_count};
 pub use material::{
     AlphaMode, ImageAddressMode, ImageFilterMode, MaterialData, MaterialTexture, ShadingModel, TextureData,
     TextureSampler, UvChannel,

@@ -4,6 +4,10 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use thiserror::Error;
 
+pub mod tangents;
+
+pub use tangents::{TangentFallback, TangentMethod};
+
 /// Interleaved vertex as the GPU reads it (`shaders/common/vertex.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -204,43 +208,40 @@ impl MeshData {
         }
     }
 
-    /// Generates tangents with MikkTSpace (`bevy_mikktspace`, as Blender, Substance and the
-    /// glTF sample models' bakers use) from positions, normals and uvs. Vertices the
-    /// algorithm gives no frame (only degenerate triangles touch them) get all-zero tangents.
-    pub fn generate_tangents(&mut self) {
-        struct Geometry<'a>(&'a mut MeshData);
-        impl bevy_mikktspace::Geometry for Geometry<'_> {
-            fn num_faces(&self) -> usize {
-                self.0.indices.len() / 3
-            }
-            fn num_vertices_of_face(&self, _face: usize) -> usize {
-                3
-            }
-            fn position(&self, face: usize, vert: usize) -> [f32; 3] {
-                self.0.vertices[self.0.indices[face * 3 + vert] as usize].position
-            }
-            fn normal(&self, face: usize, vert: usize) -> [f32; 3] {
-                self.0.vertices[self.0.indices[face * 3 + vert] as usize].normal
-            }
-            fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
-                self.0.vertices[self.0.indices[face * 3 + vert] as usize].uv
-            }
-            fn set_tangent(
-                &mut self,
-                tangent_space: Option<bevy_mikktspace::TangentSpace>,
-                face: usize,
-                vert: usize,
-            ) {
-                let i = self.0.indices[face * 3 + vert] as usize;
-                self.0.vertices[i].tangent =
-                    tangent_space.map_or([0.0; 4], |t| sanitize_tangent(Vec4::from(t.tangent_encoded())));
-            }
-        }
+    /// Generates tangents from positions, normals and uvs, in bounded time and stack whatever
+    /// the mesh's topology, and says how.
+    ///
+    /// MikkTSpace (`bevy_mikktspace`, as Blender, Substance and the glTF sample models' bakers
+    /// use, and as the glTF specification asks) is used when its cost on this mesh is bounded:
+    /// its work grows with the square of the triangles around one vertex, on one edge or of
+    /// the corners at one position, and its grouping recurses once per triangle around a
+    /// vertex, so a fan of 100 000 triangles or one triangle repeated 200 000 times would take
+    /// minutes or overflow the stack. Those costs are estimated from the mesh first
+    /// (O(n log n), see [`tangents::work_limit`]), and when the recursion is deep MikkTSpace
+    /// runs on a thread whose stack fits it. Vertices MikkTSpace gives no frame (only
+    /// degenerate triangles touch them) get all-zero tangents.
+    ///
+    /// Otherwise (and for non-finite or out-of-range data) the tangents are per-vertex UV
+    /// derivatives (Lengyel's method) in O(n): each triangle's derivatives of position along u
+    /// and v, weighted by its UV area, summed at its vertices, made orthogonal to the normal,
+    /// handedness from the v derivative, all zero where there is no usable frame. They match
+    /// MikkTSpace's on planar, linearly mapped surfaces, are close on smooth ones, and differ
+    /// where uv seams, mirrored islands or degenerate triangles meet a vertex. The result
+    /// says which was used, and why.
+    #[must_use = "the tangents may come from the fallback, which the caller should report"]
+    pub fn generate_tangents(&mut self) -> TangentMethod {
         for v in &mut self.vertices {
             v.tangent = [0.0; 4];
         }
-        // The error type has no variants: generation cannot fail.
-        let _ = bevy_mikktspace::generate_tangents(&mut Geometry(self));
+        let fallback = match tangents::plan(self) {
+            Ok(plan) => match tangents::run_mikktspace(self, &plan) {
+                Ok(()) => return TangentMethod::MikkTSpace,
+                Err(why) => why,
+            },
+            Err(why) => why,
+        };
+        tangents::uv_derivative_tangents(self);
+        TangentMethod::UvDerivatives(fallback)
     }
 
     /// True when at least one vertex has a tangent frame.
@@ -298,7 +299,7 @@ mod tests {
         let uvs = [Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, 0.0)];
         let indices = Some(vec![0, 1, 2, 0, 2, 3]);
         let mut m = MeshData::from_attributes("quad", &positions, None, Some(&uvs), indices.clone()).unwrap();
-        m.generate_tangents();
+        assert_eq!(m.generate_tangents(), TangentMethod::MikkTSpace);
         for v in &m.vertices {
             let t = Vec4::from(v.tangent);
             assert!((t - Vec4::new(1.0, 0.0, 0.0, -1.0)).abs().max_element() < 1e-5, "{t}");
@@ -306,7 +307,7 @@ mod tests {
         let mirrored = uvs.map(|uv| Vec2::new(1.0 - uv.x, uv.y));
         let mut m =
             MeshData::from_attributes("mirrored", &positions, None, Some(&mirrored), indices).unwrap();
-        m.generate_tangents();
+        assert_eq!(m.generate_tangents(), TangentMethod::MikkTSpace);
         for v in &m.vertices {
             let t = Vec4::from(v.tangent);
             assert!((t - Vec4::new(-1.0, 0.0, 0.0, 1.0)).abs().max_element() < 1e-5, "{t}");
@@ -322,7 +323,7 @@ mod tests {
         assert_eq!(m.vertices[1].tangent, [1.0, 0.0, 0.0, 1.0]);
         assert_eq!(m.vertices[2].tangent, [0.0; 4]);
         // Degenerate uvs (all zero) give no frame, not NaN.
-        m.generate_tangents();
+        assert_eq!(m.generate_tangents(), TangentMethod::MikkTSpace);
         assert!(m.vertices.iter().all(|v| v.tangent.iter().all(|x| x.is_finite())));
     }
 

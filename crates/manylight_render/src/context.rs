@@ -1,5 +1,6 @@
 //! The GPU context: instance, adapter, device and queue, for headless rendering or a surface.
 
+use manylight_core::LightLimit;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 use thiserror::Error;
@@ -228,10 +229,31 @@ impl GpuContext {
     }
 
     /// Creates a buffer with its contents (counted in [`GpuCounts::buffers`]).
+    ///
+    /// As wgpu's `DeviceExt::create_buffer_init` (mapped at creation, size padded to
+    /// `COPY_BUFFER_ALIGNMENT`), but a buffer that cannot be mapped — its device is lost or out
+    /// of memory, so the buffer is invalid — is returned unfilled instead of panicking: the frame
+    /// then fails on the lost device and the renderer recovers (wgpu's helper panics there,
+    /// inside the frame, where no recovery can run).
     pub fn create_buffer_init(&self, desc: &wgpu::util::BufferInitDescriptor<'_>) -> wgpu::Buffer {
-        use wgpu::util::DeviceExt;
         self.counters.buffers.fetch_add(1, Ordering::Relaxed);
-        self.device.create_buffer_init(desc)
+        let len = desc.contents.len() as u64;
+        let align = wgpu::COPY_BUFFER_ALIGNMENT;
+        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: desc.label,
+            size: len.div_ceil(align).max(1) * align,
+            usage: desc.usage,
+            mapped_at_creation: true,
+        });
+        match buffer.get_mapped_range_mut(..) {
+            Ok(mut range) => range.slice(..desc.contents.len()).copy_from_slice(desc.contents),
+            Err(e) => tracing::warn!(
+                "buffer `{}` could not be filled (lost device or out of memory): {e}",
+                desc.label.unwrap_or("unnamed")
+            ),
+        }
+        buffer.unmap();
+        buffer
     }
 
     /// Creates a bind group (counted in [`GpuCounts::bind_groups`]).
@@ -260,13 +282,7 @@ impl GpuContext {
         instance: wgpu::Instance,
         surface: Option<&wgpu::Surface<'_>>,
     ) -> Result<GpuContext, RenderError> {
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            force_fallback_adapter: false,
-            compatible_surface: surface,
-            apply_limit_buckets: false,
-        }))
-        .map_err(|e| RenderError::NoAdapter(e.to_string()))?;
+        let adapter = request_adapter(&instance, surface)?;
         let info = adapter.get_info();
         let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
         let mut required_features = wgpu::Features::empty();
@@ -357,6 +373,12 @@ impl GpuContext {
         self.lost.lock().ok().and_then(|slot| slot.clone())
     }
 
+    /// Most lights this device's light buffer can hold (its largest storage binding over the
+    /// size of a `GpuPointLight`): past it a frame fails with [`RenderError::BufferTooLarge`].
+    pub fn light_limit(&self) -> LightLimit {
+        light_limit_of(&self.device.limits())
+    }
+
     /// Largest 2D texture side this device accepts.
     pub fn max_texture_size(&self) -> u32 {
         self.device.limits().max_texture_dimension_2d
@@ -366,6 +388,43 @@ impl GpuContext {
     pub fn take_errors(&self) -> Vec<String> {
         self.errors.lock().map(|mut v| std::mem::take(&mut *v)).unwrap_or_default()
     }
+}
+
+/// The adapter a context on `instance` renders with (one able to present to `surface`, if given).
+fn request_adapter(
+    instance: &wgpu::Instance,
+    surface: Option<&wgpu::Surface<'_>>,
+) -> Result<wgpu::Adapter, RenderError> {
+    pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+        power_preference: wgpu::PowerPreference::HighPerformance,
+        force_fallback_adapter: false,
+        compatible_surface: surface,
+        apply_limit_buckets: false,
+    }))
+    .map_err(|e| RenderError::NoAdapter(e.to_string()))
+}
+
+/// The light limit of the adapter a headless context would render with, read without creating
+/// a device: for checking a light count before anything is allocated.
+pub fn adapter_light_limit() -> Result<LightLimit, RenderError> {
+    let adapter = request_adapter(&new_instance(), None)?;
+    Ok(light_limit_of(&adapter.limits()))
+}
+
+/// The largest buffer a device with `limits` can bind as storage, in bytes (a multiple of 4),
+/// and the name of the limit that sets it.
+pub(crate) fn max_binding_bytes(limits: &wgpu::Limits) -> (u64, &'static str) {
+    if limits.max_storage_buffer_binding_size <= limits.max_buffer_size {
+        (limits.max_storage_buffer_binding_size & !3, "max_storage_buffer_binding_size")
+    } else {
+        (limits.max_buffer_size & !3, "max_buffer_size")
+    }
+}
+
+/// Most lights a device with `limits` binds in its light buffer.
+fn light_limit_of(limits: &wgpu::Limits) -> LightLimit {
+    let (bytes, name) = max_binding_bytes(limits);
+    LightLimit::from_buffer(bytes, std::mem::size_of::<crate::gpu_types::GpuPointLight>() as u64, name)
 }
 
 /// A wgpu instance on the backends from `WGPU_BACKEND` (default: Vulkan, Metal, DX12; set

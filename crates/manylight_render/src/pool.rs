@@ -132,21 +132,10 @@ pub struct GrowableBuffer {
     limit_name: &'static str,
 }
 
-/// The largest buffer `device` can bind as storage, in bytes (a multiple of 4), and the name of
-/// the limit that sets it.
-fn max_binding_bytes(device: &wgpu::Device) -> (u64, &'static str) {
-    let limits = device.limits();
-    if limits.max_storage_buffer_binding_size <= limits.max_buffer_size {
-        (limits.max_storage_buffer_binding_size & !3, "max_storage_buffer_binding_size")
-    } else {
-        (limits.max_buffer_size & !3, "max_buffer_size")
-    }
-}
-
 impl GrowableBuffer {
     /// Creates a buffer of at least `min_bytes`.
     pub fn new(gpu: &GpuContext, label: &'static str, usage: wgpu::BufferUsages, min_bytes: u64) -> Self {
-        let (max_bytes, limit_name) = max_binding_bytes(&gpu.device);
+        let (max_bytes, limit_name) = crate::context::max_binding_bytes(&gpu.device.limits());
         // Powers of two keep regrowth rare; near the device's limit the buffer takes the limit.
         let capacity =
             min_bytes.max(16).next_power_of_two().min(max_bytes.max(16)).max(min_bytes.min(max_bytes));

@@ -83,6 +83,7 @@ impl Renderer {
     /// flight).
     pub fn prepare(&mut self, snapshot: &FrameSnapshot) -> Result<(), RenderError> {
         let settings = &snapshot.settings;
+        settings.check_values().map_err(RenderError::UnsupportedSettings)?;
         if settings.pipeline.is_deferred() && !settings.gbuffer.supports(settings.normal_codec) {
             return Err(RenderError::UnsupportedSettings(format!(
                 "the {} G-buffer cannot store normals with the {} codec",

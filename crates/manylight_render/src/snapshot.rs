@@ -345,6 +345,24 @@ pub struct RenderSettings {
     pub normal_codec: NormalCodec,
 }
 
+impl RenderSettings {
+    /// Refuses values no frame can be rendered with, naming the field: an `exposure` that is
+    /// not finite and positive (NaN used to give an all-black image with no non-finite pixel
+    /// counted), an `ambient` or a `clear_color` channel that is not finite and non-negative.
+    pub fn check_values(&self) -> Result<(), String> {
+        if !(self.exposure.is_finite() && self.exposure > 0.0) {
+            return Err(format!("exposure {} must be finite and positive", self.exposure));
+        }
+        if !(self.ambient.is_finite() && self.ambient >= 0.0) {
+            return Err(format!("ambient {} must be finite and non-negative", self.ambient));
+        }
+        if !self.clear_color.iter().all(|c| c.is_finite() && *c >= 0.0) {
+            return Err(format!("clear_color {:?} must be finite and non-negative", self.clear_color));
+        }
+        Ok(())
+    }
+}
+
 impl Default for RenderSettings {
     fn default() -> Self {
         Self {
@@ -734,5 +752,29 @@ impl FrameSnapshot {
     /// transparent pass.
     pub fn has_blended(&self) -> bool {
         self.instances.iter().any(|i| i.material.alpha_mode == manylight_core::AlphaMode::Blend)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An exposure of NaN used to render an all-black frame with no non-finite pixel counted:
+    /// values no frame can render with are refused, naming the field.
+    #[test]
+    fn settings_no_frame_can_render_with_are_refused_by_name() {
+        assert_eq!(RenderSettings::default().check_values(), Ok(()));
+        let cases = [
+            (RenderSettings { exposure: f32::NAN, ..Default::default() }, "exposure"),
+            (RenderSettings { exposure: 0.0, ..Default::default() }, "exposure"),
+            (RenderSettings { exposure: f32::INFINITY, ..Default::default() }, "exposure"),
+            (RenderSettings { ambient: -0.1, ..Default::default() }, "ambient"),
+            (RenderSettings { ambient: f32::NAN, ..Default::default() }, "ambient"),
+            (RenderSettings { clear_color: [0.0, f32::INFINITY, 0.0], ..Default::default() }, "clear_color"),
+        ];
+        for (settings, field) in cases {
+            let message = settings.check_values().expect_err(field);
+            assert!(message.starts_with(field), "{message}");
+        }
     }
 }

@@ -32,7 +32,9 @@
 //!    rejecting non-finite transforms; each mesh primitive and material is converted once
 //!    and shared, after its accessor counts were checked against `max_vertices`,
 //!    `max_indices` and `max_accessor_bytes`; each image source is decoded once, after its
-//!    header was checked against `max_texture_size` and `max_image_bytes`.
+//!    header was checked against `max_texture_size` and `max_image_bytes`. Generated
+//!    tangents count their triangles against `max_tangent_triangles` first, and cost time
+//!    linear in them whatever the topology (`MeshData::generate_tangents`).
 //! 4. The whole load runs under `catch_unwind`, so even a loader bug cannot take the caller
 //!    down ([`SceneError::Internal`]).
 //!
@@ -112,11 +114,25 @@ pub struct LoadOptions {
     /// The node tree is walked without recursion, so depth costs no stack; the limit refuses
     /// degenerate chains whose transforms lose all precision. Default 1024.
     pub max_node_depth: u32,
-    /// Most bytes of all decoded images together (RGBA8: width × height × 4 each). Images
-    /// are decoded once per distinct source (the same resolved file, the same `data:` URI or
-    /// the same buffer view), however many `images` entries name it; each new source is
-    /// checked from its header before decoding. Default 1 GiB.
+    /// Most bytes of all decoded images together: each kept image counts as RGBA8 with its
+    /// mip chain (width × height × 4 × about 4/3, as the renderer uploads it), and while an
+    /// image decodes, what the decode holds at its peak counts too (a 16-bit source in its own
+    /// format, 8 bytes a pixel for RGBA, beside its RGBA8 copy; a downscaled copy). Images are
+    /// decoded once per distinct source (the same resolved file, the same `data:` URI or the
+    /// same buffer view), however many `images` entries name it; each new source is checked
+    /// from its header before decoding. Default 1 GiB.
     pub max_image_bytes: u64,
+    /// Most triangles of all meshes whose tangents are generated (primitives with a normal
+    /// map and `TEXCOORD_0` but no `TANGENT`), counted before each mesh is read or its
+    /// tangents generated. Generation uses MikkTSpace where its cost on the mesh's topology
+    /// is bounded and per-vertex UV derivatives elsewhere (a fan of hundreds of triangles
+    /// around one vertex, one triangle repeated many times: a warning names the mesh; see
+    /// `MeshData::generate_tangents`), so its time is linear in the triangles either way; but
+    /// MikkTSpace still holds about 400 bytes of temporary memory per triangle and takes
+    /// about 3 µs per triangle (one core). Default 4 000 000: at most about 1.6 GB and 12 s
+    /// (twice that for the costliest topologies it accepts), 250 times the largest mesh in
+    /// the repository's `assets/`, and a quarter of the triangles `max_indices` allows.
+    pub max_tangent_triangles: u64,
 }
 
 /// What the loader does with an image larger than [`LoadOptions::max_texture_size`].
@@ -151,6 +167,7 @@ impl Default for LoadOptions {
             max_lights: 1_000_000,
             max_node_depth: 1024,
             max_image_bytes: 1 << 30,
+            max_tangent_triangles: 4_000_000,
         }
     }
 }
@@ -420,6 +437,8 @@ struct Used {
     indices: u64,
     /// Bytes of decoded images.
     image_bytes: u64,
+    /// Triangles of the meshes whose tangents were generated.
+    tangent_triangles: u64,
 }
 
 /// Everything the loading steps share.

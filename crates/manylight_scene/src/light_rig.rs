@@ -7,7 +7,7 @@
 use crate::shapes::{cuboid, uv_sphere};
 use crate::{Scene, SceneCamera, SceneInstance, SceneLight};
 use glam::{Mat4, Vec3};
-use manylight_core::{Aabb, MaterialData, Projection};
+use manylight_core::{Aabb, LightCountError, LightLimit, MaterialData, Projection, check_light_count};
 use std::f64::consts::TAU;
 use std::sync::Arc;
 
@@ -163,7 +163,11 @@ fn usable_bounds(bounds: Aabb) -> Aabb {
 /// `K` = [`RIG_RADIUS_K`], so the expected number of lights touching a point stays about 4 as
 /// `count` grows (until the clamp); the intensity is [`intensity_for_radius`]. An empty or
 /// non-finite `bounds` is replaced by the cube [-1, 1]³.
-pub fn light_rig(count: usize, bounds: Aabb, seed: u64) -> Vec<AnimatedLight> {
+///
+/// A `count` past [`manylight_core::MAX_LIGHTS`], or whose lights would not fit the memory
+/// available, is refused before anything is allocated.
+pub fn light_rig(count: usize, bounds: Aabb, seed: u64) -> Result<Vec<AnimatedLight>, LightCountError> {
+    check_count::<AnimatedLight>(count)?;
     let bounds = usable_bounds(bounds);
     let size = bounds.size();
     let inner = Aabb { min: bounds.min + size * 0.05, max: bounds.max - size * 0.05 };
@@ -171,7 +175,7 @@ pub fn light_rig(count: usize, bounds: Aabb, seed: u64) -> Vec<AnimatedLight> {
     let radius = (RIG_RADIUS_K * (volume / count.max(1) as f32).cbrt()).clamp(0.5, 8.0);
     let intensity = intensity_for_radius(radius);
     let mut rng = SplitMix64(seed ^ 0x6c69_6768_7472_6967);
-    (0..count)
+    Ok((0..count)
         .map(|_| {
             let u = Vec3::new(rng.f32(), rng.f32(), rng.f32());
             let center = inner.min + (inner.max - inner.min) * u;
@@ -195,7 +199,12 @@ pub fn light_rig(count: usize, bounds: Aabb, seed: u64) -> Vec<AnimatedLight> {
                 radius,
             }
         })
-        .collect()
+        .collect())
+}
+
+/// Checks `count` lights of type `T` against [`LightLimit::INDICES`] and the memory available.
+fn check_count<T>(count: usize) -> Result<(), LightCountError> {
+    check_light_count(count, LightLimit::INDICES, std::mem::size_of::<T>() as u64)
 }
 
 /// `count` unit directions spread evenly over the sphere: the Fibonacci (golden-angle) lattice,
@@ -223,12 +232,21 @@ pub const SHELL_LIGHT_RANGE: f32 = 0.3;
 /// tessellated shell of [`sphere_shell_scene`] (whose faces sag up to ~0.21 below the sphere at
 /// r = 50), while its sphere of influence still reaches the shell (for range 0.3 the light is
 /// 0.24 inside).
-pub fn sphere_shell_lights(count: usize, shell_radius: f32, light_range: f32, seed: u64) -> Vec<SceneLight> {
+///
+/// A `count` past [`manylight_core::MAX_LIGHTS`], or whose lights would not fit the memory
+/// available, is refused before anything is allocated.
+pub fn sphere_shell_lights(
+    count: usize,
+    shell_radius: f32,
+    light_range: f32,
+    seed: u64,
+) -> Result<Vec<SceneLight>, LightCountError> {
+    check_count::<SceneLight>(count)?;
     let shell = if shell_radius.is_finite() { shell_radius.max(0.0) } else { 0.0 };
     let range = if light_range.is_finite() { light_range.max(0.0) } else { 0.0 };
     let r = shell - (0.8 * range).min(1.0).min(shell);
     let mut rng = SplitMix64(seed ^ 0x7368_656c_6c5f_6c74);
-    fibonacci_sphere(count)
+    Ok(fibonacci_sphere(count)
         .map(|dir| SceneLight {
             position: dir * r,
             color: hsv(rng.f32(), rng.range(0.7, 1.0)),
@@ -236,7 +254,7 @@ pub fn sphere_shell_lights(count: usize, shell_radius: f32, light_range: f32, se
             radius: range,
             spot: None,
         })
-        .collect()
+        .collect())
 }
 
 /// `count` static white point lights on a dome around `bounds`, as a model viewer lights a model
@@ -248,12 +266,16 @@ pub fn sphere_shell_lights(count: usize, shell_radius: f32, light_range: f32, se
 /// then receives about 1 lux from the lights of its side (`count/4π` lights per steradian, each
 /// `I · 0.88 / (2ρ)²` with the window at half the range, integrated over the cosine). An empty
 /// or non-finite `bounds` is replaced by the cube [-1, 1]³.
-pub fn studio_lights(count: usize, bounds: Aabb) -> Vec<SceneLight> {
+///
+/// A `count` past [`manylight_core::MAX_LIGHTS`], or whose lights would not fit the memory
+/// available, is refused before anything is allocated.
+pub fn studio_lights(count: usize, bounds: Aabb) -> Result<Vec<SceneLight>, LightCountError> {
+    check_count::<SceneLight>(count)?;
     let bounds = usable_bounds(bounds);
     let rho = (bounds.size().length() * 0.5).max(1e-3);
     let center = bounds.center();
     let intensity = 18.0 * rho * rho / count.max(1) as f32;
-    fibonacci_sphere(count)
+    Ok(fibonacci_sphere(count)
         .map(|dir| SceneLight {
             position: center + dir * (2.0 * rho),
             color: Vec3::ONE,
@@ -261,7 +283,7 @@ pub fn studio_lights(count: usize, bounds: Aabb) -> Vec<SceneLight> {
             radius: 4.0 * rho,
             spot: None,
         })
-        .collect()
+        .collect())
 }
 
 /// The sphere-shell stress scene: an inward-facing white sphere of radius 50 (~2200
@@ -305,7 +327,7 @@ mod tests {
     #[test]
     fn studio_lights_give_about_one_lux_facing_out() {
         let bounds = Aabb { min: Vec3::new(-3.0, 0.0, -1.0), max: Vec3::new(5.0, 2.0, 1.0) };
-        let lights = studio_lights(64, bounds);
+        let lights = studio_lights(64, bounds).expect("64 lights");
         let rho = bounds.size().length() * 0.5;
         for l in &lights {
             assert!(((l.position - bounds.center()).length() - 2.0 * rho).abs() < 1e-3 * rho);
@@ -346,10 +368,22 @@ mod tests {
                 inscribed = inscribed.min(n.dot(a).abs());
             }
         }
-        for l in sphere_shell_lights(500, 50.0, 0.3, 1) {
+        for l in sphere_shell_lights(500, 50.0, 0.3, 1).expect("500 lights") {
             let d = l.position.length();
             assert!(d < inscribed, "{d} >= {inscribed}");
             assert!(d + l.radius > inscribed);
+        }
+    }
+
+    /// Counts no device could hold are refused before anything is allocated (they used to
+    /// abort on a 240 GB allocation or panic with "capacity overflow").
+    #[test]
+    fn impossible_light_counts_are_refused_before_allocation() {
+        let bounds = Aabb { min: Vec3::ZERO, max: Vec3::ONE };
+        for count in [u32::MAX as usize, usize::MAX] {
+            assert!(light_rig(count, bounds, 1).is_err(), "{count}");
+            assert!(studio_lights(count, bounds).is_err(), "{count}");
+            assert!(sphere_shell_lights(count, 50.0, 0.3, 1).is_err(), "{count}");
         }
     }
 

@@ -33,7 +33,9 @@ impl Builder {
 
     fn build(self, label: &str) -> MeshData {
         let mut mesh = MeshData { label: label.to_owned(), vertices: self.vertices, indices: self.indices };
-        mesh.generate_tangents();
+        // Built-in shapes are small and ordinary: MikkTSpace always runs on them.
+        let method = mesh.generate_tangents();
+        debug_assert_eq!(method, manylight_core::mesh::TangentMethod::MikkTSpace, "{label}");
         mesh
     }
 }

@@ -9,72 +9,20 @@
 
 #[path = "support/counting_alloc.rs"]
 mod counting_alloc;
+#[path = "support/measured_load.rs"]
+mod measured_load;
 #[path = "support/sandbox.rs"]
 mod sandbox;
 
-use manylight_scene::{LoadOptions, Scene, SceneError, load_gltf};
+use manylight_scene::{LoadOptions, Scene, SceneError};
+use measured_load::{MIB, load, serial};
 use sandbox::Sandbox;
 use serde_json::{Value, json};
 use std::path::Path;
-use std::sync::Mutex;
 use std::time::Duration;
 
 #[global_allocator]
 static ALLOC: counting_alloc::Counting = counting_alloc::Counting;
-
-/// Tests run one at a time (each holds this for its whole body), so a peak measured during a
-/// load belongs to that load alone.
-static SERIAL: Mutex<()> = Mutex::new(());
-
-/// Takes [`SERIAL`] for the rest of the test.
-fn serial() -> std::sync::MutexGuard<'static, ()> {
-    SERIAL.lock().unwrap_or_else(|e| e.into_inner())
-}
-
-const MIB: usize = 1 << 20;
-
-/// Longest a single load may take before the test fails.
-const LOAD_TIMEOUT: Duration = Duration::from_secs(60);
-
-/// What a load returned and cost.
-struct Outcome {
-    result: Result<Scene, SceneError>,
-    /// Peak heap growth during the load (the returned scene included).
-    peak: usize,
-    elapsed: Duration,
-}
-
-impl Outcome {
-    /// The error, which must be an `OverBudget` for `option` naming `path`.
-    fn over_budget(self, path: &Path, option: &str) -> String {
-        let message = match self.result {
-            Ok(s) => {
-                panic!("{} loaded ({} instances) but must be refused", path.display(), s.instances.len())
-            }
-            Err(e) => {
-                assert!(matches!(&e, SceneError::OverBudget { option: o, .. } if *o == option), "{e}");
-                e.to_string()
-            }
-        };
-        assert!(message.contains(&path.display().to_string()), "does not name the file: {message}");
-        assert!(message.contains(&format!("(LoadOptions::{option})")), "{message}");
-        message
-    }
-
-    fn scene(self) -> Scene {
-        self.result.unwrap_or_else(|e| panic!("{e}"))
-    }
-}
-
-/// Loads `path` on a worker thread, measuring its peak heap growth and time.
-fn load(path: &Path, options: LoadOptions) -> Outcome {
-    counting_alloc::set_cap(4 << 30);
-    let owned = path.to_owned();
-    let (result, peak, elapsed) = counting_alloc::measure(LOAD_TIMEOUT, move || load_gltf(&owned, &options))
-        .unwrap_or_else(|| panic!("loading {} took over {LOAD_TIMEOUT:?}", path.display()));
-    eprintln!("{}: peak {:.1} MiB, {elapsed:?}", path.display(), peak as f64 / MIB as f64);
-    Outcome { result, peak, elapsed }
-}
 
 /// A `data:` URI of `bytes`.
 fn data_uri(bytes: &[u8]) -> String {
@@ -317,8 +265,9 @@ fn one_image_named_by_many_entries_is_decoded_once() {
         let scene = out.scene();
         assert_eq!(scene.materials.len(), 200, "{name}");
         assert_eq!(distinct_textures(&scene), 1, "{name}");
-        // One decode of 16 MiB fits a budget of exactly 16 MiB.
-        let exact = LoadOptions { max_image_bytes: 2048 * 2048 * 4, ..LoadOptions::default() };
+        // One decode fits a budget of exactly its RGBA8 bytes with their mip chain
+        // (4 · (2048² + 1024² + … + 1) = 22 369 620).
+        let exact = LoadOptions { max_image_bytes: 22_369_620, ..LoadOptions::default() };
         assert_eq!(distinct_textures(&load(&path, exact).scene()), 1);
     }
 }
@@ -339,7 +288,7 @@ fn distinct_images_count_against_the_decoded_bytes_budget() {
     let message = out.over_budget(&path, "max_image_bytes");
     assert!(
         message
-            .contains("image 4 (with the images decoded before it) needs 83886080 bytes of decoded images"),
+            .contains("image 3 (with the images decoded before it) needs 89478480 bytes of decoded images"),
         "{message}"
     );
     let scene = load(&path, LoadOptions::default()).scene();
@@ -589,4 +538,77 @@ fn deeply_nested_json_is_refused_or_skipped_without_recursion() {
             other => panic!("{name}: {:?}", other.map(|s| s.instances.len())),
         }
     }
+}
+
+/// A solid-colour 16-bit RGBA PNG.
+fn solid_png16(size: u32) -> Vec<u8> {
+    let img = image::ImageBuffer::<image::Rgba<u16>, _>::from_pixel(
+        size,
+        size,
+        image::Rgba([40_000, 0, 0, 65_535]),
+    );
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, image::ImageFormat::Png).expect("encode PNG");
+    out.into_inner()
+}
+
+/// The PNG CRC-32 of `bytes` (ISO 3309, reflected polynomial 0xEDB88320).
+fn png_crc(bytes: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &b in bytes {
+        crc ^= b as u32;
+        for _ in 0..8 {
+            crc = if crc & 1 == 1 { (crc >> 1) ^ 0xEDB8_8320 } else { crc >> 1 };
+        }
+    }
+    !crc
+}
+
+/// `png` with its header (IHDR, the first chunk) declaring `size` × `size` pixels: the file stays
+/// small, and only a decoder that goes past the header notices that the pixel data are short.
+fn png_declaring(png: &[u8], size: u32) -> Vec<u8> {
+    let mut out = png.to_vec();
+    // Signature (8), IHDR length (4), "IHDR" (4), width (4), height (4), ..., CRC after 13 bytes.
+    out[16..20].copy_from_slice(&size.to_be_bytes());
+    out[20..24].copy_from_slice(&size.to_be_bytes());
+    let crc = png_crc(&out[12..29]);
+    out[29..33].copy_from_slice(&crc.to_be_bytes());
+    out
+}
+
+/// A 16-bit image decodes into 8 bytes a pixel and is then converted to RGBA8: the budget
+/// counts both (and the kept image's mip chain), not `w × h × 4`. Four 8192² 16-bit PNGs under
+/// a 512 MiB budget used to pass its check (256 MiB each as counted) and decode the first at a
+/// peak of 768 MiB; now they are refused before any pixel is decoded.
+#[test]
+fn sixteen_bit_images_count_their_decode_peak() {
+    let _serial = serial();
+    let sandbox = Sandbox::new("png16_budget");
+    let small = solid_png16(1024);
+    sandbox.write("small16.png", &small);
+    let path = sandbox.write_json(
+        "small16.gltf",
+        &many_images_doc(vec![json!({ "uri": "small16.png" })], Value::Null, Value::Null),
+    );
+    // Kept: 1024² × 4 with mips (5.3 MiB); decoding: 8 MiB of 16-bit pixels beside 4 MiB of RGBA8.
+    let kept_only = LoadOptions { max_image_bytes: 6 * MIB as u64, ..LoadOptions::default() };
+    let message = load(&path, kept_only).over_budget(&path, "max_image_bytes");
+    assert!(message.contains("needs 12582912 bytes of decoded images"), "{message}");
+    let out = load(&path, LoadOptions { max_image_bytes: 12 * MIB as u64, ..LoadOptions::default() });
+    assert!(out.peak < 12 * MIB + 2 * MIB, "peak {:.1} MiB", out.peak as f64 / MIB as f64);
+    assert_eq!(distinct_textures(&out.scene()), 1);
+
+    let huge = png_declaring(&small, 8192);
+    let images: Vec<Value> = (0..4)
+        .map(|i| {
+            sandbox.write(&format!("huge{i}.png"), &huge);
+            json!({ "uri": format!("huge{i}.png") })
+        })
+        .collect();
+    let path = sandbox.write_json("huge16.gltf", &many_images_doc(images, Value::Null, Value::Null));
+    let out = load(&path, LoadOptions { max_image_bytes: 512 * MIB as u64, ..LoadOptions::default() });
+    assert!(out.elapsed < Duration::from_secs(2), "{:?}", out.elapsed);
+    assert!(out.peak < 256 * MIB, "peak {:.1} MiB", out.peak as f64 / MIB as f64);
+    let message = out.over_budget(&path, "max_image_bytes");
+    assert!(message.contains("image 0"), "refused before the first decode: {message}");
 }

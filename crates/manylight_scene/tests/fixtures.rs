@@ -139,6 +139,23 @@ fn an_orthographic_camera_loads_as_one() {
     assert!(c.projection.matrix(1.5).is_finite());
 }
 
+/// `ymag` 3e38 makes a view height of 6e38, infinite in `f32`: refused by name instead of
+/// silently rendered with a height of 1.
+#[test]
+fn an_orthographic_camera_too_tall_for_f32_is_refused() {
+    let text = std::fs::read_to_string(fixture("orthographic_camera.gltf")).expect("fixture");
+    let mut json: serde_json::Value = serde_json::from_str(&text).expect("JSON");
+    json["cameras"][0]["orthographic"]["ymag"] = serde_json::json!(3e38);
+    let dir = std::env::temp_dir().join(format!("manylight_ortho_ymag_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join("huge_ymag.gltf");
+    std::fs::write(&path, json.to_string()).expect("write");
+    let error = load_gltf(&path, &LoadOptions::default()).expect_err("refused");
+    let _ = std::fs::remove_dir_all(&dir);
+    let message = error.to_string();
+    assert!(message.contains("huge_ymag.gltf") && message.contains("MAX_ORTHOGRAPHIC_HEIGHT"), "{message}");
+}
+
 // Files the glTF 2.0 specification (and the Khronos validator) allow, one family per test.
 
 /// Loads fixture `name`, panicking with the error's message.

@@ -5,9 +5,11 @@
 //! rebuilt around its JSON chunk, its geometry and a small PNG), parses its JSON as a
 //! `serde_json::Value` and applies a few mutations that know the glTF structure: counts,
 //! offsets, strides, lengths, indices, component types and URIs set to edge values, node
-//! children made into cycles and deep chains, accessors declaring billions of elements,
-//! arrays repeated to multiply instances and images, values of the wrong JSON type, deeply
-//! nested arrays. A GLB is re-packed and then, sometimes, its header and chunk headers are
+//! children made into cycles, deep chains and deep, wide trees, accessors declaring billions
+//! of elements, arrays repeated to multiply instances (up to and past the instance budget) and
+//! images, values of the wrong JSON type, deeply nested arrays, and normal-mapped meshes with
+//! hostile topologies for tangent generation (fans, repeated triangles, zero-area triangles,
+//! duplicated and degenerate uvs, one position with many uvs, random triangle soups). A GLB is re-packed and then, sometimes, its header and chunk headers are
 //! flipped, overwritten or truncated.
 //!
 //! Every case is written to a temporary folder (next to the seed's buffers and images) and
@@ -61,6 +63,7 @@ fn budgets() -> LoadOptions {
         max_lights: 1_000,
         max_node_depth: 64,
         max_image_bytes: 4 << 20,
+        max_tangent_triangles: 100_000,
     }
 }
 
@@ -469,9 +472,9 @@ fn fields_of(array: &str) -> &'static [&'static str] {
 fn mutate(doc: &mut Value, op: u8, selector: u32, value: u64, dir: &Path) {
     let mut m = Mix(value ^ u64::from(selector) << 32);
     let all = || paths(doc);
-    // The structure-aware mutations (2..=5, 8..=13) get more weight than the generic ones.
+    // The structure-aware mutations (2..=5, 8..=13, 16) get more weight than the generic ones.
     let op = match op % 20 {
-        16 | 17 => 2,
+        17 => 2,
         18 => 5,
         19 => 11,
         op => op,
@@ -622,17 +625,30 @@ fn mutate(doc: &mut Value, op: u8, selector: u32, value: u64, dir: &Path) {
                 }
             }
         }
-        // A deep chain of new nodes hung under a node or added as a scene root.
+        // A deep chain, or a deep and wide tree (every node with `branching` children, up to
+        // 5 000 nodes), of new nodes hung under a node or added as a scene root.
         9 => {
             let depth = *m.pick(&[10usize, 63, 64, 65, 100, 1000, 5000]);
+            let branching = if m.below(3) == 0 { *m.pick(&[2usize, 3, 10, 100]) } else { 1 };
             let Some(nodes) = doc.get_mut("nodes").and_then(Value::as_array_mut) else { return };
             let start = nodes.len();
             let mesh = if m.below(2) == 0 { Some(0) } else { None };
-            for k in 0..depth {
-                let mut node = json!({ "children": [start + k + 1] });
-                if k + 1 == depth {
-                    node = json!({});
-                }
+            // Breadth first: node k's children are branching * k + 1 ..= branching * (k + 1),
+            // stopping at `depth` levels or 5 000 nodes.
+            let mut count = 1usize;
+            let mut level = 1usize;
+            let mut width = 1usize;
+            while level < depth && count + width * branching <= 5000 {
+                width *= branching;
+                count += width;
+                level += 1;
+            }
+            for k in 0..count {
+                let children: Vec<usize> = (branching * k + 1..=branching * (k + 1))
+                    .filter(|&c| c < count)
+                    .map(|c| start + c)
+                    .collect();
+                let mut node = if children.is_empty() { json!({}) } else { json!({ "children": children }) };
                 if let Some(mesh) = mesh {
                     node["mesh"] = json!(mesh);
                 }
@@ -696,8 +712,10 @@ fn mutate(doc: &mut Value, op: u8, selector: u32, value: u64, dir: &Path) {
                 return;
             }
             let mesh = selector as usize % meshes;
-            let nodes_count = *m.pick(&[1usize, 10, 100, 1000]);
-            let prims_count = *m.pick(&[1usize, 10, 100, 1000]);
+            // Up to and past the 10 000 instances `budgets` allows (100 x 100, 1000 x 10,
+            // 5000 x 2 are exactly that, before the seed's own).
+            let nodes_count = *m.pick(&[1usize, 10, 100, 1000, 5000]);
+            let prims_count = *m.pick(&[1usize, 2, 10, 100, 1000]);
             if let Some(prims) =
                 doc.pointer_mut(&format!("/meshes/{mesh}/primitives")).and_then(Value::as_array_mut)
                 && let Some(p) = prims.first().cloned()
@@ -746,6 +764,8 @@ fn mutate(doc: &mut Value, op: u8, selector: u32, value: u64, dir: &Path) {
                 }
             }
         }
+        // A hostile topology on a new normal-mapped primitive, so tangents are generated.
+        16 => add_topology(doc, &mut m),
         // A value anywhere replaced by a value of another kind, or by another value of the doc.
         14 => {
             let every = all();
@@ -780,6 +800,148 @@ fn mutate(doc: &mut Value, op: u8, selector: u32, value: u64, dir: &Path) {
                 o.insert(key.to_owned(), json!("@@DEEP@@"));
             }
         }
+    }
+}
+
+/// Appends `value` to the top-level array `key` (created when absent) and returns its index;
+/// `None` when `key` holds something else.
+fn push(doc: &mut Value, key: &str, value: Value) -> Option<usize> {
+    let obj = doc.as_object_mut()?;
+    let arr = obj.entry(key).or_insert_with(|| json!([])).as_array_mut()?;
+    arr.push(value);
+    Some(arr.len() - 1)
+}
+
+/// A 2 x 2 flat normal map as a `data:` URI.
+fn normal_map_uri() -> String {
+    use base64::Engine as _;
+    let img = image::RgbaImage::from_pixel(2, 2, image::Rgba([128, 128, 255, 255]));
+    let mut png = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut png, image::ImageFormat::Png).expect("encode PNG");
+    format!("data:image/png;base64,{}", base64::engine::general_purpose::STANDARD.encode(png.into_inner()))
+}
+
+/// Adds a mesh with a hostile topology for tangent generation (MikkTSpace's costs grow with
+/// the triangles around a vertex, on an edge and at a position): a fan around one vertex,
+/// one triangle repeated, zero-area triangles, duplicated or degenerate uvs, one position
+/// with a different uv per triangle, or a random soup of triangles over a few vertices. Its
+/// primitive has `TEXCOORD_0`, no `TANGENT` and a normal-mapped material; a new root node
+/// draws it. The geometry goes in a new `data:` buffer (within the JSON budget).
+fn add_topology(doc: &mut Value, m: &mut Mix) {
+    // Triangles: mostly small (each case stays fast), now and then ten thousand.
+    let n = *m.pick(&[1usize, 3, 30, 300, 300, 1000, 1000, 3000, 10_000]);
+    let mut positions: Vec<[f32; 3]> = Vec::new();
+    let mut uvs: Vec<[f32; 2]> = Vec::new();
+    let mut indices: Vec<u32> = Vec::new();
+    let ring = |k: usize| {
+        let a = std::f32::consts::TAU * k as f32 / n as f32;
+        [a.cos(), a.sin(), 0.0]
+    };
+    match m.below(6) {
+        // A fan around vertex 0.
+        0 => {
+            positions.push([0.0; 3]);
+            positions.extend((0..=n).map(ring));
+            uvs.extend(positions.iter().map(|p| [p[0] * 0.5 + 0.5, 0.5 - p[1] * 0.5]));
+            indices.extend((0..n as u32).flat_map(|k| [0, k + 1, k + 2]));
+        }
+        // One triangle repeated (with either winding now and then).
+        1 => {
+            positions.extend([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+            uvs.extend([[0.0, 1.0], [1.0, 1.0], [0.0, 0.0]]);
+            let flip = m.below(2) == 0;
+            indices.extend((0..n).flat_map(|k| if flip && k % 3 == 0 { [0, 2, 1] } else { [0, 1, 2] }));
+        }
+        // Zero-area triangles (two corners at one position), some next to good ones.
+        2 => {
+            for k in 0..n {
+                let p = ring(k);
+                let base = positions.len() as u32;
+                positions.extend([p, p, [p[0], p[1], 1.0]]);
+                uvs.extend([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
+                indices.extend(if k % 4 == 0 { [base, base + 2, 0] } else { [base, base + 1, base + 2] });
+            }
+        }
+        // A strip whose uvs are all equal, or all on one line (zero uv area everywhere).
+        3 => {
+            let equal = m.below(2) == 0;
+            for k in 0..n + 2 {
+                positions.push([(k / 2) as f32, (k % 2) as f32, 0.0]);
+                uvs.push(if equal { [0.5, 0.5] } else { [k as f32 / (n + 2) as f32, 0.25] });
+            }
+            indices.extend((0..n as u32).flat_map(|k| [k, k + 1, k + 2]));
+        }
+        // A fan whose centre is repeated for each triangle with its own uv.
+        4 => {
+            for k in 0..n {
+                let base = positions.len() as u32;
+                positions.extend([[0.0; 3], ring(k), ring(k + 1)]);
+                uvs.extend([[k as f32 / n as f32, 0.0], [1.0, 0.0], [1.0, 1.0]]);
+                indices.extend([base, base + 1, base + 2]);
+            }
+        }
+        // A soup of random triangles over a few vertices: edges shared by many triangles
+        // with both windings.
+        _ => {
+            let v = 3 + m.below(14);
+            for k in 0..v {
+                positions.push([(k % 3) as f32, (k / 3 % 3) as f32, (k / 9) as f32]);
+                uvs.push([(k % 4) as f32 * 0.25, (k / 4) as f32 * 0.25]);
+            }
+            indices.extend((0..3 * n).map(|_| m.below(v) as u32));
+        }
+    }
+    let max_index = indices.iter().copied().max().unwrap_or(0);
+    let mut bin: Vec<u8> = positions.iter().flatten().flat_map(|f| f.to_le_bytes()).collect();
+    let uv_at = bin.len();
+    bin.extend(uvs.iter().flatten().flat_map(|f| f.to_le_bytes()));
+    let index_at = bin.len();
+    let component = match m.below(3) {
+        0 if max_index < 256 => {
+            bin.extend(indices.iter().map(|&i| i as u8));
+            5121
+        }
+        1 if max_index < 65_536 => {
+            bin.extend(indices.iter().flat_map(|&i| (i as u16).to_le_bytes()));
+            5123
+        }
+        _ => {
+            bin.extend(indices.iter().flat_map(|i| i.to_le_bytes()));
+            5125
+        }
+    };
+    let index_end = bin.len();
+    let buffer = {
+        use base64::Engine as _;
+        let uri = format!(
+            "data:application/octet-stream;base64,{}",
+            base64::engine::general_purpose::STANDARD.encode(&bin)
+        );
+        push(doc, "buffers", json!({ "byteLength": bin.len(), "uri": uri }))
+    };
+    let Some(buffer) = buffer else { return };
+    let views = [(0, uv_at), (uv_at, index_at), (index_at, index_end)].map(|(at, end)| {
+        push(doc, "bufferViews", json!({ "buffer": buffer, "byteOffset": at, "byteLength": end - at }))
+    });
+    let [Some(pv), Some(uv), Some(iv)] = views else { return };
+    let accessors = [
+        json!({ "bufferView": pv, "componentType": 5126, "count": positions.len(), "type": "VEC3" }),
+        json!({ "bufferView": uv, "componentType": 5126, "count": uvs.len(), "type": "VEC2" }),
+        json!({ "bufferView": iv, "componentType": component, "count": indices.len(), "type": "SCALAR" }),
+    ]
+    .map(|a| push(doc, "accessors", a));
+    let [Some(pa), Some(ua), Some(ia)] = accessors else { return };
+    let Some(image) = push(doc, "images", json!({ "uri": normal_map_uri() })) else { return };
+    let Some(texture) = push(doc, "textures", json!({ "source": image })) else { return };
+    let Some(material) = push(doc, "materials", json!({ "normalTexture": { "index": texture } })) else {
+        return;
+    };
+    let primitive =
+        json!({ "attributes": { "POSITION": pa, "TEXCOORD_0": ua }, "indices": ia, "material": material });
+    let Some(mesh) = push(doc, "meshes", json!({ "primitives": [primitive] })) else { return };
+    let Some(node) = push(doc, "nodes", json!({ "mesh": mesh })) else { return };
+    if let Some(roots) = doc.pointer_mut("/scenes/0/nodes").and_then(Value::as_array_mut) {
+        roots.push(json!(node));
     }
 }
 

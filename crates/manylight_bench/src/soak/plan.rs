@@ -59,13 +59,18 @@ fn cycle<T: Copy>(values: &[T], frame: u64, every: u64) -> T {
 }
 
 impl Plan {
-    /// Refuses an empty list or a zero period, naming the option.
+    /// Refuses an empty list, a zero period or a light count that cannot fit, naming the option.
     pub fn validate(&self) -> Result<(), String> {
         if self.sizes.is_empty() {
             return Err("--sizes: give at least one size".into());
         }
         if self.light_counts.is_empty() {
             return Err("--lights: give at least one light count".into());
+        }
+        for &count in &self.light_counts {
+            use manylight_core::light_count::{APP_BYTES_PER_LIGHT, LightLimit, check_light_count};
+            check_light_count(count, LightLimit::INDICES, APP_BYTES_PER_LIGHT)
+                .map_err(|e| format!("--lights: {e}"))?;
         }
         for (name, every) in [
             ("--resize-every", self.resize_every),

@@ -3,8 +3,9 @@
 //! Images are decoded to sRGB RGBA8 once per distinct source (the same resolved file, the same
 //! `data:` URI or the same buffer view), however many `images` entries name it. Dimensions
 //! are read from the image header and checked against `LoadOptions::max_texture_size` and
-//! the `LoadOptions::max_image_bytes` budget before any pixel is decoded, so a tiny file that
-//! declares a huge image, or names one image many times, costs nothing.
+//! the `LoadOptions::max_image_bytes` budget before any pixel is decoded — the decode's peak (a
+//! 16-bit source beside its RGBA8 copy) and what stays (RGBA8 with its mip chain) — so a tiny
+//! file that declares a huge image, or names one image many times, costs nothing.
 //!
 //! Colour textures (base colour, emissive) use the sRGB decode; data textures
 //! (metallic-roughness, normal, occlusion) use a linear copy of the same pixels, made once per
@@ -402,7 +403,7 @@ impl<'a> Ctx<'a> {
             return Ok(t.clone());
         }
         // The same pixels, sampled without the sRGB decode; counted in the decoded-bytes budget.
-        let needed = self.used.image_bytes.saturating_add(data.rgba8.len() as u64);
+        let needed = self.used.image_bytes.saturating_add(mip_chain_bytes(data.width, data.height));
         if needed > self.options.max_image_bytes {
             let what = format!("image {image} as linear data (with the images decoded before it)");
             let (unit, limit) = ("bytes of decoded images", self.options.max_image_bytes);
@@ -496,7 +497,7 @@ impl<'a> Ctx<'a> {
         };
         let data = self.decode(index, &bytes, format, label)?;
         drop(bytes);
-        self.used.image_bytes += data.rgba8.len() as u64;
+        self.used.image_bytes += mip_chain_bytes(data.width, data.height);
         let data = Arc::new(data);
         self.textures.insert(index, data.clone());
         self.images.insert(source, data.clone());
@@ -539,8 +540,19 @@ impl<'a> Ctx<'a> {
                 message: "image has zero size".into(),
             });
         }
-        // Decoded as RGBA8; counted with the images decoded before it.
-        let needed = self.used.image_bytes.saturating_add(width as u64 * height as u64 * 4);
+        // Counted with the images decoded before it: what the decode holds at its peak, and
+        // what stays (`DecodeCost`).
+        let (kept_width, kept_height) =
+            if width > max || height > max { downscaled_size(width, height, max) } else { (width, height) };
+        let cost = DecodeCost {
+            source: decoder.total_bytes(),
+            converts: decoder.color_type() != image::ColorType::Rgba8,
+            width,
+            height,
+            kept_width,
+            kept_height,
+        };
+        let needed = self.used.image_bytes.saturating_add(cost.peak().max(cost.kept()));
         if needed > self.options.max_image_bytes {
             let what = format!("image {index} (with the images decoded before it)");
             let (unit, limit) = ("bytes of decoded images", self.options.max_image_bytes);
@@ -553,11 +565,9 @@ impl<'a> Ctx<'a> {
         limits.max_alloc = Some((width as u64 * height as u64 * 8 * 2).max(512 << 20));
         decoder.set_limits(limits).map_err(decode_err)?;
         let mut rgba = image::DynamicImage::from_decoder(decoder).map_err(decode_err)?.into_rgba8();
-        if width > max || height > max {
+        if (kept_width, kept_height) != (width, height) {
             // Only with OversizedTextures::Downscale: the larger side becomes `max`.
-            let scale = max as f64 / width.max(height) as f64;
-            let w = ((width as f64 * scale).round() as u32).clamp(1, max);
-            let h = ((height as f64 * scale).round() as u32).clamp(1, max);
+            let (w, h) = (kept_width, kept_height);
             tracing::info!(
                 "{}: image {index} is {width}x{height}, downscaled to {w}x{h}",
                 self.path.display()
@@ -566,5 +576,81 @@ impl<'a> Ctx<'a> {
         }
         let (width, height) = rgba.dimensions();
         Ok(TextureData { label, width, height, rgba8: rgba.into_raw(), srgb: true })
+    }
+}
+
+/// `width` × `height` scaled so that the larger side becomes `max` (each side at least 1).
+fn downscaled_size(width: u32, height: u32, max: u32) -> (u32, u32) {
+    let scale = max as f64 / width.max(height) as f64;
+    let w = ((width as f64 * scale).round() as u32).clamp(1, max);
+    let h = ((height as f64 * scale).round() as u32).clamp(1, max);
+    (w, h)
+}
+
+/// Bytes an RGBA8 image of `width` × `height` takes with its whole mip chain, as the renderer
+/// builds it at upload (each level half the size of the one before, down to 1 × 1).
+pub(crate) fn mip_chain_bytes(width: u32, height: u32) -> u64 {
+    let (mut w, mut h, mut total) = (width.max(1) as u64, height.max(1) as u64, 0u64);
+    loop {
+        total = total.saturating_add(w.saturating_mul(h).saturating_mul(4));
+        if w == 1 && h == 1 {
+            return total;
+        }
+        (w, h) = ((w / 2).max(1), (h / 2).max(1));
+    }
+}
+
+/// The memory one image decode takes, counted in `LoadOptions::max_image_bytes` before it runs.
+struct DecodeCost {
+    /// Bytes of the image in the source's own pixel format (16-bit RGBA: 8 a pixel).
+    source: u64,
+    /// Whether the decoded image is converted to RGBA8 (a second copy while both are held).
+    converts: bool,
+    /// Source size.
+    width: u32,
+    height: u32,
+    /// Size kept (after a downscale).
+    kept_width: u32,
+    kept_height: u32,
+}
+
+impl DecodeCost {
+    /// Most bytes held at once while decoding: the source-format image with its RGBA8 copy,
+    /// then the RGBA8 image with its downscaled copy.
+    fn peak(&self) -> u64 {
+        let rgba = self.width as u64 * self.height as u64 * 4;
+        let converting = self.source.saturating_add(if self.converts { rgba } else { 0 });
+        let downscaled = (self.kept_width, self.kept_height) != (self.width, self.height);
+        let resizing =
+            if downscaled { rgba + self.kept_width as u64 * self.kept_height as u64 * 4 } else { 0 };
+        converting.max(resizing)
+    }
+
+    /// Bytes that stay once decoded: the RGBA8 image with its mip chain.
+    fn kept(&self) -> u64 {
+        mip_chain_bytes(self.kept_width, self.kept_height)
+    }
+}
+
+#[cfg(test)]
+mod decode_cost_tests {
+    use super::*;
+
+    #[test]
+    fn a_16_bit_source_costs_its_own_bytes_and_the_rgba8_copy() {
+        let cost =
+            DecodeCost { source: 8 * 64, converts: true, width: 8, height: 8, kept_width: 8, kept_height: 8 };
+        assert_eq!(cost.peak(), 8 * 64 + 4 * 64);
+        assert_eq!(cost.kept(), 4 * (64 + 16 + 4 + 1));
+        let rgba8 = DecodeCost { source: 4 * 64, converts: false, ..cost };
+        assert_eq!(rgba8.peak(), 4 * 64);
+    }
+
+    #[test]
+    fn mip_chains_of_odd_and_flat_images_end_at_one_pixel() {
+        assert_eq!(mip_chain_bytes(1, 1), 4);
+        assert_eq!(mip_chain_bytes(4, 1), 4 * (4 + 2 + 1));
+        assert_eq!(mip_chain_bytes(3, 5), 4 * (15 + 2 + 1));
+        assert!(mip_chain_bytes(u32::MAX, u32::MAX) > 0);
     }
 }

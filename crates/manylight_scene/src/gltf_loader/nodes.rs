@@ -8,6 +8,7 @@ use gltf::json::extensions::scene::khr_lights_punctual::Type as LightType;
 use gltf::json::mesh::{Mode, Semantic};
 use gltf::json::validation::Checked;
 use manylight_core::attenuation::RANGELESS_LIGHT_CUTOFF;
+use manylight_core::mesh::TangentMethod;
 use manylight_core::{MeshData, Projection, SpotCone, radius_for_intensity};
 use std::f32::consts::FRAC_PI_2;
 use std::sync::Arc;
@@ -197,9 +198,11 @@ impl Ctx<'_> {
     /// `LoadOptions::max_vertices` and `LoadOptions::max_indices`, before any is read.
     ///
     /// Tangents come from `TANGENT`; without it, when the primitive is `normal_mapped` and
-    /// has `TEXCOORD_0`, they are generated with MikkTSpace, as the glTF specification asks
-    /// (once per mesh, also when the mesh was first converted for a primitive without a
-    /// normal map).
+    /// has `TEXCOORD_0`, they are generated (`MeshData::generate_tangents`: MikkTSpace, as
+    /// the glTF specification asks, or per-vertex UV derivatives with a warning where
+    /// MikkTSpace's cost on the mesh is not bounded), once per mesh, also when the mesh was
+    /// first converted for a primitive without a normal map; its triangles count against
+    /// `LoadOptions::max_tangent_triangles` before anything is read or generated.
     fn primitive_mesh(
         &mut self,
         mesh: usize,
@@ -226,9 +229,12 @@ impl Ctx<'_> {
         if let Some(&index) = self.meshes.get(&key) {
             if let Some(i) = index
                 && generate_tangents
-                && self.generated_tangents.insert(i)
+                && !self.generated_tangents.contains(&i)
             {
-                Arc::make_mut(&mut self.scene.meshes[i]).generate_tangents();
+                self.count_tangent_triangles(self.scene.meshes[i].triangle_count() as u64, mesh, p)?;
+                self.generated_tangents.insert(i);
+                let method = Arc::make_mut(&mut self.scene.meshes[i]).generate_tangents();
+                self.report_tangents(method, mesh, p, i);
             }
             return Ok(index);
         }
@@ -280,6 +286,9 @@ impl Ctx<'_> {
         if used_indices > options.max_indices {
             let limit = options.max_indices;
             return Err(over_budget(self.path, what_all(), used_indices, "indices", limit, "max_indices"));
+        }
+        if generate_tangents {
+            self.count_tangent_triangles(indices as u64 / 3, mesh, p)?;
         }
         self.used.vertices = used_vertices;
         self.used.indices = used_indices;
@@ -339,15 +348,50 @@ impl Ctx<'_> {
         if let Some(u) = &uv1 {
             data.set_uv1(u);
         }
+        let mut method = None;
         if let Some(t) = &tangents {
             data.set_tangents(t);
         } else if generate_tangents {
-            data.generate_tangents();
-            self.generated_tangents.insert(index);
+            method = Some(data.generate_tangents());
         }
         self.scene.meshes.push(Arc::new(data));
         self.meshes.insert(key, Some(index));
+        if let Some(method) = method {
+            self.generated_tangents.insert(index);
+            self.report_tangents(method, mesh, p, index);
+        }
         Ok(Some(index))
+    }
+
+    /// Counts `triangles` more triangles with generated tangents (primitive `p` of mesh
+    /// `mesh`) against `LoadOptions::max_tangent_triangles`.
+    fn count_tangent_triangles(&mut self, triangles: u64, mesh: usize, p: usize) -> Result<(), SceneError> {
+        let used = self.used.tangent_triangles.saturating_add(triangles);
+        let limit = self.options.max_tangent_triangles;
+        if used > limit {
+            return Err(over_budget(
+                self.path,
+                format!("mesh {mesh} primitive {p} (with the meshes before it)"),
+                used,
+                "triangles with generated tangents",
+                limit,
+                "max_tangent_triangles",
+            ));
+        }
+        self.used.tangent_triangles = used;
+        Ok(())
+    }
+
+    /// Warns when the tangents of scene mesh `index` (primitive `p` of mesh `mesh`) came from
+    /// the UV-derivative fallback rather than MikkTSpace.
+    fn report_tangents(&self, method: TangentMethod, mesh: usize, p: usize, index: usize) {
+        if let TangentMethod::UvDerivatives(reason) = method {
+            tracing::warn!(
+                file = %self.path.display(), mesh, primitive = p, label = %self.scene.meshes[index].label,
+                %reason,
+                "tangents generated from UV derivatives instead of MikkTSpace; normal maps may shade differently from the authoring tool"
+            );
+        }
     }
 
     /// Scene material index for glTF material `material` (`None`: the default material).
@@ -485,6 +529,11 @@ impl Ctx<'_> {
             (Checked::Valid(CameraType::Orthographic), _, Some(o)) => {
                 if !(o.ymag.is_finite() && o.ymag > 0.0 && o.xmag.is_finite() && o.xmag > 0.0) {
                     return Err(bad("xmag and ymag must be finite and positive"));
+                }
+                // The view's height is 2 · ymag: 3e38 would overflow to infinity.
+                let max_ymag = manylight_core::camera::MAX_ORTHOGRAPHIC_HEIGHT / 2.0;
+                if o.ymag > max_ymag {
+                    return Err(bad("ymag must be at most 5e29 (MAX_ORTHOGRAPHIC_HEIGHT / 2)"));
                 }
                 if !(o.znear.is_finite() && o.znear >= 0.0 && o.zfar.is_finite() && o.zfar > o.znear) {
                     return Err(bad(
