@@ -15,6 +15,7 @@ pub mod image_metrics;
 pub mod light_count;
 pub mod material;
 pub mod mesh;
+pub mod shadow_oracle;
 pub mod spot;
 pub mod tonemap;
 
