@@ -13,7 +13,7 @@ use manylight::app::RenderFailure;
 use manylight::app::cli::parse_pipeline;
 use manylight::app::headless::save_png;
 use manylight::app::window::WindowConfig;
-use manylight::core::light_count::{APP_BYTES_PER_LIGHT, LightLimit, check_light_count};
+use manylight::core::light_count::check_app_lights;
 use manylight::prelude::*;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -134,7 +134,7 @@ fn run_headless(lights: usize, settings: RenderSettings, out_dir: PathBuf) -> an
 fn main() -> ExitCode {
     tracing_subscriber::fmt().with_env_filter("warn,winit=error,manylight_app=info").init();
     let args = Args::parse();
-    if let Err(e) = check_light_count(args.lights, LightLimit::INDICES, APP_BYTES_PER_LIGHT) {
+    if let Err(e) = check_app_lights(args.lights) {
         eprintln!("error: --lights: {e}");
         return ExitCode::FAILURE;
     }

@@ -12,7 +12,7 @@
 use clap::Parser;
 use manylight::app::window::WindowConfig;
 use manylight::core::Aabb;
-use manylight::core::light_count::{APP_BYTES_PER_LIGHT, LightLimit, check_light_count};
+use manylight::core::light_count::check_app_lights;
 use manylight::prelude::*;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -64,7 +64,7 @@ fn main() -> ExitCode {
         scene.lights.extend(studio);
     }
     let lights = args.lights.unwrap_or(0);
-    if let Err(e) = check_light_count(lights, LightLimit::INDICES, APP_BYTES_PER_LIGHT) {
+    if let Err(e) = check_app_lights(lights) {
         eprintln!("error: --lights: {e}");
         return ExitCode::FAILURE;
     }

@@ -7,7 +7,7 @@ use crate::components::{
 use bevy_ecs::name::Name;
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
-use manylight_core::{Aabb, LightCountError, LightLimit, check_light_count, lumens_from_candela};
+use manylight_core::{Aabb, LightCountError, lumens_from_candela};
 use manylight_render::{
     ExtractedCamera, ExtractedDirectionalLight, ExtractedInstance, ExtractedPointLight, ExtractedView,
     FrameSettings, FrameSnapshot,
@@ -161,7 +161,7 @@ pub fn spawn_light_rig(
     bounds: Aabb,
     seed: u64,
 ) -> Result<(), LightCountError> {
-    check_light_count(count, LightLimit::INDICES, manylight_core::light_count::APP_BYTES_PER_LIGHT)?;
+    manylight_core::light_count::check_app_lights(count)?;
     for anim in light_rig(count, bounds, seed)? {
         commands.spawn((
             Transform::from_translation(anim.position_at(0.0)),

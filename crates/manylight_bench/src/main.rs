@@ -816,12 +816,9 @@ fn main() -> ExitCode {
             Ok(())
         }
         Command::CodecAccuracy { samples } => codec_accuracy_cmd(samples.max(1)),
-        Command::CullingTests { lights, seed } => {
-            use manylight_core::light_count::{APP_BYTES_PER_LIGHT, LightLimit, check_light_count};
-            check_light_count(lights, LightLimit::INDICES, APP_BYTES_PER_LIGHT)
-                .map_err(anyhow::Error::from)
-                .map(|()| print!("{}", culling_tests::table(lights, seed)))
-        }
+        Command::CullingTests { lights, seed } => manylight_core::light_count::check_app_lights(lights)
+            .map_err(anyhow::Error::from)
+            .map(|()| print!("{}", culling_tests::table(lights, seed))),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -77,6 +77,12 @@ pub fn check_light_count(
     check_light_count_within(count, limit, bytes_per_light, available_memory())
 }
 
+/// The check for lights an app spawns before any device is known: [`LightLimit::INDICES`] and
+/// the memory available at [`APP_BYTES_PER_LIGHT`] a light.
+pub fn check_app_lights(count: usize) -> Result<(), LightCountError> {
+    check_light_count(count, LightLimit::INDICES, APP_BYTES_PER_LIGHT)
+}
+
 /// [`check_light_count`] against `available` bytes of memory (`None`: unknown, not checked).
 pub fn check_light_count_within(
     count: usize,

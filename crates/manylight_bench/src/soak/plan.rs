@@ -68,9 +68,7 @@ impl Plan {
             return Err("--lights: give at least one light count".into());
         }
         for &count in &self.light_counts {
-            use manylight_core::light_count::{APP_BYTES_PER_LIGHT, LightLimit, check_light_count};
-            check_light_count(count, LightLimit::INDICES, APP_BYTES_PER_LIGHT)
-                .map_err(|e| format!("--lights: {e}"))?;
+            manylight_core::light_count::check_app_lights(count).map_err(|e| format!("--lights: {e}"))?;
         }
         for (name, every) in [
             ("--resize-every", self.resize_every),
