@@ -30,7 +30,7 @@ fn setup(mut commands: Commands) {
     // Dim moonlight from above and to the side, reaching every surface that faces it.
     commands.spawn((
         Transform::default().looking_to(Vec3::new(0.3, -1.0, 0.4), Vec3::Y),
-        DirectionalLight { color: Vec3::new(0.6, 0.7, 1.0), illuminance: 0.15 },
+        DirectionalLight { color: Vec3::new(0.6, 0.7, 1.0), illuminance: 0.15, ..Default::default() },
     ));
 }
 

@@ -186,6 +186,7 @@ pub fn sync_light_count(
                     intensity: lumens_from_candela(l.intensity),
                     range: l.radius * scale,
                     radius: 0.0,
+                    ..Default::default()
                 },
                 ShellLight { base_radius: l.radius },
             )
@@ -203,6 +204,7 @@ pub fn sync_light_count(
                     intensity: lumens_from_candela(a.intensity),
                     range: a.radius * scale,
                     radius: 0.0,
+                    ..Default::default()
                 },
                 StressLight(a),
             )

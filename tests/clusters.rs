@@ -44,7 +44,7 @@ fn shell_lights() -> Vec<ExtractedPointLight> {
 }
 
 fn light(position: Vec3, radius: f32) -> ExtractedPointLight {
-    ExtractedPointLight { position, color: Vec3::ONE, intensity: 1.0, radius, spot: None }
+    ExtractedPointLight { position, color: Vec3::ONE, intensity: 1.0, radius, spot: None, shadow: None }
 }
 
 /// Clustered forward with whole slices: the lists the CPU reference (`assign_lights`) builds.

@@ -229,6 +229,7 @@ fn light_volumes_plan_only_what_they_need() {
         intensity: 1.0,
         radius: 2.0,
         spot: None,
+        shadow: None,
     };
     let settings = FrameSettings {
         render: RenderSettings { pipeline: PipelineKind::LightVolumes, ..Default::default() },

@@ -23,7 +23,13 @@ fn next_frame(app: &mut App) -> image::RgbaImage {
 
 /// A bright light that makes a visible spot on the default scene's floor.
 fn spot_light() -> PointLight {
-    PointLight { color: Vec3::new(1.0, 0.3, 0.1), intensity: 1000.0, range: 5.0, radius: 0.0 }
+    PointLight {
+        color: Vec3::new(1.0, 0.3, 0.1),
+        intensity: 1000.0,
+        range: 5.0,
+        radius: 0.0,
+        ..Default::default()
+    }
 }
 
 /// The default scene with its camera and one light, placed by `light` in `Startup`.

@@ -96,6 +96,7 @@ fn orthographic_gpu_lists_equal_the_cpu_reference() {
             intensity: 1.0,
             radius,
             spot: None,
+            shadow: None,
         });
     }
     for cull in [CullTest::Aabb, CullTest::Planes, CullTest::Both] {

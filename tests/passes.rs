@@ -159,7 +159,13 @@ fn set_point(app: &mut App, p: Point) {
         for l in &default_scene().lights {
             world.spawn((
                 Transform::from_translation(l.position),
-                PointLight { color: l.color, intensity: l.intensity, range: l.radius, radius: 0.0 },
+                PointLight {
+                    color: l.color,
+                    intensity: l.intensity,
+                    range: l.radius,
+                    radius: 0.0,
+                    ..Default::default()
+                },
             ));
         }
     } else if !p.lights {
@@ -484,4 +490,30 @@ fn refined_lists_plan_a_refine_pass_where_distances_are_known() {
         with(ClusteredForward, true, true, true, true),
         ["depth_prepass", "cluster_build", "debug_view"]
     );
+}
+
+#[test]
+fn the_shadow_pass_runs_only_where_a_light_casts_and_lights_are_shaded() {
+    for deferred in [false, true] {
+        let p = Point { lights: true, bloom: false, motion_blur: false, deferred, debug: false };
+        let casting = || {
+            let mut s = snapshot(p);
+            s.lights.iter_mut().for_each(|l| *l = manylight::app::scene::with_shadow(*l, true));
+            s
+        };
+        let mut with_shadows = vec!["shadow_maps"];
+        with_shadows.extend(expected(p));
+        assert_eq!(plan_passes(casting()).unwrap(), with_shadows, "{p:?}");
+        // No light casts: today's list, unchanged.
+        assert_eq!(plan_passes(snapshot(p)).unwrap(), expected(p), "{p:?}");
+        // Shadows turned off for the view: no shadow pass though the lights cast.
+        let mut off = casting();
+        off.settings.render.shadows.enabled = false;
+        assert_eq!(plan_passes(off).unwrap(), expected(p), "{p:?}");
+        // A debug view that replaces shading draws no shadow maps.
+        let debug = Point { debug: true, ..p };
+        let mut s = snapshot(debug);
+        s.lights.iter_mut().for_each(|l| *l = manylight::app::scene::with_shadow(*l, true));
+        assert_eq!(plan_passes(s).unwrap(), expected(debug), "{debug:?}");
+    }
 }

@@ -64,7 +64,7 @@ fn point_light_lumens_are_scene_light_candela() {
             let intensity = lumens_from_candela(l.intensity);
             commands.spawn((
                 Transform::from_translation(l.position),
-                PointLight { color: l.color, intensity, range: l.radius, radius: 0.0 },
+                PointLight { color: l.color, intensity, range: l.radius, radius: 0.0, ..Default::default() },
             ));
         }
         commands.spawn((camera(), Camera3d));

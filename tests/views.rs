@@ -30,7 +30,7 @@ fn scene(commands: &mut Commands) {
         let color = Vec3::new(1.0, 0.4 + 0.5 * (i % 3) as f32 / 2.0, 0.2 + 0.6 * (i % 5) as f32 / 4.0);
         commands.spawn((
             Transform::from_xyz(x, 0.6, z),
-            PointLight { color, intensity: 400.0, range: 4.0, radius: 0.0 },
+            PointLight { color, intensity: 400.0, range: 4.0, radius: 0.0, ..Default::default() },
         ));
     }
 }

@@ -81,7 +81,7 @@ fn spawn_small_scene(mut commands: Commands) {
         let color = Vec3::new(0.5 + 0.5 * a.cos(), 0.5 + 0.5 * a.sin(), 0.6);
         commands.spawn((
             Transform::from_xyz(3.0 * a.cos(), 1.5, 3.0 * a.sin()),
-            PointLight { color, intensity: 50.0, range: 6.0, radius: 0.0 },
+            PointLight { color, intensity: 50.0, range: 6.0, radius: 0.0, ..Default::default() },
         ));
     }
     commands.spawn((Transform::from_xyz(0.0, 4.0, 7.0).looking_at(Vec3::ZERO, Vec3::Y), Camera3d));

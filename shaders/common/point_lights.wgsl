@@ -2,6 +2,9 @@
 // `SceneResources::view_layout`) and the shading of one of them by index.
 //!include common/lights.wgsl
 //!include common/brdf.wgsl
+//!if SHADOWS
+//!include common/shadows.wgsl
+//!endif
 
 @group(0) @binding(1) var<storage, read> lights: array<GpuPointLight>;
 
@@ -14,5 +17,10 @@ fn shade_light(s: SurfaceParams, position: vec3<f32>, view_dir: vec3<f32>, k: u3
     if reach.attenuation <= 0.0 {
         return vec3<f32>(0.0);
     }
-    return shade_reached_light(s, reach, view_dir, lights[k].color, lights[k].spot);
+    let radiance = shade_reached_light(s, reach, view_dir, lights[k].color, lights[k].spot);
+//!if SHADOWS
+    return radiance * shadow_visibility(k, lights[k].position_radius.xyz, position, s.normal);
+//!else
+    return radiance;
+//!endif
 }

@@ -3,6 +3,7 @@
 use bevy_ecs::prelude::*;
 use glam::{Mat4, Quat, Vec3};
 use manylight_core::{MaterialData, MeshData};
+use manylight_render::snapshot::ShadowBias;
 use std::sync::Arc;
 
 pub use bevy_transform::components::{GlobalTransform, Transform};
@@ -251,11 +252,40 @@ pub struct PointLight {
     /// Radius of the emitting sphere. Kept for Bevy's vocabulary; the shading treats every
     /// light as a point, so it does not change the image.
     pub radius: f32,
+    /// The light casts shadows (a cube of six faces in the shadow atlas; off by default, as in
+    /// Bevy).
+    pub shadows_enabled: bool,
+    /// World units the shadow test moves the shaded point towards the light (against acne).
+    pub shadow_depth_bias: f32,
+    /// Shadow-map texels the shadow test moves the shaded point off the surface along its
+    /// normal (against acne on surfaces at grazing angles).
+    pub shadow_normal_bias: f32,
+}
+
+impl PointLight {
+    /// Bevy's default `shadow_depth_bias` of a point light.
+    pub const DEFAULT_SHADOW_DEPTH_BIAS: f32 = ShadowBias::POINT.depth;
+    /// Bevy's default `shadow_normal_bias` of a point light.
+    pub const DEFAULT_SHADOW_NORMAL_BIAS: f32 = ShadowBias::POINT.normal;
+
+    /// The light's shadow biases when it casts.
+    pub fn shadow(&self) -> Option<ShadowBias> {
+        self.shadows_enabled
+            .then_some(ShadowBias { depth: self.shadow_depth_bias, normal: self.shadow_normal_bias })
+    }
 }
 
 impl Default for PointLight {
     fn default() -> Self {
-        Self { color: Vec3::ONE, intensity: 800.0, range: 10.0, radius: 0.0 }
+        Self {
+            color: Vec3::ONE,
+            intensity: 800.0,
+            range: 10.0,
+            radius: 0.0,
+            shadows_enabled: false,
+            shadow_depth_bias: Self::DEFAULT_SHADOW_DEPTH_BIAS,
+            shadow_normal_bias: Self::DEFAULT_SHADOW_NORMAL_BIAS,
+        }
     }
 }
 
@@ -280,6 +310,25 @@ pub struct SpotLight {
     pub inner_angle: f32,
     /// Angle from the axis, in radians, at which the light reaches zero (at most π/2).
     pub outer_angle: f32,
+    /// The light casts shadows (off by default, as in Bevy).
+    pub shadows_enabled: bool,
+    /// World units the shadow test moves the shaded point towards the light.
+    pub shadow_depth_bias: f32,
+    /// Shadow-map texels the shadow test moves the shaded point off the surface.
+    pub shadow_normal_bias: f32,
+}
+
+impl SpotLight {
+    /// Bevy's default `shadow_depth_bias` of a spot light.
+    pub const DEFAULT_SHADOW_DEPTH_BIAS: f32 = ShadowBias::SPOT.depth;
+    /// Bevy's default `shadow_normal_bias` of a spot light.
+    pub const DEFAULT_SHADOW_NORMAL_BIAS: f32 = ShadowBias::SPOT.normal;
+
+    /// The light's shadow biases when it casts.
+    pub fn shadow(&self) -> Option<ShadowBias> {
+        self.shadows_enabled
+            .then_some(ShadowBias { depth: self.shadow_depth_bias, normal: self.shadow_normal_bias })
+    }
 }
 
 impl Default for SpotLight {
@@ -291,6 +340,9 @@ impl Default for SpotLight {
             radius: 0.0,
             inner_angle: 0.0,
             outer_angle: std::f32::consts::FRAC_PI_4,
+            shadows_enabled: false,
+            shadow_depth_bias: Self::DEFAULT_SHADOW_DEPTH_BIAS,
+            shadow_normal_bias: Self::DEFAULT_SHADOW_NORMAL_BIAS,
         }
     }
 }
@@ -306,11 +358,31 @@ pub struct DirectionalLight {
     pub color: Vec3,
     /// Illuminance in lux, multiplying `color`.
     pub illuminance: f32,
+    /// Asks for shadows. Directional shadows (cascades fitted to the view) are not drawn yet:
+    /// a casting directional light lights through everything.
+    pub shadows_enabled: bool,
+    /// World units the shadow test moves the shaded point towards the light.
+    pub shadow_depth_bias: f32,
+    /// Shadow-map texels the shadow test moves the shaded point off the surface.
+    pub shadow_normal_bias: f32,
+}
+
+impl DirectionalLight {
+    /// Bevy's default `shadow_depth_bias` of a directional light.
+    pub const DEFAULT_SHADOW_DEPTH_BIAS: f32 = 0.02;
+    /// Bevy's default `shadow_normal_bias` of a directional light.
+    pub const DEFAULT_SHADOW_NORMAL_BIAS: f32 = 1.8;
 }
 
 impl Default for DirectionalLight {
     fn default() -> Self {
-        Self { color: Vec3::ONE, illuminance: 1.0 }
+        Self {
+            color: Vec3::ONE,
+            illuminance: 1.0,
+            shadows_enabled: false,
+            shadow_depth_bias: Self::DEFAULT_SHADOW_DEPTH_BIAS,
+            shadow_normal_bias: Self::DEFAULT_SHADOW_NORMAL_BIAS,
+        }
     }
 }
 

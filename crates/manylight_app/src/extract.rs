@@ -135,12 +135,12 @@ pub fn build_snapshot(
         // One light per entity: a point light wins over a spot light, which wins over a
         // directional one. Point and spot lights come in lumens (Bevy's unit) and render in
         // candela.
-        let (color, lumens, range, cone) = match (point, spot, directional) {
-            (Some(l), ..) => (l.color, l.intensity, l.range, None),
+        let (color, lumens, range, cone, shadow) = match (point, spot, directional) {
+            (Some(l), ..) => (l.color, l.intensity, l.range, None, l.shadow()),
             (None, Some(l), _) => {
                 let direction = t.forward().into();
                 let cone = SpotCone { direction, inner_angle: l.inner_angle, outer_angle: l.outer_angle };
-                (l.color, l.intensity, l.range, Some(cone))
+                (l.color, l.intensity, l.range, Some(cone), l.shadow())
             }
             (None, None, Some(l)) => {
                 let direction = t.forward().into();
@@ -159,6 +159,7 @@ pub fn build_snapshot(
             intensity: candela_from_lumens(lumens),
             radius: range,
             spot: cone,
+            shadow,
         });
     }
     let snapshot = FrameSnapshot {

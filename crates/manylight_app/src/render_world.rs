@@ -38,9 +38,10 @@ pub struct CurrentSnapshot(pub FrameSnapshot);
 
 /// The view being rendered (its camera, image size and settings), whether the frame has
 /// lights to shade it with, whether it draws blended materials, and whether it brings its own
-/// per-pixel light lists (`FrameSnapshot::pixel_light_lists`).
+/// per-pixel light lists (`FrameSnapshot::pixel_light_lists`), and whether a light casts a
+/// shadow (`FrameSnapshot::casts_shadows`).
 #[derive(Resource, Clone, Copy, Debug)]
-pub struct CurrentView(pub RenderView, pub bool, pub bool, pub bool);
+pub struct CurrentView(pub RenderView, pub bool, pub bool, pub bool, pub bool);
 
 impl CurrentView {
     /// View `index` of `snapshot`.
@@ -50,6 +51,7 @@ impl CurrentView {
             snapshot.has_lights(),
             snapshot.has_blended(),
             snapshot.pixel_light_lists.is_some(),
+            snapshot.casts_shadows(),
         )
     }
 
@@ -72,6 +74,7 @@ impl CurrentView {
             has_lights: self.has_lights(),
             has_blended: self.has_blended(),
             has_pixel_lists: self.has_pixel_lists(),
+            casts_shadows: self.4,
             accumulation,
         }
     }

@@ -10,7 +10,7 @@ use glam::{Quat, Vec3};
 use manylight_core::{Aabb, LightCountError, lumens_from_candela};
 use manylight_render::{
     ExtractedCamera, ExtractedDirectionalLight, ExtractedInstance, ExtractedPointLight, ExtractedView,
-    FrameSettings, FrameSnapshot,
+    FrameSettings, FrameSnapshot, ShadowBias,
 };
 use manylight_scene::light_rig;
 use manylight_scene::{Scene, SceneLight};
@@ -79,7 +79,7 @@ pub fn spawn_scene(commands: &mut Commands, scene: &Scene, spawn_camera: bool, a
     for l in &scene.directional_lights {
         let rotation =
             Quat::from_rotation_arc(Vec3::NEG_Z, l.direction.try_normalize().unwrap_or(Vec3::NEG_Z));
-        let light = DirectionalLight { color: l.color, illuminance: l.illuminance };
+        let light = DirectionalLight { color: l.color, illuminance: l.illuminance, ..Default::default() };
         commands.spawn((Transform::from_rotation(rotation), light, ChildOf(root)));
     }
     if spawn_camera && !camera_placed {
@@ -121,7 +121,8 @@ fn spawn_light(commands: &mut Commands, light: &SceneLight, local: Transform, on
     let (color, intensity, range) = (light.color, lumens_from_candela(light.intensity), light.radius);
     match &light.spot {
         None => {
-            commands.spawn((local, PointLight { color, intensity, range, radius: 0.0 }, ChildOf(parent)));
+            let point = PointLight { color, intensity, range, radius: 0.0, ..Default::default() };
+            commands.spawn((local, point, ChildOf(parent)));
         }
         Some(cone) => {
             let mut transform = local;
@@ -135,6 +136,7 @@ fn spawn_light(commands: &mut Commands, light: &SceneLight, local: Transform, on
                 radius: 0.0,
                 inner_angle: cone.inner_angle,
                 outer_angle: cone.outer_angle,
+                ..Default::default()
             };
             commands.spawn((transform, spot, ChildOf(parent)));
         }
@@ -170,6 +172,7 @@ pub fn spawn_light_rig(
                 intensity: lumens_from_candela(anim.intensity),
                 range: anim.radius,
                 radius: 0.0,
+                ..Default::default()
             },
             LightAnimation(anim),
         ));
@@ -185,7 +188,32 @@ pub fn extracted_light(l: &SceneLight) -> ExtractedPointLight {
         intensity: l.intensity,
         radius: l.radius,
         spot: l.spot,
+        shadow: None,
     }
+}
+
+/// Turns shadows on or off for every point, spot and directional light of `world` (glTF has
+/// no shadow flag: the CLI's `--shadows on|off` and the examples decide for a whole scene).
+/// Biases are left as they are.
+pub fn set_shadows(world: &mut World, enabled: bool) {
+    let mut points = world.query::<&mut PointLight>();
+    for mut l in points.iter_mut(world) {
+        l.shadows_enabled = enabled;
+    }
+    let mut spots = world.query::<&mut SpotLight>();
+    for mut l in spots.iter_mut(world) {
+        l.shadows_enabled = enabled;
+    }
+    let mut suns = world.query::<&mut DirectionalLight>();
+    for mut l in suns.iter_mut(world) {
+        l.shadows_enabled = enabled;
+    }
+}
+
+/// `light` casting a shadow with the biases Bevy gives its kind (`shadows`), or not.
+pub fn with_shadow(mut light: ExtractedPointLight, shadows: bool) -> ExtractedPointLight {
+    light.shadow = shadows.then_some(if light.spot.is_some() { ShadowBias::SPOT } else { ShadowBias::POINT });
+    light
 }
 
 /// The snapshot of `scene` seen through its camera (or one framing it) at `size`, lit by

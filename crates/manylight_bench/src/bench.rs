@@ -28,6 +28,8 @@ pub struct Row {
     /// An oracle's row: the same frames shaded from exact per-pixel lists, by clustered forward
     /// (the forward oracle) or clustered deferred (the deferred oracle, per G-buffer layout).
     oracle: bool,
+    /// Every light casts a shadow.
+    shadows: bool,
 }
 
 impl Row {
@@ -37,6 +39,7 @@ impl Row {
         rows.iter().find(|o| {
             o.oracle
                 && o.lights == self.lights
+                && o.shadows == self.shadows
                 && o.pipeline.is_deferred() == self.pipeline.is_deferred()
                 && o.gbuffer == self.gbuffer
         })
@@ -98,6 +101,8 @@ pub struct Sweep {
     pub shell_lattice: bool,
     /// G-buffer layouts swept for the deferred pipeline.
     pub gbuffers: Vec<GBufferLayout>,
+    /// Shadow settings swept: every light casts (`true`) or none does.
+    pub shadows: Vec<bool>,
     /// Settings other than the pipeline.
     pub settings: FrameSettings,
 }
@@ -106,25 +111,31 @@ pub struct Sweep {
 pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
     let mut renderer = HeadlessRenderer::new()?;
     let adapter = renderer.render_world.gpu().info.name.clone();
-    let configs: Vec<(PipelineKind, Option<GBufferLayout>, usize)> = sweep
+    let shadow_settings: Vec<bool> =
+        if sweep.shadows.is_empty() { vec![false] } else { sweep.shadows.clone() };
+    let configs: Vec<(PipelineKind, Option<GBufferLayout>, usize, bool)> = sweep
         .lights
         .iter()
         .flat_map(|&n| {
+            let shadow_settings = shadow_settings.clone();
             sweep.pipelines.iter().flat_map(move |&p| {
                 let layouts: Vec<Option<GBufferLayout>> = if p.is_deferred() {
                     sweep.gbuffers.iter().copied().map(Some).collect()
                 } else {
                     vec![None]
                 };
-                layouts.into_iter().map(move |g| (p, g, n))
+                let shadow_settings = shadow_settings.clone();
+                layouts
+                    .into_iter()
+                    .flat_map(move |g| shadow_settings.clone().into_iter().map(move |s| (p, g, n, s)))
             })
         })
-        .filter(|&(p, _, n)| p != PipelineKind::NaiveForward || n <= sweep.naive_max_lights)
+        .filter(|&(p, _, n, _)| p != PipelineKind::NaiveForward || n <= sweep.naive_max_lights)
         .collect();
     // One forward oracle per light count, and a deferred one per G-buffer layout when the
     // sweep has deferred pipelines.
     let deferred = sweep.pipelines.iter().any(|p| p.is_deferred());
-    let oracles: Vec<(PipelineKind, Option<GBufferLayout>, usize)> = if sweep.oracle {
+    let oracles: Vec<(PipelineKind, Option<GBufferLayout>, usize, bool)> = if sweep.oracle {
         let kinds: Vec<(PipelineKind, Option<GBufferLayout>)> =
             std::iter::once((PipelineKind::ClusteredForward, None))
                 .chain(
@@ -140,6 +151,7 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
             .iter()
             .filter(|&&n| n > 0)
             .flat_map(|&n| kinds.iter().map(move |&(p, g)| (p, g, n)))
+            .flat_map(|(p, g, n)| shadow_settings.iter().map(move |&s| (p, g, n, s)))
             .collect()
     } else {
         Vec::new()
@@ -147,13 +159,14 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
     let mut progress = Progress::new((configs.len() + oracles.len()) as u64, "configurations");
     let mut rows = Vec::new();
     let runs = configs.into_iter().map(|c| (c, false)).chain(oracles.into_iter().map(|c| (c, true)));
-    for ((pipeline, gbuffer, lights), oracle) in runs {
+    for ((pipeline, gbuffer, lights, shadows), oracle) in runs {
         let label = match (oracle, gbuffer) {
             (true, Some(g)) => format!("deferred oracle ({} G-buffer), {lights} lights", g.name()),
             (true, None) => format!("forward oracle, {lights} lights"),
             (false, Some(g)) => format!("{} ({} G-buffer), {lights} lights", pipeline.name(), g.name()),
             (false, None) => format!("{}, {lights} lights", pipeline.name()),
         };
+        let label = if shadows { format!("{label}, shadows") } else { label };
         progress.set_message(label.clone());
         let (lit, rig) = lights_of(scene, sweep.shell_lattice, lights)?;
         let settings = FrameSettings {
@@ -165,7 +178,7 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
             ..sweep.settings
         };
         let (frame_ms, last, oracle_culling) =
-            timed_frames(&mut renderer, &lit, &rig, sweep, settings, oracle)?;
+            timed_frames(&mut renderer, &lit, &rig, sweep, settings, oracle, shadows)?;
         let (culling, depth_bounded, zbinned) = if oracle {
             (oracle_culling, None, None)
         } else if sweep.culling_efficiency && pipeline.uses_clusters() && lights > 0 {
@@ -177,7 +190,18 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
         };
         let median_ms = median(&frame_ms);
         progress.step(|| format!("{label}: {median_ms:.1} ms"));
-        rows.push(Row { pipeline, gbuffer, lights, frame_ms, last, culling, depth_bounded, zbinned, oracle });
+        rows.push(Row {
+            pipeline,
+            gbuffer,
+            lights,
+            frame_ms,
+            last,
+            culling,
+            depth_bounded,
+            zbinned,
+            oracle,
+            shadows,
+        });
     }
     progress.finish();
     warn_unlike_oracle_frames(&rows);
@@ -234,7 +258,7 @@ fn lights_of(scene: &Scene, shell_lattice: bool, count: usize) -> Result<(Scene,
 /// Renders `sweep.warmup + sweep.frames` frames of `rig` animated at 60 frames a second with
 /// `settings`; returns the timed frames' wall milliseconds and the last report. With `oracle`,
 /// each frame is shaded from exact per-pixel lists built (not timed) from a render of that same
-/// frame, and the lists' culling ratio comes back too.
+/// frame, and the lists' culling ratio comes back too. With `shadows` every light casts.
 fn timed_frames(
     renderer: &mut HeadlessRenderer,
     scene: &Scene,
@@ -242,12 +266,18 @@ fn timed_frames(
     sweep: &Sweep,
     settings: FrameSettings,
     oracle: bool,
+    shadows: bool,
 ) -> Result<(Vec<f64>, FrameReport, Option<f64>)> {
     let mut frame_ms = Vec::new();
     let mut last = None;
     let mut culling = None;
     for f in 0..sweep.warmup + sweep.frames {
         let mut snap = snapshot(scene, rig, f as f32 / 60.0, sweep.size, settings, f as u64);
+        if shadows {
+            for light in &mut snap.lights {
+                *light = manylight_app::scene::with_shadow(*light, true);
+            }
+        }
         if oracle {
             let (lists, efficiency) = oracle_snapshot(renderer, snap)?;
             (snap, culling) = (lists, Some(efficiency.ratio()));
@@ -311,7 +341,7 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
          max_per_cluster,mean_per_non_empty,dropped_pairs,culling_ratio,transient_mib,cluster_buffer_mib,\
          list_entry_bound,tile_entries,tile_entry_bound,list_bound_cpu_ms,shading_ms,shading_vs_oracle,\
          coarse_tiles,coarse_entries,depth_bounded_ratio,cluster_depth_gpu_ms,light_refine_gpu_ms,\
-         zbinned_ratio\n",
+         zbinned_ratio,shadows,shadow_maps_rendered,shadow_maps_cached,shadow_atlas_bytes,shadow_gpu_ms\n",
     );
     for r in rows {
         let c = r.last.clusters.as_ref();
@@ -371,6 +401,11 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
             pass_ms(&r.last, "cluster_depth"),
             pass_ms(&r.last, "light_refine"),
             r.zbinned.map_or(String::new(), |x| format!("{x:.3}")),
+            if r.shadows { "on" } else { "off" },
+            r.last.shadows.map_or(0, |s| s.maps_rendered),
+            r.last.shadows.map_or(0, |s| s.maps_cached),
+            r.last.shadows.map_or(0, |s| s.atlas_bytes),
+            pass_ms(&r.last, "shadow_maps"),
         );
     }
     out

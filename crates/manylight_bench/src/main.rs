@@ -184,6 +184,10 @@ struct BenchArgs {
     /// light-volumes).
     #[arg(long, value_delimiter = ',', default_value = "full,compact", value_parser = parse_gbuffer)]
     gbuffers: Vec<GBufferLayout>,
+    /// Comma-separated shadow settings swept: `off` (no light casts), `on` (every light of the
+    /// scene and the rig casts).
+    #[arg(long, value_delimiter = ',', default_value = "off", value_parser = parse_on_off, action = clap::ArgAction::Set)]
+    shadows: Vec<bool>,
     #[command(flatten)]
     clusters: ClusterArgs,
     /// Shading model for materials without their own: pbr (default), lambert, blinn-phong or toon.
@@ -245,6 +249,10 @@ struct RenderArgs {
     /// scene), or the index of one of the file's cameras.
     #[arg(long, default_value = "scene")]
     camera: String,
+    /// Shadows: `on` makes every light of the scene and of `--lights` cast one (glTF has no
+    /// shadow flag), `off` (default) none.
+    #[arg(long, default_value = "off", value_parser = parse_on_off, action = clap::ArgAction::Set)]
+    shadows: bool,
     /// Output PNG.
     #[arg(long)]
     out: PathBuf,
@@ -286,6 +294,8 @@ struct Extras {
     bloom: Option<manylight_app::Bloom>,
     motion_blur: Option<manylight_app::MotionBlur>,
     debug: manylight_app::DebugView,
+    /// Every light casts a shadow.
+    shadows: bool,
 }
 
 /// Camera turn per frame under `--motion-blur` (about 20 px of motion at 1280 px wide).
@@ -409,6 +419,11 @@ fn render_scene(
                 }
             },
         );
+        if extras.shadows {
+            app.add_systems(bevy_app::PostStartup, |world: &mut bevy_ecs::world::World| {
+                manylight_app::scene::set_shadows(world, true)
+            });
+        }
         if extras.motion_blur.is_some() {
             app.add_systems(bevy_app::Update, |mut cameras: Query<&mut Transform, With<Camera3d>>| {
                 for mut t in &mut cameras {
@@ -579,6 +594,7 @@ fn render(args: RenderArgs) -> Result<()> {
         }),
         motion_blur: args.post.motion_blur.then(manylight_app::MotionBlur::default),
         debug: manylight_app::DebugView::new(args.clusters.debug_view),
+        shadows: args.shadows,
     };
     let frames = if args.post.motion_blur { args.frames.max(2) } else { args.frames };
     let (image, stats) = render_scene(scene, args.size, frames, lights, args.seed, settings, extras)?;
@@ -766,6 +782,7 @@ fn bench_cmd(args: BenchArgs) -> Result<()> {
         oracle: args.oracle,
         shell_lattice: args.scene == "sphere-shell",
         gbuffers: args.gbuffers,
+        shadows: args.shadows,
         settings: manylight_render::FrameSettings {
             render: manylight_render::RenderSettings {
                 clusters: args.clusters.settings(&args.scene),

@@ -298,6 +298,11 @@ impl GpuContext {
         if adapter.features().contains(wgpu::Features::FLOAT32_BLENDABLE) {
             required_features |= wgpu::Features::FLOAT32_BLENDABLE;
         }
+        // The shadow pass cuts each cube face to its atlas tile with clip distances where it can
+        // (otherwise it discards the fragments outside the tile).
+        if adapter.features().contains(wgpu::Features::CLIP_DISTANCES) {
+            required_features |= wgpu::Features::CLIP_DISTANCES;
+        }
         let adapter_limits = adapter.limits();
         let required_limits = wgpu::Limits {
             max_texture_dimension_2d: adapter_limits.max_texture_dimension_2d,

@@ -99,6 +99,8 @@ pub fn shared_u32_constants() -> Vec<(&'static str, u32)> {
     use manylight_core::cluster::ZSlicing;
     vec![
         ("MAX_DIRECTIONAL_LIGHTS", MAX_DIRECTIONAL_LIGHTS),
+        ("SHADOW_FACES", SHADOW_FACES),
+        ("SHADOW_TILE_COLUMNS", SHADOW_TILE_COLUMNS),
         ("MATERIAL_TEXTURE_SLOTS", MATERIAL_TEXTURE_SLOTS),
         ("TEXTURE_SLOT_BASE_COLOR", TEXTURE_SLOT_BASE_COLOR),
         ("TEXTURE_SLOT_METALLIC_ROUGHNESS", TEXTURE_SLOT_METALLIC_ROUGHNESS),
@@ -205,6 +207,49 @@ pub struct GpuPointLight {
     pub color: [f32; 4],
     /// xyz: a spot light's unit direction (0 for a point light), w: the falloff's scale (0).
     pub spot: [f32; 4],
+}
+
+/// Cube faces of a point or spot light's shadow map: +X, -X, +Y, -Y, +Z, -Z (face `f` looks
+/// down axis `f / 2`, towards + when `f` is even).
+pub const SHADOW_FACES: u32 = 6;
+/// A light's faces lie in the shadow atlas as a block of this many columns (and
+/// `SHADOW_FACES / SHADOW_TILE_COLUMNS` rows) of square tiles.
+pub const SHADOW_TILE_COLUMNS: u32 = 3;
+
+/// A light's shadow map as the shading passes read it (`GpuShadowLight` in
+/// `shaders/common/shadows.wgsl`): one entry per uploaded point or spot light, in light-buffer
+/// order.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuShadowLight {
+    /// x, y: the atlas texel at the top left of the light's block of face tiles; z: a face
+    /// tile's edge in texels, 0 when the light has no shadow map this frame; w: 0.
+    pub tile: [u32; 4],
+    /// x: the faces' near plane, y: their far plane (the light's range), z: depth bias (world
+    /// units along the ray), w: normal bias (texels of the face at the receiver).
+    pub params: [f32; 4],
+}
+
+/// One cube face of a shadow map as the shadow pass draws it (`GpuShadowFace` in
+/// `shaders/shadow_maps.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct GpuShadowFace {
+    /// The face's projection: x, y in [-w, w] inside the face, z / w its depth in [0, 1].
+    pub clip_from_world: Mat4,
+    /// (sx, ox, sy, oy): the face's tile in atlas clip space is x·sx + w·ox, y·sy + w·oy.
+    pub atlas: [f32; 4],
+}
+
+/// One instance of the shadow pass's draws: a scene instance drawn into one face
+/// (`GpuShadowDraw` in `shaders/shadow_maps.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct GpuShadowDraw {
+    /// Index into the instance buffer.
+    pub instance: u32,
+    /// Index into the frame's faces.
+    pub face: u32,
 }
 
 /// Per-instance transforms (`GpuInstance` in `shaders/common/mesh.wgsl`).

@@ -63,6 +63,8 @@ pub struct PassContext<'a> {
     pub pipelines: &'a PipelineCache,
     /// Cluster buffers, when the frame uses clusters.
     pub clusters: Option<&'a crate::clusters::ClusterResources>,
+    /// The shadow atlas and its pass's buffers (`None` outside a renderer).
+    pub shadows: Option<&'a crate::shadows::ShadowResources>,
     /// Bind groups and uniform buffers kept across frames (record creates none in steady
     /// state).
     pub bindings: &'a crate::bindings::BindingCache,

@@ -21,6 +21,7 @@ pub mod renderer;
 pub mod resources;
 pub mod settings;
 pub mod shaders;
+pub mod shadows;
 pub mod snapshot;
 pub mod stats;
 
@@ -31,10 +32,11 @@ pub use plan::PlanInputs;
 pub use planner::FramePlanner;
 pub use readback::{HEADLESS_FORMAT, HeadlessTarget};
 pub use renderer::Renderer;
+pub use shadows::{ShadowReport, ShadowSettings};
 pub use snapshot::{
     BloomChain, BloomSettings, ClusterSettings, DEFAULT_COARSE_TILES, DebugViewMode, Exposure,
     ExtractedCamera, ExtractedDirectionalLight, ExtractedInstance, ExtractedPointLight, ExtractedView,
     FrameSettings, FrameSnapshot, GBufferLayout, MotionBlurSettings, PipelineKind, RenderSettings,
-    RenderTextureId, RenderView, ViewRect, ViewTarget,
+    RenderTextureId, RenderView, ShadowBias, ViewRect, ViewTarget,
 };
 pub use stats::{FrameReport, PassTiming, ViewReport};

@@ -21,6 +21,9 @@ pub struct PlanInputs<'a> {
     /// The frame brings its own per-pixel light lists (`FrameSnapshot::pixel_light_lists`):
     /// no cluster build.
     pub has_pixel_lists: bool,
+    /// The frame has a light that casts a shadow with shadows enabled
+    /// (`FrameSnapshot::casts_shadows`).
+    pub casts_shadows: bool,
     /// Where light volumes sum their lights (`LightVolumesPass::accumulation_format` of the
     /// device; `HDR_FORMAT` when planning without one).
     pub accumulation: wgpu::TextureFormat,
@@ -47,6 +50,18 @@ impl PlanInputs<'_> {
     /// True when the view shades with cluster lists (a tiled/clustered pipeline with lights).
     pub fn shades_with_clusters(&self) -> bool {
         self.settings().pipeline.uses_clusters() && self.has_lights && !self.replaces_shading()
+    }
+
+    /// True when the view shades lights that cast shadows: the shadow pass runs and every
+    /// shading pass reads its atlas ([`crate::passes::SHADOW_ATLAS`]).
+    pub fn shades_shadows(&self) -> bool {
+        self.casts_shadows && self.has_lights && !self.replaces_shading()
+    }
+
+    /// The resources a shading pass reads besides its own: the shadow atlas when the view
+    /// [`shades_shadows`](Self::shades_shadows).
+    pub fn shading_reads(&self) -> Vec<crate::graph::ResourceName> {
+        if self.shades_shadows() { vec![crate::passes::SHADOW_ATLAS] } else { Vec::new() }
     }
 
     /// True when the view is shaded deferred: a G-buffer, then a full-screen lighting pass or

@@ -7,7 +7,8 @@ use crate::passes;
 use crate::plan::{PlanInputs, Planner};
 
 /// The stages, in order: each pass module's `plan` function.
-pub const STAGES: [(&str, Planner); 15] = [
+pub const STAGES: [(&str, Planner); 16] = [
+    ("shadow_maps", passes::shadow_maps::plan),
     ("depth_prepass", passes::depth_prepass::plan),
     ("cluster_depth", passes::cluster_depth::plan),
     ("cluster_build", passes::cluster_build::plan),

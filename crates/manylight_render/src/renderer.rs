@@ -28,6 +28,8 @@ pub struct Renderer {
     pub gpu: GpuContext,
     /// Uploaded scene data.
     pub scene: SceneResources,
+    /// The shadow atlas and its pass's buffers.
+    pub shadows: crate::shadows::ShadowResources,
     /// Pipelines created so far.
     pub pipelines: PipelineCache,
     /// Cluster buffers of each view (by its position in the frame's views), created the first
@@ -58,6 +60,7 @@ impl Renderer {
         let cpu_adapter = gpu.info.device_type == wgpu::DeviceType::Cpu;
         Renderer {
             scene: SceneResources::new(&gpu),
+            shadows: crate::shadows::ShadowResources::new(&gpu),
             pipelines: PipelineCache::default(),
             clusters: Vec::new(),
             pool: TransientPool::default(),
@@ -97,6 +100,8 @@ impl Renderer {
         self.pool.begin_frame();
         self.bindings.begin_frame();
         self.scene.prepare(&self.gpu, snapshot)?;
+        self.shadows.prepare(&self.gpu, &self.scene, snapshot)?;
+        self.scene.bind_view(&self.gpu, &self.shadows);
         self.pixel_light_lists = snapshot.pixel_light_lists.clone();
         // Views that went away free their cluster buffers.
         self.clusters.truncate(snapshot.views.len().max(1));
@@ -313,6 +318,7 @@ impl Renderer {
                 scene: &self.scene,
                 pipelines: &self.pipelines,
                 clusters,
+                shadows: Some(&self.shadows),
                 bindings: &self.bindings,
                 encoder: &mut encoder,
                 output_format,
@@ -373,6 +379,7 @@ impl Renderer {
             light_uploads: 0,
             light_upload_bytes: 0,
             device_recoveries: 0,
+            shadows: (self.shadows.report.casting_lights > 0).then_some(self.shadows.report),
             ..Default::default()
         })
     }

@@ -40,6 +40,8 @@ pub struct GpuMesh {
     pub order: u64,
     /// Centre of the mesh's bounds (local space).
     pub center: glam::Vec3,
+    /// The mesh's bounds (local space).
+    pub bounds: manylight_core::Aabb,
     last_used: u64,
 }
 
@@ -93,6 +95,9 @@ pub struct SurfaceVariant {
     /// lavapipe does not run the other models' code for every light (it runs both sides of a
     /// branch on the material's model).
     pub shading: u32,
+    /// The frame's lights cast shadows: the shaders are composed with `SHADOWS` and group 0
+    /// has the shadow bindings (set per frame by [`SurfaceVariant::with_shadows`]).
+    pub shadows: bool,
 }
 
 impl SurfaceVariant {
@@ -111,7 +116,18 @@ impl SurfaceVariant {
                 .filter(|(_, t)| t.is_some())
                 .fold(0, |bits, (slot, _)| bits | 1 << slot),
             shading: material.shading.map_or(SHADING_GLOBAL, |s| s.gpu_id()),
+            shadows: false,
         }
+    }
+
+    /// The variant in a frame whose lights cast shadows (`shadows`) or not.
+    pub fn with_shadows(self, shadows: bool) -> SurfaceVariant {
+        SurfaceVariant { shadows, ..self }
+    }
+
+    /// The shader defines of the variant.
+    pub fn defs(self) -> crate::shaders::ShaderDefs {
+        crate::shaders::ShaderDefs { shadows: self.shadows, ..Default::default() }
     }
 
     /// The variant with the view's model `global` (`ShadingModel::gpu_id`) where the material
@@ -164,12 +180,80 @@ pub struct Draw {
     pub variant: SurfaceVariant,
     /// World-space centre of the mesh's bounds (blended draws are sorted by its distance).
     pub center: glam::Vec3,
+    /// World-space box around the mesh's bounds (the shadow pass culls with it).
+    pub world_bounds: manylight_core::Aabb,
+}
+
+/// Layout of group 0 of every scene pass: the view uniform (0), the point and spot lights (1),
+/// the instances (2) and, in a frame whose lights cast shadows (`shadows`), the shadow atlas
+/// (3), its comparison sampler (4) and the lights' shadow table (5) of
+/// `shaders/common/shadows.wgsl`.
+fn make_view_layout(device: &wgpu::Device, shadows: bool) -> wgpu::BindGroupLayout {
+    let all = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
+    let shading = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
+    let storage = |binding, visibility| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: true },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    };
+    let mut entries = vec![
+        wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: all,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<ViewUniform>() as u64),
+            },
+            count: None,
+        },
+        storage(1, all),
+        storage(2, wgpu::ShaderStages::VERTEX),
+    ];
+    if shadows {
+        entries.extend([
+            wgpu::BindGroupLayoutEntry {
+                binding: 3,
+                visibility: shading,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Depth,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 4,
+                visibility: shading,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                count: None,
+            },
+            storage(5, shading),
+        ]);
+    }
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(if shadows { "view_layout_shadowed" } else { "view_layout" }),
+        entries: &entries,
+    })
 }
 
 /// Scene data on the GPU for the current frame.
 pub struct SceneResources {
-    /// Layout of group 0: view uniform, lights, instances.
+    /// Layout of group 0 this frame: view uniform, lights, instances, and the shadow bindings
+    /// when [`SceneResources::shadows_active`].
     pub view_layout: wgpu::BindGroupLayout,
+    /// Group 0's layout without shadows.
+    plain_view_layout: wgpu::BindGroupLayout,
+    /// Group 0's layout with shadows.
+    shadowed_view_layout: wgpu::BindGroupLayout,
+    /// This frame's lights cast shadows: group 0 holds the shadow bindings and every shading
+    /// pipeline is composed with `SHADOWS`.
+    pub shadows_active: bool,
     /// Layout of group 1: material uniform, the material's five textures and their samplers.
     pub material_layout: wgpu::BindGroupLayout,
     /// Group 0 for this frame.
@@ -221,7 +305,7 @@ pub struct SceneResources {
     /// The adapter filters anisotropically (`DownlevelFlags::ANISOTROPIC_FILTERING`).
     anisotropic: bool,
     frame: u64,
-    bound_generations: (u64, u64),
+    bound_generations: (u64, u64, u64),
     max_texture_size: u32,
     uploads: u64,
 }
@@ -256,34 +340,8 @@ impl SceneResources {
     /// Creates the layouts and empty buffers.
     pub fn new(gpu: &GpuContext) -> SceneResources {
         let device = &gpu.device;
-        let storage = |binding, visibility| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only: true },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let all = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
-        let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("view_layout"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: all,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<ViewUniform>() as u64),
-                    },
-                    count: None,
-                },
-                storage(1, all),
-                storage(2, wgpu::ShaderStages::VERTEX),
-            ],
-        });
+        let view_layout = make_view_layout(device, false);
+        let shadowed_view_layout = make_view_layout(device, true);
         // A filterable 2D texture of the material (base colour, metallic-roughness).
         let material_texture = |binding| wgpu::BindGroupLayoutEntry {
             binding,
@@ -342,7 +400,7 @@ impl SceneResources {
         let lights = GrowableBuffer::new(gpu, "point_lights", storage_usage, light_bytes);
         let instances = GrowableBuffer::new(gpu, "instances", storage_usage, 64 * 128);
         let view_bind_group =
-            Self::make_view_bind_group(gpu, &view_layout, &view_buffer, &lights, &instances);
+            Self::make_view_bind_group(gpu, &view_layout, &view_buffer, &lights, &instances, None);
         let white = upload_texture(
             gpu,
             &TextureData { label: "white".into(), width: 1, height: 1, rgba8: vec![255; 4], srgb: true },
@@ -353,7 +411,10 @@ impl SceneResources {
             .flags
             .contains(wgpu::DownlevelFlags::ANISOTROPIC_FILTERING);
         SceneResources {
+            plain_view_layout: view_layout.clone(),
             view_layout,
+            shadowed_view_layout,
+            shadows_active: false,
             material_layout,
             view_bind_group,
             view_buffer,
@@ -381,7 +442,7 @@ impl SceneResources {
             samplers: HashMap::new(),
             anisotropic,
             frame: 0,
-            bound_generations: (0, 0),
+            bound_generations: (0, 0, 0),
             max_texture_size: gpu.max_texture_size(),
             uploads: 0,
         }
@@ -393,16 +454,55 @@ impl SceneResources {
         view: &wgpu::Buffer,
         lights: &GrowableBuffer,
         instances: &GrowableBuffer,
+        shadows: Option<&crate::shadows::ShadowResources>,
     ) -> wgpu::BindGroup {
+        let mut entries = vec![
+            wgpu::BindGroupEntry { binding: 0, resource: view.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: lights.buffer().as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 2, resource: instances.buffer().as_entire_binding() },
+        ];
+        if let Some((shadows, atlas)) = shadows.and_then(|s| Some((s, s.atlas_view()?))) {
+            entries.extend([
+                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(atlas) },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: wgpu::BindingResource::Sampler(&shadows.sampler),
+                },
+                wgpu::BindGroupEntry { binding: 5, resource: shadows.lights.buffer().as_entire_binding() },
+            ]);
+        }
         gpu.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("view_bind_group"),
             layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: view.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: lights.buffer().as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: instances.buffer().as_entire_binding() },
-            ],
+            entries: &entries,
         })
+    }
+
+    /// Binds group 0 for the frame (after [`SceneResources::prepare`] and the shadows'
+    /// `prepare`): with the shadow atlas, its sampler and light table when `shadows` is active,
+    /// else without them. Re-created only when a buffer, the atlas or the shadow state changed.
+    pub fn bind_view(&mut self, gpu: &GpuContext, shadows: &crate::shadows::ShadowResources) {
+        let active = shadows.active && shadows.atlas_view().is_some();
+        let generations = (
+            self.lights.generation(),
+            self.instances.generation(),
+            if active { shadows.generation + 1 } else { 0 },
+        );
+        if generations == self.bound_generations {
+            return;
+        }
+        self.shadows_active = active;
+        self.view_layout =
+            if active { self.shadowed_view_layout.clone() } else { self.plain_view_layout.clone() };
+        self.view_bind_group = Self::make_view_bind_group(
+            gpu,
+            &self.view_layout,
+            &self.view_buffer,
+            &self.lights,
+            &self.instances,
+            active.then_some(shadows),
+        );
+        self.bound_generations = generations;
     }
 
     /// Writes the view constants of `view` (before each view's submission: the views of a
@@ -527,14 +627,15 @@ impl SceneResources {
             if inst.mesh.indices.is_empty() {
                 continue;
             }
-            let (mesh, mesh_order, local_center) = self.mesh_entry(gpu, &inst.mesh)?;
+            let (mesh, mesh_order, local_center, local_bounds) = self.mesh_entry(gpu, &inst.mesh)?;
             let (material, material_order) = self.material_entry(gpu, &inst.material)?;
             let order = (material_order, mesh_order);
             let mirrored = glam::Mat3::from_mat4(inst.world_from_local).determinant() < 0.0;
             let variant = SurfaceVariant::of(&inst.material, mirrored);
             let center = inst.world_from_local.transform_point3(local_center);
             let instance = instance_data.len() as u32;
-            self.draws.push(Draw { mesh, material, instance, order, variant, center });
+            let world_bounds = local_bounds.transformed(&inst.world_from_local);
+            self.draws.push(Draw { mesh, material, instance, order, variant, center, world_bounds });
             instance_data.push(gpu_instance);
         }
         self.draws.sort_by_key(|d| d.order);
@@ -549,18 +650,6 @@ impl SceneResources {
         }
         self.instances.write(gpu, bytemuck::cast_slice(&instance_data))?;
 
-        let generations = (self.lights.generation(), self.instances.generation());
-        if generations != self.bound_generations {
-            self.view_bind_group = Self::make_view_bind_group(
-                gpu,
-                &self.view_layout,
-                &self.view_buffer,
-                &self.lights,
-                &self.instances,
-            );
-            self.bound_generations = generations;
-        }
-
         let frame = self.frame;
         self.meshes.retain(|_, m| frame - m.last_used <= KEEP_FRAMES);
         self.materials.retain(|_, m| frame - m.last_used <= KEEP_FRAMES);
@@ -574,7 +663,7 @@ impl SceneResources {
         &mut self,
         gpu: &GpuContext,
         mesh: &Arc<MeshData>,
-    ) -> Result<(usize, u64, glam::Vec3), RenderError> {
+    ) -> Result<(usize, u64, glam::Vec3, manylight_core::Aabb), RenderError> {
         let k = key(mesh);
         let frame = self.frame;
         if !self.meshes.contains_key(&k) {
@@ -614,11 +703,12 @@ impl SceneResources {
                     let c = (b.min + b.max) * 0.5;
                     if c.is_finite() { c } else { glam::Vec3::ZERO }
                 },
+                bounds: mesh.bounds(),
                 last_used: frame,
             }
         });
         entry.last_used = frame;
-        Ok((k, entry.order, entry.center))
+        Ok((k, entry.order, entry.center, entry.bounds))
     }
 
     fn material_entry(

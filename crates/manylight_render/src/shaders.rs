@@ -3,6 +3,10 @@
 //! A shader names shared code with a line `//!include common/file.wgsl`; each file is pasted
 //! once, in order of first mention. Every shader starts with the constants preamble generated
 //! from [`crate::gpu_types::shared_u32_constants`].
+//!
+//! Lines between `//!if NAME` and `//!endif` (with an optional `//!else`) are kept only when
+//! the [`ShaderDefs`] the shader is composed with turn `NAME` on: a frame whose lights cast
+//! no shadow compiles shaders with no shadow binding and no shadow code at all.
 
 use crate::gpu_types::{shared_f32_constants, shared_u32_constants};
 use std::fmt::Write as _;
@@ -25,6 +29,8 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("common/cluster_lists.wgsl", include_str!("../../../shaders/common/cluster_lists.wgsl")),
     ("common/light_lists.wgsl", include_str!("../../../shaders/common/light_lists.wgsl")),
     ("common/point_lights.wgsl", include_str!("../../../shaders/common/point_lights.wgsl")),
+    ("common/shadows.wgsl", include_str!("../../../shaders/common/shadows.wgsl")),
+    ("shadow_maps.wgsl", include_str!("../../../shaders/shadow_maps.wgsl")),
     ("light_volumes.wgsl", include_str!("../../../shaders/light_volumes.wgsl")),
     ("forward.wgsl", include_str!("../../../shaders/forward.wgsl")),
     ("depth_prepass.wgsl", include_str!("../../../shaders/depth_prepass.wgsl")),
@@ -49,6 +55,37 @@ pub enum ShaderError {
     /// The named file is not in [`SOURCES`].
     #[error("shader `{0}` is not embedded (add it to manylight_render::shaders::SOURCES)")]
     Unknown(String),
+    /// A `//!if`, `//!else` or `//!endif` line without its partner, or naming no known define.
+    #[error("shader `{file}`: {problem}")]
+    Conditional {
+        /// The file holding the line.
+        file: String,
+        /// What is wrong with it.
+        problem: String,
+    },
+}
+
+/// The switches a shader is composed with (`//!if NAME` … `//!endif` blocks).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct ShaderDefs {
+    /// `SHADOWS`: point and spot lights read their shadow maps (`common/shadows.wgsl`): the
+    /// shadow atlas, its sampler and the per-light shadow table are bound in group 0.
+    pub shadows: bool,
+    /// `CLIP_DISTANCES`: the device draws `@builtin(clip_distances)`
+    /// (`wgpu::Features::CLIP_DISTANCES`); the shadow pass clips each face to its tile with
+    /// them instead of discarding fragments.
+    pub clip_distances: bool,
+}
+
+impl ShaderDefs {
+    /// The defines a shader can test, with their state.
+    fn flags(self) -> [(&'static str, bool); 2] {
+        [("SHADOWS", self.shadows), ("CLIP_DISTANCES", self.clip_distances)]
+    }
+
+    fn get(self, name: &str) -> Option<bool> {
+        self.flags().iter().find(|(n, _)| *n == name).map(|(_, on)| *on)
+    }
 }
 
 /// `const NAME: u32 = VALUE;` lines for every shared constant.
@@ -71,33 +108,86 @@ fn source(path: &str) -> Result<&'static str, ShaderError> {
         .ok_or_else(|| ShaderError::Unknown(path.to_string()))
 }
 
-/// The full WGSL of `path`: preamble, then its includes, then its own body.
+/// The full WGSL of `path` with every define off: preamble, then its includes, then its own
+/// body.
 pub fn compose(path: &str) -> Result<String, ShaderError> {
-    let mut out = constants_preamble();
+    compose_with(path, ShaderDefs::default())
+}
+
+/// The full WGSL of `path` composed with `defs`.
+///
+/// WGSL wants its `enable` directives before every declaration: they are moved above the
+/// preamble.
+pub fn compose_with(path: &str, defs: ShaderDefs) -> Result<String, ShaderError> {
+    let mut body = String::new();
     let mut seen = Vec::new();
-    append(path, &mut out, &mut seen)?;
+    append(path, defs, &mut body, &mut seen)?;
+    let mut out = String::new();
+    for line in body.lines().filter(|l| l.starts_with("enable ")) {
+        out.push_str(line);
+        out.push('\n');
+    }
+    out.push_str(&constants_preamble());
+    for line in body.lines().filter(|l| !l.starts_with("enable ")) {
+        out.push_str(line);
+        out.push('\n');
+    }
     Ok(out)
 }
 
-fn append(path: &str, out: &mut String, seen: &mut Vec<String>) -> Result<(), ShaderError> {
+fn append(path: &str, defs: ShaderDefs, out: &mut String, seen: &mut Vec<String>) -> Result<(), ShaderError> {
     if seen.iter().any(|s| s == path) {
         return Ok(());
     }
     seen.push(path.to_string());
+    let problem = |problem: String| ShaderError::Conditional { file: path.to_string(), problem };
+    // One entry per open `//!if`: whether its current branch is kept.
+    let mut open: Vec<bool> = Vec::new();
     for line in source(path)?.lines() {
-        if let Some(include) = line.trim().strip_prefix("//!include ") {
-            append(include.trim(), out, seen)?;
+        let trimmed = line.trim();
+        if let Some(name) = trimmed.strip_prefix("//!if ") {
+            let on =
+                defs.get(name.trim()).ok_or_else(|| problem(format!("unknown define `{}`", name.trim())))?;
+            open.push(on);
+            continue;
+        }
+        if trimmed == "//!else" {
+            let branch = open.last_mut().ok_or_else(|| problem("`//!else` without `//!if`".into()))?;
+            *branch = !*branch;
+            continue;
+        }
+        if trimmed == "//!endif" {
+            open.pop().ok_or_else(|| problem("`//!endif` without `//!if`".into()))?;
+            continue;
+        }
+        if !open.iter().all(|&kept| kept) {
+            continue;
+        }
+        if let Some(include) = trimmed.strip_prefix("//!include ") {
+            append(include.trim(), defs, out, seen)?;
         } else {
             out.push_str(line);
             out.push('\n');
         }
     }
+    if !open.is_empty() {
+        return Err(problem("`//!if` without `//!endif`".into()));
+    }
     Ok(())
 }
 
-/// Creates a shader module from the composed source of `path`.
+/// Creates a shader module from the composed source of `path` (every define off).
 pub fn create_module(device: &wgpu::Device, path: &str) -> Result<wgpu::ShaderModule, ShaderError> {
-    let code = compose(path)?;
+    create_module_with(device, path, ShaderDefs::default())
+}
+
+/// Creates a shader module from the source of `path` composed with `defs`.
+pub fn create_module_with(
+    device: &wgpu::Device,
+    path: &str,
+    defs: ShaderDefs,
+) -> Result<wgpu::ShaderModule, ShaderError> {
+    let code = compose_with(path, defs)?;
     Ok(device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(path),
         source: wgpu::ShaderSource::Wgsl(code.into()),

@@ -343,6 +343,8 @@ pub struct RenderSettings {
     pub gbuffer: GBufferLayout,
     /// Normal encoding of the `Packed` and `Compact` G-buffer layouts.
     pub normal_codec: NormalCodec,
+    /// Shadow atlas and face sizes, and whether casting lights cast.
+    pub shadows: crate::shadows::ShadowSettings,
 }
 
 impl RenderSettings {
@@ -359,7 +361,7 @@ impl RenderSettings {
         if !self.clear_color.iter().all(|c| c.is_finite() && *c >= 0.0) {
             return Err(format!("clear_color {:?} must be finite and non-negative", self.clear_color));
         }
-        Ok(())
+        self.shadows.check_values()
     }
 }
 
@@ -374,6 +376,7 @@ impl Default for RenderSettings {
             clusters: ClusterSettings::default(),
             gbuffer: GBufferLayout::Full,
             normal_codec: NormalCodec::Octa16,
+            shadows: crate::shadows::ShadowSettings::default(),
         }
     }
 }
@@ -491,6 +494,39 @@ pub struct ExtractedPointLight {
     pub radius: f32,
     /// The cone of a spot light (`None`: a point light, lighting every direction).
     pub spot: Option<SpotCone>,
+    /// The light casts shadows, with these biases (`None`: it lights through everything).
+    pub shadow: Option<ShadowBias>,
+}
+
+/// How a light's shadow test keeps a surface from shadowing itself (Bevy's
+/// `shadow_depth_bias` and `shadow_normal_bias`): the shaded point moves `normal` texels of the
+/// light's shadow map off the surface towards the light, and `depth` world units nearer to
+/// it along the ray. Larger values remove acne and detach shadows from their casters
+/// (peter-panning).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowBias {
+    /// World units along the ray from the light.
+    pub depth: f32,
+    /// Texels of the shadow map at the shaded point, along the surface normal.
+    pub normal: f32,
+}
+
+impl ShadowBias {
+    /// Bevy's `PointLight` defaults.
+    pub const POINT: ShadowBias = ShadowBias { depth: 0.08, normal: 0.6 };
+    /// Bevy's `SpotLight` defaults.
+    pub const SPOT: ShadowBias = ShadowBias { depth: 0.02, normal: 1.8 };
+
+    /// True when both biases are finite and not negative.
+    pub fn is_valid(&self) -> bool {
+        self.depth.is_finite() && self.normal.is_finite() && self.depth >= 0.0 && self.normal >= 0.0
+    }
+}
+
+impl Default for ShadowBias {
+    fn default() -> Self {
+        ShadowBias::POINT
+    }
 }
 
 impl ExtractedPointLight {
@@ -514,6 +550,7 @@ impl ExtractedPointLight {
             && self.radius.is_finite()
             && self.radius >= 0.0
             && self.intensity >= 0.0
+            && self.shadow.is_none_or(|b| b.is_valid())
     }
 }
 
@@ -746,6 +783,13 @@ impl FrameSnapshot {
     /// True when at least one light has valid parameters.
     pub fn has_lights(&self) -> bool {
         self.lights.iter().any(|l| l.is_valid())
+    }
+
+    /// True when the frame draws shadow maps: shadows are enabled and a valid point or spot
+    /// light with a range casts one.
+    pub fn casts_shadows(&self) -> bool {
+        self.settings.shadows.enabled
+            && self.lights.iter().any(|l| l.shadow.is_some() && l.is_valid() && l.radius > 0.0)
     }
 
     /// True when an instance's material is blended (`AlphaMode::Blend`): the frame needs the

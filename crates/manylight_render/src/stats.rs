@@ -68,6 +68,8 @@ pub struct FrameReport {
     pub transient_allocations: u64,
     /// Cluster statistics, when the frame built clusters.
     pub clusters: Option<crate::clusters::ClusterReport>,
+    /// What the shadows took, when a light asked to cast one.
+    pub shadows: Option<crate::shadows::ShadowReport>,
     /// The views the frame rendered, in order (the passes of each are in [`FrameReport::passes`],
     /// one view after the other).
     pub views: Vec<ViewReport>,

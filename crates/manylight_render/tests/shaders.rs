@@ -5,28 +5,63 @@ use manylight_render::gpu_types::{
     GpuClusterBounds, GpuClusterCounters, GpuClusterParams, GpuDirectionalLight, GpuInstance, GpuMaterial,
     GpuPointLight, GpuTextureUv, ViewUniform,
 };
+use manylight_render::gpu_types::{GpuShadowDraw, GpuShadowFace, GpuShadowLight};
 use manylight_render::resources::SurfaceVariant;
-use manylight_render::shaders::{SOURCES, compose};
+use manylight_render::shaders::{SOURCES, ShaderDefs, compose, compose_with};
 use std::mem::{offset_of, size_of};
 
-fn parse(path: &str) -> naga::Module {
-    let code = compose(path).unwrap_or_else(|e| panic!("{path}: {e}"));
-    naga::front::wgsl::parse_str(&code).unwrap_or_else(|e| panic!("{path}: {}", e.emit_to_string(&code)))
+fn validate(path: &str) -> naga::Module {
+    validate_with(path, ShaderDefs::default())
 }
 
-fn validate(path: &str) -> naga::Module {
-    let module = parse(path);
+fn validate_with(path: &str, defs: ShaderDefs) -> naga::Module {
+    let code = compose_with(path, defs).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let module = naga::front::wgsl::parse_str(&code)
+        .unwrap_or_else(|e| panic!("{path} ({defs:?}): {}", e.emit_to_string(&code)));
     naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
         .validate(&module)
-        .unwrap_or_else(|e| panic!("{path}: {}", e.emit_to_string(&compose(path).unwrap())));
+        .unwrap_or_else(|e| panic!("{path} ({defs:?}): {}", e.emit_to_string(&code)));
     module
+}
+
+/// Every combination of the defines a shader can be composed with.
+fn all_defs() -> Vec<ShaderDefs> {
+    let mut out = Vec::new();
+    for shadows in [false, true] {
+        for clip_distances in [false, true] {
+            out.push(ShaderDefs { shadows, clip_distances });
+        }
+    }
+    out
 }
 
 #[test]
 fn every_embedded_shader_validates() {
     for (path, _) in SOURCES {
-        validate(path);
+        for defs in all_defs() {
+            validate_with(path, defs);
+        }
     }
+}
+
+#[test]
+fn shadow_code_and_bindings_appear_only_with_shadows() {
+    for path in [
+        "forward.wgsl",
+        "clustered_forward.wgsl",
+        "deferred_lighting.wgsl",
+        "tiled_deferred.wgsl",
+        "light_volumes.wgsl",
+    ] {
+        let plain = compose(path).unwrap();
+        let shadowed = compose_with(path, ShaderDefs { shadows: true, ..Default::default() }).unwrap();
+        assert!(!plain.contains("shadow_atlas") && !plain.contains("shadow_visibility"), "{path}");
+        assert!(shadowed.contains("var shadow_atlas") && shadowed.contains("shadow_visibility(k"), "{path}");
+    }
+    let clipped =
+        compose_with("shadow_maps.wgsl", ShaderDefs { clip_distances: true, ..Default::default() }).unwrap();
+    assert!(clipped.starts_with("enable clip_distances;"), "the directive leads the module");
+    assert!(!compose("shadow_maps.wgsl").unwrap().contains("enable clip_distances"));
 }
 
 #[test]
@@ -79,6 +114,29 @@ fn offsets(module: &naga::Module, name: &str, size: usize, rust: &[(&str, usize)
 
 #[test]
 fn shared_structs_match_rust() {
+    let shadowed = validate_with("forward.wgsl", ShaderDefs { shadows: true, ..Default::default() });
+    offsets(
+        &shadowed,
+        "GpuShadowLight",
+        size_of::<GpuShadowLight>(),
+        &[("tile", offset_of!(GpuShadowLight, tile)), ("params", offset_of!(GpuShadowLight, params))],
+    );
+    let shadow_maps = validate("shadow_maps.wgsl");
+    offsets(
+        &shadow_maps,
+        "GpuShadowFace",
+        size_of::<GpuShadowFace>(),
+        &[
+            ("clip_from_world", offset_of!(GpuShadowFace, clip_from_world)),
+            ("atlas", offset_of!(GpuShadowFace, atlas)),
+        ],
+    );
+    offsets(
+        &shadow_maps,
+        "GpuShadowDraw",
+        size_of::<GpuShadowDraw>(),
+        &[("instance", offset_of!(GpuShadowDraw, instance)), ("face", offset_of!(GpuShadowDraw, face))],
+    );
     let forward = validate("forward.wgsl");
     offsets(
         &forward,

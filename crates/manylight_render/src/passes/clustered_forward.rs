@@ -69,6 +69,8 @@ pub struct ClusteredForwardPass {
     pub clear_color: [f32; 3],
     /// True when a depth pre-pass wrote [`DEPTH`] already.
     pub after_prepass: bool,
+    /// Reads the shadow atlas: the frame's lights cast shadows ([`PlanInputs::shades_shadows`]).
+    pub shadows: bool,
 }
 
 impl Pass for ClusteredForwardPass {
@@ -76,7 +78,9 @@ impl Pass for ClusteredForwardPass {
         "clustered_forward"
     }
     fn reads(&self) -> Vec<ResourceName> {
-        if self.after_prepass { vec![CLUSTERS, DEPTH] } else { vec![CLUSTERS] }
+        let mut reads = if self.after_prepass { vec![CLUSTERS, DEPTH] } else { vec![CLUSTERS] };
+        reads.extend(self.shadows.then_some(super::SHADOW_ATLAS));
+        reads
     }
     fn writes(&self) -> Vec<ResourceName> {
         if self.after_prepass { vec![HDR] } else { vec![HDR, DEPTH] }
@@ -118,6 +122,7 @@ pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
         out.push(Box::new(ClusteredForwardPass {
             clear_color: p.settings().clear_color,
             after_prepass: p.runs_depth_prepass(),
+            shadows: p.shades_shadows(),
         }));
     }
 }

@@ -30,7 +30,20 @@ pub fn compute_pipeline(
     entry: &str,
     constants: &[(&str, f64)],
 ) -> Result<wgpu::ComputePipeline, RenderError> {
-    let module = crate::shaders::create_module(device, shader)?;
+    compute_pipeline_with_defs(device, label, shader, layouts, entry, constants, Default::default())
+}
+
+/// [`compute_pipeline`] with its shader composed with `defs`.
+pub fn compute_pipeline_with_defs(
+    device: &wgpu::Device,
+    label: &str,
+    shader: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+    entry: &str,
+    constants: &[(&str, f64)],
+    defs: crate::shaders::ShaderDefs,
+) -> Result<wgpu::ComputePipeline, RenderError> {
+    let module = crate::shaders::create_module_with(device, shader, defs)?;
     let layout = pipeline_layout(device, label, layouts);
     Ok(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some(label),
@@ -89,7 +102,7 @@ pub fn mesh_pipeline_with_constants(
 ) -> Result<wgpu::RenderPipeline, RenderError> {
     let constants: Vec<(&str, f64)> = constants.iter().copied().chain(d.variant.constants()).collect();
     let options = || wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
-    let module = crate::shaders::create_module(device, d.shader)?;
+    let module = crate::shaders::create_module_with(device, d.shader, d.variant.defs())?;
     let layout = pipeline_layout(device, d.label, d.layouts);
     // Blended variants draw over the target by the fragment's alpha (glTF `BLEND`).
     let targets = color_targets(d.targets, d.variant.blend.then_some(wgpu::BlendState::ALPHA_BLENDING));
@@ -169,8 +182,17 @@ pub fn fullscreen_pipeline_desc(
     device: &wgpu::Device,
     d: &FullscreenPipelineDesc<'_>,
 ) -> Result<wgpu::RenderPipeline, RenderError> {
+    fullscreen_pipeline_with_defs(device, d, crate::shaders::ShaderDefs::default())
+}
+
+/// [`fullscreen_pipeline_desc`] with its shader composed with `defs`.
+pub fn fullscreen_pipeline_with_defs(
+    device: &wgpu::Device,
+    d: &FullscreenPipelineDesc<'_>,
+    defs: crate::shaders::ShaderDefs,
+) -> Result<wgpu::RenderPipeline, RenderError> {
     let options = || wgpu::PipelineCompilationOptions { constants: d.constants, ..Default::default() };
-    let module = crate::shaders::create_module(device, d.shader)?;
+    let module = crate::shaders::create_module_with(device, d.shader, defs)?;
     let layout = pipeline_layout(device, d.label, d.layouts);
     let target =
         wgpu::ColorTargetState { format: d.output, blend: d.blend, write_mask: wgpu::ColorWrites::ALL };

@@ -1,7 +1,7 @@
 //! Clustered deferred lighting: one full-screen pass reads the G-buffer and walks each pixel's
 //! cluster list into [`HDR`].
 
-use super::common::{FullscreenPipelineDesc, draw_fullscreen, fullscreen_pipeline_desc};
+use super::common::{FullscreenPipelineDesc, draw_fullscreen, fullscreen_pipeline_with_defs};
 use super::gbuffer_layout::{
     codec_constants, fragment_entry, gbuffer_read_bind_group, gbuffer_read_layout, gbuffer_reads,
 };
@@ -21,6 +21,8 @@ pub struct DeferredLightingKey {
     pub layout: GBufferLayout,
     /// Its normal codec.
     pub codec: NormalCodec,
+    /// Composed with `SHADOWS` (group 0 has the shadow bindings).
+    pub shadows: bool,
 }
 
 impl PipelineKey for DeferredLightingKey {
@@ -40,11 +42,12 @@ impl DeferredLightingPipeline {
         cluster_layout: &wgpu::BindGroupLayout,
         layout: GBufferLayout,
         codec: NormalCodec,
+        defs: crate::shaders::ShaderDefs,
     ) -> Result<Self, RenderError> {
         let gbuffer_layout = gbuffer_read_layout(device, layout);
         let layouts = [view_layout, &gbuffer_layout, cluster_layout];
         let constants = codec_constants(codec);
-        let pipeline = fullscreen_pipeline_desc(
+        let pipeline = fullscreen_pipeline_with_defs(
             device,
             &FullscreenPipelineDesc {
                 label: "deferred_lighting",
@@ -56,6 +59,7 @@ impl DeferredLightingPipeline {
                 depth: None,
                 constants: &constants,
             },
+            defs,
         )?;
         Ok(DeferredLightingPipeline { pipeline, gbuffer_layout })
     }
@@ -69,6 +73,8 @@ pub struct DeferredLightingPass {
     pub codec: NormalCodec,
     /// Linear colour of pixels no geometry covers.
     pub clear_color: [f32; 3],
+    /// Reads the shadow atlas: the frame's lights cast shadows ([`PlanInputs::shades_shadows`]).
+    pub shadows: bool,
 }
 
 impl Pass for DeferredLightingPass {
@@ -76,7 +82,10 @@ impl Pass for DeferredLightingPass {
         "deferred_lighting"
     }
     fn reads(&self) -> Vec<ResourceName> {
-        gbuffer_reads(self.layout).chain([CLUSTERS]).collect()
+        gbuffer_reads(self.layout)
+            .chain([CLUSTERS])
+            .chain(self.shadows.then_some(super::SHADOW_ATLAS))
+            .collect()
     }
     fn writes(&self) -> Vec<ResourceName> {
         vec![HDR]
@@ -90,9 +99,20 @@ impl Pass for DeferredLightingPass {
         let device = &ctx.gpu.device;
         let (layout, codec) = (self.layout, self.codec);
         let view_layout = &ctx.scene.view_layout;
-        let pipeline = ctx.pipelines.get_or_create(DeferredLightingKey { layout, codec }, |k| {
-            DeferredLightingPipeline::new(device, view_layout, &clusters.shading_layout, k.layout, k.codec)
-        })?;
+        let pipeline = ctx.pipelines.get_or_create(
+            DeferredLightingKey { layout, codec, shadows: ctx.scene.shadows_active },
+            |k| {
+                let defs = crate::shaders::ShaderDefs { shadows: k.shadows, ..Default::default() };
+                DeferredLightingPipeline::new(
+                    device,
+                    view_layout,
+                    &clusters.shading_layout,
+                    k.layout,
+                    k.codec,
+                    defs,
+                )
+            },
+        )?;
         let gbuffer = gbuffer_read_bind_group(ctx, &pipeline.gbuffer_layout, layout, self.clear_color)?;
         let hdr = ctx.texture(HDR)?;
         let timestamps = ctx.render_timestamps(true, true);
@@ -114,6 +134,6 @@ pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
     };
     if p.shades_deferred() && lit_here {
         let (layout, codec, clear_color) = (s.gbuffer, s.normal_codec, s.clear_color);
-        out.push(Box::new(DeferredLightingPass { layout, codec, clear_color }));
+        out.push(Box::new(DeferredLightingPass { layout, codec, clear_color, shadows: p.shades_shadows() }));
     }
 }

@@ -56,6 +56,8 @@ impl ScenePipeline for ForwardPipeline {
 pub struct ForwardPass {
     /// Linear clear colour of the HDR target.
     pub clear_color: [f32; 3],
+    /// Reads the shadow atlas: the frame's lights cast shadows ([`PlanInputs::shades_shadows`]).
+    pub shadows: bool,
 }
 
 impl Pass for ForwardPass {
@@ -63,7 +65,7 @@ impl Pass for ForwardPass {
         "forward"
     }
     fn reads(&self) -> Vec<ResourceName> {
-        Vec::new()
+        if self.shadows { vec![super::SHADOW_ATLAS] } else { Vec::new() }
     }
     fn writes(&self) -> Vec<ResourceName> {
         vec![HDR, DEPTH]
@@ -90,6 +92,9 @@ impl Pass for ForwardPass {
 /// draws the ambient), unless a debug view replaces the image.
 pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
     if !p.shades_with_clusters() && !p.shades_deferred() && !p.replaces_shading() {
-        out.push(Box::new(ForwardPass { clear_color: p.settings().clear_color }));
+        out.push(Box::new(ForwardPass {
+            clear_color: p.settings().clear_color,
+            shadows: p.shades_shadows(),
+        }));
     }
 }

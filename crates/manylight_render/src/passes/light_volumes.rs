@@ -29,6 +29,8 @@ pub struct LightVolumesKey {
     pub codec: NormalCodec,
     /// Where the lights are summed.
     pub accumulation: wgpu::TextureFormat,
+    /// Composed with `SHADOWS` (group 0 has the shadow bindings).
+    pub shadows: bool,
 }
 
 impl PipelineKey for LightVolumesKey {
@@ -62,9 +64,10 @@ impl LightVolumesPipeline {
         layout: GBufferLayout,
         codec: NormalCodec,
         accumulation: wgpu::TextureFormat,
+        defs: crate::shaders::ShaderDefs,
     ) -> Result<Self, RenderError> {
         let device = &gpu.device;
-        let module = crate::shaders::create_module(device, "light_volumes.wgsl")?;
+        let module = crate::shaders::create_module_with(device, "light_volumes.wgsl", defs)?;
         let gbuffer_layout = gbuffer_read_layout(device, layout);
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("light_volumes"),
@@ -205,6 +208,9 @@ pub struct LightVolumesPass {
     /// Format the lights are summed in: [`HDR_FORMAT`] (directly into HDR), or rgba32f where
     /// the device can blend it ([`LightVolumesPass::accumulation_format`]), then copied to HDR.
     pub accumulation: wgpu::TextureFormat,
+    /// Reads the shadow atlas: the frame's lights cast shadows
+    /// ([`crate::plan::PlanInputs::shades_shadows`]).
+    pub shadows: bool,
 }
 
 impl LightVolumesPass {
@@ -227,7 +233,8 @@ impl Pass for LightVolumesPass {
         "light_volumes"
     }
     fn reads(&self) -> Vec<ResourceName> {
-        targets(self.layout).iter().map(|&(name, _)| name).chain([DEPTH]).collect()
+        let shadows = self.shadows.then_some(super::SHADOW_ATLAS);
+        targets(self.layout).iter().map(|&(name, _)| name).chain([DEPTH]).chain(shadows).collect()
     }
     fn writes(&self) -> Vec<ResourceName> {
         vec![HDR]
@@ -244,9 +251,10 @@ impl Pass for LightVolumesPass {
         let (layout, codec, accumulation) = (self.layout, self.codec, self.accumulation);
         let scene = ctx.scene;
         let gpu = ctx.gpu;
-        let key = LightVolumesKey { layout, codec, accumulation };
+        let key = LightVolumesKey { layout, codec, accumulation, shadows: scene.shadows_active };
         let pipeline = ctx.pipelines.get_or_create(key, |k| {
-            LightVolumesPipeline::new(gpu, &scene.view_layout, k.layout, k.codec, k.accumulation)
+            let defs = crate::shaders::ShaderDefs { shadows: k.shadows, ..Default::default() };
+            LightVolumesPipeline::new(gpu, &scene.view_layout, k.layout, k.codec, k.accumulation, defs)
         })?;
         let gbuffer = gbuffer_read_bind_group(ctx, &pipeline.gbuffer_layout, layout, self.clear_color)?;
         let hdr = ctx.texture(HDR)?;
@@ -295,6 +303,12 @@ pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
     let s = p.settings();
     if p.shades_deferred() && s.pipeline == crate::snapshot::PipelineKind::LightVolumes {
         let (layout, codec, clear_color) = (s.gbuffer, s.normal_codec, s.clear_color);
-        out.push(Box::new(LightVolumesPass { layout, codec, clear_color, accumulation: p.accumulation }));
+        out.push(Box::new(LightVolumesPass {
+            layout,
+            codec,
+            clear_color,
+            accumulation: p.accumulation,
+            shadows: p.shades_shadows(),
+        }));
     }
 }

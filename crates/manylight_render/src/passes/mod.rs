@@ -20,6 +20,7 @@ pub mod light_refine;
 pub mod light_volumes;
 pub mod motion_blur;
 pub mod scene_draw;
+pub mod shadow_maps;
 pub mod tiled_deferred;
 pub mod tonemap;
 pub mod transparent;
@@ -36,6 +37,7 @@ pub use gbuffer::GBufferPass;
 pub use light_refine::LightRefinePass;
 pub use light_volumes::LightVolumesPass;
 pub use motion_blur::MotionBlurPass;
+pub use shadow_maps::ShadowMapsPass;
 pub use tiled_deferred::TiledDeferredPass;
 pub use tonemap::TonemapPass;
 pub use transparent::TransparentPass;
@@ -60,6 +62,9 @@ pub const GBUFFER_PACKED_POSITION: crate::graph::ResourceName = "gbuffer_packed_
 pub const GBUFFER_EMISSIVE: crate::graph::ResourceName = "gbuffer_emissive";
 /// Light volumes: the sum of the lights, in f32 where the device can blend it.
 pub const LIGHT_ACCUM: crate::graph::ResourceName = "light_accum";
+/// Graph resource: the shadow atlas (a persistent texture, [`crate::shadows`]), written by the
+/// shadow pass and read by every shading pass of a frame whose lights cast shadows.
+pub const SHADOW_ATLAS: crate::graph::ResourceName = "shadow_atlas";
 /// Graph resource: the cluster light lists (persistent buffers, ordered through the graph).
 pub const CLUSTERS: crate::graph::ResourceName = "clusters";
 /// Graph resource: each pixel's view distance as forward shading computes it (the depth

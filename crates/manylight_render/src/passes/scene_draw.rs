@@ -43,10 +43,16 @@ fn pipelines_where<K: PipelineKey>(
     key: impl Fn(SurfaceVariant) -> K,
     create: impl Fn(&K) -> Result<K::Pipeline, RenderError>,
 ) -> Result<VariantPipelines<K::Pipeline>, RenderError> {
-    // Each variant's pipeline has the view's shading model where its material has none.
+    // Each variant's pipeline has the view's shading model where its material has none, and
+    // reads shadows when the frame's lights cast them.
     let global = ctx.scene.view.shading_model;
+    let shadows = ctx.scene.shadows_active;
     let variants = ctx.scene.variants.iter().filter(|v| filter(v));
-    variants.map(|&v| Ok((v, ctx.pipelines.get_or_create(key(v.resolved(global)), &create)?))).collect()
+    variants
+        .map(|&v| {
+            Ok((v, ctx.pipelines.get_or_create(key(v.resolved(global).with_shadows(shadows)), &create)?))
+        })
+        .collect()
 }
 
 /// Records the graph pass as one timed wgpu render pass that draws every scene instance with

@@ -2,7 +2,7 @@
 //! of the light grid cuts the tile's list to its pixels' depths (range and 2.5D mask) in
 //! workgroup memory and shades its pixels from it into [`HDR`].
 
-use super::common::compute_pipeline;
+use super::common::compute_pipeline_with_defs;
 use super::gbuffer_layout::{
     codec_constants, compute_entry, gbuffer_read_bind_group, gbuffer_read_layout, gbuffer_reads,
 };
@@ -23,6 +23,8 @@ pub struct TiledDeferredKey {
     pub layout: GBufferLayout,
     /// Its normal codec.
     pub codec: NormalCodec,
+    /// Composed with `SHADOWS` (group 0 has the shadow bindings).
+    pub shadows: bool,
 }
 
 impl PipelineKey for TiledDeferredKey {
@@ -43,6 +45,7 @@ impl TiledDeferredPipeline {
         cluster_layout: &wgpu::BindGroupLayout,
         layout: GBufferLayout,
         codec: NormalCodec,
+        defs: crate::shaders::ShaderDefs,
     ) -> Result<Self, RenderError> {
         let gbuffer_layout = gbuffer_read_layout(device, layout);
         let output_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -60,8 +63,15 @@ impl TiledDeferredPipeline {
         });
         let layouts = [view_layout, &gbuffer_layout, cluster_layout, &output_layout];
         let (entry, constants) = (compute_entry(layout), codec_constants(codec));
-        let pipeline =
-            compute_pipeline(device, "tiled_deferred", "tiled_deferred.wgsl", &layouts, entry, &constants)?;
+        let pipeline = compute_pipeline_with_defs(
+            device,
+            "tiled_deferred",
+            "tiled_deferred.wgsl",
+            &layouts,
+            entry,
+            &constants,
+            defs,
+        )?;
         Ok(TiledDeferredPipeline { pipeline, gbuffer_layout, output_layout })
     }
 }
@@ -74,6 +84,8 @@ pub struct TiledDeferredPass {
     pub codec: NormalCodec,
     /// Linear colour of pixels no geometry covers.
     pub clear_color: [f32; 3],
+    /// Reads the shadow atlas: the frame's lights cast shadows ([`PlanInputs::shades_shadows`]).
+    pub shadows: bool,
 }
 
 impl Pass for TiledDeferredPass {
@@ -81,7 +93,10 @@ impl Pass for TiledDeferredPass {
         "tiled_deferred"
     }
     fn reads(&self) -> Vec<ResourceName> {
-        gbuffer_reads(self.layout).chain([CLUSTERS]).collect()
+        gbuffer_reads(self.layout)
+            .chain([CLUSTERS])
+            .chain(self.shadows.then_some(super::SHADOW_ATLAS))
+            .collect()
     }
     fn writes(&self) -> Vec<ResourceName> {
         vec![HDR]
@@ -114,9 +129,20 @@ impl Pass for TiledDeferredPass {
         let device = &ctx.gpu.device;
         let (layout, codec) = (self.layout, self.codec);
         let view_layout = &ctx.scene.view_layout;
-        let pipeline = ctx.pipelines.get_or_create(TiledDeferredKey { layout, codec }, |k| {
-            TiledDeferredPipeline::new(device, view_layout, &clusters.shading_layout, k.layout, k.codec)
-        })?;
+        let pipeline = ctx.pipelines.get_or_create(
+            TiledDeferredKey { layout, codec, shadows: ctx.scene.shadows_active },
+            |k| {
+                let defs = crate::shaders::ShaderDefs { shadows: k.shadows, ..Default::default() };
+                TiledDeferredPipeline::new(
+                    device,
+                    view_layout,
+                    &clusters.shading_layout,
+                    k.layout,
+                    k.codec,
+                    defs,
+                )
+            },
+        )?;
         let gbuffer = gbuffer_read_bind_group(ctx, &pipeline.gbuffer_layout, layout, self.clear_color)?;
         let output = ctx.bind_group(
             "tiled_deferred_output",
@@ -146,6 +172,6 @@ pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
     let s = p.settings();
     if p.shades_deferred() && s.pipeline == PipelineKind::TiledDeferred && !p.has_pixel_lists {
         let (layout, codec, clear_color) = (s.gbuffer, s.normal_codec, s.clear_color);
-        out.push(Box::new(TiledDeferredPass { layout, codec, clear_color }));
+        out.push(Box::new(TiledDeferredPass { layout, codec, clear_color, shadows: p.shades_shadows() }));
     }
 }

@@ -65,6 +65,8 @@ impl ScenePipeline for TransparentPipeline {
 pub struct TransparentPass {
     /// Lit through the cluster lists (the view built them) rather than by every light.
     pub clustered: bool,
+    /// Reads the shadow atlas: the frame's lights cast shadows ([`PlanInputs::shades_shadows`]).
+    pub shadows: bool,
 }
 
 impl Pass for TransparentPass {
@@ -72,7 +74,9 @@ impl Pass for TransparentPass {
         "transparent"
     }
     fn reads(&self) -> Vec<ResourceName> {
-        if self.clustered { vec![HDR, DEPTH, CLUSTERS] } else { vec![HDR, DEPTH] }
+        let mut reads = if self.clustered { vec![HDR, DEPTH, CLUSTERS] } else { vec![HDR, DEPTH] };
+        reads.extend(self.shadows.then_some(super::SHADOW_ATLAS));
+        reads
     }
     fn writes(&self) -> Vec<ResourceName> {
         vec![HDR]
@@ -121,6 +125,9 @@ impl Pass for TransparentPass {
 /// Needed when the frame draws a blended material and the view shows shaded surfaces.
 pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
     if p.has_blended && !p.replaces_shading() {
-        out.push(Box::new(TransparentPass { clustered: p.shades_with_clusters() }));
+        out.push(Box::new(TransparentPass {
+            clustered: p.shades_with_clusters(),
+            shadows: p.shades_shadows(),
+        }));
     }
 }

@@ -1,0 +1,147 @@
+//! The shadow pass: draws every casting light's cube faces into the shadow atlas
+//! ([`crate::shadows`]), one instanced draw per mesh over all (instance, face) pairs.
+
+use super::SHADOW_ATLAS;
+use super::common::vertex_layout;
+use crate::bindings::Binding;
+use crate::context::RenderError;
+use crate::graph::{Pass, PassContext, ResourceName};
+use crate::pipelines::PipelineKey;
+use crate::plan::PlanInputs;
+use crate::shaders::ShaderDefs;
+use crate::shadows::SHADOW_ATLAS_FORMAT;
+
+/// The shadow pass's pipeline: with clip distances where the device has them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ShadowMapsKey {
+    /// Faces are cut to their tiles by clip distances; otherwise by discarding fragments.
+    pub clip_distances: bool,
+}
+
+impl PipelineKey for ShadowMapsKey {
+    type Pipeline = ShadowMapsPipeline;
+}
+
+/// The pipeline of [`ShadowMapsPass`] and the layout of its group 0 (faces, draws, instances).
+pub struct ShadowMapsPipeline {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+impl ShadowMapsPipeline {
+    fn new(device: &wgpu::Device, key: &ShadowMapsKey) -> Result<Self, RenderError> {
+        let storage = |binding| crate::layouts::storage_entry(binding, wgpu::ShaderStages::VERTEX, true);
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shadow_maps"),
+            entries: &[storage(0), storage(1), storage(2)],
+        });
+        let defs = ShaderDefs { clip_distances: key.clip_distances, ..Default::default() };
+        let module = crate::shaders::create_module_with(device, "shadow_maps.wgsl", defs)?;
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("shadow_maps"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("shadow_maps"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[Some(vertex_layout())],
+            },
+            // Both sides cast: a single-sided mesh seen from behind by the light still blocks it.
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: SHADOW_ATLAS_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            // Without clip distances a fragment shader discards what falls outside the tile.
+            fragment: (!key.clip_distances).then(|| wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        Ok(ShadowMapsPipeline { pipeline, layout })
+    }
+}
+
+/// Draws the frame's shadow maps into [`SHADOW_ATLAS`].
+pub struct ShadowMapsPass;
+
+impl Pass for ShadowMapsPass {
+    fn name(&self) -> &'static str {
+        "shadow_maps"
+    }
+    fn reads(&self) -> Vec<ResourceName> {
+        Vec::new()
+    }
+    fn writes(&self) -> Vec<ResourceName> {
+        vec![SHADOW_ATLAS]
+    }
+    fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
+        let Some(shadows) = ctx.shadows.filter(|s| s.active) else {
+            return Ok(());
+        };
+        let Some(atlas) = shadows.atlas_view() else {
+            return Ok(());
+        };
+        let key = ShadowMapsKey { clip_distances: shadows.clip_distances };
+        let device = &ctx.gpu.device;
+        let pipeline = ctx.pipelines.get_or_create(key, |k| ShadowMapsPipeline::new(device, k))?;
+        let bind_group = ctx.bind_group(
+            "shadow_maps",
+            &pipeline.layout,
+            &[
+                Binding::Buffer(shadows.faces.buffer()),
+                Binding::Buffer(shadows.draws.buffer()),
+                Binding::Buffer(ctx.scene.instances.buffer()),
+            ],
+        );
+        let scene = ctx.scene;
+        let timestamps = ctx.render_timestamps(true, true);
+        let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("shadow_maps"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: atlas,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: timestamps,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&pipeline.pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        for run in &shadows.mesh_draws {
+            let Some(mesh) = scene.mesh(run.mesh) else {
+                continue;
+            };
+            pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+            pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..mesh.index_count, 0, run.first..run.first + run.count);
+        }
+        Ok(())
+    }
+}
+
+/// Needed when the view shades lights and the frame has a casting light
+/// ([`PlanInputs::shades_shadows`]).
+pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn crate::graph::Pass>>) {
+    if p.shades_shadows() {
+        out.push(Box::new(ShadowMapsPass));
+    }
+}

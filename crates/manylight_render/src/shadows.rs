@@ -1,0 +1,731 @@
+//! Shadows of point and spot lights: one depth atlas holds a cube of six square face tiles for
+//! every casting light, each light's tile edge chosen every frame from the size of its sphere on
+//! screen under the atlas's room.
+//!
+//! Per frame ([`ShadowResources::prepare`], once whatever the views):
+//! 1. every valid light with a [`ShadowBias`](crate::snapshot::ShadowBias) asks for a face edge
+//!    ([`requested_edge`]): its sphere's projected radius in pixels times
+//!    [`ShadowSettings::resolution_scale`], as a power of two in
+//!    [`ShadowSettings::min_face_size`]..=[`ShadowSettings::max_face_size`];
+//! 2. [`plan_atlas`] packs the blocks (3 × 2 tiles) in rows, largest first; when they do not fit,
+//!    the largest edges halve until they do, and at the smallest edge the least important
+//!    lights (smallest on screen) go without a shadow: both are counted
+//!    ([`ShadowReport::downgraded_lights`], [`ShadowReport::dropped_lights`]), never silent;
+//! 3. each opaque instance whose bounds meet a light's sphere is drawn into each face whose
+//!    frustum its bounds meet: one instanced draw per mesh for all the pairs
+//!    (`passes::shadow_maps`), so a thousand lights are a few dozen draw calls;
+//! 4. the shading passes read the light's face at the shaded point with a 2×2 comparison filter
+//!    (`shaders/common/shadows.wgsl`).
+//!
+//! A frame without a casting light has no atlas, no shadow pass and no shadow binding: the
+//! shaders are composed without `SHADOWS` ([`crate::shaders::ShaderDefs`]).
+
+use crate::context::{GpuContext, RenderError};
+use crate::gpu_types::{GpuShadowDraw, GpuShadowFace, GpuShadowLight, SHADOW_FACES, SHADOW_TILE_COLUMNS};
+use crate::pool::GrowableBuffer;
+use crate::resources::SceneResources;
+use crate::snapshot::{ExtractedCamera, FrameSnapshot};
+use glam::{Mat4, UVec2, Vec3, Vec4};
+use manylight_core::{Aabb, ProjectionKind};
+use serde::Serialize;
+
+/// Depth format of the shadow atlas.
+pub const SHADOW_ATLAS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// Face rows of a light's block of tiles.
+pub const SHADOW_TILE_ROWS: u32 = SHADOW_FACES / SHADOW_TILE_COLUMNS;
+
+/// The faces' near plane as a fraction of the light's range (a point nearer the light than
+/// that is never shadowed).
+pub const SHADOW_NEAR_FRACTION: f32 = 1e-3;
+
+/// The smallest atlas edge: an atlas grows from it in powers of two as the lights ask.
+pub const MIN_ATLAS_SIZE: u32 = 256;
+
+/// How shadow maps are sized (part of [`crate::snapshot::RenderSettings`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowSettings {
+    /// Lights that cast shadows cast them; `false` renders every light unshadowed (no atlas, no
+    /// pass), whatever the lights say. A camera's shadows checkbox.
+    pub enabled: bool,
+    /// Largest edge of the atlas in texels (a power of two); a device with a smaller
+    /// `max_texture_dimension_2d` gets its own limit, counted in
+    /// [`ShadowReport::atlas_limited_by_device`].
+    pub atlas_size: u32,
+    /// Largest face edge a light gets (a power of two).
+    pub max_face_size: u32,
+    /// Smallest face edge a casting light gets (a power of two): below it, a light goes
+    /// without a shadow and is counted.
+    pub min_face_size: u32,
+    /// Face texels asked per pixel of the light sphere's projected radius.
+    pub resolution_scale: f32,
+}
+
+impl Default for ShadowSettings {
+    fn default() -> Self {
+        ShadowSettings {
+            enabled: true,
+            atlas_size: 4096,
+            max_face_size: 512,
+            min_face_size: 16,
+            resolution_scale: 1.0,
+        }
+    }
+}
+
+impl ShadowSettings {
+    /// Refuses sizes no atlas can be planned with, naming the field.
+    pub fn check_values(&self) -> Result<(), String> {
+        for (name, value) in [
+            ("shadows.atlas_size", self.atlas_size),
+            ("shadows.max_face_size", self.max_face_size),
+            ("shadows.min_face_size", self.min_face_size),
+        ] {
+            if !value.is_power_of_two() {
+                return Err(format!("{name} {value} must be a power of two"));
+            }
+        }
+        if self.min_face_size > self.max_face_size {
+            return Err(format!(
+                "shadows.min_face_size {} must not exceed shadows.max_face_size {}",
+                self.min_face_size, self.max_face_size
+            ));
+        }
+        if self.atlas_size < SHADOW_TILE_COLUMNS * self.min_face_size {
+            return Err(format!(
+                "shadows.atlas_size {} cannot hold one light at shadows.min_face_size {} ({} texels wide)",
+                self.atlas_size,
+                self.min_face_size,
+                SHADOW_TILE_COLUMNS * self.min_face_size
+            ));
+        }
+        if !(self.resolution_scale.is_finite() && self.resolution_scale > 0.0) {
+            return Err(format!(
+                "shadows.resolution_scale {} must be finite and positive",
+                self.resolution_scale
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// What the frame's shadows took, in the stats JSON and the overlay.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct ShadowReport {
+    /// Lights that asked for a shadow.
+    pub casting_lights: u32,
+    /// Lights whose six faces were drawn this frame.
+    pub maps_rendered: u32,
+    /// Lights whose maps were kept from an earlier frame (maps are drawn every frame: 0).
+    pub maps_cached: u32,
+    /// (instance, face) pairs drawn.
+    pub instance_faces: u32,
+    /// Draw calls of the shadow pass (one per mesh).
+    pub draw_calls: u32,
+    /// Edge of the atlas texture in texels.
+    pub atlas_size: u32,
+    /// Bytes of the atlas texture.
+    pub atlas_bytes: u64,
+    /// Fraction of the atlas's texels in a light's tiles.
+    pub atlas_occupancy: f32,
+    /// Lights that got a smaller face than they asked for (the atlas was full).
+    pub downgraded_lights: u32,
+    /// Lights that got no shadow map at all (no room even at the smallest face): lit unshadowed.
+    pub dropped_lights: u32,
+    /// The device's texture limit is below [`ShadowSettings::atlas_size`]: the atlas is the
+    /// device's largest.
+    pub atlas_limited_by_device: bool,
+}
+
+/// The depth face `f` stores at distance `depth` along its axis: 0 at `near`, 1 at `far`
+/// (`shadow_face_depth` in `shaders/common/shadows.wgsl`).
+pub fn face_depth(depth: f32, near: f32, far: f32) -> f32 {
+    far * (depth - near) / (depth * (far - near))
+}
+
+/// Axis (0 = x) and direction (+1 or -1) face `face` looks along.
+pub fn face_axis(face: u32) -> (usize, f32) {
+    ((face / 2) as usize % 3, if face.is_multiple_of(2) { 1.0 } else { -1.0 })
+}
+
+/// The projection of cube face `face` of a light at `light`: x and y are the coordinates on the
+/// next two axes (x on axis + 1, y on axis + 2, modulo 3) over the distance along the face's
+/// axis, so the face is x, y ∈ [-w, w]; z / w is [`face_depth`].
+pub fn face_clip_from_world(light: Vec3, face: u32, near: f32, far: f32) -> Mat4 {
+    let (axis, sign) = face_axis(face);
+    let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
+    let row = |i: usize, s: f32| (Vec3::AXES[i] * s).extend(-s * light[i]);
+    let w = row(axis, sign);
+    let k = far / (far - near);
+    let z = w * k - Vec4::W * (k * near);
+    Mat4::from_cols(row(a, 1.0), row(b, 1.0), z, w).transpose()
+}
+
+/// The atlas transform of a tile at texel (`x`, `y`) with edge `edge` in an atlas `atlas`
+/// texels wide: (sx, ox, sy, oy) of [`GpuShadowFace::atlas`].
+pub fn tile_transform(x: u32, y: u32, edge: u32, atlas: u32) -> [f32; 4] {
+    let (a, e) = (atlas as f32, edge as f32);
+    [e / a, (2.0 * x as f32 + e) / a - 1.0, e / a, 1.0 - (2.0 * y as f32 + e) / a]
+}
+
+/// The face edge a light with the sphere (`center`, `radius`) asks for in a view through
+/// `camera` of `size` pixels: its projected radius in pixels times `resolution_scale`, rounded
+/// up to a power of two in the settings' range; the largest for a camera inside the sphere
+/// or no camera.
+pub fn requested_edge(
+    settings: &ShadowSettings,
+    camera: Option<(&ExtractedCamera, UVec2)>,
+    center: Vec3,
+    radius: f32,
+) -> u32 {
+    let (lo, hi) = (settings.min_face_size, settings.max_face_size);
+    let Some((camera, size)) = camera else {
+        return hi;
+    };
+    let half_height = size.y.max(1) as f32 * 0.5;
+    let projection = camera.projection.sanitized();
+    let pixels = match projection.kind {
+        ProjectionKind::Orthographic { height } => radius / (0.5 * height) * half_height,
+        ProjectionKind::Perspective => {
+            let distance = camera.position().distance(center);
+            if distance <= radius {
+                return hi;
+            }
+            let tangent = radius / (distance * distance - radius * radius).sqrt();
+            tangent / (0.5 * projection.fov_y).tan() * half_height
+        }
+    };
+    let wanted = pixels * settings.resolution_scale;
+    if !wanted.is_finite() || wanted >= hi as f32 {
+        return hi;
+    }
+    (wanted.max(1.0).ceil() as u32).next_power_of_two().clamp(lo, hi)
+}
+
+/// One light's request for a shadow map.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowRequest {
+    /// The light's index in the light buffer.
+    pub light: u32,
+    /// Face edge asked for (a power of two).
+    pub edge: u32,
+    /// Larger is kept first when the atlas is full (the projected size).
+    pub importance: f32,
+}
+
+/// Where a light's faces lie in the atlas.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShadowPlacement {
+    /// The light's index in the light buffer.
+    pub light: u32,
+    /// Top-left texel of its block of tiles.
+    pub x: u32,
+    /// Top-left texel of its block of tiles.
+    pub y: u32,
+    /// Face edge it got.
+    pub edge: u32,
+    /// Face edge it asked for.
+    pub asked: u32,
+}
+
+/// The frame's atlas: every placed light, and what did not fit.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct AtlasPlan {
+    /// Placed lights, largest faces first.
+    pub placements: Vec<ShadowPlacement>,
+    /// Atlas edge in texels.
+    pub atlas_size: u32,
+    /// Lights placed with a smaller edge than asked.
+    pub downgraded: u32,
+    /// Lights not placed.
+    pub dropped: u32,
+}
+
+impl AtlasPlan {
+    /// Fraction of the atlas's texels in a tile.
+    pub fn occupancy(&self) -> f32 {
+        let used: u64 =
+            self.placements.iter().map(|p| u64::from(p.edge).pow(2) * u64::from(SHADOW_FACES)).sum();
+        used as f32 / (u64::from(self.atlas_size).pow(2)).max(1) as f32
+    }
+}
+
+/// Packs blocks of `edges` (sorted largest first) in rows of an `atlas` × `atlas` square;
+/// `None` when they do not fit. Each row is as tall as its first block.
+fn pack_rows(edges: impl Iterator<Item = u32>, atlas: u32) -> Option<Vec<(u32, u32)>> {
+    let (mut x, mut y, mut row) = (0u32, 0u32, 0u32);
+    let mut out = Vec::new();
+    for edge in edges {
+        let (w, h) = (SHADOW_TILE_COLUMNS * edge, SHADOW_TILE_ROWS * edge);
+        if x + w > atlas {
+            (x, y, row) = (0, y + row, 0);
+        }
+        if w > atlas || y + h > atlas {
+            return None;
+        }
+        out.push((x, y));
+        x += w;
+        row = row.max(h);
+    }
+    Some(out)
+}
+
+/// Plans the atlas for `requests` (edges are powers of two of at least `min_edge`): the
+/// smallest power-of-two atlas from [`MIN_ATLAS_SIZE`] to `max_atlas` that holds every request
+/// as asked, or `max_atlas` with the largest edges halved until they fit and, at `min_edge`,
+/// the least important lights left out. Cost: O(n log n) to sort, then O(n) per halving
+/// (at most log2 of the largest edge).
+pub fn plan_atlas(requests: &[ShadowRequest], max_atlas: u32, min_edge: u32) -> AtlasPlan {
+    let mut order: Vec<ShadowRequest> = requests.to_vec();
+    order.sort_by(|a, b| {
+        b.edge.cmp(&a.edge).then(b.importance.total_cmp(&a.importance)).then(a.light.cmp(&b.light))
+    });
+    let placed = |granted: &[u32], order: &[ShadowRequest], atlas: u32, spots: Vec<(u32, u32)>| AtlasPlan {
+        placements: order
+            .iter()
+            .zip(granted)
+            .zip(spots)
+            .map(|((r, &edge), (x, y))| ShadowPlacement { light: r.light, x, y, edge, asked: r.edge })
+            .collect(),
+        atlas_size: atlas,
+        downgraded: order.iter().zip(granted).filter(|(r, g)| **g < r.edge).count() as u32,
+        dropped: 0,
+    };
+    let mut atlas = MIN_ATLAS_SIZE.min(max_atlas);
+    loop {
+        if let Some(spots) = pack_rows(order.iter().map(|r| r.edge), atlas) {
+            let granted: Vec<u32> = order.iter().map(|r| r.edge).collect();
+            return placed(&granted, &order, atlas, spots);
+        }
+        if atlas >= max_atlas {
+            break;
+        }
+        atlas *= 2;
+    }
+    // Halve the largest edges until the blocks fit.
+    let mut granted: Vec<u32> = order.iter().map(|r| r.edge).collect();
+    loop {
+        let largest = granted.iter().copied().max().unwrap_or(min_edge);
+        if largest <= min_edge {
+            break;
+        }
+        for g in granted.iter_mut().filter(|g| **g == largest) {
+            *g /= 2;
+        }
+        // Halving can reorder requests of equal granted edge only by importance, which the
+        // sort already follows within each asked edge; re-sort to keep rows largest first.
+        let mut paired: Vec<(ShadowRequest, u32)> =
+            order.iter().copied().zip(granted.iter().copied()).collect();
+        paired.sort_by(|(a, ga), (b, gb)| {
+            gb.cmp(ga).then(b.importance.total_cmp(&a.importance)).then(a.light.cmp(&b.light))
+        });
+        order = paired.iter().map(|(r, _)| *r).collect();
+        granted = paired.iter().map(|(_, g)| *g).collect();
+        if let Some(spots) = pack_rows(granted.iter().copied(), atlas) {
+            return placed(&granted, &order, atlas, spots);
+        }
+    }
+    // Every light at the smallest edge and still too many: keep the most important ones.
+    let per_row = atlas / (SHADOW_TILE_COLUMNS * min_edge);
+    let rows = atlas / (SHADOW_TILE_ROWS * min_edge);
+    let capacity = (per_row as usize) * (rows as usize);
+    order.sort_by(|a, b| b.importance.total_cmp(&a.importance).then(a.light.cmp(&b.light)));
+    let kept = order.len().min(capacity);
+    let dropped = (order.len() - kept) as u32;
+    order.truncate(kept);
+    let granted = vec![min_edge; kept];
+    let spots = pack_rows(granted.iter().copied(), atlas).unwrap_or_default();
+    AtlasPlan { dropped, ..placed(&granted, &order, atlas, spots) }
+}
+
+/// True when `bounds` meets the sphere (`center`, `radius`).
+fn sphere_meets_box(center: Vec3, radius: f32, bounds: &Aabb) -> bool {
+    if bounds.is_empty() {
+        return false;
+    }
+    let nearest = center.clamp(bounds.min, bounds.max);
+    nearest.distance_squared(center) <= radius * radius
+}
+
+/// True when `bounds` may meet face `face`'s frustum from `light` (a conservative test against
+/// the four planes through the light and the half-space in front of it).
+pub fn box_meets_face(light: Vec3, face: u32, bounds: &Aabb) -> bool {
+    let (axis, sign) = face_axis(face);
+    let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
+    let (lo, hi) = (bounds.min - light, bounds.max - light);
+    // The largest value of n·p over the box.
+    let max_over_box = |n: Vec3| -> f32 { (n * lo).max(n * hi).element_sum() };
+    let w = Vec3::AXES[axis] * sign;
+    let planes = [w, w - Vec3::AXES[a], w + Vec3::AXES[a], w - Vec3::AXES[b], w + Vec3::AXES[b]];
+    planes.iter().all(|&n| max_over_box(n) >= 0.0)
+}
+
+/// A run of the shadow pass's draw instances that share a mesh.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShadowMeshDraws {
+    /// Key into `SceneResources::mesh`.
+    pub mesh: usize,
+    /// First instance (index into the draw buffer).
+    pub first: u32,
+    /// Instances.
+    pub count: u32,
+}
+
+/// The shadow atlas and the buffers of its pass, kept across frames.
+pub struct ShadowResources {
+    /// The atlas (created on the first frame with a casting light, grown when a frame needs a
+    /// larger one, never shrunk).
+    atlas: Option<wgpu::Texture>,
+    atlas_view: Option<wgpu::TextureView>,
+    /// The comparison sampler of the shading passes (linear: a 2×2 filter).
+    pub sampler: wgpu::Sampler,
+    /// [`GpuShadowLight`] per light of the light buffer.
+    pub lights: GrowableBuffer,
+    /// [`GpuShadowFace`] per placed face.
+    pub faces: GrowableBuffer,
+    /// [`GpuShadowDraw`] per (instance, face) pair, grouped by mesh.
+    pub draws: GrowableBuffer,
+    /// The runs of `draws` by mesh, in the scene's draw order.
+    pub mesh_draws: Vec<ShadowMeshDraws>,
+    /// This frame's plan.
+    pub plan: AtlasPlan,
+    /// This frame's counters.
+    pub report: ShadowReport,
+    /// True when the frame has a shadow map to draw and read.
+    pub active: bool,
+    /// Bumped whenever the atlas or the light table is re-created (the view bind group follows).
+    pub generation: u64,
+    /// The device draws clip distances (`Features::CLIP_DISTANCES`); otherwise the shadow
+    /// pass discards the fragments outside each face's tile.
+    pub clip_distances: bool,
+    max_texture: u32,
+    gpu_lights: Vec<GpuShadowLight>,
+    gpu_faces: Vec<GpuShadowFace>,
+    by_mesh: Vec<(usize, Vec<GpuShadowDraw>)>,
+    requests: Vec<ShadowRequest>,
+}
+
+impl ShadowResources {
+    /// Empty buffers and the sampler; no atlas until a light casts.
+    pub fn new(gpu: &GpuContext) -> ShadowResources {
+        let storage = wgpu::BufferUsages::STORAGE;
+        ShadowResources {
+            atlas: None,
+            atlas_view: None,
+            sampler: gpu.device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("shadow_sampler"),
+                mag_filter: wgpu::FilterMode::Linear,
+                min_filter: wgpu::FilterMode::Linear,
+                compare: Some(wgpu::CompareFunction::LessEqual),
+                ..Default::default()
+            }),
+            lights: GrowableBuffer::new(
+                gpu,
+                "shadow_lights",
+                storage,
+                std::mem::size_of::<GpuShadowLight>() as u64,
+            ),
+            faces: GrowableBuffer::new(
+                gpu,
+                "shadow_faces",
+                storage,
+                std::mem::size_of::<GpuShadowFace>() as u64,
+            ),
+            draws: GrowableBuffer::new(
+                gpu,
+                "shadow_draws",
+                storage,
+                std::mem::size_of::<GpuShadowDraw>() as u64,
+            ),
+            mesh_draws: Vec::new(),
+            plan: AtlasPlan::default(),
+            report: ShadowReport::default(),
+            active: false,
+            generation: 0,
+            clip_distances: gpu.device.features().contains(wgpu::Features::CLIP_DISTANCES),
+            max_texture: gpu.max_texture_size(),
+            gpu_lights: Vec::new(),
+            gpu_faces: Vec::new(),
+            by_mesh: Vec::new(),
+            requests: Vec::new(),
+        }
+    }
+
+    /// The atlas's view, once a frame had a casting light.
+    pub fn atlas_view(&self) -> Option<&wgpu::TextureView> {
+        self.atlas_view.as_ref()
+    }
+
+    /// Plans the frame's atlas and uploads its faces, draws and light table (after
+    /// [`SceneResources::prepare`], whose lights, instances and draws it reads).
+    pub fn prepare(
+        &mut self,
+        gpu: &GpuContext,
+        scene: &SceneResources,
+        snapshot: &FrameSnapshot,
+    ) -> Result<(), RenderError> {
+        let settings = snapshot.settings.shadows;
+        self.report = ShadowReport::default();
+        self.active = false;
+        self.mesh_draws.clear();
+        if !snapshot.casts_shadows() {
+            self.plan = AtlasPlan::default();
+            return Ok(());
+        }
+        let camera = snapshot.views.first().map(|v| (&v.camera, snapshot.viewport));
+        // Requests, by the light's index in the light buffer (the valid lights in order).
+        self.requests.clear();
+        let valid = snapshot.lights.iter().filter(|l| l.is_valid());
+        for (k, light) in valid.enumerate() {
+            if light.shadow.is_none() || !(light.radius > 0.0) {
+                continue;
+            }
+            let (center, radius) = light.bounding_sphere();
+            let edge = requested_edge(&settings, camera, center, radius);
+            let importance = requested_edge(
+                &ShadowSettings { max_face_size: 1 << 30, min_face_size: 1, ..settings },
+                camera,
+                center,
+                radius,
+            ) as f32;
+            self.requests.push(ShadowRequest { light: k as u32, edge, importance });
+        }
+        // The largest power of two the device's textures allow.
+        let device_limit = 1u32 << (31 - self.max_texture.max(1).leading_zeros());
+        let max_atlas = settings.atlas_size.min(device_limit);
+        self.plan = plan_atlas(
+            &self.requests,
+            max_atlas,
+            settings.min_face_size.min(max_atlas / SHADOW_TILE_COLUMNS).max(1),
+        );
+        self.report.casting_lights = self.requests.len() as u32;
+        self.report.atlas_limited_by_device = device_limit < settings.atlas_size;
+        self.report.downgraded_lights = self.plan.downgraded;
+        self.report.dropped_lights = self.plan.dropped;
+        if self.plan.placements.is_empty() {
+            return Ok(());
+        }
+        self.ensure_atlas(gpu, self.plan.atlas_size);
+        let atlas = self.atlas.as_ref().map_or(self.plan.atlas_size, |t| t.width());
+
+        // The light table: every light of the buffer, edge 0 where it has no map.
+        self.gpu_lights.clear();
+        self.gpu_lights.resize(scene.light_count.max(1) as usize, GpuShadowLight::default());
+        let lights: Vec<_> = snapshot.lights.iter().filter(|l| l.is_valid()).collect();
+        self.gpu_faces.clear();
+        for list in &mut self.by_mesh {
+            list.1.clear();
+        }
+        let opaque: Vec<_> = scene.draws.iter().filter(|d| !d.variant.blend).collect();
+        for p in &self.plan.placements {
+            let light = lights[p.light as usize];
+            let bias = light.shadow.unwrap_or_default();
+            let far = light.radius;
+            let near = far * SHADOW_NEAR_FRACTION;
+            self.gpu_lights[p.light as usize] =
+                GpuShadowLight { tile: [p.x, p.y, p.edge, 0], params: [near, far, bias.depth, bias.normal] };
+            let first_face = self.gpu_faces.len() as u32;
+            for face in 0..SHADOW_FACES {
+                let (tx, ty) = (
+                    p.x + (face % SHADOW_TILE_COLUMNS) * p.edge,
+                    p.y + (face / SHADOW_TILE_COLUMNS) * p.edge,
+                );
+                self.gpu_faces.push(GpuShadowFace {
+                    clip_from_world: face_clip_from_world(light.position, face, near, far),
+                    atlas: tile_transform(tx, ty, p.edge, atlas),
+                });
+            }
+            let (center, radius) = light.bounding_sphere();
+            for d in &opaque {
+                if !sphere_meets_box(center, radius, &d.world_bounds) {
+                    continue;
+                }
+                let slot = match self.by_mesh.iter().position(|(m, _)| *m == d.mesh) {
+                    Some(i) => i,
+                    None => {
+                        self.by_mesh.push((d.mesh, Vec::new()));
+                        self.by_mesh.len() - 1
+                    }
+                };
+                for face in 0..SHADOW_FACES {
+                    if box_meets_face(light.position, face, &d.world_bounds) {
+                        self.by_mesh[slot]
+                            .1
+                            .push(GpuShadowDraw { instance: d.instance, face: first_face + face });
+                    }
+                }
+            }
+        }
+        // Meshes no longer drawn leave the list.
+        self.by_mesh.retain(|(mesh, _)| scene.mesh(*mesh).is_some());
+        let mut all = Vec::new();
+        for (mesh, list) in &self.by_mesh {
+            if list.is_empty() {
+                continue;
+            }
+            self.mesh_draws.push(ShadowMeshDraws {
+                mesh: *mesh,
+                first: all.len() as u32,
+                count: list.len() as u32,
+            });
+            all.extend_from_slice(list);
+        }
+        let mut grew = self.lights.write(gpu, bytemuck::cast_slice(&self.gpu_lights))?;
+        grew |= self.faces.write(gpu, bytemuck::cast_slice(&self.gpu_faces))?;
+        if !all.is_empty() {
+            grew |= self.draws.write(gpu, bytemuck::cast_slice(&all))?;
+        }
+        if grew {
+            self.generation += 1;
+        }
+        self.active = true;
+        self.report.maps_rendered = self.plan.placements.len() as u32;
+        self.report.instance_faces = all.len() as u32;
+        self.report.draw_calls = self.mesh_draws.len() as u32;
+        self.report.atlas_size = atlas;
+        self.report.atlas_bytes = u64::from(atlas).pow(2) * 4;
+        self.report.atlas_occupancy = AtlasPlan { atlas_size: atlas, ..self.plan.clone() }.occupancy();
+        Ok(())
+    }
+
+    /// Creates the atlas, or a larger one, when `size` does not fit the current one.
+    fn ensure_atlas(&mut self, gpu: &GpuContext, size: u32) {
+        if self.atlas.as_ref().is_some_and(|t| t.width() >= size) {
+            return;
+        }
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("shadow_atlas"),
+            size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: SHADOW_ATLAS_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        self.atlas_view = Some(texture.create_view(&Default::default()));
+        self.atlas = Some(texture);
+        self.generation += 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_face_projects_its_axis_to_the_centre_and_its_edges_to_the_tile() {
+        let light = Vec3::new(1.0, 2.0, 3.0);
+        let (near, far) = (0.01, 10.0);
+        for face in 0..SHADOW_FACES {
+            let (axis, sign) = face_axis(face);
+            let m = face_clip_from_world(light, face, near, far);
+            let ahead = light + Vec3::AXES[axis] * sign * 2.0;
+            let c = m * ahead.extend(1.0);
+            assert!((c.x / c.w).abs() < 1e-6 && (c.y / c.w).abs() < 1e-6, "face {face}: {c}");
+            assert!((c.z / c.w - face_depth(2.0, near, far)).abs() < 1e-6);
+            // A point on the next axis at 45° is on the face's edge x = 1.
+            let edge = ahead + Vec3::AXES[(axis + 1) % 3] * 2.0;
+            let c = m * edge.extend(1.0);
+            assert!((c.x / c.w - 1.0).abs() < 1e-6, "face {face}: {c}");
+            assert!(box_meets_face(light, face, &Aabb { min: ahead - 0.1, max: ahead + 0.1 }));
+            assert!(!box_meets_face(
+                light,
+                face,
+                &Aabb { min: light - ahead + light - 0.1, max: light - ahead + light + 0.1 }
+            ));
+        }
+        assert_eq!(face_depth(near, near, far), 0.0);
+        assert!((face_depth(far, near, far) - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn tiles_map_the_face_square_onto_their_texels() {
+        let [sx, ox, sy, oy] = tile_transform(64, 32, 16, 256);
+        // Face corner (-1, 1) (u = 0, top row) lands on texel (64, 32).
+        let to_texel = |x: f32| ((x * sx + ox) * 0.5 + 0.5) * 256.0;
+        assert!((to_texel(-1.0) - 64.0).abs() < 1e-4);
+        assert!((to_texel(1.0) - 80.0).abs() < 1e-4);
+        let row = |y: f32| (0.5 - 0.5 * (y * sy + oy)) * 256.0;
+        assert!((row(1.0) - 32.0).abs() < 1e-4);
+        assert!((row(-1.0) - 48.0).abs() < 1e-4);
+    }
+
+    fn requests(edges: &[u32]) -> Vec<ShadowRequest> {
+        edges
+            .iter()
+            .enumerate()
+            .map(|(i, &edge)| ShadowRequest {
+                light: i as u32,
+                edge,
+                importance: edge as f32 + i as f32 * 1e-3,
+            })
+            .collect()
+    }
+
+    fn no_overlap(plan: &AtlasPlan) {
+        let rect = |p: &ShadowPlacement| (p.x, p.y, p.x + 3 * p.edge, p.y + 2 * p.edge);
+        for (i, a) in plan.placements.iter().enumerate() {
+            let ra = rect(a);
+            assert!(ra.2 <= plan.atlas_size && ra.3 <= plan.atlas_size, "{a:?} outside {}", plan.atlas_size);
+            for b in &plan.placements[i + 1..] {
+                let rb = rect(b);
+                let apart = ra.2 <= rb.0 || rb.2 <= ra.0 || ra.3 <= rb.1 || rb.3 <= ra.1;
+                assert!(apart, "{a:?} overlaps {b:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_atlas_grows_to_hold_every_request_as_asked() {
+        let plan = plan_atlas(&requests(&[64, 32, 32, 16, 16, 16]), 4096, 16);
+        assert_eq!(plan.atlas_size, 256);
+        assert_eq!((plan.downgraded, plan.dropped), (0, 0));
+        assert_eq!(plan.placements.len(), 6);
+        no_overlap(&plan);
+        // Blocks of 1536 × 1024: one a row at 2048, two at 4096.
+        let plan = plan_atlas(&requests(&[512; 4]), 4096, 16);
+        assert_eq!(plan.atlas_size, 4096);
+        no_overlap(&plan);
+    }
+
+    #[test]
+    fn a_full_atlas_halves_the_largest_then_drops_the_least_important_and_counts_both() {
+        // 10 lights at 512 need 10 blocks of 1536 × 1024: four fit a 4096 atlas.
+        let plan = plan_atlas(&requests(&[512; 10]), 4096, 16);
+        assert_eq!(plan.placements.len(), 10);
+        assert_eq!(plan.downgraded, 10);
+        assert!(plan.placements.iter().all(|p| p.edge == 256));
+        no_overlap(&plan);
+        // 100 000 lights at the smallest edge cannot all fit: the most important stay.
+        let many = requests(&vec![16; 100_000]);
+        let plan = plan_atlas(&many, 1024, 16);
+        let capacity = (1024 / 48) * (1024 / 32);
+        assert_eq!(plan.placements.len(), capacity as usize);
+        assert_eq!(plan.dropped, 100_000 - capacity);
+        assert!(plan.placements.iter().all(|p| p.light >= 100_000 - capacity), "the most important are kept");
+        no_overlap(&plan);
+    }
+
+    #[test]
+    fn requested_edges_follow_the_projected_size() {
+        let settings = ShadowSettings::default();
+        let camera = ExtractedCamera {
+            world_from_view: Mat4::IDENTITY,
+            projection: Default::default(),
+            prev_clip_from_world: None,
+            bloom: None,
+            motion_blur: None,
+            exposure: None,
+        };
+        let size = UVec2::new(1280, 720);
+        let near = requested_edge(&settings, Some((&camera, size)), Vec3::new(0.0, 0.0, -5.0), 1.0);
+        let far = requested_edge(&settings, Some((&camera, size)), Vec3::new(0.0, 0.0, -80.0), 1.0);
+        assert!(near > far, "{near} vs {far}");
+        assert_eq!(far, 16);
+        assert_eq!(requested_edge(&settings, Some((&camera, size)), Vec3::ZERO, 1.0), 512, "camera inside");
+        assert!(ShadowSettings { min_face_size: 24, ..settings }.check_values().is_err());
+        assert!(ShadowSettings { min_face_size: 1024, ..settings }.check_values().is_err());
+        assert!(settings.check_values().is_ok());
+    }
+}

@@ -1,0 +1,210 @@
+//! Shadows of point and spot lights: a plate over a floor shadows the floor where the exact
+//! visibility oracle (`manylight_core::shadow_oracle`) says, for a point and a spot light;
+//! every pipeline gives naive forward's shadowed image; lights that do not cast change nothing.
+
+mod support;
+
+use manylight::app::headless::{HeadlessFrame, render_headless};
+use manylight::core::shadow_oracle::{LightSource, OccluderSet, ShadowQuery};
+use manylight::prelude::*;
+use manylight::scene::shapes::cuboid;
+use manylight::scene::{SceneCamera, SceneInstance, camera_looking_at};
+use glam::{Mat4, Vec4};
+use std::sync::Arc;
+use support::{COMPACT, STRICT, assert_similar, gpu};
+
+const SIZE: UVec2 = UVec2::new(160, 120);
+const LIGHT: Vec3 = Vec3::new(0.0, 2.0, 0.0);
+const EYE: Vec3 = Vec3::new(0.0, 5.0, 5.0);
+/// Half the floor's edge.
+const FLOOR: f32 = 4.0;
+
+/// A floor (top at y = 0), a 1 × 1 plate at y = 1 and the camera looking down at them.
+fn plate_scene() -> Scene {
+    let white = MaterialData { base_color: Vec4::new(0.8, 0.8, 0.8, 1.0), ..MaterialData::default() };
+    Scene {
+        name: "plate".into(),
+        meshes: vec![
+            Arc::new(cuboid("floor", Vec3::new(2.0 * FLOOR, 0.2, 2.0 * FLOOR), 1.0)),
+            Arc::new(cuboid("plate", Vec3::new(1.0, 0.05, 1.0), 1.0)),
+        ],
+        materials: vec![Arc::new(white)],
+        instances: vec![
+            SceneInstance {
+                mesh: 0,
+                material: 0,
+                transform: Mat4::from_translation(Vec3::new(0.0, -0.1, 0.0)),
+            },
+            SceneInstance {
+                mesh: 1,
+                material: 0,
+                transform: Mat4::from_translation(Vec3::new(0.0, 1.0, 0.0)),
+            },
+        ],
+        cameras: vec![SceneCamera {
+            transform: camera_looking_at(EYE, Vec3::ZERO),
+            projection: Default::default(),
+        }],
+        ..Scene::default()
+    }
+}
+
+/// Which light lights the plate scene.
+#[derive(Clone, Copy, Debug)]
+enum Kind {
+    Point,
+    Spot,
+}
+
+fn render(kind: Kind, shadows: bool, settings: RenderSettings) -> HeadlessFrame {
+    let scene = plate_scene();
+    let frame = render_headless(SIZE, 1, move |app| {
+        app.insert_resource(settings).add_systems(Startup, move |mut commands: Commands| {
+            spawn_scene(&mut commands, &scene, true, SIZE.x as f32 / SIZE.y as f32);
+            let at = Transform::from_translation(LIGHT);
+            match kind {
+                Kind::Point => {
+                    let light = PointLight {
+                        intensity: 150.0,
+                        range: 8.0,
+                        shadows_enabled: shadows,
+                        ..Default::default()
+                    };
+                    commands.spawn((at, light));
+                }
+                Kind::Spot => {
+                    let light = SpotLight {
+                        intensity: 150.0,
+                        range: 8.0,
+                        inner_angle: 0.9,
+                        outer_angle: 1.2,
+                        shadows_enabled: shadows,
+                        ..Default::default()
+                    };
+                    commands.spawn((at.looking_to(Vec3::NEG_Y, Vec3::Z), light));
+                }
+            }
+        });
+    })
+    .unwrap_or_else(|e| panic!("render failed: {e}"));
+    support::assert_finite(&frame);
+    frame
+}
+
+fn luminance(p: &image::Rgba<u8>) -> f32 {
+    (0.2126 * p[0] as f32 + 0.7152 * p[1] as f32 + 0.0722 * p[2] as f32) / 255.0
+}
+
+/// The floor point each pixel shows (`None` where it shows no floor, or the plate hides it).
+fn floor_points(scene: &Scene, occluders: &OccluderSet) -> Vec<Option<(u32, u32, Vec3)>> {
+    let camera = scene.cameras[0];
+    let clip_from_world =
+        camera.projection.matrix(SIZE.x as f32 / SIZE.y as f32) * camera.transform.inverse();
+    let world_from_clip = clip_from_world.inverse();
+    let mut out = Vec::new();
+    for y in 0..SIZE.y {
+        for x in 0..SIZE.x {
+            let ndc = Vec2::new(
+                (x as f32 + 0.5) / SIZE.x as f32 * 2.0 - 1.0,
+                1.0 - (y as f32 + 0.5) / SIZE.y as f32 * 2.0,
+            );
+            let far = world_from_clip.project_point3(ndc.extend(0.5));
+            let dir = (far - EYE).normalize();
+            let t = -EYE.y / dir.y;
+            let p = EYE + dir * t;
+            let on_floor = t > 0.0 && p.x.abs() < FLOOR && p.z.abs() < FLOOR;
+            // The camera sees the floor there unless the plate is in between.
+            let seen = on_floor
+                && occluders.visible(&ShadowQuery { point: p, normal: Vec3::Y, light: LightSource::At(EYE) });
+            out.push(seen.then_some((x, y, p)));
+        }
+    }
+    out
+}
+
+/// The fraction of the floor's lit pixels whose shadow disagrees with the oracle: shadowed
+/// (less than half of the unshadowed light over the ambient) where the light reaches the point,
+/// or lit where it is blocked.
+fn visibility_error(
+    kind: Kind,
+    shadowed: &HeadlessFrame,
+    unshadowed: &HeadlessFrame,
+    ambient: &HeadlessFrame,
+) -> f32 {
+    let scene = plate_scene();
+    let occluders = OccluderSet::from_instances(
+        scene.instances.iter().map(|i| (scene.meshes[i.mesh].as_ref(), i.transform)),
+    );
+    let (mut pairs, mut wrong, mut blocked) = (0u32, 0u32, 0u32);
+    for (x, y, p) in floor_points(&scene, &occluders).into_iter().flatten() {
+        let base = luminance(ambient.image.get_pixel(x, y));
+        let light = luminance(unshadowed.image.get_pixel(x, y)) - base;
+        if light < 0.05 {
+            continue; // the light does not reach the point enough to tell
+        }
+        let visible =
+            occluders.visible(&ShadowQuery { point: p, normal: Vec3::Y, light: LightSource::At(LIGHT) });
+        let got = luminance(shadowed.image.get_pixel(x, y)) - base;
+        let lit = got > 0.5 * light;
+        pairs += 1;
+        blocked += u32::from(!visible);
+        wrong += u32::from(lit != visible);
+    }
+    assert!(pairs > 2000, "{kind:?}: too few lit floor pixels ({pairs})");
+    assert!(blocked > 200, "{kind:?}: the plate blocks the light from few pixels ({blocked})");
+    wrong as f32 / pairs as f32
+}
+
+#[test]
+fn a_plate_shadows_the_floor_where_the_oracle_says_for_point_and_spot_lights() {
+    let _gpu = gpu();
+    let naive = RenderSettings { pipeline: PipelineKind::NaiveForward, ..RenderSettings::default() };
+    let ambient = {
+        let scene = plate_scene();
+        render_headless(SIZE, 1, move |app| {
+            app.insert_resource(naive).add_systems(Startup, move |mut commands: Commands| {
+                spawn_scene(&mut commands, &scene, true, SIZE.x as f32 / SIZE.y as f32);
+            });
+        })
+        .expect("the unlit scene renders")
+    };
+    for kind in [Kind::Point, Kind::Spot] {
+        let on = render(kind, true, naive);
+        let off = render(kind, false, naive);
+        let error = visibility_error(kind, &on, &off, &ambient);
+        eprintln!("{kind:?}: visibility error {:.3} %", error * 100.0);
+        assert!(
+            error < 0.02,
+            "{kind:?}: {:.2} % of the floor's pixels disagree with the oracle",
+            error * 100.0
+        );
+        let report = on.stats.last.as_ref().and_then(|r| r.shadows).expect("a shadow report");
+        assert_eq!((report.casting_lights, report.maps_rendered, report.dropped_lights), (1, 1, 0));
+        assert!(report.instance_faces >= 2, "the floor and the plate are drawn: {report:?}");
+        // Unshadowed, the frame has no shadow pass and no report.
+        assert!(off.stats.last.as_ref().is_some_and(|r| r.shadows.is_none()));
+    }
+}
+
+#[test]
+fn every_pipeline_gives_naive_forwards_shadowed_image() {
+    let _gpu = gpu();
+    let settings = |pipeline| RenderSettings { pipeline, ..RenderSettings::default() };
+    let naive = render(Kind::Point, true, settings(PipelineKind::NaiveForward));
+    for (name, s) in support::pipelines_besides_naive("shadows", settings) {
+        let frame = render(Kind::Point, true, s);
+        let tolerance = if name.ends_with("compact") { COMPACT } else { STRICT };
+        assert_similar(&name, &naive.image, &frame.image, tolerance);
+    }
+}
+
+#[test]
+fn disabled_shadows_give_the_unshadowed_image() {
+    let _gpu = gpu();
+    let off = render(Kind::Point, false, RenderSettings::default());
+    let mut settings = RenderSettings::default();
+    settings.shadows.enabled = false;
+    let disabled = render(Kind::Point, true, settings);
+    assert_eq!(off.image, disabled.image, "a casting light with shadows disabled lights through the plate");
+    assert!(disabled.stats.last.as_ref().is_some_and(|r| !r.passes.iter().any(|p| p.name == "shadow_maps")));
+}
