@@ -4,12 +4,12 @@
 
 mod support;
 
+use glam::{Mat4, Vec4};
 use manylight::app::headless::{HeadlessFrame, render_headless};
 use manylight::core::shadow_oracle::{LightSource, OccluderSet, ShadowQuery};
 use manylight::prelude::*;
 use manylight::scene::shapes::cuboid;
 use manylight::scene::{SceneCamera, SceneInstance, camera_looking_at};
-use glam::{Mat4, Vec4};
 use std::sync::Arc;
 use support::{COMPACT, STRICT, assert_similar, gpu};
 

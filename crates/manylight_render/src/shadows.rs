@@ -477,7 +477,7 @@ impl ShadowResources {
         self.requests.clear();
         let valid = snapshot.lights.iter().filter(|l| l.is_valid());
         for (k, light) in valid.enumerate() {
-            if light.shadow.is_none() || !(light.radius > 0.0) {
+            if light.shadow.is_none() || light.radius <= 0.0 {
                 continue;
             }
             let (center, radius) = light.bounding_sphere();
