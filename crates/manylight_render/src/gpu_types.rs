@@ -209,12 +209,7 @@ pub struct GpuPointLight {
     pub spot: [f32; 4],
 }
 
-/// Cube faces of a point or spot light's shadow map: +X, -X, +Y, -Y, +Z, -Z (face `f` looks
-/// down axis `f / 2`, towards + when `f` is even).
-pub const SHADOW_FACES: u32 = 6;
-/// A light's faces lie in the shadow atlas as a block of this many columns (and
-/// `SHADOW_FACES / SHADOW_TILE_COLUMNS` rows) of square tiles.
-pub const SHADOW_TILE_COLUMNS: u32 = 3;
+pub use crate::settings::{SHADOW_FACES, SHADOW_TILE_COLUMNS};
 
 /// A light's shadow map as the shading passes read it (`GpuShadowLight` in
 /// `shaders/common/shadows.wgsl`): one entry per uploaded point or spot light, in light-buffer

@@ -58,12 +58,6 @@ impl PlanInputs<'_> {
         self.casts_shadows && self.has_lights && !self.replaces_shading()
     }
 
-    /// The resources a shading pass reads besides its own: the shadow atlas when the view
-    /// [`shades_shadows`](Self::shades_shadows).
-    pub fn shading_reads(&self) -> Vec<crate::graph::ResourceName> {
-        if self.shades_shadows() { vec![crate::passes::SHADOW_ATLAS] } else { Vec::new() }
-    }
-
     /// True when the view is shaded deferred: a G-buffer, then a full-screen lighting pass or
     /// light volumes. Without lights the forward pass draws the ambient.
     pub fn shades_deferred(&self) -> bool {

@@ -101,7 +101,7 @@ impl Renderer {
         self.bindings.begin_frame();
         self.scene.prepare(&self.gpu, snapshot)?;
         self.shadows.prepare(&self.gpu, &self.scene, snapshot)?;
-        self.scene.bind_view(&self.gpu, &self.shadows);
+        self.scene.bind_view(&self.gpu, self.shadows.bindings());
         self.pixel_light_lists = snapshot.pixel_light_lists.clone();
         // Views that went away free their cluster buffers.
         self.clusters.truncate(snapshot.views.len().max(1));

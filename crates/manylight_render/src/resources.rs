@@ -242,6 +242,18 @@ fn make_view_layout(device: &wgpu::Device, shadows: bool) -> wgpu::BindGroupLayo
     })
 }
 
+/// What group 0 binds for shadows (`crate::shadows::ShadowResources::bindings`).
+pub struct ShadowBindings<'a> {
+    /// The shadow atlas.
+    pub atlas: &'a wgpu::TextureView,
+    /// Its comparison sampler.
+    pub sampler: &'a wgpu::Sampler,
+    /// The lights' shadow table.
+    pub lights: &'a wgpu::Buffer,
+    /// Changes whenever one of them is re-created.
+    pub generation: u64,
+}
+
 /// Scene data on the GPU for the current frame.
 pub struct SceneResources {
     /// Layout of group 0 this frame: view uniform, lights, instances, and the shadow bindings
@@ -454,21 +466,24 @@ impl SceneResources {
         view: &wgpu::Buffer,
         lights: &GrowableBuffer,
         instances: &GrowableBuffer,
-        shadows: Option<&crate::shadows::ShadowResources>,
+        shadows: Option<&ShadowBindings<'_>>,
     ) -> wgpu::BindGroup {
         let mut entries = vec![
             wgpu::BindGroupEntry { binding: 0, resource: view.as_entire_binding() },
             wgpu::BindGroupEntry { binding: 1, resource: lights.buffer().as_entire_binding() },
             wgpu::BindGroupEntry { binding: 2, resource: instances.buffer().as_entire_binding() },
         ];
-        if let Some((shadows, atlas)) = shadows.and_then(|s| Some((s, s.atlas_view()?))) {
+        if let Some(shadows) = shadows {
             entries.extend([
-                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(atlas) },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(shadows.atlas),
+                },
                 wgpu::BindGroupEntry {
                     binding: 4,
-                    resource: wgpu::BindingResource::Sampler(&shadows.sampler),
+                    resource: wgpu::BindingResource::Sampler(shadows.sampler),
                 },
-                wgpu::BindGroupEntry { binding: 5, resource: shadows.lights.buffer().as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 5, resource: shadows.lights.as_entire_binding() },
             ]);
         }
         gpu.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -481,12 +496,12 @@ impl SceneResources {
     /// Binds group 0 for the frame (after [`SceneResources::prepare`] and the shadows'
     /// `prepare`): with the shadow atlas, its sampler and light table when `shadows` is active,
     /// else without them. Re-created only when a buffer, the atlas or the shadow state changed.
-    pub fn bind_view(&mut self, gpu: &GpuContext, shadows: &crate::shadows::ShadowResources) {
-        let active = shadows.active && shadows.atlas_view().is_some();
+    pub fn bind_view(&mut self, gpu: &GpuContext, shadows: Option<ShadowBindings<'_>>) {
+        let active = shadows.is_some();
         let generations = (
             self.lights.generation(),
             self.instances.generation(),
-            if active { shadows.generation + 1 } else { 0 },
+            shadows.as_ref().map_or(0, |s| s.generation + 1),
         );
         if generations == self.bound_generations {
             return;
@@ -500,7 +515,7 @@ impl SceneResources {
             &self.view_buffer,
             &self.lights,
             &self.instances,
-            active.then_some(shadows),
+            shadows.as_ref(),
         );
         self.bound_generations = generations;
     }

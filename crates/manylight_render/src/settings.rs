@@ -140,3 +140,105 @@ impl Default for MotionBlurSettings {
         Self { samples: 8, strength: 1.0, max_pixels: 64.0 }
     }
 }
+
+/// How shadow maps are sized (part of [`crate::snapshot::RenderSettings`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowSettings {
+    /// Lights that cast shadows cast them; `false` renders every light unshadowed (no atlas, no
+    /// pass), whatever the lights say. A camera's shadows checkbox.
+    pub enabled: bool,
+    /// Largest edge of the atlas in texels (a power of two); a device with a smaller
+    /// `max_texture_dimension_2d` gets its own limit, counted in
+    /// [`ShadowReport::atlas_limited_by_device`].
+    pub atlas_size: u32,
+    /// Largest face edge a light gets (a power of two).
+    pub max_face_size: u32,
+    /// Smallest face edge a casting light gets (a power of two): below it, a light goes
+    /// without a shadow and is counted.
+    pub min_face_size: u32,
+    /// Face texels asked per pixel of the light sphere's projected radius.
+    pub resolution_scale: f32,
+}
+
+impl Default for ShadowSettings {
+    fn default() -> Self {
+        ShadowSettings {
+            enabled: true,
+            atlas_size: 4096,
+            max_face_size: 512,
+            min_face_size: 16,
+            resolution_scale: 1.0,
+        }
+    }
+}
+
+impl ShadowSettings {
+    /// Refuses sizes no atlas can be planned with, naming the field.
+    pub fn check_values(&self) -> Result<(), String> {
+        for (name, value) in [
+            ("shadows.atlas_size", self.atlas_size),
+            ("shadows.max_face_size", self.max_face_size),
+            ("shadows.min_face_size", self.min_face_size),
+        ] {
+            if !value.is_power_of_two() {
+                return Err(format!("{name} {value} must be a power of two"));
+            }
+        }
+        if self.min_face_size > self.max_face_size {
+            return Err(format!(
+                "shadows.min_face_size {} must not exceed shadows.max_face_size {}",
+                self.min_face_size, self.max_face_size
+            ));
+        }
+        if self.atlas_size < SHADOW_TILE_COLUMNS * self.min_face_size {
+            return Err(format!(
+                "shadows.atlas_size {} cannot hold one light at shadows.min_face_size {} ({} texels wide)",
+                self.atlas_size,
+                self.min_face_size,
+                SHADOW_TILE_COLUMNS * self.min_face_size
+            ));
+        }
+        if !(self.resolution_scale.is_finite() && self.resolution_scale > 0.0) {
+            return Err(format!(
+                "shadows.resolution_scale {} must be finite and positive",
+                self.resolution_scale
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// What the frame's shadows took, in the stats JSON and the overlay.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct ShadowReport {
+    /// Lights that asked for a shadow.
+    pub casting_lights: u32,
+    /// Lights whose six faces were drawn this frame.
+    pub maps_rendered: u32,
+    /// Lights whose maps were kept from an earlier frame (maps are drawn every frame: 0).
+    pub maps_cached: u32,
+    /// (instance, face) pairs drawn.
+    pub instance_faces: u32,
+    /// Draw calls of the shadow pass (one per mesh).
+    pub draw_calls: u32,
+    /// Edge of the atlas texture in texels.
+    pub atlas_size: u32,
+    /// Bytes of the atlas texture.
+    pub atlas_bytes: u64,
+    /// Fraction of the atlas's texels in a light's tiles.
+    pub atlas_occupancy: f32,
+    /// Lights that got a smaller face than they asked for (the atlas was full).
+    pub downgraded_lights: u32,
+    /// Lights that got no shadow map at all (no room even at the smallest face): lit unshadowed.
+    pub dropped_lights: u32,
+    /// The device's texture limit is below [`ShadowSettings::atlas_size`]: the atlas is the
+    /// device's largest.
+    pub atlas_limited_by_device: bool,
+}
+
+/// Cube faces of a point or spot light's shadow map: +X, -X, +Y, -Y, +Z, -Z (face `f` looks
+/// down axis `f / 2`, towards + when `f` is even).
+pub const SHADOW_FACES: u32 = 6;
+/// A light's faces lie in the shadow atlas as a block of this many columns (and
+/// `SHADOW_FACES / SHADOW_TILE_COLUMNS` rows) of square tiles.
+pub const SHADOW_TILE_COLUMNS: u32 = 3;

@@ -27,7 +27,6 @@ use crate::resources::SceneResources;
 use crate::snapshot::{ExtractedCamera, FrameSnapshot};
 use glam::{Mat4, UVec2, Vec3, Vec4};
 use manylight_core::{Aabb, ProjectionKind};
-use serde::Serialize;
 
 /// Depth format of the shadow atlas.
 pub const SHADOW_ATLAS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -42,100 +41,7 @@ pub const SHADOW_NEAR_FRACTION: f32 = 1e-3;
 /// The smallest atlas edge: an atlas grows from it in powers of two as the lights ask.
 pub const MIN_ATLAS_SIZE: u32 = 256;
 
-/// How shadow maps are sized (part of [`crate::snapshot::RenderSettings`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ShadowSettings {
-    /// Lights that cast shadows cast them; `false` renders every light unshadowed (no atlas, no
-    /// pass), whatever the lights say. A camera's shadows checkbox.
-    pub enabled: bool,
-    /// Largest edge of the atlas in texels (a power of two); a device with a smaller
-    /// `max_texture_dimension_2d` gets its own limit, counted in
-    /// [`ShadowReport::atlas_limited_by_device`].
-    pub atlas_size: u32,
-    /// Largest face edge a light gets (a power of two).
-    pub max_face_size: u32,
-    /// Smallest face edge a casting light gets (a power of two): below it, a light goes
-    /// without a shadow and is counted.
-    pub min_face_size: u32,
-    /// Face texels asked per pixel of the light sphere's projected radius.
-    pub resolution_scale: f32,
-}
-
-impl Default for ShadowSettings {
-    fn default() -> Self {
-        ShadowSettings {
-            enabled: true,
-            atlas_size: 4096,
-            max_face_size: 512,
-            min_face_size: 16,
-            resolution_scale: 1.0,
-        }
-    }
-}
-
-impl ShadowSettings {
-    /// Refuses sizes no atlas can be planned with, naming the field.
-    pub fn check_values(&self) -> Result<(), String> {
-        for (name, value) in [
-            ("shadows.atlas_size", self.atlas_size),
-            ("shadows.max_face_size", self.max_face_size),
-            ("shadows.min_face_size", self.min_face_size),
-        ] {
-            if !value.is_power_of_two() {
-                return Err(format!("{name} {value} must be a power of two"));
-            }
-        }
-        if self.min_face_size > self.max_face_size {
-            return Err(format!(
-                "shadows.min_face_size {} must not exceed shadows.max_face_size {}",
-                self.min_face_size, self.max_face_size
-            ));
-        }
-        if self.atlas_size < SHADOW_TILE_COLUMNS * self.min_face_size {
-            return Err(format!(
-                "shadows.atlas_size {} cannot hold one light at shadows.min_face_size {} ({} texels wide)",
-                self.atlas_size,
-                self.min_face_size,
-                SHADOW_TILE_COLUMNS * self.min_face_size
-            ));
-        }
-        if !(self.resolution_scale.is_finite() && self.resolution_scale > 0.0) {
-            return Err(format!(
-                "shadows.resolution_scale {} must be finite and positive",
-                self.resolution_scale
-            ));
-        }
-        Ok(())
-    }
-}
-
-/// What the frame's shadows took, in the stats JSON and the overlay.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-pub struct ShadowReport {
-    /// Lights that asked for a shadow.
-    pub casting_lights: u32,
-    /// Lights whose six faces were drawn this frame.
-    pub maps_rendered: u32,
-    /// Lights whose maps were kept from an earlier frame (maps are drawn every frame: 0).
-    pub maps_cached: u32,
-    /// (instance, face) pairs drawn.
-    pub instance_faces: u32,
-    /// Draw calls of the shadow pass (one per mesh).
-    pub draw_calls: u32,
-    /// Edge of the atlas texture in texels.
-    pub atlas_size: u32,
-    /// Bytes of the atlas texture.
-    pub atlas_bytes: u64,
-    /// Fraction of the atlas's texels in a light's tiles.
-    pub atlas_occupancy: f32,
-    /// Lights that got a smaller face than they asked for (the atlas was full).
-    pub downgraded_lights: u32,
-    /// Lights that got no shadow map at all (no room even at the smallest face): lit unshadowed.
-    pub dropped_lights: u32,
-    /// The device's texture limit is below [`ShadowSettings::atlas_size`]: the atlas is the
-    /// device's largest.
-    pub atlas_limited_by_device: bool,
-}
+pub use crate::settings::{ShadowReport, ShadowSettings};
 
 /// The depth face `f` stores at distance `depth` along its axis: 0 at `near`, 1 at `far`
 /// (`shadow_face_depth` in `shaders/common/shadows.wgsl`).
@@ -454,6 +360,17 @@ impl ShadowResources {
     /// The atlas's view, once a frame had a casting light.
     pub fn atlas_view(&self) -> Option<&wgpu::TextureView> {
         self.atlas_view.as_ref()
+    }
+
+    /// What group 0 binds for this frame's shadows; `None` when the frame draws none.
+    pub fn bindings(&self) -> Option<crate::resources::ShadowBindings<'_>> {
+        let atlas = self.atlas_view.as_ref().filter(|_| self.active)?;
+        Some(crate::resources::ShadowBindings {
+            atlas,
+            sampler: &self.sampler,
+            lights: self.lights.buffer(),
+            generation: self.generation,
+        })
     }
 
     /// Plans the frame's atlas and uploads its faces, draws and light table (after

@@ -344,7 +344,7 @@ pub struct RenderSettings {
     /// Normal encoding of the `Packed` and `Compact` G-buffer layouts.
     pub normal_codec: NormalCodec,
     /// Shadow atlas and face sizes, and whether casting lights cast.
-    pub shadows: crate::shadows::ShadowSettings,
+    pub shadows: crate::settings::ShadowSettings,
 }
 
 impl RenderSettings {
@@ -376,7 +376,7 @@ impl Default for RenderSettings {
             clusters: ClusterSettings::default(),
             gbuffer: GBufferLayout::Full,
             normal_codec: NormalCodec::Octa16,
-            shadows: crate::shadows::ShadowSettings::default(),
+            shadows: crate::settings::ShadowSettings::default(),
         }
     }
 }

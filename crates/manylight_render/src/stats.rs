@@ -69,7 +69,7 @@ pub struct FrameReport {
     /// Cluster statistics, when the frame built clusters.
     pub clusters: Option<crate::clusters::ClusterReport>,
     /// What the shadows took, when a light asked to cast one.
-    pub shadows: Option<crate::shadows::ShadowReport>,
+    pub shadows: Option<crate::settings::ShadowReport>,
     /// The views the frame rendered, in order (the passes of each are in [`FrameReport::passes`],
     /// one view after the other).
     pub views: Vec<ViewReport>,
