@@ -74,38 +74,48 @@ pub fn tile_transform(x: u32, y: u32, edge: u32, atlas: u32) -> [f32; 4] {
     [e / a, (2.0 * x as f32 + e) / a - 1.0, e / a, 1.0 - (2.0 * y as f32 + e) / a]
 }
 
+/// The radius in pixels of the sphere (`center`, `radius`) in a view through `camera` of
+/// `size` pixels; `None` when it has no bound: no camera, or a camera inside the sphere.
+pub fn projected_radius(camera: Option<(&ExtractedCamera, UVec2)>, center: Vec3, radius: f32) -> Option<f32> {
+    let (camera, size) = camera?;
+    let half_height = size.y.max(1) as f32 * 0.5;
+    let projection = camera.projection.sanitized();
+    match projection.kind {
+        ProjectionKind::Orthographic { height } => Some(radius / (0.5 * height) * half_height),
+        ProjectionKind::Perspective => {
+            let distance = camera.position().distance(center);
+            if distance <= radius {
+                return None;
+            }
+            let tangent = radius / (distance * distance - radius * radius).sqrt();
+            Some(tangent / (0.5 * projection.fov_y).tan() * half_height)
+        }
+    }
+}
+
+/// `wanted` texels rounded up to a power of two in `lo..=hi`; `hi` when unbounded (`None`) or
+/// not finite.
+fn edge_for(wanted: Option<f32>, lo: u32, hi: u32) -> u32 {
+    match wanted {
+        Some(w) if w.is_finite() && w < hi as f32 => {
+            (w.max(1.0).ceil() as u32).next_power_of_two().clamp(lo, hi)
+        }
+        _ => hi,
+    }
+}
+
 /// The face edge a light with the sphere (`center`, `radius`) asks for in a view through
-/// `camera` of `size` pixels: its projected radius in pixels times `resolution_scale`, rounded
-/// up to a power of two in the settings' range; the largest for a camera inside the sphere
-/// or no camera.
+/// `camera` of `size` pixels: its projected radius in pixels ([`projected_radius`]) times
+/// `resolution_scale`, rounded up to a power of two in the settings' range; the largest for a
+/// camera inside the sphere or no camera.
 pub fn requested_edge(
     settings: &ShadowSettings,
     camera: Option<(&ExtractedCamera, UVec2)>,
     center: Vec3,
     radius: f32,
 ) -> u32 {
-    let (lo, hi) = (settings.min_face_size, settings.max_face_size);
-    let Some((camera, size)) = camera else {
-        return hi;
-    };
-    let half_height = size.y.max(1) as f32 * 0.5;
-    let projection = camera.projection.sanitized();
-    let pixels = match projection.kind {
-        ProjectionKind::Orthographic { height } => radius / (0.5 * height) * half_height,
-        ProjectionKind::Perspective => {
-            let distance = camera.position().distance(center);
-            if distance <= radius {
-                return hi;
-            }
-            let tangent = radius / (distance * distance - radius * radius).sqrt();
-            tangent / (0.5 * projection.fov_y).tan() * half_height
-        }
-    };
-    let wanted = pixels * settings.resolution_scale;
-    if !wanted.is_finite() || wanted >= hi as f32 {
-        return hi;
-    }
-    (wanted.max(1.0).ceil() as u32).next_power_of_two().clamp(lo, hi)
+    let wanted = projected_radius(camera, center, radius).map(|p| p * settings.resolution_scale);
+    edge_for(wanted, settings.min_face_size, settings.max_face_size)
 }
 
 /// One light's request for a shadow map.
@@ -148,11 +158,12 @@ pub struct AtlasPlan {
 }
 
 impl AtlasPlan {
-    /// Fraction of the atlas's texels in a tile.
-    pub fn occupancy(&self) -> f32 {
+    /// Fraction of the texels of an atlas `atlas` texels wide in a tile (the texture can be
+    /// larger than [`AtlasPlan::atlas_size`]: it is never shrunk).
+    pub fn occupancy(&self, atlas: u32) -> f32 {
         let used: u64 =
             self.placements.iter().map(|p| u64::from(p.edge).pow(2) * u64::from(SHADOW_FACES)).sum();
-        used as f32 / (u64::from(self.atlas_size).pow(2)).max(1) as f32
+        used as f32 / (u64::from(atlas).pow(2)).max(1) as f32
     }
 }
 
@@ -398,13 +409,10 @@ impl ShadowResources {
                 continue;
             }
             let (center, radius) = light.bounding_sphere();
-            let edge = requested_edge(&settings, camera, center, radius);
-            let importance = requested_edge(
-                &ShadowSettings { max_face_size: 1 << 30, min_face_size: 1, ..settings },
-                camera,
-                center,
-                radius,
-            ) as f32;
+            // The same rounding as the edge, without its range: lights larger on screen first.
+            let wanted = projected_radius(camera, center, radius).map(|p| p * settings.resolution_scale);
+            let edge = edge_for(wanted, settings.min_face_size, settings.max_face_size);
+            let importance = edge_for(wanted, 1, 1 << 30) as f32;
             self.requests.push(ShadowRequest { light: k as u32, edge, importance });
         }
         // The largest power of two the device's textures allow.
@@ -433,7 +441,18 @@ impl ShadowResources {
         for list in &mut self.by_mesh {
             list.1.clear();
         }
-        let opaque: Vec<_> = scene.draws.iter().filter(|d| !d.variant.blend).collect();
+        // Each opaque draw with the slot of its mesh's pairs, found once a frame.
+        let mut opaque = Vec::new();
+        for d in scene.draws.iter().filter(|d| !d.variant.blend) {
+            let slot = match self.by_mesh.iter().position(|(m, _)| *m == d.mesh) {
+                Some(i) => i,
+                None => {
+                    self.by_mesh.push((d.mesh, Vec::new()));
+                    self.by_mesh.len() - 1
+                }
+            };
+            opaque.push((d, slot));
+        }
         for p in &self.plan.placements {
             let light = lights[p.light as usize];
             let bias = light.shadow.unwrap_or_default();
@@ -453,17 +472,10 @@ impl ShadowResources {
                 });
             }
             let (center, radius) = light.bounding_sphere();
-            for d in &opaque {
+            for &(d, slot) in &opaque {
                 if !sphere_meets_box(center, radius, &d.world_bounds) {
                     continue;
                 }
-                let slot = match self.by_mesh.iter().position(|(m, _)| *m == d.mesh) {
-                    Some(i) => i,
-                    None => {
-                        self.by_mesh.push((d.mesh, Vec::new()));
-                        self.by_mesh.len() - 1
-                    }
-                };
                 for face in 0..SHADOW_FACES {
                     if box_meets_face(light.position, face, &d.world_bounds) {
                         self.by_mesh[slot]
@@ -501,7 +513,7 @@ impl ShadowResources {
         self.report.draw_calls = self.mesh_draws.len() as u32;
         self.report.atlas_size = atlas;
         self.report.atlas_bytes = u64::from(atlas).pow(2) * 4;
-        self.report.atlas_occupancy = AtlasPlan { atlas_size: atlas, ..self.plan.clone() }.occupancy();
+        self.report.atlas_occupancy = self.plan.occupancy(atlas);
         Ok(())
     }
 
