@@ -208,3 +208,32 @@ fn disabled_shadows_give_the_unshadowed_image() {
     assert_eq!(off.image, disabled.image, "a casting light with shadows disabled lights through the plate");
     assert!(disabled.stats.last.as_ref().is_some_and(|r| !r.passes.iter().any(|p| p.name == "shadow_maps")));
 }
+
+/// One renderer whose light starts and stops casting between frames: every pass keeps working
+/// (the passes sharing the view's bind group follow its layout), and the last frame is the
+/// frame a renderer that always cast would give.
+#[test]
+fn a_light_that_starts_and_stops_casting_renders_every_frame() {
+    let _gpu = gpu();
+    let scene = plate_scene();
+    let settings = RenderSettings::default();
+    // Frames: off (spawned), on, off, on.
+    let toggled = render_headless(SIZE, 4, move |app| {
+        app.insert_resource(settings)
+            .add_systems(Startup, move |mut commands: Commands| {
+                spawn_scene(&mut commands, &scene, true, SIZE.x as f32 / SIZE.y as f32);
+                let light = PointLight { intensity: 150.0, range: 8.0, ..Default::default() };
+                commands.spawn((Transform::from_translation(LIGHT), light));
+            })
+            .add_systems(Update, |mut lights: Query<&mut PointLight>, mut frame: Local<u32>| {
+                *frame += 1;
+                for mut light in &mut lights {
+                    light.shadows_enabled = *frame % 2 == 0;
+                }
+            });
+    })
+    .unwrap_or_else(|e| panic!("toggling shadows failed: {e}"));
+    assert_eq!(toggled.stats.frames_rendered, 4);
+    let always = render(Kind::Point, true, settings);
+    assert_similar("toggled shadows", &always.image, &toggled.image, STRICT);
+}

@@ -3,6 +3,7 @@
 
 use crate::direct::{measure_culling, oracle_snapshot, snapshot};
 use crate::progress::Progress;
+use crate::shadow_error::{measure_shadows, occluders};
 use anyhow::{Context, Result};
 use glam::UVec2;
 use manylight_app::render_world::HeadlessRenderer;
@@ -30,6 +31,15 @@ pub struct Row {
     oracle: bool,
     /// Every light casts a shadow.
     shadows: bool,
+    /// The last frame's shadows against exact visibility (`--shadow-oracle`).
+    shadow_accuracy: Option<ShadowFigures>,
+}
+
+/// What `--shadow-oracle` adds to a row.
+#[derive(Clone, Copy, Debug)]
+struct ShadowFigures {
+    visibility_error: f64,
+    flip_vs_reference: f32,
 }
 
 impl Row {
@@ -103,6 +113,9 @@ pub struct Sweep {
     pub gbuffers: Vec<GBufferLayout>,
     /// Shadow settings swept: every light casts (`true`) or none does.
     pub shadows: Vec<bool>,
+    /// Also measure each pipeline row's last frame against exact visibility (visibility error
+    /// and FLIP against the shadow reference).
+    pub shadow_oracle: bool,
     /// Settings other than the pipeline.
     pub settings: FrameSettings,
 }
@@ -156,6 +169,7 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
     } else {
         Vec::new()
     };
+    let occluders = sweep.shadow_oracle.then(|| occluders(scene));
     let mut progress = Progress::new((configs.len() + oracles.len()) as u64, "configurations");
     let mut rows = Vec::new();
     let runs = configs.into_iter().map(|c| (c, false)).chain(oracles.into_iter().map(|c| (c, true)));
@@ -188,6 +202,18 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
         } else {
             (None, None, None)
         };
+        let shadow_accuracy = match &occluders {
+            Some(occluders) if !oracle => {
+                let t = (sweep.warmup + sweep.frames).saturating_sub(1);
+                let mut snap = snapshot(&lit, &rig, t as f32 / 60.0, sweep.size, settings, u64::from(t));
+                if shadows {
+                    crate::direct::cast_every_shadow(&mut snap);
+                }
+                let a = measure_shadows(&mut renderer, snap, occluders)?;
+                Some(ShadowFigures { visibility_error: a.visibility_error, flip_vs_reference: a.flip.mean })
+            }
+            _ => None,
+        };
         let median_ms = median(&frame_ms);
         progress.step(|| format!("{label}: {median_ms:.1} ms"));
         rows.push(Row {
@@ -201,6 +227,7 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
             zbinned,
             oracle,
             shadows,
+            shadow_accuracy,
         });
     }
     progress.finish();
@@ -274,9 +301,7 @@ fn timed_frames(
     for f in 0..sweep.warmup + sweep.frames {
         let mut snap = snapshot(scene, rig, f as f32 / 60.0, sweep.size, settings, f as u64);
         if shadows {
-            for light in &mut snap.lights {
-                *light = manylight_app::scene::with_shadow(*light, true);
-            }
+            crate::direct::cast_every_shadow(&mut snap);
         }
         if oracle {
             let (lists, efficiency) = oracle_snapshot(renderer, snap)?;
@@ -341,7 +366,8 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
          max_per_cluster,mean_per_non_empty,dropped_pairs,culling_ratio,transient_mib,cluster_buffer_mib,\
          list_entry_bound,tile_entries,tile_entry_bound,list_bound_cpu_ms,shading_ms,shading_vs_oracle,\
          coarse_tiles,coarse_entries,depth_bounded_ratio,cluster_depth_gpu_ms,light_refine_gpu_ms,\
-         zbinned_ratio,shadows,shadow_maps_rendered,shadow_maps_cached,shadow_atlas_bytes,shadow_gpu_ms\n",
+         zbinned_ratio,shadows,shadow_maps_rendered,shadow_maps_cached,shadow_atlas_bytes,shadow_gpu_ms,\
+         visibility_error,flip_vs_shadow_reference\n",
     );
     for r in rows {
         let c = r.last.clusters.as_ref();
@@ -357,7 +383,7 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
         let vs_oracle = shading.zip(oracle).filter(|&(_, o)| o > 0.0).map(|(s, o)| s / o);
         let _ = writeln!(
             out,
-            "\"{adapter}\",\"{scene}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "\"{adapter}\",\"{scene}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             match (r.oracle, r.pipeline.is_deferred()) {
                 (true, false) => "oracle-forward",
                 (true, true) => "oracle-deferred",
@@ -406,6 +432,8 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
             r.last.shadows.map_or(0, |s| s.maps_cached),
             r.last.shadows.map_or(0, |s| s.atlas_bytes),
             pass_ms(&r.last, "shadow_maps"),
+            r.shadow_accuracy.map_or(String::new(), |a| format!("{:.5}", a.visibility_error)),
+            r.shadow_accuracy.map_or(String::new(), |a| format!("{:.5}", a.flip_vs_reference)),
         );
     }
     out

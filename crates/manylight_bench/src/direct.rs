@@ -29,6 +29,14 @@ pub fn snapshot(
     scene_snapshot(scene, lights, size, settings, frame_index)
 }
 
+/// Makes every light of `snapshot` cast a shadow, with its kind's default biases (what
+/// `--shadows on` means for a scene: glTF has no shadow flag).
+pub fn cast_every_shadow(snapshot: &mut FrameSnapshot) {
+    for light in &mut snapshot.lights {
+        *light = manylight_app::scene::with_shadow(*light, true);
+    }
+}
+
 /// What a rendered frame's light lists are measured from, read back from the GPU.
 struct FrameLists {
     report: FrameReport,

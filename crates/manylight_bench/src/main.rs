@@ -33,6 +33,7 @@ mod plot;
 mod post;
 mod progress;
 mod report;
+mod shadow_error;
 mod soak;
 mod views;
 
@@ -188,6 +189,12 @@ struct BenchArgs {
     /// scene and the rig casts).
     #[arg(long, value_delimiter = ',', default_value = "off", value_parser = parse_on_off, action = clap::ArgAction::Set)]
     shadows: Vec<bool>,
+    /// Also measure each pipeline row's last frame against exact visibility: the CSV columns
+    /// `visibility_error` (mean |shadow test - exact| over the light-pixel pairs the light
+    /// reaches) and `flip_vs_shadow_reference` (FLIP mean against naive forward with exact
+    /// visibility). Not timed.
+    #[arg(long)]
+    shadow_oracle: bool,
     #[command(flatten)]
     clusters: ClusterArgs,
     /// Shading model for materials without their own: pbr (default), lambert, blinn-phong or toon.
@@ -268,6 +275,15 @@ struct RenderArgs {
     /// its depth.
     #[arg(long)]
     oracle: bool,
+    /// Also measure the last frame's shadows against exact visibility (a ray cast from every
+    /// pixel's surface to each light that reaches it): prints the visibility error (mean
+    /// |shadow test - exact| over those pairs) and FLIP against the shadow reference (the
+    /// oracle's lists without the blocked pairs: naive forward with exact visibility).
+    #[arg(long)]
+    shadow_oracle: bool,
+    /// Where `--shadow-oracle` writes the shadow reference image (PNG).
+    #[arg(long, requires = "shadow_oracle")]
+    shadow_reference: Option<PathBuf>,
     #[command(flatten)]
     post: PostArgs,
 }
@@ -495,6 +511,23 @@ fn measure_oracle(snapshot: manylight_render::FrameSnapshot, pipeline: PipelineK
     Ok((ours, floor))
 }
 
+/// Measures `snapshot`'s shadows against exact visibility through `scene`'s triangles and
+/// prints the result.
+fn measure_shadow_accuracy(
+    scene: &Scene,
+    snapshot: manylight_render::FrameSnapshot,
+) -> Result<shadow_error::ShadowAccuracy> {
+    let mut renderer = manylight_app::render_world::HeadlessRenderer::new()?;
+    let occluders = shadow_error::occluders(scene);
+    let a = shadow_error::measure_shadows(&mut renderer, snapshot, &occluders)?;
+    println!(
+        "shadow oracle: visibility error {:.4} over {} contributing light-pixel pairs ({} blocked, \
+         {} tested on the wrong side); FLIP against the shadow reference: mean {:.4}, p99 {:.4}",
+        a.visibility_error, a.contributing_pairs, a.blocked_pairs, a.wrong_pairs, a.flip.mean, a.flip.p99
+    );
+    Ok(a)
+}
+
 fn render(args: RenderArgs) -> Result<()> {
     let mut scene = args.clusters.load(&args.scene)?;
     select_camera(&mut scene, &args.camera)?;
@@ -520,7 +553,7 @@ fn render(args: RenderArgs) -> Result<()> {
     let ambient = args.ambient.unwrap_or(if unlit { 0.2 } else { RenderSettings::default().ambient });
     // The measured frame of `--culling-efficiency` and `--oracle`: the last frame's animation
     // time, rendered straight from the scene (no app).
-    let measured = (args.culling_efficiency || args.oracle).then(|| -> Result<_> {
+    let measured = (args.culling_efficiency || args.oracle || args.shadow_oracle).then(|| -> Result<_> {
         let rig = manylight_scene::light_rig(lights, scene.bounds(), args.seed)?;
         let t = args.frames.max(1).saturating_sub(1) as f32 / 60.0;
         let settings = manylight_render::FrameSettings {
@@ -534,7 +567,11 @@ fn render(args: RenderArgs) -> Result<()> {
             },
             ..Default::default()
         };
-        Ok(direct::snapshot(&scene, &rig, t, args.size, settings, 0))
+        let mut snapshot = direct::snapshot(&scene, &rig, t, args.size, settings, 0);
+        if args.shadows {
+            direct::cast_every_shadow(&mut snapshot);
+        }
+        Ok(snapshot)
     });
     let measured = measured.transpose()?;
     let culling = match &measured {
@@ -573,6 +610,17 @@ fn render(args: RenderArgs) -> Result<()> {
         }
         _ => None,
     };
+    let shadow_accuracy = match &measured {
+        Some(snap) if args.shadow_oracle => {
+            let a = measure_shadow_accuracy(&scene, snap.clone())?;
+            if let Some(path) = &args.shadow_reference {
+                save_png(&a.reference, path).map_err(anyhow::Error::msg)?;
+                println!("wrote the shadow reference to {}", path.display());
+            }
+            Some(a)
+        }
+        _ => None,
+    };
     let oracle = match measured {
         Some(snap) if args.oracle => Some(measure_oracle(snap, args.pipeline)?),
         _ => None,
@@ -606,6 +654,16 @@ fn render(args: RenderArgs) -> Result<()> {
                 "shading_ms": ours,
                 "oracle_shading_ms": floor,
                 "shading_vs_oracle": ours / floor,
+            });
+        }
+        if let Some(a) = &shadow_accuracy {
+            json["shadow_oracle"] = serde_json::json!({
+                "contributing_pairs": a.contributing_pairs,
+                "blocked_pairs": a.blocked_pairs,
+                "wrong_pairs": a.wrong_pairs,
+                "visibility_error": a.visibility_error,
+                "flip_vs_shadow_reference": a.flip.mean,
+                "flip_vs_shadow_reference_p99": a.flip.p99,
             });
         }
         if let Some(e) = culling {
@@ -783,6 +841,7 @@ fn bench_cmd(args: BenchArgs) -> Result<()> {
         shell_lattice: args.scene == "sphere-shell",
         gbuffers: args.gbuffers,
         shadows: args.shadows,
+        shadow_oracle: args.shadow_oracle,
         settings: manylight_render::FrameSettings {
             render: manylight_render::RenderSettings {
                 clusters: args.clusters.settings(&args.scene),

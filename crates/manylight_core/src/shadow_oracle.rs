@@ -22,7 +22,7 @@ use glam::{Mat4, Vec3, Vec3A};
 use obvhs::BvhBuildParams;
 use obvhs::bvh2::Bvh2;
 use obvhs::bvh2::builder::build_bvh2_from_tris;
-use obvhs::ray::Ray;
+use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
 use rayon::prelude::*;
 
@@ -53,6 +53,17 @@ pub struct ShadowQuery {
 /// at 10⁴.
 pub fn surface_offset(point: Vec3) -> f32 {
     64.0 * f32::EPSILON * point.abs().max_element().max(1.0)
+}
+
+/// Where a ray first meets the scene (see [`OccluderSet::first_hit`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceHit {
+    /// The point met, in world space.
+    pub point: Vec3,
+    /// The unit normal of the triangle met, on the side the ray came from.
+    pub normal: Vec3,
+    /// Distance along the (unit) ray.
+    pub distance: f32,
 }
 
 /// The scene's triangles in world space, in a BVH, for exact light–point visibility.
@@ -108,6 +119,25 @@ impl OccluderSet {
             return true;
         }
         self.bvh.ray_traverse_miss(ray, |ray, i| hit_distance(&self.triangles[i], ray))
+    }
+
+    /// The first triangle the ray from `origin` along `direction` meets (either side), with
+    /// its normal turned towards `origin`: a camera ray finds the surface a pixel shows.
+    /// `None` when it meets none, or an input is not finite.
+    pub fn first_hit(&self, origin: Vec3, direction: Vec3) -> Option<SurfaceHit> {
+        let direction = direction.try_normalize()?;
+        if self.triangles.is_empty() || !origin.is_finite() {
+            return None;
+        }
+        let ray = Ray::new(Vec3A::from(origin), Vec3A::from(direction), 0.0, f32::INFINITY);
+        let mut hit = RayHit::none();
+        if !self.bvh.ray_traverse(ray, &mut hit, |ray, i| hit_distance(&self.triangles[i], ray)) {
+            return None;
+        }
+        let tri = &self.triangles[hit.primitive_id as usize];
+        let normal = Vec3::from((tri.v1 - tri.v0).cross(tri.v2 - tri.v0)).try_normalize()?;
+        let normal = if normal.dot(direction) > 0.0 { -normal } else { normal };
+        Some(SurfaceHit { point: origin + direction * hit.t, normal, distance: hit.t })
     }
 
     /// [`OccluderSet::visible`] for every query, on all cores.
@@ -207,6 +237,21 @@ mod tests {
         for (x, lit) in [(0.3, true), (0.7, false), (1.3, false), (1.7, true)] {
             assert_eq!(set.visible(&floor_query(x, 0.0, slanted)), lit, "x = {x}");
         }
+    }
+
+    /// A camera ray finds the surface it looks at, with the normal facing it.
+    #[test]
+    fn first_hit_finds_the_nearest_surface() {
+        let set = plate_over_floor();
+        let down = set.first_hit(Vec3::new(0.0, 3.0, 0.0), Vec3::NEG_Y).expect("the plate");
+        assert!((down.point.y - 1.0).abs() < 1e-5 && (down.distance - 2.0).abs() < 1e-5, "{down:?}");
+        assert_eq!(down.normal, Vec3::Y);
+        let beside = set.first_hit(Vec3::new(2.0, 3.0, 0.0), Vec3::new(0.0, -2.0, 0.0)).expect("the floor");
+        assert!(beside.point.abs_diff_eq(Vec3::new(2.0, 0.0, 0.0), 1e-5), "{beside:?}");
+        let up = set.first_hit(Vec3::new(0.0, 0.5, 0.0), Vec3::Y).expect("the plate's underside");
+        assert_eq!(up.normal, Vec3::NEG_Y);
+        assert!(set.first_hit(Vec3::new(0.0, 3.0, 0.0), Vec3::Y).is_none());
+        assert!(set.first_hit(Vec3::NAN, Vec3::Y).is_none());
     }
 
     /// A light below the plate's top, touching the floor, inside a closed box, or at the

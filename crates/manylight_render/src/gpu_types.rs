@@ -247,6 +247,21 @@ pub struct GpuShadowDraw {
     pub face: u32,
 }
 
+/// One light–point pair whose shadow test `shaders/shadow_probe.wgsl` reads back
+/// (`GpuShadowProbe` there): a measurement, not part of a frame.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuShadowProbe {
+    /// The surface point, in world space.
+    pub position: [f32; 3],
+    /// The light's index in the light buffer.
+    pub light: u32,
+    /// The surface's normal (any length).
+    pub normal: [f32; 3],
+    /// Padding to 32 bytes.
+    pub pad: f32,
+}
+
 /// Per-instance transforms (`GpuInstance` in `shaders/common/mesh.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]

@@ -21,6 +21,7 @@ pub mod renderer;
 pub mod resources;
 pub mod settings;
 pub mod shaders;
+pub mod shadow_probe;
 pub mod shadows;
 pub mod snapshot;
 pub mod stats;

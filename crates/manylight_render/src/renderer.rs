@@ -158,6 +158,16 @@ impl Renderer {
         Ok(Some((w, h, depth)))
     }
 
+    /// The shadow test the last frame's shading made at each of `probes`, in [0, 1]
+    /// ([`crate::shadow_probe::probe_shadows`]; waits for the GPU).
+    pub fn probe_shadows(
+        &self,
+        probes: &[crate::shadow_probe::ShadowProbe],
+    ) -> Result<Vec<f32>, RenderError> {
+        let lights = self.scene.lights.buffer();
+        crate::shadow_probe::probe_shadows(&self.gpu, &self.shadows, lights, self.scene.light_count, probes)
+    }
+
     /// The transient pool (tests read its allocation counts).
     pub fn pool(&self) -> &TransientPool {
         &self.pool

@@ -31,6 +31,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("common/point_lights.wgsl", include_str!("../../../shaders/common/point_lights.wgsl")),
     ("common/shadows.wgsl", include_str!("../../../shaders/common/shadows.wgsl")),
     ("shadow_maps.wgsl", include_str!("../../../shaders/shadow_maps.wgsl")),
+    ("shadow_probe.wgsl", include_str!("../../../shaders/shadow_probe.wgsl")),
     ("light_volumes.wgsl", include_str!("../../../shaders/light_volumes.wgsl")),
     ("forward.wgsl", include_str!("../../../shaders/forward.wgsl")),
     ("depth_prepass.wgsl", include_str!("../../../shaders/depth_prepass.wgsl")),

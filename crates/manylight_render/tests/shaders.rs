@@ -5,7 +5,7 @@ use manylight_render::gpu_types::{
     GpuClusterBounds, GpuClusterCounters, GpuClusterParams, GpuDirectionalLight, GpuInstance, GpuMaterial,
     GpuPointLight, GpuTextureUv, ViewUniform,
 };
-use manylight_render::gpu_types::{GpuShadowDraw, GpuShadowFace, GpuShadowLight};
+use manylight_render::gpu_types::{GpuShadowDraw, GpuShadowFace, GpuShadowLight, GpuShadowProbe};
 use manylight_render::resources::SurfaceVariant;
 use manylight_render::shaders::{SOURCES, ShaderDefs, compose, compose_with};
 use std::mem::{offset_of, size_of};
@@ -136,6 +136,16 @@ fn shared_structs_match_rust() {
         "GpuShadowDraw",
         size_of::<GpuShadowDraw>(),
         &[("instance", offset_of!(GpuShadowDraw, instance)), ("face", offset_of!(GpuShadowDraw, face))],
+    );
+    offsets(
+        &validate("shadow_probe.wgsl"),
+        "GpuShadowProbe",
+        size_of::<GpuShadowProbe>(),
+        &[
+            ("position", offset_of!(GpuShadowProbe, position)),
+            ("light", offset_of!(GpuShadowProbe, light)),
+            ("normal", offset_of!(GpuShadowProbe, normal)),
+        ],
     );
     let forward = validate("forward.wgsl");
     offsets(

@@ -12,9 +12,15 @@ use crate::graph::{Pass, PassContext, ResourceName};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 
-/// The pipeline key of [`ClusterDepthPass`]: where it reads the shading distances.
+/// The pipeline key of [`ClusterDepthPass`]: where it reads the shading distances, and whether
+/// group 0 (the view, which it shares with the shading passes) has the shadow bindings.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct ClusterDepthKey(pub DistanceSource);
+pub struct ClusterDepthKey {
+    /// Where the shading distances come from.
+    pub source: DistanceSource,
+    /// The view layout is the shadowed one.
+    pub shadowed_view: bool,
+}
 
 impl PipelineKey for ClusterDepthKey {
     type Pipeline = DistancePipeline;
@@ -46,16 +52,18 @@ impl Pass for ClusterDepthPass {
         let clusters = ctx.require_clusters("cluster_depth")?;
         let scene = ctx.scene;
         let device = &ctx.gpu.device;
-        let pipeline =
-            ctx.pipelines.get_or_create(ClusterDepthKey(self.source), |&ClusterDepthKey(source)| {
+        let pipeline = ctx.pipelines.get_or_create(
+            ClusterDepthKey { source: self.source, shadowed_view: scene.shadows_active },
+            |k| {
                 DistancePipeline::new(
                     device,
                     "cluster_depth.wgsl",
                     "cluster_depth",
                     [&scene.view_layout, &clusters.depth_layout],
-                    source,
+                    k.source,
                 )
-            })?;
+            },
+        )?;
         let source = self.source.bind_group(ctx, &pipeline.source_layout, self.clear_color)?;
         // Zero the depth ranges (no pixel yet), which follow the cluster ranges.
         let ranges = clusters.ranges.buffer();

@@ -13,9 +13,15 @@ use crate::graph::{Pass, PassContext, ResourceName};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 
-/// The pipeline key of [`LightRefinePass`]: where it reads the shading distances.
+/// The pipeline key of [`LightRefinePass`]: where it reads the shading distances, and whether
+/// group 0 (the view, which it shares with the shading passes) has the shadow bindings.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct RefineKey(pub DistanceSource);
+pub struct RefineKey {
+    /// Where the shading distances come from.
+    pub source: DistanceSource,
+    /// The view layout is the shadowed one.
+    pub shadowed_view: bool,
+}
 
 impl PipelineKey for RefineKey {
     type Pipeline = DistancePipeline;
@@ -48,15 +54,18 @@ impl Pass for LightRefinePass {
         let clusters = ctx.require_clusters("light_refine")?;
         let scene = ctx.scene;
         let device = &ctx.gpu.device;
-        let pipeline = ctx.pipelines.get_or_create(RefineKey(self.source), |&RefineKey(source)| {
-            DistancePipeline::new(
-                device,
-                "light_refine.wgsl",
-                "light_refine",
-                [&scene.view_layout, &clusters.refine_layout],
-                source,
-            )
-        })?;
+        let pipeline = ctx.pipelines.get_or_create(
+            RefineKey { source: self.source, shadowed_view: scene.shadows_active },
+            |k| {
+                DistancePipeline::new(
+                    device,
+                    "light_refine.wgsl",
+                    "light_refine",
+                    [&scene.view_layout, &clusters.refine_layout],
+                    k.source,
+                )
+            },
+        )?;
         let source = self.source.bind_group(ctx, &pipeline.source_layout, self.clear_color)?;
         let lists = ctx.bind_group(
             "light_refine",

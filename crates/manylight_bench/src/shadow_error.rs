@@ -1,0 +1,213 @@
+//! How far a frame's shadows are from exact visibility (`render --shadow-oracle`,
+//! `bench --shadow-oracle`).
+//!
+//! 1. The frame's exact per-pixel light lists come from the light-list oracle
+//!    ([`oracle_snapshot`]), whose render also leaves the frame's shadow atlas on the renderer.
+//! 2. Each pixel's surface is found by casting its camera ray into the scene's triangles
+//!    ([`OccluderSet::first_hit`]): a point and a geometric normal facing the camera.
+//! 3. For each light of the pixel's list, the ray-cast oracle decides whether anything blocks
+//!    the segment to the light ([`OccluderSet::visibility`]), and the GPU evaluates the
+//!    shading passes' own shadow test there ([`manylight_render::Renderer::probe_shadows`]).
+//! 4. The **visibility error** is the mean of `|test − exact|` over the contributing pairs (the
+//!    light reaches the point: inside its range, in front of the surface, inside a spot's
+//!    cone): a filtered test half-lit at a lit pair counts one half.
+//! 5. The **shadow reference image** is the light-list oracle with every blocked pair removed
+//!    from its lists and no shadow map: naive forward's image with exact visibility. The frame
+//!    is compared with it by FLIP.
+
+use crate::direct::oracle_snapshot;
+use anyhow::{Context, Result};
+use glam::{UVec2, Vec2};
+use manylight_app::render_world::HeadlessRenderer;
+use manylight_core::AlphaMode;
+use manylight_core::cluster::ClusterAssignment;
+use manylight_core::image_metrics::{FlipStats, flip_compare};
+use manylight_core::shadow_oracle::{LightSource, OccluderSet, ShadowQuery, SurfaceHit};
+use manylight_core::spot::spot_attenuation;
+use manylight_render::shadow_probe::ShadowProbe;
+use manylight_render::{ExtractedPointLight, FrameSnapshot};
+use manylight_scene::Scene;
+use rayon::prelude::*;
+use std::sync::Arc;
+
+/// A frame's shadows measured against exact visibility.
+pub struct ShadowAccuracy {
+    /// Light–pixel pairs where the light reaches the surface (the error's denominator).
+    pub contributing_pairs: u64,
+    /// Of those, the pairs the oracle finds blocked.
+    pub blocked_pairs: u64,
+    /// Mean `|shadow test − exact visibility|` over the contributing pairs, in [0, 1].
+    pub visibility_error: f64,
+    /// Contributing pairs whose test is on the wrong side of one half.
+    pub wrong_pairs: u64,
+    /// FLIP of the frame against the shadow reference.
+    pub flip: FlipStats,
+    /// The shadow reference image.
+    pub reference: image::RgbaImage,
+}
+
+/// The opaque triangles of `scene` in world space: what casts shadows (blended materials cast
+/// none, as in the shadow pass).
+pub fn occluders(scene: &Scene) -> OccluderSet {
+    OccluderSet::from_instances(
+        scene
+            .instances
+            .iter()
+            .filter(|i| scene.materials.get(i.material).is_none_or(|m| m.alpha_mode != AlphaMode::Blend))
+            .map(|i| (scene.meshes[i.mesh].as_ref(), i.transform)),
+    )
+}
+
+/// Measures `snapshot`'s frame (a snapshot of `scene`, as rendered by its pipeline and shadow
+/// settings) against exact visibility through `occluders` (see the module's steps).
+pub fn measure_shadows(
+    renderer: &mut HeadlessRenderer,
+    snapshot: FrameSnapshot,
+    occluders: &OccluderSet,
+) -> Result<ShadowAccuracy> {
+    let camera = *snapshot.camera().context("the frame has no camera to measure")?;
+    let size = snapshot.viewport.max(UVec2::ONE);
+    let (_, frame) = renderer.render(snapshot.clone(), true)?;
+    let image = frame.context("the frame was not read back")?;
+    // The oracle's render leaves the same shadow atlas as the frame's (the plan depends on the
+    // lights and the camera only), which the probes read.
+    let (oracle, _) = oracle_snapshot(renderer, snapshot.clone())?;
+    let lists = oracle.pixel_light_lists.clone().context("the oracle made no lists")?;
+    let lights: Vec<&ExtractedPointLight> = snapshot.lights.iter().filter(|l| l.is_valid()).collect();
+
+    let world_from_clip =
+        camera.world_from_view * camera.projection.matrix(size.x as f32 / size.y as f32).inverse();
+    let surfaces: Vec<Option<SurfaceHit>> = (0..size.x * size.y)
+        .into_par_iter()
+        .map(|i| {
+            let [_, count] = lists.ranges.get(i as usize).copied().unwrap_or_default();
+            if count == 0 {
+                return None;
+            }
+            let (x, y) = (i % size.x, i / size.x);
+            let ndc = Vec2::new(
+                (x as f32 + 0.5) / size.x as f32 * 2.0 - 1.0,
+                1.0 - (y as f32 + 0.5) / size.y as f32 * 2.0,
+            );
+            // Reverse-Z: 1 is the near plane.
+            let near = world_from_clip.project_point3(ndc.extend(1.0));
+            let further = world_from_clip.project_point3(ndc.extend(0.5));
+            occluders.first_hit(near, further - near)
+        })
+        .collect();
+
+    // Every (pixel, light) entry of the lists with a surface, and whether the light reaches it.
+    let mut entries = Vec::new();
+    let mut queries = Vec::new();
+    for (pixel, surface) in surfaces.iter().enumerate() {
+        let Some(s) = surface else { continue };
+        let [offset, count] = lists.ranges[pixel];
+        for entry in offset..offset + count {
+            let k = lists.indices[entry as usize];
+            let Some(light) = lights.get(k as usize) else { continue };
+            entries.push((entry, reaches(light, s)));
+            queries.push(ShadowQuery {
+                point: s.point,
+                normal: s.normal,
+                light: LightSource::At(light.position),
+            });
+        }
+    }
+    let visible = occluders.visibility(&queries);
+    let probe_inputs: Vec<ShadowProbe> = entries
+        .iter()
+        .zip(&queries)
+        .filter(|((_, reaches), _)| *reaches)
+        .map(|((entry, _), q)| ShadowProbe {
+            position: q.point,
+            normal: q.normal,
+            light: lists.indices[*entry as usize],
+        })
+        .collect();
+    let tested = renderer.render_world.renderer().probe_shadows(&probe_inputs)?;
+    let exact: Vec<bool> =
+        entries.iter().zip(&visible).filter(|((_, reaches), _)| *reaches).map(|(_, &v)| v).collect();
+    let (mut error, mut wrong) = (0.0f64, 0u64);
+    for (&test, &lit) in tested.iter().zip(&exact) {
+        let truth = if lit { 1.0 } else { 0.0 };
+        let e = (f64::from(test) - truth).abs();
+        error += e;
+        wrong += u64::from(e > 0.5);
+    }
+    let contributing_pairs = exact.len() as u64;
+    let blocked_pairs = exact.iter().filter(|&&v| !v).count() as u64;
+
+    // The reference: the oracle's lists without the blocked pairs, no shadow maps.
+    let blocked: Vec<u32> =
+        entries.iter().zip(&visible).filter(|(_, v)| !**v).map(|((entry, _), _)| *entry).collect();
+    let mut reference_snapshot = oracle;
+    reference_snapshot.settings.shadows.enabled = false;
+    reference_snapshot.pixel_light_lists = Some(Arc::new(without_entries(&lists, &blocked)));
+    let (_, reference) = renderer.render(reference_snapshot, true)?;
+    let reference = reference.context("the reference was not read back")?;
+    let (flip, _) =
+        flip_compare(reference.dimensions(), reference.as_raw(), image.dimensions(), image.as_raw())?;
+    Ok(ShadowAccuracy {
+        contributing_pairs,
+        blocked_pairs,
+        visibility_error: if contributing_pairs == 0 { 0.0 } else { error / contributing_pairs as f64 },
+        wrong_pairs: wrong,
+        flip,
+        reference,
+    })
+}
+
+/// True when `light` sends light to the surface at `s`: in front of it and, for a spot light,
+/// inside its cone (the lists hold only lights whose range reaches the point).
+fn reaches(light: &ExtractedPointLight, s: &SurfaceHit) -> bool {
+    let to_light = light.position - s.point;
+    if to_light.dot(s.normal) <= 0.0 {
+        return false;
+    }
+    match light.spot {
+        None => true,
+        Some(cone) => {
+            let (scale, offset) = cone.sanitized().scale_offset();
+            let cos = cone.direction.dot(-to_light.normalize_or_zero());
+            spot_attenuation(cos, scale, offset) > 0.0
+        }
+    }
+}
+
+/// `lists` without the entries (indices into `lists.indices`, ascending) in `removed`.
+fn without_entries(lists: &ClusterAssignment, removed: &[u32]) -> ClusterAssignment {
+    let mut ranges = Vec::with_capacity(lists.ranges.len());
+    let mut indices = Vec::with_capacity(lists.indices.len() - removed.len().min(lists.indices.len()));
+    let mut next = removed.iter().peekable();
+    for &[offset, count] in &lists.ranges {
+        let start = indices.len() as u32;
+        for entry in offset..offset + count {
+            if next.peek() == Some(&&entry) {
+                next.next();
+                continue;
+            }
+            indices.push(lists.indices[entry as usize]);
+        }
+        ranges.push([start, indices.len() as u32 - start]);
+    }
+    ClusterAssignment { ranges, indices, dropped_pairs: 0, clusters_overflowed: 0 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn removing_entries_keeps_the_others_in_order() {
+        let lists = ClusterAssignment {
+            ranges: vec![[0, 2], [2, 0], [2, 3]],
+            indices: vec![7, 8, 1, 2, 3],
+            dropped_pairs: 0,
+            clusters_overflowed: 0,
+        };
+        let cut = without_entries(&lists, &[1, 3]);
+        assert_eq!(cut.ranges, vec![[0, 1], [1, 0], [1, 2]]);
+        assert_eq!(cut.indices, vec![7, 1, 3]);
+        assert_eq!(without_entries(&lists, &[]).indices, lists.indices);
+    }
+}

@@ -1,0 +1,124 @@
+//! Reads back the shadow test the shading passes make, at chosen light–point pairs: the
+//! measurement side of shadows (`manylight render --shadow-oracle` compares it with the exact
+//! visibility of `manylight_core::shadow_oracle`). It runs `shaders/shadow_probe.wgsl`, which
+//! calls the very `shadow_visibility` of the shading passes against the last frame's atlas and
+//! light table, so what is measured is what was shaded. Not part of a frame.
+
+use crate::context::{GpuContext, RenderError};
+use crate::gpu_types::{GpuPointLight, GpuShadowProbe};
+use crate::readback::read_buffer;
+use crate::shadows::ShadowResources;
+use glam::Vec3;
+
+/// Probes evaluated per dispatch (32 MiB of probes): a frame's millions of pairs go in parts.
+pub const PROBES_PER_DISPATCH: usize = 1 << 20;
+
+/// Workgroup size of `shadow_probe.wgsl`.
+const WORKGROUP: u32 = 64;
+
+/// One light–point pair to probe.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowProbe {
+    /// The surface point, in world space.
+    pub position: Vec3,
+    /// The surface's normal (any length).
+    pub normal: Vec3,
+    /// The light's index in the frame's light buffer (its valid lights, in order).
+    pub light: u32,
+}
+
+/// The shadow test of `shadows`' last frame for each probe, in [0, 1] (1: fully lit). Every
+/// probe is 1 when that frame drew no shadow map; a probe of a light the buffer lacks is 1.
+/// `lights` is the frame's light buffer (`SceneResources::lights`), holding `light_count`
+/// lights. Waits for the GPU.
+pub fn probe_shadows(
+    gpu: &GpuContext,
+    shadows: &ShadowResources,
+    lights: &wgpu::Buffer,
+    light_count: u32,
+    probes: &[ShadowProbe],
+) -> Result<Vec<f32>, RenderError> {
+    let Some(bindings) = shadows.bindings() else {
+        return Ok(vec![1.0; probes.len()]);
+    };
+    if probes.is_empty() || light_count == 0 {
+        return Ok(vec![1.0; probes.len()]);
+    }
+    let module = crate::shaders::create_module(&gpu.device, "shadow_probe.wgsl")
+        .map_err(|e| RenderError::Graph(format!("shadow_probe.wgsl: {e}")))?;
+    let pipeline = gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("shadow_probe"),
+        layout: None,
+        module: &module,
+        entry_point: Some("main"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    let shadow_group = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("shadow_probe_shadows"),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[
+            wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(bindings.atlas) },
+            wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::Sampler(bindings.sampler) },
+            wgpu::BindGroupEntry { binding: 5, resource: bindings.lights.as_entire_binding() },
+        ],
+    });
+    let light_bytes = u64::from(light_count) * std::mem::size_of::<GpuPointLight>() as u64;
+    let mut out = Vec::with_capacity(probes.len());
+    for part in probes.chunks(PROBES_PER_DISPATCH) {
+        let gpu_probes: Vec<GpuShadowProbe> = part
+            .iter()
+            .map(|p| GpuShadowProbe {
+                position: p.position.to_array(),
+                light: p.light,
+                normal: p.normal.to_array(),
+                pad: 0.0,
+            })
+            .collect();
+        let input = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("shadow_probes"),
+            contents: bytemuck::cast_slice(&gpu_probes),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let result_bytes = (part.len() * 4) as u64;
+        let output = gpu.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("shadow_probed"),
+            size: result_bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let group = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shadow_probe"),
+            layout: &pipeline.get_bind_group_layout(1),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: lights,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(light_bytes),
+                    }),
+                },
+                wgpu::BindGroupEntry { binding: 1, resource: input.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: output.as_entire_binding() },
+            ],
+        });
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("shadow_probe") });
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("shadow_probe"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &shadow_group, &[]);
+            pass.set_bind_group(1, &group, &[]);
+            pass.dispatch_workgroups((part.len() as u32).div_ceil(WORKGROUP), 1, 1);
+        }
+        gpu.queue.submit([encoder.finish()]);
+        let bytes = read_buffer(gpu, &output, 0, result_bytes)?;
+        out.extend_from_slice(&bytemuck::pod_collect_to_vec::<u8, f32>(&bytes)[..part.len()]);
+    }
+    Ok(out)
+}

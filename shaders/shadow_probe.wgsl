@@ -1,0 +1,34 @@
+// The shadow test of the shading passes (`shadow_visibility`, common/shadows.wgsl) at given
+// surface points, for measuring it against the exact visibility reference (Rust:
+// `shadow_probe::probe_shadows`). Not part of a frame.
+//!include common/shadows.wgsl
+
+// Rust: `GpuShadowProbe`.
+struct GpuShadowProbe {
+    // The surface point (world).
+    position: vec3<f32>,
+    // The light's index in the light buffer.
+    light: u32,
+    // The surface's normal (any length).
+    normal: vec3<f32>,
+    pad: f32,
+};
+
+@group(1) @binding(0) var<storage, read> lights: array<GpuPointLight>;
+@group(1) @binding(1) var<storage, read> probes: array<GpuShadowProbe>;
+@group(1) @binding(2) var<storage, read_write> probed: array<f32>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if i >= arrayLength(&probes) {
+        return;
+    }
+    let probe = probes[i];
+    let k = probe.light;
+    if k >= arrayLength(&lights) {
+        probed[i] = 1.0;
+        return;
+    }
+    probed[i] = shadow_visibility(k, lights[k].position_radius.xyz, probe.position, probe.normal);
+}
