@@ -18,7 +18,7 @@
 fn shade(g: GSurface, frag: vec2<f32>) -> vec4<f32> {
     let view_dir = direction_to_eye(view, g.world_position);
     let range = light_list_range(frag, gbuffer_view_distance(g.world_position));
-    var color = gbuffer_base_radiance(g) + shade_directional_lights(g.params, view_dir);
+    var color = gbuffer_base_radiance(g) + shade_directional_lights(g.params, g.world_position, view_dir);
     for (var i = 0u; i < range.y; i++) {
         color += shade_light(g.params, g.world_position, view_dir, cluster_indices[range.x + i]);
     }

@@ -49,7 +49,7 @@ fn vs_volume(@location(0) position: vec3<f32>, @builtin(instance_index) light_in
 // lights (which no volume bounds).
 fn ambient(g: GSurface) -> vec4<f32> {
     let view_dir = direction_to_eye(view, g.world_position);
-    return vec4<f32>(gbuffer_base_radiance(g) + shade_directional_lights(g.params, view_dir), 1.0);
+    return vec4<f32>(gbuffer_base_radiance(g) + shade_directional_lights(g.params, g.world_position, view_dir), 1.0);
 }
 
 fn one_light(g: GSurface, light_index: u32) -> vec4<f32> {

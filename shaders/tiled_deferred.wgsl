@@ -147,7 +147,7 @@ fn cull_tile(tile: vec2<u32>, li: u32) {
 
 fn shade(g: GSurface, tile: vec2<u32>) -> vec4<f32> {
     let view_dir = direction_to_eye(view, g.world_position);
-    var color = gbuffer_base_radiance(g) + shade_directional_lights(g.params, view_dir);
+    var color = gbuffer_base_radiance(g) + shade_directional_lights(g.params, g.world_position, view_dir);
     let count = atomicLoad(&list_count);
     if count <= TILED_LIST_CAPACITY {
         for (var i = 0u; i < count; i++) {

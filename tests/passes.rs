@@ -515,5 +515,19 @@ fn the_shadow_pass_runs_only_where_a_light_casts_and_lights_are_shaded() {
         let mut s = snapshot(debug);
         s.lights.iter_mut().for_each(|l| *l = manylight::app::scene::with_shadow(*l, true));
         assert_eq!(plan_passes(s).unwrap(), expected(debug), "{debug:?}");
+        // A casting sun alone (no point light): the shadow pass, then the frame of no lights.
+        let unlit = Point { lights: false, ..p };
+        let mut sun = snapshot(unlit);
+        sun.directional_lights.push(manylight::render::ExtractedDirectionalLight {
+            direction: Vec3::NEG_Y,
+            color: Vec3::ONE,
+            illuminance: 1.0,
+            shadow: Some(manylight::render::DirectionalShadow::default()),
+        });
+        let mut with_sun = vec!["shadow_maps"];
+        with_sun.extend(expected(unlit));
+        assert_eq!(plan_passes(sun.clone()).unwrap(), with_sun, "{unlit:?}");
+        sun.directional_lights[0].shadow = None;
+        assert_eq!(plan_passes(sun).unwrap(), expected(unlit), "{unlit:?}");
     }
 }

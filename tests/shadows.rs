@@ -1,5 +1,5 @@
-//! Shadows of point and spot lights: a plate over a floor shadows the floor where the exact
-//! visibility oracle (`manylight_core::shadow_oracle`) says, for a point and a spot light;
+//! Shadows: a plate over a floor shadows the floor where the exact visibility oracle
+//! (`manylight_core::shadow_oracle`) says, for a point, a spot and a directional light;
 //! every pipeline gives naive forward's shadowed image; lights that do not cast change nothing.
 
 mod support;
@@ -54,6 +54,22 @@ fn plate_scene() -> Scene {
 enum Kind {
     Point,
     Spot,
+    /// Light travelling along [`SUN`].
+    Directional,
+}
+
+/// Where the directional light travels: down and towards +x, so the plate's shadow (its own
+/// size, 1 × 1) falls beside it where the camera sees it.
+const SUN: Vec3 = Vec3::new(1.0, -1.0, 0.2);
+
+impl Kind {
+    /// The light as the oracle sees it.
+    fn source(self) -> LightSource {
+        match self {
+            Kind::Point | Kind::Spot => LightSource::At(LIGHT),
+            Kind::Directional => LightSource::Travelling(SUN),
+        }
+    }
 }
 
 fn render(kind: Kind, shadows: bool, settings: RenderSettings) -> HeadlessFrame {
@@ -82,6 +98,11 @@ fn render(kind: Kind, shadows: bool, settings: RenderSettings) -> HeadlessFrame 
                         ..Default::default()
                     };
                     commands.spawn((at.looking_to(Vec3::NEG_Y, Vec3::Z), light));
+                }
+                Kind::Directional => {
+                    let light =
+                        DirectionalLight { illuminance: 3.0, shadows_enabled: shadows, ..Default::default() };
+                    commands.spawn((Transform::default().looking_to(SUN, Vec3::Z), light));
                 }
             }
         });
@@ -142,8 +163,7 @@ fn visibility_error(
         if light < 0.05 {
             continue; // the light does not reach the point enough to tell
         }
-        let visible =
-            occluders.visible(&ShadowQuery { point: p, normal: Vec3::Y, light: LightSource::At(LIGHT) });
+        let visible = occluders.visible(&ShadowQuery { point: p, normal: Vec3::Y, light: kind.source() });
         let got = luminance(shadowed.image.get_pixel(x, y)) - base;
         let lit = got > 0.5 * light;
         pairs += 1;
@@ -151,12 +171,14 @@ fn visibility_error(
         wrong += u32::from(lit != visible);
     }
     assert!(pairs > 2000, "{kind:?}: too few lit floor pixels ({pairs})");
-    assert!(blocked > 200, "{kind:?}: the plate blocks the light from few pixels ({blocked})");
+    // A point light 1 above the plate projects it at twice its size; the sun at its own size.
+    let umbra = if let Kind::Directional = kind { 100 } else { 200 };
+    assert!(blocked > umbra, "{kind:?}: the plate blocks the light from few pixels ({blocked})");
     wrong as f32 / pairs as f32
 }
 
 #[test]
-fn a_plate_shadows_the_floor_where_the_oracle_says_for_point_and_spot_lights() {
+fn a_plate_shadows_the_floor_where_the_oracle_says_for_every_light_kind() {
     let _gpu = gpu();
     let naive = RenderSettings { pipeline: PipelineKind::NaiveForward, ..RenderSettings::default() };
     let ambient = {
@@ -168,7 +190,7 @@ fn a_plate_shadows_the_floor_where_the_oracle_says_for_point_and_spot_lights() {
         })
         .expect("the unlit scene renders")
     };
-    for kind in [Kind::Point, Kind::Spot] {
+    for kind in [Kind::Point, Kind::Spot, Kind::Directional] {
         let on = render(kind, true, naive);
         let off = render(kind, false, naive);
         let error = visibility_error(kind, &on, &off, &ambient);
@@ -180,6 +202,8 @@ fn a_plate_shadows_the_floor_where_the_oracle_says_for_point_and_spot_lights() {
         );
         let report = on.stats.last.as_ref().and_then(|r| r.shadows).expect("a shadow report");
         assert_eq!((report.casting_lights, report.maps_rendered, report.dropped_lights), (1, 1, 0));
+        let cascades = if let Kind::Directional = kind { 4 } else { 0 };
+        assert_eq!(report.cascades_rendered, cascades, "{kind:?}");
         assert!(report.instance_faces >= 2, "the floor and the plate are drawn: {report:?}");
         // Unshadowed, the frame has no shadow pass and no report.
         assert!(off.stats.last.as_ref().is_some_and(|r| r.shadows.is_none()));
@@ -228,7 +252,7 @@ fn a_light_that_starts_and_stops_casting_renders_every_frame() {
             .add_systems(Update, |mut lights: Query<&mut PointLight>, mut frame: Local<u32>| {
                 *frame += 1;
                 for mut light in &mut lights {
-                    light.shadows_enabled = *frame % 2 == 0;
+                    light.shadows_enabled = frame.is_multiple_of(2);
                 }
             });
     })

@@ -24,7 +24,7 @@ fn forward_fragment(in: SurfaceVertexOut, front_facing: bool) -> ForwardFragment
     alpha_test(m.base_color);
     let view_dir = direction_to_eye(view, p.world_position);
     var color = surface_base_radiance(m.params.albedo, view.params.w, m.occlusion, m.emissive);
-    color += shade_directional_lights(m.params, view_dir);
+    color += shade_directional_lights(m.params, p.world_position, view_dir);
     return ForwardFragment(p, m, view_dir, color);
 }
 

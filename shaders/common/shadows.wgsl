@@ -1,6 +1,7 @@
-// Shadows of point and spot lights: each casting light's six cube faces are tiles of one
-// depth atlas (Rust: `crate::shadows`), drawn by `shadow_maps.wgsl`. Bound in group 0 of
-// every shading pass only when the frame has a casting light (`//!if SHADOWS`).
+// Shadows: each casting point or spot light's six cube faces, and each casting directional
+// light's cascades, are tiles of one depth atlas (Rust: `crate::shadows`), drawn by
+// `shadow_maps.wgsl`. Bound in group 0 of every shading pass only when the frame has a casting
+// light (`//!if SHADOWS`).
 //!include common/lights.wgsl
 
 // Rust: `GpuShadowLight`.
@@ -13,9 +14,29 @@ struct GpuShadowLight {
     params: vec4<f32>,
 };
 
+// Rust: `GpuCascade`.
+struct GpuCascade {
+    // x, y ∈ [-1, 1] across the cascade's square, z ∈ [0, 1] through its depth range
+    clip_from_world: mat4x4<f32>,
+    // xy: top-left atlas texel of the tile, z: its edge in texels, w: 0
+    tile: vec4<u32>,
+    // x: far bound (view distance), y: a texel's width (world), z: depth range (world), w: 0
+    params: vec4<f32>,
+};
+
+// Rust: `GpuDirectionalShadow`.
+struct GpuDirectionalShadow {
+    cascades: array<GpuCascade, MAX_CASCADES>,
+    // x: cascades in use (0: no shadow)
+    count: vec4<u32>,
+    // x: depth bias (world units), y: normal bias (texels of the cascade)
+    bias: vec4<f32>,
+};
+
 @group(0) @binding(3) var shadow_atlas: texture_depth_2d;
 @group(0) @binding(4) var shadow_sampler: sampler_comparison;
 @group(0) @binding(5) var<storage, read> shadow_lights: array<GpuShadowLight>;
+@group(0) @binding(6) var<storage, read> directional_shadows: array<GpuDirectionalShadow>;
 
 // The depth a face stores for a point `depth` along its axis: a perspective depth, 0 at the
 // near plane and 1 at the far one (Rust: `shadows::face_depth`).
@@ -60,4 +81,39 @@ fn shadow_visibility(k: u32, light_position: vec3<f32>, position: vec3<f32>, nor
     let near = shadow.params.x;
     let reference = shadow_face_depth(max(depth - shadow.params.z, near), near, shadow.params.y);
     return textureSampleCompareLevel(shadow_atlas, shadow_sampler, atlas_uv, reference);
+}
+
+// How much of directional light `i` (travelling along the unit `direction`) reaches
+// `position`, `view_distance` from the camera along its axis: the 2×2 comparison-filtered test
+// of the first cascade whose far bound lies beyond the point, or 1 past the last cascade or
+// when the light casts no shadow. The biases work as for point lights, in the cascade's
+// texels and along the light's direction.
+fn directional_shadow_visibility(
+    i: u32,
+    direction: vec3<f32>,
+    position: vec3<f32>,
+    normal: vec3<f32>,
+    view_distance: f32,
+) -> f32 {
+    let count = min(directional_shadows[i].count.x, MAX_CASCADES);
+    var c = 0u;
+    loop {
+        if c >= count || view_distance <= directional_shadows[i].cascades[c].params.x {
+            break;
+        }
+        c++;
+    }
+    if c >= count {
+        return 1.0;
+    }
+    let cascade = directional_shadows[i].cascades[c];
+    let bias = directional_shadows[i].bias;
+    let to_light = -direction;
+    let facing = select(-normal, normal, dot(normal, to_light) >= 0.0);
+    let p = position + facing * (bias.y * cascade.params.y) + to_light * bias.x;
+    let clip = cascade.clip_from_world * vec4<f32>(p, 1.0);
+    let edge = f32(cascade.tile.z);
+    let local = clamp(vec2<f32>(0.5 + 0.5 * clip.x, 0.5 - 0.5 * clip.y) * edge, vec2<f32>(0.5), vec2<f32>(edge - 0.5));
+    let atlas_uv = (vec2<f32>(cascade.tile.xy) + local) / vec2<f32>(textureDimensions(shadow_atlas));
+    return textureSampleCompareLevel(shadow_atlas, shadow_sampler, atlas_uv, saturate(clip.z));
 }

@@ -3,7 +3,10 @@
 use bevy_ecs::prelude::*;
 use glam::{Mat4, Quat, Vec3};
 use manylight_core::{MaterialData, MeshData};
-use manylight_render::snapshot::ShadowBias;
+/// How a directional light's shadow splits the view (Bevy's `CascadeShadowConfig`): a
+/// component on the light's entity.
+pub use manylight_render::settings::{CascadeShadowConfig, CascadeShadowConfigBuilder};
+use manylight_render::snapshot::{DirectionalShadow, ShadowBias};
 use std::sync::Arc;
 
 pub use bevy_transform::components::{GlobalTransform, Transform};
@@ -358,8 +361,8 @@ pub struct DirectionalLight {
     pub color: Vec3,
     /// Illuminance in lux, multiplying `color`.
     pub illuminance: f32,
-    /// Asks for shadows. Directional shadows (cascades fitted to the view) are not drawn yet:
-    /// a casting directional light lights through everything.
+    /// Casts shadows: cascades of orthographic maps fitted to the view, split as the entity's
+    /// [`CascadeShadowConfig`] says (the default without one).
     pub shadows_enabled: bool,
     /// World units the shadow test moves the shaded point towards the light.
     pub shadow_depth_bias: f32,
@@ -369,9 +372,17 @@ pub struct DirectionalLight {
 
 impl DirectionalLight {
     /// Bevy's default `shadow_depth_bias` of a directional light.
-    pub const DEFAULT_SHADOW_DEPTH_BIAS: f32 = 0.02;
+    pub const DEFAULT_SHADOW_DEPTH_BIAS: f32 = ShadowBias::DIRECTIONAL.depth;
     /// Bevy's default `shadow_normal_bias` of a directional light.
-    pub const DEFAULT_SHADOW_NORMAL_BIAS: f32 = 1.8;
+    pub const DEFAULT_SHADOW_NORMAL_BIAS: f32 = ShadowBias::DIRECTIONAL.normal;
+
+    /// The light's shadow, split by `cascades`, when it casts.
+    pub fn shadow(&self, cascades: CascadeShadowConfig) -> Option<DirectionalShadow> {
+        self.shadows_enabled.then_some(DirectionalShadow {
+            bias: ShadowBias { depth: self.shadow_depth_bias, normal: self.shadow_normal_bias },
+            cascades,
+        })
+    }
 }
 
 impl Default for DirectionalLight {

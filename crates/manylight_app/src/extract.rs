@@ -3,9 +3,9 @@
 
 use crate::backend::{RenderBackend, record_results};
 use crate::components::{
-    Bloom, Camera, Camera3d, CameraDebugView, DirectionalLight, Exposure, GlobalTransform,
-    InheritedVisibility, LightAnimation, Material, Mesh3d, MotionBlur, PointLight, Projection, RenderTarget,
-    SpotLight, Transform,
+    Bloom, Camera, Camera3d, CameraDebugView, CascadeShadowConfig, DirectionalLight, Exposure,
+    GlobalTransform, InheritedVisibility, LightAnimation, Material, Mesh3d, MotionBlur, PointLight,
+    Projection, RenderTarget, SpotLight, Transform,
 };
 use crate::resources::{DebugView, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize};
 use bevy_app::AppExit;
@@ -55,6 +55,7 @@ pub type LightItem = (
     &'static GlobalTransform,
     AnyOf<(&'static PointLight, &'static SpotLight, &'static DirectionalLight)>,
     Option<&'static InheritedVisibility>,
+    Option<&'static CascadeShadowConfig>,
 );
 
 /// Whether an entity's computed visibility lets it render (none computed yet: visible).
@@ -128,7 +129,7 @@ pub fn build_snapshot(
         .collect();
     let mut point_lights = Vec::new();
     let mut directional_lights = Vec::new();
-    for (t, (point, spot, directional), visibility) in lights {
+    for (t, (point, spot, directional), visibility, cascades) in lights {
         if !shown(visibility) {
             continue;
         }
@@ -148,6 +149,7 @@ pub fn build_snapshot(
                     direction,
                     color: l.color,
                     illuminance: l.illuminance,
+                    shadow: l.shadow(cascades.copied().unwrap_or_default()),
                 });
                 continue;
             }

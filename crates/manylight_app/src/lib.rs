@@ -27,10 +27,10 @@ pub mod window;
 
 pub use backend::RenderFailed;
 pub use components::{
-    Bloom, Camera, Camera3d, CameraDebugView, DirectionalLight, Exposure, GlobalTransform,
-    InheritedVisibility, LightAnimation, Material, Mesh3d, MotionBlur, OrthographicProjection,
-    PerspectiveProjection, PointLight, Projection, RenderImage, RenderTarget, SpotLight, Transform, Viewport,
-    Visibility,
+    Bloom, Camera, Camera3d, CameraDebugView, CascadeShadowConfig, CascadeShadowConfigBuilder,
+    DirectionalLight, Exposure, GlobalTransform, InheritedVisibility, LightAnimation, Material, Mesh3d,
+    MotionBlur, OrthographicProjection, PerspectiveProjection, PointLight, Projection, RenderImage,
+    RenderTarget, SpotLight, Transform, Viewport, Visibility,
 };
 pub use plugin::{HEADLESS_TIME_STEP, HeadlessConfig, ManyLightPlugin, ManyLightSet, OutputMode};
 pub use resources::{
@@ -47,10 +47,10 @@ pub mod prelude {
     }
 
     pub use crate::components::{
-        Bloom, Camera, Camera3d, CameraDebugView, DirectionalLight, Exposure, GlobalTransform,
-        InheritedVisibility, LightAnimation, Material, Mesh3d, MotionBlur, OrthographicProjection,
-        PerspectiveProjection, PointLight, Projection, RenderImage, RenderTarget, SpotLight, Transform,
-        Viewport, Visibility,
+        Bloom, Camera, Camera3d, CameraDebugView, CascadeShadowConfig, CascadeShadowConfigBuilder,
+        DirectionalLight, Exposure, GlobalTransform, InheritedVisibility, LightAnimation, Material, Mesh3d,
+        MotionBlur, OrthographicProjection, PerspectiveProjection, PointLight, Projection, RenderImage,
+        RenderTarget, SpotLight, Transform, Viewport, Visibility,
     };
     pub use crate::plugin::{ManyLightPlugin, ManyLightSet};
     pub use crate::resources::{

@@ -233,6 +233,7 @@ pub fn scene_snapshot(
             direction: l.direction,
             color: l.color,
             illuminance: l.illuminance,
+            shadow: None,
         })
         .collect();
     FrameSnapshot {

@@ -35,6 +35,9 @@ pub fn cast_every_shadow(snapshot: &mut FrameSnapshot) {
     for light in &mut snapshot.lights {
         *light = manylight_app::scene::with_shadow(*light, true);
     }
+    for light in &mut snapshot.directional_lights {
+        light.shadow = Some(manylight_render::DirectionalShadow::default());
+    }
 }
 
 /// What a rendered frame's light lists are measured from, read back from the GPU.

@@ -101,6 +101,7 @@ pub fn shared_u32_constants() -> Vec<(&'static str, u32)> {
         ("MAX_DIRECTIONAL_LIGHTS", MAX_DIRECTIONAL_LIGHTS),
         ("SHADOW_FACES", SHADOW_FACES),
         ("SHADOW_TILE_COLUMNS", SHADOW_TILE_COLUMNS),
+        ("MAX_CASCADES", MAX_CASCADES as u32),
         ("MATERIAL_TEXTURE_SLOTS", MATERIAL_TEXTURE_SLOTS),
         ("TEXTURE_SLOT_BASE_COLOR", TEXTURE_SLOT_BASE_COLOR),
         ("TEXTURE_SLOT_METALLIC_ROUGHNESS", TEXTURE_SLOT_METALLIC_ROUGHNESS),
@@ -209,7 +210,35 @@ pub struct GpuPointLight {
     pub spot: [f32; 4],
 }
 
-pub use crate::settings::{SHADOW_FACES, SHADOW_TILE_COLUMNS};
+pub use crate::settings::{MAX_CASCADES, SHADOW_FACES, SHADOW_TILE_COLUMNS};
+
+/// One cascade of a directional light's shadow (`GpuCascade` in
+/// `shaders/common/shadows.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuCascade {
+    /// The cascade's orthographic projection: x, y ∈ [-1, 1] across its square, z ∈ [0, 1]
+    /// from the casters nearest the light to the far side of the view's slice.
+    pub clip_from_world: Mat4,
+    /// x, y: the atlas texel at the tile's top left; z: its edge in texels; w: 0.
+    pub tile: [u32; 4],
+    /// x: the far bound (view distance) up to which it is used; y: a texel's width in world
+    /// units; z: its depth range in world units; w: 0.
+    pub params: [f32; 4],
+}
+
+/// A directional light's shadow (`GpuDirectionalShadow` in `shaders/common/shadows.wgsl`),
+/// one per entry of `ViewUniform::directional`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuDirectionalShadow {
+    /// The cascades, nearest first.
+    pub cascades: [GpuCascade; MAX_CASCADES],
+    /// x: cascades in use (0: the light casts no shadow); y, z, w: 0.
+    pub count: [u32; 4],
+    /// x: depth bias (world units), y: normal bias (texels of the cascade); z, w: 0.
+    pub bias: [f32; 4],
+}
 
 /// A light's shadow map as the shading passes read it (`GpuShadowLight` in
 /// `shaders/common/shadows.wgsl`): one entry per uploaded point or spot light, in light-buffer

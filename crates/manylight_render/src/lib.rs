@@ -33,11 +33,12 @@ pub use plan::PlanInputs;
 pub use planner::FramePlanner;
 pub use readback::{HEADLESS_FORMAT, HeadlessTarget};
 pub use renderer::Renderer;
+pub use settings::{CascadeShadowConfig, CascadeShadowConfigBuilder};
 pub use shadows::{ShadowReport, ShadowSettings};
 pub use snapshot::{
-    BloomChain, BloomSettings, ClusterSettings, DEFAULT_COARSE_TILES, DebugViewMode, Exposure,
-    ExtractedCamera, ExtractedDirectionalLight, ExtractedInstance, ExtractedPointLight, ExtractedView,
-    FrameSettings, FrameSnapshot, GBufferLayout, MotionBlurSettings, PipelineKind, RenderSettings,
-    RenderTextureId, RenderView, ShadowBias, ViewRect, ViewTarget,
+    BloomChain, BloomSettings, ClusterSettings, DEFAULT_COARSE_TILES, DebugViewMode, DirectionalShadow,
+    Exposure, ExtractedCamera, ExtractedDirectionalLight, ExtractedInstance, ExtractedPointLight,
+    ExtractedView, FrameSettings, FrameSnapshot, GBufferLayout, MotionBlurSettings, PipelineKind,
+    RenderSettings, RenderTextureId, RenderView, ShadowBias, ViewRect, ViewTarget,
 };
 pub use stats::{FrameReport, PassTiming, ViewReport};

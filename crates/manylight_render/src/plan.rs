@@ -52,10 +52,11 @@ impl PlanInputs<'_> {
         self.settings().pipeline.uses_clusters() && self.has_lights && !self.replaces_shading()
     }
 
-    /// True when the view shades lights that cast shadows: the shadow pass runs and every
-    /// shading pass reads its atlas ([`crate::passes::SHADOW_ATLAS`]).
+    /// True when the view shades lights that cast shadows (point, spot or directional): the
+    /// shadow pass runs and every shading pass reads its atlas
+    /// ([`crate::passes::SHADOW_ATLAS`]).
     pub fn shades_shadows(&self) -> bool {
-        self.casts_shadows && self.has_lights && !self.replaces_shading()
+        self.casts_shadows && !self.replaces_shading()
     }
 
     /// True when the view is shaded deferred: a G-buffer, then a full-screen lighting pass or

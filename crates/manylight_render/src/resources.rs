@@ -234,6 +234,7 @@ fn make_view_layout(device: &wgpu::Device, shadows: bool) -> wgpu::BindGroupLayo
                 count: None,
             },
             storage(5, shading),
+            storage(6, shading),
         ]);
     }
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -250,6 +251,8 @@ pub struct ShadowBindings<'a> {
     pub sampler: &'a wgpu::Sampler,
     /// The lights' shadow table.
     pub lights: &'a wgpu::Buffer,
+    /// The directional lights' cascades.
+    pub directional: &'a wgpu::Buffer,
     /// Changes whenever one of them is re-created.
     pub generation: u64,
 }
@@ -484,6 +487,7 @@ impl SceneResources {
                     resource: wgpu::BindingResource::Sampler(shadows.sampler),
                 },
                 wgpu::BindGroupEntry { binding: 5, resource: shadows.lights.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 6, resource: shadows.directional.as_entire_binding() },
             ]);
         }
         gpu.create_bind_group(&wgpu::BindGroupDescriptor {

@@ -158,6 +158,9 @@ pub struct ShadowSettings {
     pub min_face_size: u32,
     /// Face texels asked per pixel of the light sphere's projected radius.
     pub resolution_scale: f32,
+    /// Edge of each cascade of a directional light (a power of two, at most a third of the
+    /// atlas: a light's cascades share one block of tiles).
+    pub cascade_size: u32,
 }
 
 impl Default for ShadowSettings {
@@ -168,6 +171,7 @@ impl Default for ShadowSettings {
             max_face_size: 512,
             min_face_size: 16,
             resolution_scale: 1.0,
+            cascade_size: 1024,
         }
     }
 }
@@ -179,6 +183,7 @@ impl ShadowSettings {
             ("shadows.atlas_size", self.atlas_size),
             ("shadows.max_face_size", self.max_face_size),
             ("shadows.min_face_size", self.min_face_size),
+            ("shadows.cascade_size", self.cascade_size),
         ] {
             if !value.is_power_of_two() {
                 return Err(format!("{name} {value} must be a power of two"));
@@ -198,6 +203,14 @@ impl ShadowSettings {
                 SHADOW_TILE_COLUMNS * self.min_face_size
             ));
         }
+        if self.atlas_size < SHADOW_TILE_COLUMNS * self.cascade_size {
+            return Err(format!(
+                "shadows.atlas_size {} cannot hold a directional light's cascades at shadows.cascade_size {} ({} texels wide)",
+                self.atlas_size,
+                self.cascade_size,
+                SHADOW_TILE_COLUMNS * self.cascade_size
+            ));
+        }
         if !(self.resolution_scale.is_finite() && self.resolution_scale > 0.0) {
             return Err(format!(
                 "shadows.resolution_scale {} must be finite and positive",
@@ -213,8 +226,11 @@ impl ShadowSettings {
 pub struct ShadowReport {
     /// Lights that asked for a shadow.
     pub casting_lights: u32,
-    /// Lights whose six faces were drawn this frame.
+    /// Lights whose maps were drawn this frame (a point or spot light's six faces, a
+    /// directional light's cascades).
     pub maps_rendered: u32,
+    /// Cascades drawn for the directional lights.
+    pub cascades_rendered: u32,
     /// Lights whose maps were kept from an earlier frame (maps are drawn every frame: 0).
     pub maps_cached: u32,
     /// (instance, face) pairs drawn.
@@ -234,6 +250,142 @@ pub struct ShadowReport {
     /// The device's texture limit is below [`ShadowSettings::atlas_size`]: the atlas is the
     /// device's largest.
     pub atlas_limited_by_device: bool,
+}
+
+/// Most cascades a directional light's shadow has (they share one block of
+/// [`SHADOW_FACES`] tiles).
+pub const MAX_CASCADES: usize = 4;
+
+/// How a directional light's shadow is split along the view into cascades, each an
+/// orthographic map fitted to its slice of the camera's frustum (Bevy's
+/// `CascadeShadowConfig`; build one with [`CascadeShadowConfigBuilder`]). With the `bevy`
+/// feature it is a component: put it on a `DirectionalLight`'s entity (without one, the
+/// default).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_ecs::component::Component))]
+pub struct CascadeShadowConfig {
+    /// The far bound of each cascade (view-space distance along the camera's axis), increasing;
+    /// only the first `count` are used. Past the last, nothing is shadowed.
+    pub bounds: [f32; MAX_CASCADES],
+    /// Cascades in use, 1 to [`MAX_CASCADES`].
+    pub count: u32,
+    /// Fraction of the previous cascade's far bound by which each cascade reaches nearer, so
+    /// neighbouring cascades overlap.
+    pub overlap_proportion: f32,
+    /// Where the first cascade starts.
+    pub minimum_distance: f32,
+}
+
+impl Default for CascadeShadowConfig {
+    fn default() -> Self {
+        CascadeShadowConfigBuilder::default().build().unwrap_or(CascadeShadowConfig {
+            bounds: [150.0; MAX_CASCADES],
+            count: 1,
+            overlap_proportion: 0.2,
+            minimum_distance: 0.1,
+        })
+    }
+}
+
+impl CascadeShadowConfig {
+    /// The used far bounds.
+    pub fn far_bounds(&self) -> &[f32] {
+        &self.bounds[..(self.count as usize).clamp(1, MAX_CASCADES)]
+    }
+
+    /// Where cascade `i` starts: the minimum distance for the first, the previous far bound
+    /// less the overlap for the others.
+    pub fn near_bound(&self, i: usize) -> f32 {
+        match i {
+            0 => self.minimum_distance,
+            _ => self.bounds[i - 1] * (1.0 - self.overlap_proportion),
+        }
+    }
+}
+
+/// Builds a [`CascadeShadowConfig`] as Bevy's builder does: the first cascade ends at
+/// `first_cascade_far_bound`, the others grow geometrically to `maximum_distance`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CascadeShadowConfigBuilder {
+    /// Cascades, 1 to [`MAX_CASCADES`] (default 4).
+    pub num_cascades: usize,
+    /// Where the first cascade starts (default 0.1).
+    pub minimum_distance: f32,
+    /// Where the last cascade ends: nothing further is shadowed (default 150).
+    pub maximum_distance: f32,
+    /// Where the first cascade ends (default 5).
+    pub first_cascade_far_bound: f32,
+    /// How far each cascade reaches into the previous one, as a fraction of its far bound
+    /// (default 0.2).
+    pub overlap_proportion: f32,
+}
+
+impl Default for CascadeShadowConfigBuilder {
+    fn default() -> Self {
+        CascadeShadowConfigBuilder {
+            num_cascades: MAX_CASCADES,
+            minimum_distance: 0.1,
+            maximum_distance: 150.0,
+            first_cascade_far_bound: 5.0,
+            overlap_proportion: 0.2,
+        }
+    }
+}
+
+/// A [`CascadeShadowConfigBuilder`] that describes no cascades.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum CascadeConfigError {
+    /// `num_cascades` is 0 or above [`MAX_CASCADES`].
+    #[error("num_cascades {0} must be 1 to {MAX_CASCADES}")]
+    Count(usize),
+    /// The distances are not finite, positive and increasing.
+    #[error(
+        "cascade distances must be finite with 0 <= minimum_distance ({minimum}) < first_cascade_far_bound ({first}) <= maximum_distance ({maximum})"
+    )]
+    Distances {
+        /// `minimum_distance`.
+        minimum: f32,
+        /// `first_cascade_far_bound`.
+        first: f32,
+        /// `maximum_distance`.
+        maximum: f32,
+    },
+    /// `overlap_proportion` is outside [0, 1).
+    #[error("overlap_proportion {0} must be in [0, 1)")]
+    Overlap(f32),
+}
+
+impl CascadeShadowConfigBuilder {
+    /// The configuration, or what is wrong with the builder.
+    pub fn build(&self) -> Result<CascadeShadowConfig, CascadeConfigError> {
+        let n = self.num_cascades;
+        if n == 0 || n > MAX_CASCADES {
+            return Err(CascadeConfigError::Count(n));
+        }
+        let (minimum, first, maximum) =
+            (self.minimum_distance, self.first_cascade_far_bound, self.maximum_distance);
+        let ordered = minimum >= 0.0 && minimum < first && first <= maximum;
+        if !(minimum.is_finite() && first.is_finite() && maximum.is_finite() && ordered) {
+            return Err(CascadeConfigError::Distances { minimum, first, maximum });
+        }
+        if !(0.0..1.0).contains(&self.overlap_proportion) {
+            return Err(CascadeConfigError::Overlap(self.overlap_proportion));
+        }
+        let mut bounds = [maximum; MAX_CASCADES];
+        if n > 1 {
+            let base = (maximum / first).powf(1.0 / (n - 1) as f32);
+            for (i, b) in bounds.iter_mut().take(n).enumerate() {
+                *b = first * base.powi(i as i32);
+            }
+            bounds[n - 1] = maximum;
+        }
+        Ok(CascadeShadowConfig {
+            bounds,
+            count: n as u32,
+            overlap_proportion: self.overlap_proportion,
+            minimum_distance: minimum,
+        })
+    }
 }
 
 /// Cube faces of a point or spot light's shadow map: +X, -X, +Y, -Y, +Z, -Z (face `f` looks

@@ -21,10 +21,13 @@
 //! shaders are composed without `SHADOWS` ([`crate::shaders::ShaderDefs`]).
 
 use crate::context::{GpuContext, RenderError};
-use crate::gpu_types::{GpuShadowDraw, GpuShadowFace, GpuShadowLight, SHADOW_FACES, SHADOW_TILE_COLUMNS};
+use crate::gpu_types::{
+    GpuCascade, GpuDirectionalShadow, GpuShadowDraw, GpuShadowFace, GpuShadowLight, MAX_DIRECTIONAL_LIGHTS,
+    SHADOW_FACES, SHADOW_TILE_COLUMNS,
+};
 use crate::pool::GrowableBuffer;
 use crate::resources::SceneResources;
-use crate::snapshot::{ExtractedCamera, FrameSnapshot};
+use crate::snapshot::{ExtractedCamera, ExtractedDirectionalLight, FrameSnapshot};
 use glam::{Mat4, UVec2, Vec3, Vec4};
 use manylight_core::{Aabb, ProjectionKind};
 
@@ -118,11 +121,21 @@ pub fn requested_edge(
     edge_for(wanted, settings.min_face_size, settings.max_face_size)
 }
 
+/// What a shadow map belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum ShadowCaster {
+    /// A point or spot light, by its index in the light buffer: six cube faces.
+    Point(u32),
+    /// A directional light, by its index in the view's directional lights: one tile per
+    /// cascade.
+    Directional(u32),
+}
+
 /// One light's request for a shadow map.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ShadowRequest {
-    /// The light's index in the light buffer.
-    pub light: u32,
+    /// The light.
+    pub caster: ShadowCaster,
     /// Face edge asked for (a power of two).
     pub edge: u32,
     /// Larger is kept first when the atlas is full (the projected size).
@@ -132,8 +145,8 @@ pub struct ShadowRequest {
 /// Where a light's faces lie in the atlas.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ShadowPlacement {
-    /// The light's index in the light buffer.
-    pub light: u32,
+    /// The light.
+    pub caster: ShadowCaster,
     /// Top-left texel of its block of tiles.
     pub x: u32,
     /// Top-left texel of its block of tiles.
@@ -195,14 +208,14 @@ fn pack_rows(edges: impl Iterator<Item = u32>, atlas: u32) -> Option<Vec<(u32, u
 pub fn plan_atlas(requests: &[ShadowRequest], max_atlas: u32, min_edge: u32) -> AtlasPlan {
     let mut order: Vec<ShadowRequest> = requests.to_vec();
     order.sort_by(|a, b| {
-        b.edge.cmp(&a.edge).then(b.importance.total_cmp(&a.importance)).then(a.light.cmp(&b.light))
+        b.edge.cmp(&a.edge).then(b.importance.total_cmp(&a.importance)).then(a.caster.cmp(&b.caster))
     });
     let placed = |granted: &[u32], order: &[ShadowRequest], atlas: u32, spots: Vec<(u32, u32)>| AtlasPlan {
         placements: order
             .iter()
             .zip(granted)
             .zip(spots)
-            .map(|((r, &edge), (x, y))| ShadowPlacement { light: r.light, x, y, edge, asked: r.edge })
+            .map(|((r, &edge), (x, y))| ShadowPlacement { caster: r.caster, x, y, edge, asked: r.edge })
             .collect(),
         atlas_size: atlas,
         downgraded: order.iter().zip(granted).filter(|(r, g)| **g < r.edge).count() as u32,
@@ -234,7 +247,7 @@ pub fn plan_atlas(requests: &[ShadowRequest], max_atlas: u32, min_edge: u32) -> 
         let mut paired: Vec<(ShadowRequest, u32)> =
             order.iter().copied().zip(granted.iter().copied()).collect();
         paired.sort_by(|(a, ga), (b, gb)| {
-            gb.cmp(ga).then(b.importance.total_cmp(&a.importance)).then(a.light.cmp(&b.light))
+            gb.cmp(ga).then(b.importance.total_cmp(&a.importance)).then(a.caster.cmp(&b.caster))
         });
         order = paired.iter().map(|(r, _)| *r).collect();
         granted = paired.iter().map(|(_, g)| *g).collect();
@@ -246,7 +259,7 @@ pub fn plan_atlas(requests: &[ShadowRequest], max_atlas: u32, min_edge: u32) -> 
     let per_row = atlas / (SHADOW_TILE_COLUMNS * min_edge);
     let rows = atlas / (SHADOW_TILE_ROWS * min_edge);
     let capacity = (per_row as usize) * (rows as usize);
-    order.sort_by(|a, b| b.importance.total_cmp(&a.importance).then(a.light.cmp(&b.light)));
+    order.sort_by(|a, b| b.importance.total_cmp(&a.importance).then(a.caster.cmp(&b.caster)));
     let kept = order.len().min(capacity);
     let dropped = (order.len() - kept) as u32;
     order.truncate(kept);
@@ -277,6 +290,100 @@ pub fn box_meets_face(light: Vec3, face: u32, bounds: &Aabb) -> bool {
     planes.iter().all(|&n| max_over_box(n) >= 0.0)
 }
 
+/// The atlas texel at the top left of tile `tile` of a placement's block.
+fn tile_of(p: &ShadowPlacement, tile: u32) -> (u32, u32) {
+    (p.x + (tile % SHADOW_TILE_COLUMNS) * p.edge, p.y + (tile / SHADOW_TILE_COLUMNS) * p.edge)
+}
+
+/// A slice of the view between two distances along the camera's axis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewSlice {
+    /// Nearer distance.
+    pub near: f32,
+    /// Further distance.
+    pub far: f32,
+}
+
+/// A cascade fitted to its slice of the view.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CascadeFit {
+    /// Orthographic along the light: x, y ∈ [-1, 1] over a square that holds the slice's
+    /// bounding sphere, z ∈ [0, 1] from the casters nearest the light to the sphere's far side.
+    pub clip_from_world: Mat4,
+    /// Width of one of the cascade's texels in world units.
+    pub texel: f32,
+    /// The depth range in world units.
+    pub depth_range: f32,
+}
+
+/// Fits a cascade of `edge` texels for light travelling along `direction` to `slice` of the
+/// view through `camera` (of aspect `aspect`): the slice's eight corners' bounding sphere, its
+/// radius rounded up to 1/16 unit and its centre snapped to whole texels across the light, so
+/// the map keeps its size and texel grid as the camera turns and moves (no shimmering edges);
+/// its depth reaches back to every caster in `casters`.
+pub fn fit_cascade(
+    camera: &ExtractedCamera,
+    aspect: f32,
+    slice: ViewSlice,
+    direction: Vec3,
+    casters: &Aabb,
+    edge: u32,
+) -> CascadeFit {
+    let projection = camera.projection.sanitized();
+    let near = slice.near.max(projection.near);
+    let far = slice.far.min(projection.far).max(near);
+    let aspect = if aspect.is_finite() && aspect > 0.0 { aspect } else { 1.0 };
+    let half_extent = |d: f32| -> (f32, f32) {
+        let half_height = match projection.kind {
+            ProjectionKind::Perspective => d * (0.5 * projection.fov_y).tan(),
+            ProjectionKind::Orthographic { height } => 0.5 * height,
+        };
+        (half_height * aspect, half_height)
+    };
+    let mut corners = [Vec3::ZERO; 8];
+    for (i, d) in [near, far].into_iter().enumerate() {
+        let (w, h) = half_extent(d);
+        for (j, (x, y)) in [(-w, -h), (w, -h), (w, h), (-w, h)].into_iter().enumerate() {
+            corners[i * 4 + j] = camera.world_from_view.transform_point3(Vec3::new(x, y, -d));
+        }
+    }
+    let center = corners.iter().copied().sum::<Vec3>() / 8.0;
+    let radius = corners.iter().map(|c| c.distance(center)).fold(0.0f32, f32::max);
+    let radius = ((radius * 16.0).ceil() / 16.0).max(1.0 / 16.0);
+    let direction = direction.try_normalize().unwrap_or(Vec3::NEG_Y);
+    let up = if direction.y.abs() < 0.99 { Vec3::Y } else { Vec3::X };
+    let light_from_world = glam::camera::rh::view::look_to_mat4(Vec3::ZERO, direction, up);
+    let texel = 2.0 * radius / edge.max(1) as f32;
+    let c = light_from_world.transform_point3(center);
+    let (cx, cy) = ((c.x / texel).floor() * texel, (c.y / texel).floor() * texel);
+    // Distance along the light is -z in its frame: the sphere spans -c.z ± radius, and the
+    // casters nearest the light are at the smallest distance.
+    let mut nearest = -c.z - radius;
+    if !casters.is_empty() {
+        let b = casters.transformed(&light_from_world);
+        nearest = nearest.min(-b.max.z);
+    }
+    let farthest = -c.z + radius;
+    let range = (farthest - nearest).max(1e-6);
+    let scale = Mat4::from_cols(
+        Vec4::new(1.0 / radius, 0.0, 0.0, 0.0),
+        Vec4::new(0.0, 1.0 / radius, 0.0, 0.0),
+        Vec4::new(0.0, 0.0, -1.0 / range, 0.0),
+        Vec4::new(-cx / radius, -cy / radius, -nearest / range, 1.0),
+    );
+    CascadeFit { clip_from_world: scale * light_from_world, texel, depth_range: range }
+}
+
+/// True when `bounds` may meet the box x, y ∈ [-1, 1], z ∈ [0, 1] of the affine (orthographic)
+/// projection `clip_from_world`.
+pub fn box_meets_clip(clip_from_world: &Mat4, bounds: &Aabb) -> bool {
+    if bounds.is_empty() {
+        return false;
+    }
+    let b = bounds.transformed(clip_from_world);
+    b.max.x >= -1.0 && b.min.x <= 1.0 && b.max.y >= -1.0 && b.min.y <= 1.0 && b.max.z >= 0.0 && b.min.z <= 1.0
+}
+
 /// A run of the shadow pass's draw instances that share a mesh.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ShadowMeshDraws {
@@ -298,6 +405,9 @@ pub struct ShadowResources {
     pub sampler: wgpu::Sampler,
     /// [`GpuShadowLight`] per light of the light buffer.
     pub lights: GrowableBuffer,
+    /// [`GpuDirectionalShadow`] per entry of the view's directional lights
+    /// ([`MAX_DIRECTIONAL_LIGHTS`]; no cascade where a light casts none).
+    pub directional: GrowableBuffer,
     /// [`GpuShadowFace`] per placed face.
     pub faces: GrowableBuffer,
     /// [`GpuShadowDraw`] per (instance, face) pair, grouped by mesh.
@@ -317,6 +427,7 @@ pub struct ShadowResources {
     pub clip_distances: bool,
     max_texture: u32,
     gpu_lights: Vec<GpuShadowLight>,
+    gpu_directional: Vec<GpuDirectionalShadow>,
     gpu_faces: Vec<GpuShadowFace>,
     by_mesh: Vec<(usize, Vec<GpuShadowDraw>)>,
     requests: Vec<ShadowRequest>,
@@ -342,6 +453,12 @@ impl ShadowResources {
                 storage,
                 std::mem::size_of::<GpuShadowLight>() as u64,
             ),
+            directional: GrowableBuffer::new(
+                gpu,
+                "shadow_directional",
+                storage,
+                std::mem::size_of::<GpuDirectionalShadow>() as u64 * u64::from(MAX_DIRECTIONAL_LIGHTS),
+            ),
             faces: GrowableBuffer::new(
                 gpu,
                 "shadow_faces",
@@ -362,10 +479,16 @@ impl ShadowResources {
             clip_distances: gpu.device.features().contains(wgpu::Features::CLIP_DISTANCES),
             max_texture: gpu.max_texture_size(),
             gpu_lights: Vec::new(),
+            gpu_directional: vec![GpuDirectionalShadow::default(); MAX_DIRECTIONAL_LIGHTS as usize],
             gpu_faces: Vec::new(),
             by_mesh: Vec::new(),
             requests: Vec::new(),
         }
+    }
+
+    /// The atlas texture, once a frame had a casting light.
+    pub fn atlas(&self) -> Option<&wgpu::Texture> {
+        self.atlas.as_ref()
     }
 
     /// The atlas's view, once a frame had a casting light.
@@ -380,6 +503,7 @@ impl ShadowResources {
             atlas,
             sampler: &self.sampler,
             lights: self.lights.buffer(),
+            directional: self.directional.buffer(),
             generation: self.generation,
         })
     }
@@ -413,7 +537,24 @@ impl ShadowResources {
             let wanted = projected_radius(camera, center, radius).map(|p| p * settings.resolution_scale);
             let edge = edge_for(wanted, settings.min_face_size, settings.max_face_size);
             let importance = edge_for(wanted, 1, 1 << 30) as f32;
-            self.requests.push(ShadowRequest { light: k as u32, edge, importance });
+            self.requests.push(ShadowRequest { caster: ShadowCaster::Point(k as u32), edge, importance });
+        }
+        // Directional lights, by their index in the view uniform (the first
+        // MAX_DIRECTIONAL_LIGHTS valid ones), cascades at their set size, kept before any
+        // point light when the atlas is full.
+        let directional: Vec<&ExtractedDirectionalLight> = snapshot
+            .directional_lights
+            .iter()
+            .filter(|l| l.is_valid())
+            .take(MAX_DIRECTIONAL_LIGHTS as usize)
+            .collect();
+        let view = camera.map(|(c, size)| (c, size.x.max(1) as f32 / size.y.max(1) as f32));
+        for (i, light) in directional.iter().enumerate() {
+            if light.shadow.is_some() && view.is_some() {
+                let edge = settings.cascade_size.max(settings.min_face_size);
+                let caster = ShadowCaster::Directional(i as u32);
+                self.requests.push(ShadowRequest { caster, edge, importance: f32::MAX });
+            }
         }
         // The largest power of two the device's textures allow.
         let device_limit = 1u32 << (31 - self.max_texture.max(1).leading_zeros());
@@ -453,35 +594,84 @@ impl ShadowResources {
             };
             opaque.push((d, slot));
         }
-        for p in &self.plan.placements {
-            let light = lights[p.light as usize];
-            let bias = light.shadow.unwrap_or_default();
-            let far = light.radius;
-            let near = far * SHADOW_NEAR_FRACTION;
-            self.gpu_lights[p.light as usize] =
-                GpuShadowLight { tile: [p.x, p.y, p.edge, 0], params: [near, far, bias.depth, bias.normal] };
-            let first_face = self.gpu_faces.len() as u32;
-            for face in 0..SHADOW_FACES {
-                let (tx, ty) = (
-                    p.x + (face % SHADOW_TILE_COLUMNS) * p.edge,
-                    p.y + (face / SHADOW_TILE_COLUMNS) * p.edge,
-                );
-                self.gpu_faces.push(GpuShadowFace {
-                    clip_from_world: face_clip_from_world(light.position, face, near, far),
-                    atlas: tile_transform(tx, ty, p.edge, atlas),
-                });
+        // What a cascade's depth range must reach back to: every opaque draw.
+        let mut casters = Aabb::EMPTY;
+        for (d, _) in &opaque {
+            if !d.world_bounds.is_empty() {
+                casters.extend(d.world_bounds.min);
+                casters.extend(d.world_bounds.max);
             }
-            let (center, radius) = light.bounding_sphere();
-            for &(d, slot) in &opaque {
-                if !sphere_meets_box(center, radius, &d.world_bounds) {
-                    continue;
-                }
-                for face in 0..SHADOW_FACES {
-                    if box_meets_face(light.position, face, &d.world_bounds) {
-                        self.by_mesh[slot]
-                            .1
-                            .push(GpuShadowDraw { instance: d.instance, face: first_face + face });
+        }
+        self.gpu_directional.fill(GpuDirectionalShadow::default());
+        for p in &self.plan.placements {
+            let first_face = self.gpu_faces.len() as u32;
+            match p.caster {
+                ShadowCaster::Point(k) => {
+                    let light = lights[k as usize];
+                    let bias = light.shadow.unwrap_or_default();
+                    let far = light.radius;
+                    let near = far * SHADOW_NEAR_FRACTION;
+                    self.gpu_lights[k as usize] = GpuShadowLight {
+                        tile: [p.x, p.y, p.edge, 0],
+                        params: [near, far, bias.depth, bias.normal],
+                    };
+                    for face in 0..SHADOW_FACES {
+                        let (tx, ty) = tile_of(p, face);
+                        self.gpu_faces.push(GpuShadowFace {
+                            clip_from_world: face_clip_from_world(light.position, face, near, far),
+                            atlas: tile_transform(tx, ty, p.edge, atlas),
+                        });
                     }
+                    let (center, radius) = light.bounding_sphere();
+                    for &(d, slot) in &opaque {
+                        if !sphere_meets_box(center, radius, &d.world_bounds) {
+                            continue;
+                        }
+                        for face in 0..SHADOW_FACES {
+                            if box_meets_face(light.position, face, &d.world_bounds) {
+                                self.by_mesh[slot]
+                                    .1
+                                    .push(GpuShadowDraw { instance: d.instance, face: first_face + face });
+                            }
+                        }
+                    }
+                }
+                ShadowCaster::Directional(i) => {
+                    let (Some(light), Some((camera, aspect))) = (directional.get(i as usize), view) else {
+                        continue;
+                    };
+                    let Some(shadow) = light.shadow else { continue };
+                    let config = shadow.cascades;
+                    let bounds = config.far_bounds();
+                    let mut gpu = GpuDirectionalShadow {
+                        count: [bounds.len() as u32, 0, 0, 0],
+                        bias: [shadow.bias.depth, shadow.bias.normal, 0.0, 0.0],
+                        ..Default::default()
+                    };
+                    for (c, &far) in bounds.iter().enumerate() {
+                        let slice = ViewSlice { near: config.near_bound(c), far };
+                        let fit = fit_cascade(camera, aspect, slice, light.direction, &casters, p.edge);
+                        let (tx, ty) = tile_of(p, c as u32);
+                        gpu.cascades[c] = GpuCascade {
+                            clip_from_world: fit.clip_from_world,
+                            tile: [tx, ty, p.edge, 0],
+                            params: [far, fit.texel, fit.depth_range, 0.0],
+                        };
+                        self.gpu_faces.push(GpuShadowFace {
+                            clip_from_world: fit.clip_from_world,
+                            atlas: tile_transform(tx, ty, p.edge, atlas),
+                        });
+                        for &(d, slot) in &opaque {
+                            if box_meets_clip(&fit.clip_from_world, &d.world_bounds) {
+                                self.by_mesh[slot].1.push(GpuShadowDraw {
+                                    instance: d.instance,
+                                    face: first_face + c as u32,
+                                });
+                            }
+                        }
+                    }
+                    self.gpu_directional[i as usize] = gpu;
+                    self.report.cascades_rendered += bounds.len() as u32;
                 }
             }
         }
@@ -500,6 +690,7 @@ impl ShadowResources {
             all.extend_from_slice(list);
         }
         let mut grew = self.lights.write(gpu, bytemuck::cast_slice(&self.gpu_lights))?;
+        grew |= self.directional.write(gpu, bytemuck::cast_slice(&self.gpu_directional))?;
         grew |= self.faces.write(gpu, bytemuck::cast_slice(&self.gpu_faces))?;
         if !all.is_empty() {
             grew |= self.draws.write(gpu, bytemuck::cast_slice(&all))?;
@@ -529,7 +720,9 @@ impl ShadowResources {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: SHADOW_ATLAS_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
         self.atlas_view = Some(texture.create_view(&Default::default()));
@@ -541,6 +734,7 @@ impl ShadowResources {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::settings::CascadeShadowConfig;
 
     #[test]
     fn a_face_projects_its_axis_to_the_centre_and_its_edges_to_the_tile() {
@@ -580,12 +774,91 @@ mod tests {
         assert!((row(-1.0) - 48.0).abs() < 1e-4);
     }
 
+    /// A cascade holds its whole slice of the view and every caster between it and the light,
+    /// and a camera moved by less than a texel moves the cascade's grid by whole texels.
+    #[test]
+    fn a_cascade_holds_its_slice_and_its_casters_on_a_stable_grid() {
+        let camera = |at: Vec3| ExtractedCamera {
+            world_from_view: Mat4::from_translation(at) * Mat4::from_rotation_y(0.4),
+            projection: manylight_core::Projection::default(),
+            prev_clip_from_world: None,
+            bloom: None,
+            motion_blur: None,
+            exposure: None,
+        };
+        let direction = Vec3::new(0.3, -1.0, 0.2).normalize();
+        let casters = Aabb { min: Vec3::new(-50.0, -1.0, -50.0), max: Vec3::new(50.0, 30.0, 50.0) };
+        let slice = ViewSlice { near: 2.0, far: 10.0 };
+        let cam = camera(Vec3::new(1.0, 2.0, 3.0));
+        let fit = fit_cascade(&cam, 16.0 / 9.0, slice, direction, &casters, 1024);
+        let inside = |p: Vec3| {
+            let c = fit.clip_from_world.transform_point3(p);
+            c.x.abs() <= 1.0 + 1e-4 && c.y.abs() <= 1.0 + 1e-4 && (-1e-4..=1.0 + 1e-4).contains(&c.z)
+        };
+        let (w, h) = ((0.5f32 * 60f32.to_radians()).tan() * 16.0 / 9.0, (0.5f32 * 60f32.to_radians()).tan());
+        for d in [2.0, 6.0, 10.0] {
+            for (x, y) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0), (0.0, 0.0)] {
+                let p = cam.world_from_view.transform_point3(Vec3::new(x * w * d, y * h * d, -d));
+                assert!(inside(p), "slice point {p} at {d}");
+            }
+        }
+        // A caster high above the slice, towards the light, is still in front of the map.
+        let centre = cam.world_from_view.transform_point3(Vec3::new(0.0, 0.0, -6.0));
+        let above = centre - direction * ((29.0 - centre.y) / -direction.y);
+        assert!(fit.clip_from_world.transform_point3(above).z >= -1e-4);
+        assert!(box_meets_clip(&fit.clip_from_world, &Aabb { min: above - 0.1, max: above + 0.1 }));
+        assert!(!box_meets_clip(&fit.clip_from_world, &Aabb { min: centre + 100.0, max: centre + 101.0 }));
+        assert!((fit.texel - fit.depth_range).abs() > 0.0 && fit.texel > 0.0);
+        // Moved by a third of a texel: same size, the grid shifted by whole texels.
+        let moved = fit_cascade(
+            &camera(Vec3::new(1.0 + fit.texel / 3.0, 2.0, 3.0)),
+            16.0 / 9.0,
+            slice,
+            direction,
+            &casters,
+            1024,
+        );
+        assert_eq!(moved.texel, fit.texel);
+        let shift = (moved.clip_from_world.w_axis.x - fit.clip_from_world.w_axis.x) / 2.0 * 1024.0;
+        assert!((shift - shift.round()).abs() < 1e-2, "a shift of {shift} texels");
+    }
+
+    #[test]
+    fn cascade_bounds_grow_geometrically_as_bevy_builds_them() {
+        use crate::settings::{CascadeConfigError, CascadeShadowConfigBuilder};
+        let c = CascadeShadowConfig::default();
+        assert_eq!(c.count, 4);
+        let b = c.far_bounds();
+        assert!((b[0] - 5.0).abs() < 1e-5 && (b[3] - 150.0).abs() < 1e-3);
+        assert!((b[1] / b[0] - b[2] / b[1]).abs() < 1e-3, "{b:?}");
+        assert!((c.near_bound(1) - 4.0).abs() < 1e-5 && c.near_bound(0) == 0.1);
+        let one = CascadeShadowConfigBuilder { num_cascades: 1, ..Default::default() }.build().unwrap();
+        assert_eq!(one.far_bounds(), &[150.0]);
+        let bad = |b: CascadeShadowConfigBuilder| b.build().unwrap_err();
+        assert_eq!(
+            bad(CascadeShadowConfigBuilder { num_cascades: 5, ..Default::default() }),
+            CascadeConfigError::Count(5)
+        );
+        assert!(matches!(
+            bad(CascadeShadowConfigBuilder { first_cascade_far_bound: 200.0, ..Default::default() }),
+            CascadeConfigError::Distances { .. }
+        ));
+        assert!(matches!(
+            bad(CascadeShadowConfigBuilder { maximum_distance: f32::NAN, ..Default::default() }),
+            CascadeConfigError::Distances { .. }
+        ));
+        assert_eq!(
+            bad(CascadeShadowConfigBuilder { overlap_proportion: 1.0, ..Default::default() }),
+            CascadeConfigError::Overlap(1.0)
+        );
+    }
+
     fn requests(edges: &[u32]) -> Vec<ShadowRequest> {
         edges
             .iter()
             .enumerate()
             .map(|(i, &edge)| ShadowRequest {
-                light: i as u32,
+                caster: ShadowCaster::Point(i as u32),
                 edge,
                 importance: edge as f32 + i as f32 * 1e-3,
             })
@@ -632,7 +905,10 @@ mod tests {
         let capacity = (1024 / 48) * (1024 / 32);
         assert_eq!(plan.placements.len(), capacity as usize);
         assert_eq!(plan.dropped, 100_000 - capacity);
-        assert!(plan.placements.iter().all(|p| p.light >= 100_000 - capacity), "the most important are kept");
+        assert!(
+            plan.placements.iter().all(|p| p.caster >= ShadowCaster::Point(100_000 - capacity)),
+            "the most important are kept"
+        );
         no_overlap(&plan);
     }
 

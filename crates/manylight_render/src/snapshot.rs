@@ -516,6 +516,8 @@ impl ShadowBias {
     pub const POINT: ShadowBias = ShadowBias { depth: 0.08, normal: 0.6 };
     /// Bevy's `SpotLight` defaults.
     pub const SPOT: ShadowBias = ShadowBias { depth: 0.02, normal: 1.8 };
+    /// Bevy's `DirectionalLight` defaults.
+    pub const DIRECTIONAL: ShadowBias = ShadowBias { depth: 0.02, normal: 1.8 };
 
     /// True when both biases are finite and not negative.
     pub fn is_valid(&self) -> bool {
@@ -695,6 +697,24 @@ pub struct ExtractedDirectionalLight {
     pub color: Vec3,
     /// Illuminance (lux in glTF), multiplying `color`.
     pub illuminance: f32,
+    /// The light casts shadows (`None`: it lights through everything).
+    pub shadow: Option<DirectionalShadow>,
+}
+
+/// A directional light's shadow: its biases (the normal bias in texels of the cascade at the
+/// point) and how its cascades split the view.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DirectionalShadow {
+    /// Depth and normal bias.
+    pub bias: ShadowBias,
+    /// The cascades.
+    pub cascades: crate::settings::CascadeShadowConfig,
+}
+
+impl Default for DirectionalShadow {
+    fn default() -> Self {
+        DirectionalShadow { bias: ShadowBias::DIRECTIONAL, cascades: Default::default() }
+    }
 }
 
 impl ExtractedDirectionalLight {
@@ -786,10 +806,11 @@ impl FrameSnapshot {
     }
 
     /// True when the frame draws shadow maps: shadows are enabled and a valid point or spot
-    /// light with a range casts one.
+    /// light with a range, or a valid directional light, casts one.
     pub fn casts_shadows(&self) -> bool {
         self.settings.shadows.enabled
-            && self.lights.iter().any(|l| l.shadow.is_some() && l.is_valid() && l.radius > 0.0)
+            && (self.lights.iter().any(|l| l.shadow.is_some() && l.is_valid() && l.radius > 0.0)
+                || self.directional_lights.iter().any(|l| l.shadow.is_some() && l.is_valid()))
     }
 
     /// True when an instance's material is blended (`AlphaMode::Blend`): the frame needs the

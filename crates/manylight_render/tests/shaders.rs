@@ -2,10 +2,12 @@
 //! same size and field offsets on both sides. No GPU needed.
 
 use manylight_render::gpu_types::{
+    GpuCascade, GpuDirectionalShadow, GpuShadowDraw, GpuShadowFace, GpuShadowLight, GpuShadowProbe,
+};
+use manylight_render::gpu_types::{
     GpuClusterBounds, GpuClusterCounters, GpuClusterParams, GpuDirectionalLight, GpuInstance, GpuMaterial,
     GpuPointLight, GpuTextureUv, ViewUniform,
 };
-use manylight_render::gpu_types::{GpuShadowDraw, GpuShadowFace, GpuShadowLight, GpuShadowProbe};
 use manylight_render::resources::SurfaceVariant;
 use manylight_render::shaders::{SOURCES, ShaderDefs, compose, compose_with};
 use std::mem::{offset_of, size_of};
@@ -120,6 +122,26 @@ fn shared_structs_match_rust() {
         "GpuShadowLight",
         size_of::<GpuShadowLight>(),
         &[("tile", offset_of!(GpuShadowLight, tile)), ("params", offset_of!(GpuShadowLight, params))],
+    );
+    offsets(
+        &shadowed,
+        "GpuCascade",
+        size_of::<GpuCascade>(),
+        &[
+            ("clip_from_world", offset_of!(GpuCascade, clip_from_world)),
+            ("tile", offset_of!(GpuCascade, tile)),
+            ("params", offset_of!(GpuCascade, params)),
+        ],
+    );
+    offsets(
+        &shadowed,
+        "GpuDirectionalShadow",
+        size_of::<GpuDirectionalShadow>(),
+        &[
+            ("cascades", offset_of!(GpuDirectionalShadow, cascades)),
+            ("count", offset_of!(GpuDirectionalShadow, count)),
+            ("bias", offset_of!(GpuDirectionalShadow, bias)),
+        ],
     );
     let shadow_maps = validate("shadow_maps.wgsl");
     offsets(
