@@ -193,10 +193,11 @@ fn a_plate_shadows_the_floor_where_the_oracle_says_for_every_light_kind() {
     for kind in [Kind::Point, Kind::Spot, Kind::Directional] {
         let on = render(kind, true, naive);
         let off = render(kind, false, naive);
+        // One light with the largest tile: at most 0.5 % of the pairs on the wrong side.
         let error = visibility_error(kind, &on, &off, &ambient);
         eprintln!("{kind:?}: visibility error {:.3} %", error * 100.0);
         assert!(
-            error < 0.02,
+            error < 0.005,
             "{kind:?}: {:.2} % of the floor's pixels disagree with the oracle",
             error * 100.0
         );

@@ -19,8 +19,11 @@ fn shade_light(s: SurfaceParams, position: vec3<f32>, view_dir: vec3<f32>, k: u3
     }
     let radiance = shade_reached_light(s, reach, view_dir, lights[k].color, lights[k].spot);
 //!if SHADOWS
-    return radiance * shadow_visibility(k, lights[k].position_radius.xyz, position, s.normal);
-//!else
-    return radiance;
+    // Only a light that adds something (in front of the surface, inside its cone) pays for the
+    // map lookup.
+    if any(radiance > vec3<f32>(0.0)) {
+        return radiance * shadow_visibility(k, lights[k].position_radius.xyz, position, s.normal);
+    }
 //!endif
+    return radiance;
 }

@@ -196,6 +196,8 @@ struct BenchArgs {
     #[arg(long)]
     shadow_oracle: bool,
     #[command(flatten)]
+    shadow: ShadowArgs,
+    #[command(flatten)]
     clusters: ClusterArgs,
     /// Shading model for materials without their own: pbr (default), lambert, blinn-phong or toon.
     #[arg(long, default_value = "pbr", value_parser = parse_shading)]
@@ -260,6 +262,8 @@ struct RenderArgs {
     /// shadow flag), `off` (default) none.
     #[arg(long, default_value = "off", value_parser = parse_on_off, action = clap::ArgAction::Set)]
     shadows: bool,
+    #[command(flatten)]
+    shadow: ShadowArgs,
     /// Output PNG.
     #[arg(long)]
     out: PathBuf,
@@ -302,6 +306,43 @@ struct PostArgs {
     /// 2 frames are rendered).
     #[arg(long)]
     motion_blur: bool,
+}
+
+/// The shadow atlas and resolution policy (`manylight_render::ShadowSettings`).
+#[derive(clap::Args, Clone, Debug)]
+struct ShadowArgs {
+    /// Largest edge of the shadow atlas in texels (a power of two).
+    #[arg(long, default_value_t = manylight_render::ShadowSettings::default().atlas_size)]
+    shadow_atlas: u32,
+    /// Largest cube-face edge a point or spot light's shadow gets (a power of two).
+    #[arg(long, default_value_t = manylight_render::ShadowSettings::default().max_face_size)]
+    shadow_max_face: u32,
+    /// Smallest cube-face edge (a power of two): below it a light goes without a shadow, counted.
+    #[arg(long, default_value_t = manylight_render::ShadowSettings::default().min_face_size)]
+    shadow_min_face: u32,
+    /// Face texels asked per pixel of a light sphere's projected radius.
+    #[arg(long, default_value_t = manylight_render::ShadowSettings::default().resolution_scale)]
+    shadow_resolution_scale: f32,
+    /// Edge of each cascade of a directional light (a power of two).
+    #[arg(long, default_value_t = manylight_render::ShadowSettings::default().cascade_size)]
+    shadow_cascade_size: u32,
+}
+
+impl ShadowArgs {
+    /// The settings, refused with the flag's problem when no atlas can be planned with them.
+    fn settings(&self) -> Result<manylight_render::ShadowSettings> {
+        let s = manylight_render::ShadowSettings {
+            enabled: true,
+            atlas_size: self.shadow_atlas,
+            max_face_size: self.shadow_max_face,
+            min_face_size: self.shadow_min_face,
+            resolution_scale: self.shadow_resolution_scale,
+            cascade_size: self.shadow_cascade_size,
+        };
+        s.check_values()
+            .map_err(|e| anyhow::anyhow!("--{}", e.replace("shadows.", "shadow-").replace('_', "-")))?;
+        Ok(s)
+    }
 }
 
 /// What `render_scene` adds beyond the scene: post stages on the camera and the debug view.
@@ -521,9 +562,17 @@ fn measure_shadow_accuracy(
     let occluders = shadow_error::occluders(scene);
     let a = shadow_error::measure_shadows(&mut renderer, snapshot, &occluders)?;
     println!(
-        "shadow oracle: visibility error {:.4} over {} contributing light-pixel pairs ({} blocked, \
-         {} tested on the wrong side); FLIP against the shadow reference: mean {:.4}, p99 {:.4}",
-        a.visibility_error, a.contributing_pairs, a.blocked_pairs, a.wrong_pairs, a.flip.mean, a.flip.p99
+        "shadow oracle: visibility error {:.4} (false shadow {:.4}, light leak {:.4}) over {} \
+         contributing light-pixel pairs ({} blocked, {} tested on the wrong side); FLIP against \
+         the shadow reference: mean {:.4}, p99 {:.4}",
+        a.visibility_error,
+        a.false_shadow,
+        a.light_leak,
+        a.contributing_pairs,
+        a.blocked_pairs,
+        a.wrong_pairs,
+        a.flip.mean,
+        a.flip.p99
     );
     Ok(a)
 }
@@ -551,6 +600,7 @@ fn render(args: RenderArgs) -> Result<()> {
     let studio = manylight_scene::studio_lights(studio, scene.bounds())?;
     scene.lights.extend(studio);
     let ambient = args.ambient.unwrap_or(if unlit { 0.2 } else { RenderSettings::default().ambient });
+    let shadow_settings = args.shadow.settings()?;
     // The measured frame of `--culling-efficiency` and `--oracle`: the last frame's animation
     // time, rendered straight from the scene (no app).
     let measured = (args.culling_efficiency || args.oracle || args.shadow_oracle).then(|| -> Result<_> {
@@ -563,6 +613,7 @@ fn render(args: RenderArgs) -> Result<()> {
                 clusters: args.clusters.settings(&args.scene),
                 gbuffer: args.clusters.gbuffer,
                 normal_codec: args.clusters.normal_codec,
+                shadows: shadow_settings,
                 ..Default::default()
             },
             ..Default::default()
@@ -633,6 +684,7 @@ fn render(args: RenderArgs) -> Result<()> {
         clusters: args.clusters.settings(&args.scene),
         gbuffer: args.clusters.gbuffer,
         normal_codec: args.clusters.normal_codec,
+        shadows: shadow_settings,
         ..RenderSettings::default()
     };
     let extras = Extras {
@@ -662,6 +714,8 @@ fn render(args: RenderArgs) -> Result<()> {
                 "blocked_pairs": a.blocked_pairs,
                 "wrong_pairs": a.wrong_pairs,
                 "visibility_error": a.visibility_error,
+                "false_shadow": a.false_shadow,
+                "light_leak": a.light_leak,
                 "flip_vs_shadow_reference": a.flip.mean,
                 "flip_vs_shadow_reference_p99": a.flip.p99,
             });
@@ -848,6 +902,7 @@ fn bench_cmd(args: BenchArgs) -> Result<()> {
                 gbuffer: args.clusters.gbuffer,
                 normal_codec: args.clusters.normal_codec,
                 shading: args.shading,
+                shadows: args.shadow.settings()?,
                 ..Default::default()
             },
             ..Default::default()

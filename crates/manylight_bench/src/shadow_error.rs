@@ -40,6 +40,12 @@ pub struct ShadowAccuracy {
     pub visibility_error: f64,
     /// Contributing pairs whose test is on the wrong side of one half.
     pub wrong_pairs: u64,
+    /// The part of `visibility_error` from pairs the light reaches but the test shadows
+    /// (acne, over-wide filtering), over all contributing pairs.
+    pub false_shadow: f64,
+    /// The part of `visibility_error` from blocked pairs the test lights (light leaks,
+    /// peter-panning, lights without a map).
+    pub light_leak: f64,
     /// FLIP of the frame against the shadow reference.
     pub flip: FlipStats,
     /// The shadow reference image.
@@ -127,11 +133,14 @@ pub fn measure_shadows(
     let tested = renderer.render_world.renderer().probe_shadows(&probe_inputs)?;
     let exact: Vec<bool> =
         entries.iter().zip(&visible).filter(|((_, reaches), _)| *reaches).map(|(_, &v)| v).collect();
-    let (mut error, mut wrong) = (0.0f64, 0u64);
+    let (mut false_shadow, mut light_leak, mut wrong) = (0.0f64, 0.0f64, 0u64);
     for (&test, &lit) in tested.iter().zip(&exact) {
-        let truth = if lit { 1.0 } else { 0.0 };
-        let e = (f64::from(test) - truth).abs();
-        error += e;
+        let e = if lit { 1.0 - f64::from(test) } else { f64::from(test) };
+        if lit {
+            false_shadow += e;
+        } else {
+            light_leak += e;
+        }
         wrong += u64::from(e > 0.5);
     }
     let contributing_pairs = exact.len() as u64;
@@ -147,11 +156,14 @@ pub fn measure_shadows(
     let reference = reference.context("the reference was not read back")?;
     let (flip, _) =
         flip_compare(reference.dimensions(), reference.as_raw(), image.dimensions(), image.as_raw())?;
+    let per_pair = |sum: f64| if contributing_pairs == 0 { 0.0 } else { sum / contributing_pairs as f64 };
     Ok(ShadowAccuracy {
         contributing_pairs,
         blocked_pairs,
-        visibility_error: if contributing_pairs == 0 { 0.0 } else { error / contributing_pairs as f64 },
+        visibility_error: per_pair(false_shadow + light_leak),
         wrong_pairs: wrong,
+        false_shadow: per_pair(false_shadow),
+        light_leak: per_pair(light_leak),
         flip,
         reference,
     })

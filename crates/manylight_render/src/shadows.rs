@@ -251,7 +251,8 @@ pub fn plan_atlas(requests: &[ShadowRequest], max_atlas: u32, min_edge: u32) -> 
         });
         order = paired.iter().map(|(r, _)| *r).collect();
         granted = paired.iter().map(|(_, g)| *g).collect();
-        if let Some(spots) = pack_rows(granted.iter().copied(), atlas) {
+        if pack_rows(granted.iter().copied(), atlas).is_some() {
+            let spots = grow_most_important(&mut order, &mut granted, atlas);
             return placed(&granted, &order, atlas, spots);
         }
     }
@@ -266,6 +267,101 @@ pub fn plan_atlas(requests: &[ShadowRequest], max_atlas: u32, min_edge: u32) -> 
     let granted = vec![min_edge; kept];
     let spots = pack_rows(granted.iter().copied(), atlas).unwrap_or_default();
     AtlasPlan { dropped, ..placed(&granted, &order, atlas, spots) }
+}
+
+/// The planes (`n·p + d ≥ 0` inside) of a reverse-Z view frustum `clip_from_world`: left,
+/// right, bottom, top and near. The far plane is left out (it may be at infinity), so the
+/// volume is conservative.
+pub fn frustum_planes(clip_from_world: &Mat4) -> [Vec4; 5] {
+    let m = clip_from_world.transpose();
+    let (r0, r1, r2, r3) = (m.x_axis, m.y_axis, m.z_axis, m.w_axis);
+    [r3 + r0, r3 - r0, r3 + r1, r3 - r1, r3 - r2]
+}
+
+/// The frustums of every view of `snapshot` (each at its rectangle's aspect).
+pub fn view_frustums(snapshot: &FrameSnapshot) -> Vec<[Vec4; 5]> {
+    snapshot
+        .views
+        .iter()
+        .map(|v| {
+            let size = v.rect_in(v.target_size(snapshot.viewport)).size.max(UVec2::ONE);
+            frustum_planes(&v.camera.clip_from_world(size))
+        })
+        .collect()
+}
+
+/// True when some point of `points` may lie inside `planes` (false only when all of them are
+/// outside one plane: conservative).
+fn may_meet(planes: &[Vec4; 5], points: &[Vec3]) -> bool {
+    planes.iter().all(|p| points.iter().any(|q| p.truncate().dot(*q) + p.w >= 0.0))
+}
+
+/// True when the sphere (`center`, `radius`) may be seen through one of `frustums`.
+pub fn sphere_in_view(frustums: &[[Vec4; 5]], center: Vec3, radius: f32) -> bool {
+    frustums.iter().any(|planes| {
+        planes.iter().all(|p| p.truncate().dot(center) + p.w >= -radius * p.truncate().length())
+    })
+}
+
+/// True when the part of cube face `face` of a light at `light` with range `radius` may be
+/// seen through one of `frustums`: that part lies in the pyramid from the light to the face's
+/// square at distance `radius`, tested by its five corners. A face no view sees lights no
+/// visible pixel, so it is not drawn.
+pub fn face_in_view(frustums: &[[Vec4; 5]], light: Vec3, face: u32, radius: f32) -> bool {
+    let (axis, sign) = face_axis(face);
+    let (a, b) = (Vec3::AXES[(axis + 1) % 3] * radius, Vec3::AXES[(axis + 2) % 3] * radius);
+    let end = light + Vec3::AXES[axis] * sign * radius;
+    let corners = [light, end + a + b, end + a - b, end - a + b, end - a - b];
+    frustums.iter().any(|planes| may_meet(planes, &corners))
+}
+
+/// Most rounds of [`grow_most_important`]: each can double a light's edge once, so this many
+/// rounds can take a light from a sixteenth of its ask back to all of it.
+const GROW_ROUNDS: usize = 4;
+
+/// After halving made every block fit (`granted`, in `order`, fits `atlas`): doubles the edges
+/// of the most important lights still below their ask, as many as fit (found by bisection on
+/// how many), for up to [`GROW_ROUNDS`] rounds, so the room the last halving freed goes to the
+/// lights largest on screen. Leaves `order` and `granted` sorted for packing and returns the
+/// blocks' places. Cost: O(n log² n) a round.
+fn grow_most_important(
+    order: &mut Vec<ShadowRequest>,
+    granted: &mut Vec<u32>,
+    atlas: u32,
+) -> Vec<(u32, u32)> {
+    let by_size = |g: &[u32], order: &[ShadowRequest]| {
+        let mut idx: Vec<usize> = (0..order.len()).collect();
+        idx.sort_by(|&a, &b| {
+            g[b].cmp(&g[a])
+                .then(order[b].importance.total_cmp(&order[a].importance))
+                .then(order[a].caster.cmp(&order[b].caster))
+        });
+        idx
+    };
+    for _ in 0..GROW_ROUNDS {
+        let mut candidates: Vec<usize> = (0..order.len()).filter(|&i| granted[i] < order[i].edge).collect();
+        candidates.sort_by(|&a, &b| {
+            order[b].importance.total_cmp(&order[a].importance).then(order[a].caster.cmp(&order[b].caster))
+        });
+        // The first `k` candidates doubled, sorted for packing, if they fit.
+        let grown = |k: usize| {
+            let mut g = granted.clone();
+            for &i in &candidates[..k] {
+                g[i] *= 2;
+            }
+            let idx = by_size(&g, order);
+            pack_rows(idx.iter().map(|&i| g[i]), atlas).map(|_| (idx, g))
+        };
+        let (mut lo, mut hi) = (0, candidates.len());
+        while lo < hi {
+            let mid = (lo + hi).div_ceil(2);
+            if grown(mid).is_some() { lo = mid } else { hi = mid - 1 }
+        }
+        let Some((idx, g)) = grown(lo).filter(|_| lo > 0) else { break };
+        *order = idx.iter().map(|&i| order[i]).collect();
+        *granted = idx.iter().map(|&i| g[i]).collect();
+    }
+    pack_rows(granted.iter().copied(), atlas).unwrap_or_default()
 }
 
 /// True when `bounds` meets the sphere (`center`, `radius`).
@@ -527,12 +623,18 @@ impl ShadowResources {
         let camera = snapshot.views.first().map(|v| (&v.camera, snapshot.viewport));
         // Requests, by the light's index in the light buffer (the valid lights in order).
         self.requests.clear();
+        let frustums = view_frustums(snapshot);
         let valid = snapshot.lights.iter().filter(|l| l.is_valid());
         for (k, light) in valid.enumerate() {
             if light.shadow.is_none() || light.radius <= 0.0 {
                 continue;
             }
             let (center, radius) = light.bounding_sphere();
+            // A light no view sees lights no visible pixel: no map.
+            if !sphere_in_view(&frustums, center, radius) {
+                self.report.unseen_lights += 1;
+                continue;
+            }
             // The same rounding as the edge, without its range: lights larger on screen first.
             let wanted = projected_radius(camera, center, radius).map(|p| p * settings.resolution_scale);
             let edge = edge_for(wanted, settings.min_face_size, settings.max_face_size);
@@ -564,7 +666,7 @@ impl ShadowResources {
             max_atlas,
             settings.min_face_size.min(max_atlas / SHADOW_TILE_COLUMNS).max(1),
         );
-        self.report.casting_lights = self.requests.len() as u32;
+        self.report.casting_lights = self.requests.len() as u32 + self.report.unseen_lights;
         self.report.atlas_limited_by_device = device_limit < settings.atlas_size;
         self.report.downgraded_lights = self.plan.downgraded;
         self.report.dropped_lights = self.plan.dropped;
@@ -623,12 +725,16 @@ impl ShadowResources {
                         });
                     }
                     let (center, radius) = light.bounding_sphere();
+                    let seen: Vec<bool> = (0..SHADOW_FACES)
+                        .map(|face| face_in_view(&frustums, light.position, face, light.radius))
+                        .collect();
+                    self.report.unseen_faces += seen.iter().filter(|s| !**s).count() as u32;
                     for &(d, slot) in &opaque {
                         if !sphere_meets_box(center, radius, &d.world_bounds) {
                             continue;
                         }
                         for face in 0..SHADOW_FACES {
-                            if box_meets_face(light.position, face, &d.world_bounds) {
+                            if seen[face as usize] && box_meets_face(light.position, face, &d.world_bounds) {
                                 self.by_mesh[slot]
                                     .1
                                     .push(GpuShadowDraw { instance: d.instance, face: first_face + face });
@@ -823,6 +929,29 @@ mod tests {
         assert!((shift - shift.round()).abs() < 1e-2, "a shift of {shift} texels");
     }
 
+    /// Lights and faces no view sees are found (and nothing a view sees is lost).
+    #[test]
+    fn unseen_lights_and_faces_are_found_conservatively() {
+        // A camera at the origin looking down -Z.
+        let clip = manylight_core::Projection::default().matrix(1.0);
+        let frustums = [frustum_planes(&clip)];
+        assert!(sphere_in_view(&frustums, Vec3::new(0.0, 0.0, -10.0), 1.0));
+        assert!(!sphere_in_view(&frustums, Vec3::new(0.0, 0.0, 10.0), 1.0), "behind the camera");
+        assert!(sphere_in_view(&frustums, Vec3::new(0.0, 0.0, 0.5), 1.0), "around the camera");
+        assert!(!sphere_in_view(&frustums, Vec3::new(30.0, 0.0, -10.0), 1.0), "far to the right");
+        assert!(!sphere_in_view(&[], Vec3::ZERO, 1.0), "no view sees anything");
+        // A light behind the camera: its -Z face looks into the view, its +Z face away.
+        let light = Vec3::new(0.0, 0.0, 3.0);
+        assert!(face_in_view(&frustums, light, 5, 5.0), "-Z face");
+        assert!(!face_in_view(&frustums, light, 4, 5.0), "+Z face");
+        // A light inside the view: every face holds seen points.
+        assert!((0..SHADOW_FACES).all(|f| face_in_view(&frustums, Vec3::new(0.0, 0.0, -5.0), f, 2.0)));
+        // Beside the view, to its left and level with it: only the +X face looks into it.
+        let left = Vec3::new(-20.0, 0.0, -10.0);
+        let seen: Vec<u32> = (0..SHADOW_FACES).filter(|&f| face_in_view(&frustums, left, f, 30.0)).collect();
+        assert!(seen.contains(&0) && !seen.contains(&1), "{seen:?}");
+    }
+
     #[test]
     fn cascade_bounds_grow_geometrically_as_bevy_builds_them() {
         use crate::settings::{CascadeConfigError, CascadeShadowConfigBuilder};
@@ -896,9 +1025,19 @@ mod tests {
         // 10 lights at 512 need 10 blocks of 1536 × 1024: four fit a 4096 atlas.
         let plan = plan_atlas(&requests(&[512; 10]), 4096, 16);
         assert_eq!(plan.placements.len(), 10);
-        assert_eq!(plan.downgraded, 10);
-        assert!(plan.placements.iter().all(|p| p.edge == 256));
         no_overlap(&plan);
+        // Halved to 256 all ten fill 23 % of the atlas; the room left goes back to the most
+        // important (the last requests), as much as fits.
+        let at = |edge| plan.placements.iter().filter(|p| p.edge == edge).count();
+        assert_eq!(at(512) + at(256), 10, "{plan:?}");
+        assert!(at(512) >= 2, "{plan:?}");
+        assert_eq!(plan.downgraded as usize, at(256));
+        let most = plan.placements.iter().filter(|p| p.edge == 512).map(|p| p.caster).min().unwrap();
+        assert!(
+            plan.placements.iter().filter(|p| p.edge == 256).all(|p| p.caster < most),
+            "the larger faces went to the most important: {plan:?}"
+        );
+        assert!(plan.occupancy(4096) > 0.4, "{}", plan.occupancy(4096));
         // 100 000 lights at the smallest edge cannot all fit: the most important stay.
         let many = requests(&vec![16; 100_000]);
         let plan = plan_atlas(&many, 1024, 16);
