@@ -1,8 +1,11 @@
 //! The manylight demo: the embedded hall lit by a rig of animated coloured lights.
 //!
 //! ```text
-//! cargo run --release --example demo -- [--lights N] [--pipeline NAME] [--headless] [--out-dir DIR]
+//! cargo run --release --example demo -- [--lights N] [--pipeline NAME] [--shadows on|off] [--headless] [--out-dir DIR]
 //! ```
+//!
+//! Every light casts a shadow (`--shadows off` renders them unshadowed); the overlay's
+//! "Shadows" section turns them off and on.
 //!
 //! With a display (`DISPLAY` or `WAYLAND_DISPLAY` set) it opens a window and prints the frame
 //! rate once a second; Esc closes it. Without one (or with `--headless`) it renders three
@@ -10,7 +13,7 @@
 
 use clap::Parser;
 use manylight::app::RenderFailure;
-use manylight::app::cli::parse_pipeline;
+use manylight::app::cli::{parse_on_off, parse_pipeline};
 use manylight::app::headless::save_png;
 use manylight::app::window::WindowConfig;
 use manylight::core::light_count::check_app_lights;
@@ -34,6 +37,9 @@ struct Args {
     /// The many-light pipeline (default: the renderer's default).
     #[arg(long, value_parser = parse_pipeline)]
     pipeline: Option<PipelineKind>,
+    /// Every light of the hall and the rig casts a shadow: on (default) or off.
+    #[arg(long, default_value = "on", value_parser = parse_on_off, action = clap::ArgAction::Set)]
+    shadows: bool,
     /// Render frames to PNG even when a display is available.
     #[arg(long)]
     headless: bool,
@@ -42,12 +48,16 @@ struct Args {
     out_dir: Option<PathBuf>,
 }
 
-/// Spawns the hall (with its camera and six warm lights) and the light rig.
-fn scene_setup(lights: usize) -> impl FnMut(Commands) {
+/// Spawns the hall (with its camera and six warm lights) and the light rig, every light
+/// casting a shadow when `shadows` is on.
+fn scene_setup(lights: usize, shadows: bool) -> impl FnMut(&mut World) {
     let scene = default_scene();
-    move |mut commands: Commands| {
+    move |world: &mut World| {
+        let mut commands = world.commands();
         spawn_scene(&mut commands, &scene, true, SIZE.x as f32 / SIZE.y as f32);
         spawn_light_rig(&mut commands, lights, scene.bounds(), 1).expect("--lights was checked in main");
+        world.flush();
+        manylight::app::scene::set_shadows(world, shadows);
     }
 }
 
@@ -74,7 +84,7 @@ fn print_fps(stats: Res<FrameStats>, mut last: Local<Option<(Instant, u64)>>) {
     *last = Some((now, stats.frames_rendered));
 }
 
-fn run_window(lights: usize, settings: RenderSettings) -> ExitCode {
+fn run_window(lights: usize, shadows: bool, settings: RenderSettings) -> ExitCode {
     println!("manylight demo: {lights} animated lights in a window (Esc closes it)");
     let config = WindowConfig {
         title: "manylight demo".into(),
@@ -85,7 +95,7 @@ fn run_window(lights: usize, settings: RenderSettings) -> ExitCode {
     let exit = App::new()
         .add_plugins(ManyLightPlugin::window(config))
         .insert_resource(settings)
-        .add_systems(Startup, scene_setup(lights))
+        .add_systems(Startup, scene_setup(lights, shadows))
         .add_systems(Update, print_fps)
         .run();
     if exit.is_success() {
@@ -96,7 +106,12 @@ fn run_window(lights: usize, settings: RenderSettings) -> ExitCode {
     }
 }
 
-fn run_headless(lights: usize, settings: RenderSettings, out_dir: PathBuf) -> anyhow::Result<()> {
+fn run_headless(
+    lights: usize,
+    shadows: bool,
+    settings: RenderSettings,
+    out_dir: PathBuf,
+) -> anyhow::Result<()> {
     println!(
         "manylight demo: no display, rendering {HEADLESS_FRAMES} frames of {}x{} headless",
         SIZE.x, SIZE.y
@@ -107,7 +122,7 @@ fn run_headless(lights: usize, settings: RenderSettings, out_dir: PathBuf) -> an
         .insert_resource(TimeUpdateStrategy::ManualDuration(std::time::Duration::from_secs_f32(
             HEADLESS_STEP,
         )))
-        .add_systems(Startup, scene_setup(lights));
+        .add_systems(Startup, scene_setup(lights, shadows));
     for i in 0..HEADLESS_FRAMES {
         let started = Instant::now();
         app.update();
@@ -145,11 +160,11 @@ fn main() -> ExitCode {
     let has_display =
         ["DISPLAY", "WAYLAND_DISPLAY"].iter().any(|v| std::env::var_os(v).is_some_and(|d| !d.is_empty()));
     if has_display && !args.headless {
-        return run_window(args.lights, settings);
+        return run_window(args.lights, args.shadows, settings);
     }
     let out_dir =
         args.out_dir.unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/demo"));
-    match run_headless(args.lights, settings, out_dir) {
+    match run_headless(args.lights, args.shadows, settings, out_dir) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");

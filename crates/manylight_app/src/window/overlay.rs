@@ -205,6 +205,7 @@ fn panel(
             .default_open(true)
             .show(ui, |ui| lights_ui(ui, world, pending_lights));
     }
+    egui::CollapsingHeader::new("Shadows").default_open(true).show(ui, |ui| shadows_ui(ui, world));
     egui::CollapsingHeader::new("Post effects").default_open(true).show(ui, |ui| effects_ui(ui, world));
     egui::CollapsingHeader::new("Cluster grid").default_open(false).show(ui, |ui| clusters_ui(ui, world));
     egui::CollapsingHeader::new("Timings")
@@ -325,6 +326,65 @@ fn effects_ui(ui: &mut egui::Ui, world: &mut World) {
         if m != old {
             world.entity_mut(camera).insert(m);
         }
+    }
+}
+
+/// The shadows switch, a switch that makes every light cast, and the last frame's counters.
+fn shadows_ui(ui: &mut egui::Ui, world: &mut World) {
+    if let Some(old) = world.get_resource::<RenderSettings>().copied() {
+        let mut s = old;
+        ui.checkbox(&mut s.shadows.enabled, "shadows (lights that cast, cast)");
+        if s != old {
+            *world.resource_mut::<RenderSettings>() = s;
+        }
+    }
+    let mut q = world.query::<(
+        Option<&crate::PointLight>,
+        Option<&crate::SpotLight>,
+        Option<&crate::DirectionalLight>,
+    )>();
+    let (mut lights, mut casting) = (0usize, 0usize);
+    for (p, s, d) in q.iter(world) {
+        let casts =
+            [p.map(|l| l.shadows_enabled), s.map(|l| l.shadows_enabled), d.map(|l| l.shadows_enabled)];
+        lights += casts.iter().flatten().count();
+        casting += casts.iter().flatten().filter(|c| **c).count();
+    }
+    let mut all = lights > 0 && casting == lights;
+    if ui.checkbox(&mut all, format!("every light casts ({casting} of {lights} do)")).changed() {
+        crate::scene::set_shadows(world, all);
+    }
+    let Some(report) = world.get_resource::<FrameStats>().and_then(|s| s.last.clone()) else {
+        return;
+    };
+    let Some(r) = report.shadows else {
+        ui.label("no shadow pass this frame");
+        return;
+    };
+    let pass_ms = report.passes.iter().find(|p| p.name == "shadow_maps").and_then(|p| p.gpu_ms);
+    ui.monospace(format!(
+        "{} casting, {} maps ({} cascades), {} unseen lights, {} unseen faces",
+        r.casting_lights, r.maps_rendered, r.cascades_rendered, r.unseen_lights, r.unseen_faces
+    ));
+    ui.monospace(format!(
+        "atlas {0}×{0} ({1:.0} MiB) {2:.0} % used, {3} instance-faces in {4} draws, {5}",
+        r.atlas_size,
+        r.atlas_bytes as f64 / (1024.0 * 1024.0),
+        r.atlas_occupancy * 100.0,
+        r.instance_faces,
+        r.draw_calls,
+        pass_ms.map_or("GPU n/a".to_string(), |ms| format!("{ms:.2} ms GPU"))
+    ));
+    if r.downgraded_lights > 0 || r.dropped_lights > 0 || r.atlas_limited_by_device {
+        ui.colored_label(
+            Color32::YELLOW,
+            format!(
+                "{} lights got smaller maps than they asked, {} none{}",
+                r.downgraded_lights,
+                r.dropped_lights,
+                if r.atlas_limited_by_device { "; the device's texture limit caps the atlas" } else { "" }
+            ),
+        );
     }
 }
 
