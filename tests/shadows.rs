@@ -143,38 +143,66 @@ fn floor_points(scene: &Scene, occluders: &OccluderSet) -> Vec<Option<(u32, u32,
     out
 }
 
-/// The fraction of the floor's lit pixels whose shadow disagrees with the oracle: shadowed
-/// (less than half of the unshadowed light over the ambient) where the light reaches the point,
+/// Floor pixels where a light adds enough to tell lit from shadowed, against the oracle.
+#[derive(Clone, Copy, Debug)]
+struct Measured {
+    /// Floor pixels the light reaches (unshadowed) by more than 0.05 of luminance.
+    pairs: u32,
+    /// Of those, the ones the oracle finds blocked.
+    blocked: u32,
+    /// Of those, the ones whose shadowed image is on the wrong side of half the light.
+    wrong: u32,
+}
+
+impl Measured {
+    fn error(&self) -> f32 {
+        self.wrong as f32 / self.pairs.max(1) as f32
+    }
+}
+
+/// Compares each floor pixel's shadow with the oracle through `scene`'s triangles: shadowed
+/// (less than half of the unshadowed light over the ambient) where `source` reaches the point,
 /// or lit where it is blocked.
+fn measure(
+    scene: &Scene,
+    source: LightSource,
+    shadowed: &HeadlessFrame,
+    unshadowed: &HeadlessFrame,
+    ambient: &HeadlessFrame,
+) -> Measured {
+    let occluders = OccluderSet::from_instances(
+        scene.instances.iter().map(|i| (scene.meshes[i.mesh].as_ref(), i.transform)),
+    );
+    let mut m = Measured { pairs: 0, blocked: 0, wrong: 0 };
+    for (x, y, p) in floor_points(scene, &occluders).into_iter().flatten() {
+        let base = luminance(ambient.image.get_pixel(x, y));
+        let light = luminance(unshadowed.image.get_pixel(x, y)) - base;
+        if light < 0.05 {
+            continue; // the light does not reach the point enough to tell
+        }
+        let visible = occluders.visible(&ShadowQuery { point: p, normal: Vec3::Y, light: source });
+        let got = luminance(shadowed.image.get_pixel(x, y)) - base;
+        let lit = got > 0.5 * light;
+        m.pairs += 1;
+        m.blocked += u32::from(!visible);
+        m.wrong += u32::from(lit != visible);
+    }
+    m
+}
+
+/// [`measure`] for the plate scene lit by `kind`, with its umbra checked to be there.
 fn visibility_error(
     kind: Kind,
     shadowed: &HeadlessFrame,
     unshadowed: &HeadlessFrame,
     ambient: &HeadlessFrame,
 ) -> f32 {
-    let scene = plate_scene();
-    let occluders = OccluderSet::from_instances(
-        scene.instances.iter().map(|i| (scene.meshes[i.mesh].as_ref(), i.transform)),
-    );
-    let (mut pairs, mut wrong, mut blocked) = (0u32, 0u32, 0u32);
-    for (x, y, p) in floor_points(&scene, &occluders).into_iter().flatten() {
-        let base = luminance(ambient.image.get_pixel(x, y));
-        let light = luminance(unshadowed.image.get_pixel(x, y)) - base;
-        if light < 0.05 {
-            continue; // the light does not reach the point enough to tell
-        }
-        let visible = occluders.visible(&ShadowQuery { point: p, normal: Vec3::Y, light: kind.source() });
-        let got = luminance(shadowed.image.get_pixel(x, y)) - base;
-        let lit = got > 0.5 * light;
-        pairs += 1;
-        blocked += u32::from(!visible);
-        wrong += u32::from(lit != visible);
-    }
-    assert!(pairs > 2000, "{kind:?}: too few lit floor pixels ({pairs})");
+    let m = measure(&plate_scene(), kind.source(), shadowed, unshadowed, ambient);
+    assert!(m.pairs > 2000, "{kind:?}: too few lit floor pixels ({})", m.pairs);
     // A point light 1 above the plate projects it at twice its size; the sun at its own size.
     let umbra = if let Kind::Directional = kind { 100 } else { 200 };
-    assert!(blocked > umbra, "{kind:?}: the plate blocks the light from few pixels ({blocked})");
-    wrong as f32 / pairs as f32
+    assert!(m.blocked > umbra, "{kind:?}: the plate blocks the light from few pixels ({})", m.blocked);
+    m.error()
 }
 
 #[test]
@@ -261,4 +289,233 @@ fn a_light_that_starts_and_stops_casting_renders_every_frame() {
     assert_eq!(toggled.stats.frames_rendered, 4);
     let always = render(Kind::Point, true, settings);
     assert_similar("toggled shadows", &always.image, &toggled.image, STRICT);
+}
+
+/// Spawns a hard case's light, casting or not.
+type SpawnLight = fn(&mut Commands, bool);
+
+/// `scene` with the light `spawn` makes, through naive forward.
+fn render_case(scene: &Scene, spawn: SpawnLight, shadows: bool) -> HeadlessFrame {
+    let scene = scene.clone();
+    let naive = RenderSettings { pipeline: PipelineKind::NaiveForward, ..RenderSettings::default() };
+    let frame = render_headless(SIZE, 1, move |app| {
+        app.insert_resource(naive).add_systems(Startup, move |mut commands: Commands| {
+            spawn_scene(&mut commands, &scene, true, SIZE.x as f32 / SIZE.y as f32);
+            spawn(&mut commands, shadows);
+        });
+    })
+    .unwrap_or_else(|e| panic!("render failed: {e}"));
+    support::assert_finite(&frame);
+    frame
+}
+
+/// A light where shadow maps usually break, checked against the oracle.
+struct HardCase {
+    name: &'static str,
+    scene: Scene,
+    spawn: SpawnLight,
+    source: LightSource,
+    /// The oracle must find at least this many floor pixels blocked (the case has a shadow).
+    min_blocked: u32,
+    /// Largest fraction of the floor's lit pixels on the wrong side.
+    max_error: f32,
+}
+
+fn check(case: HardCase) {
+    let ambient = render_case(&case.scene, |_, _| {}, false);
+    let on = render_case(&case.scene, case.spawn, true);
+    let off = render_case(&case.scene, case.spawn, false);
+    let m = measure(&case.scene, case.source, &on, &off, &ambient);
+    eprintln!("{}: {m:?}, error {:.3} %", case.name, m.error() * 100.0);
+    assert!(m.pairs > 500, "{}: the light reaches few floor pixels ({m:?})", case.name);
+    assert!(m.blocked >= case.min_blocked, "{}: no shadow to test ({m:?})", case.name);
+    assert!(
+        m.error() <= case.max_error,
+        "{}: {:.2} % of the floor's lit pixels disagree with the oracle ({m:?})",
+        case.name,
+        m.error() * 100.0
+    );
+}
+
+/// The plate scene with one more instance.
+fn plate_scene_with(mesh: MeshData, at: Vec3) -> Scene {
+    let mut scene = plate_scene();
+    scene.meshes.push(Arc::new(mesh));
+    scene.instances.push(SceneInstance {
+        mesh: scene.meshes.len() - 1,
+        material: 0,
+        transform: Mat4::from_translation(at),
+    });
+    scene
+}
+
+fn point_at(commands: &mut Commands, at: Vec3, range: f32, shadows: bool) {
+    let light = PointLight { intensity: 150.0, range, shadows_enabled: shadows, ..Default::default() };
+    commands.spawn((Transform::from_translation(at), light));
+}
+
+#[test]
+fn a_light_of_huge_range_keeps_its_shadow() {
+    let _gpu = gpu();
+    check(HardCase {
+        name: "range 10^4",
+        scene: plate_scene(),
+        spawn: |c, s| point_at(c, LIGHT, 1e4, s),
+        source: LightSource::At(LIGHT),
+        min_blocked: 200,
+        max_error: 0.005,
+    });
+}
+
+#[test]
+fn a_light_inside_a_closed_box_lights_nothing_outside() {
+    let _gpu = gpu();
+    check(HardCase {
+        name: "inside a box",
+        scene: plate_scene_with(cuboid("box", Vec3::splat(0.6), 1.0), LIGHT),
+        spawn: |c, s| point_at(c, LIGHT, 8.0, s),
+        source: LightSource::At(LIGHT),
+        min_blocked: 2000,
+        max_error: 0.005,
+    });
+}
+
+#[test]
+fn a_light_touching_the_floor_has_neither_acne_nor_detached_shadows() {
+    let _gpu = gpu();
+    // 2 cm above the floor, a block beside it: the floor is lit at grazing angles and the
+    // block's shadow starts at its foot.
+    const LOW: Vec3 = Vec3::new(-1.0, 0.02, 0.5);
+    check(HardCase {
+        name: "touching the floor",
+        scene: plate_scene_with(cuboid("block", Vec3::splat(0.3), 1.0), Vec3::new(-0.4, 0.15, 0.5)),
+        spawn: |c, s| point_at(c, LOW, 8.0, s),
+        source: LightSource::At(LOW),
+        min_blocked: 50,
+        max_error: 0.02,
+    });
+}
+
+#[test]
+fn a_spot_light_of_nearly_a_hemisphere_shadows_like_a_point_light() {
+    let _gpu = gpu();
+    check(HardCase {
+        name: "spot outer angle 1.55",
+        scene: plate_scene(),
+        spawn: |c, s| {
+            let light = SpotLight {
+                intensity: 150.0,
+                range: 8.0,
+                inner_angle: 1.2,
+                outer_angle: 1.55,
+                shadows_enabled: s,
+                ..Default::default()
+            };
+            c.spawn((Transform::from_translation(LIGHT).looking_to(Vec3::NEG_Y, Vec3::Z), light));
+        },
+        source: LightSource::At(LIGHT),
+        min_blocked: 200,
+        max_error: 0.005,
+    });
+}
+
+#[test]
+fn a_light_at_the_camera_hides_its_shadow_behind_the_plate() {
+    let _gpu = gpu();
+    check(HardCase {
+        name: "light at the camera",
+        scene: plate_scene(),
+        spawn: |c, s| point_at(c, EYE, 12.0, s),
+        source: LightSource::At(EYE),
+        min_blocked: 0,
+        max_error: 0.005,
+    });
+}
+
+/// The scene's floor widened to 10⁷ by four slabs around the measured one: the scene's bounds,
+/// and with them the depth a cascade would need to reach every caster, grow a million times,
+/// while the plate's shadow stays 1 wide. (One triangle 10⁷ wide is a different matter: its
+/// depth, interpolated in floats between corners 5·10⁶ away, is off by tenths of a unit in
+/// any rasterised shadow map.)
+#[test]
+fn a_sun_over_a_floor_ten_million_wide_keeps_the_plate_shadow() {
+    let _gpu = gpu();
+    let mut scene = plate_scene();
+    let (half, inner) = (5e6f32, FLOOR);
+    let slabs = [
+        (Vec3::new(0.0, 0.0, (half + inner) * 0.5), Vec3::new(2.0 * half, 0.2, half - inner)),
+        (Vec3::new(0.0, 0.0, -(half + inner) * 0.5), Vec3::new(2.0 * half, 0.2, half - inner)),
+        (Vec3::new((half + inner) * 0.5, 0.0, 0.0), Vec3::new(half - inner, 0.2, 2.0 * inner)),
+        (Vec3::new(-(half + inner) * 0.5, 0.0, 0.0), Vec3::new(half - inner, 0.2, 2.0 * inner)),
+    ];
+    for (centre, size) in slabs {
+        scene.meshes.push(Arc::new(cuboid("slab", size, 1.0)));
+        let mesh = scene.meshes.len() - 1;
+        let transform = Mat4::from_translation(centre - Vec3::new(0.0, 0.1, 0.0));
+        scene.instances.push(SceneInstance { mesh, material: 0, transform });
+    }
+    check(HardCase {
+        name: "sun over 10^7",
+        scene,
+        spawn: |c, s| {
+            let light = DirectionalLight { illuminance: 3.0, shadows_enabled: s, ..Default::default() };
+            c.spawn((Transform::default().looking_to(SUN, Vec3::Z), light));
+        },
+        source: LightSource::Travelling(SUN),
+        min_blocked: 100,
+        max_error: 0.005,
+    });
+}
+
+/// 300 casting lights over the floor (a grid 1 apart, range 3).
+fn many_casting_lights() -> Vec<manylight::render::ExtractedPointLight> {
+    (0..300)
+        .map(|i| manylight::render::ExtractedPointLight {
+            position: Vec3::new(
+                (i % 20) as f32 * 0.4 - 3.8,
+                1.5 + (i / 100) as f32 * 0.3,
+                (i / 20 % 5) as f32 - 2.0,
+            ),
+            color: Vec3::ONE,
+            intensity: 1.0,
+            radius: 3.0,
+            spot: None,
+            shadow: Some(manylight::render::ShadowBias::POINT),
+        })
+        .collect()
+}
+
+/// An atlas too small for the lights: resolutions fall and, at the smallest, lights go without
+/// a map — every one counted. A device whose textures are smaller than the atlas asked for
+/// caps it, and says so.
+#[test]
+fn a_full_atlas_and_a_small_device_lower_resolutions_and_count_every_light() {
+    let _gpu = gpu();
+    let scene = plate_scene();
+    let mut settings = manylight::render::FrameSettings::default();
+    settings.render.shadows.atlas_size = 256;
+    let snapshot = manylight::app::scene::scene_snapshot(&scene, many_casting_lights(), SIZE, settings, 0);
+    let mut renderer = manylight::app::render_world::HeadlessRenderer::new().expect("a GPU");
+    let (report, image) = renderer.render(snapshot, true).expect("the frame renders");
+    let s = report.shadows.expect("a shadow report");
+    assert_eq!(s.casting_lights, 300);
+    assert_eq!(s.maps_rendered + s.dropped_lights + s.unseen_lights, 300, "{s:?}");
+    assert!(s.dropped_lights > 0 && s.maps_rendered > 0, "{s:?}");
+    assert_eq!((s.atlas_size, s.atlas_limited_by_device), (256, false), "{s:?}");
+    assert!(image.is_some());
+
+    let mut renderer = manylight::app::render_world::HeadlessRenderer::new().expect("a GPU");
+    renderer.render_world.renderer_mut().shadows.limit_texture_size(700);
+    let snapshot = manylight::app::scene::scene_snapshot(
+        &scene,
+        many_casting_lights(),
+        SIZE,
+        manylight::render::FrameSettings::default(),
+        0,
+    );
+    let (report, _) = renderer.render(snapshot, false).expect("the frame renders");
+    let s = report.shadows.expect("a shadow report");
+    assert_eq!((s.atlas_size, s.atlas_limited_by_device), (512, true), "{s:?}");
+    assert_eq!(s.maps_rendered + s.dropped_lights + s.unseen_lights, 300, "{s:?}");
+    assert!(s.downgraded_lights > 0, "{s:?}");
 }

@@ -38,10 +38,11 @@ struct GpuDirectionalShadow {
 @group(0) @binding(5) var<storage, read> shadow_lights: array<GpuShadowLight>;
 @group(0) @binding(6) var<storage, read> directional_shadows: array<GpuDirectionalShadow>;
 
-// The depth a face stores for a point `depth` along its axis: a perspective depth, 0 at the
-// near plane and 1 at the far one (Rust: `shadows::face_depth`).
+// The depth a face stores for a point `depth` along its axis: a reverse perspective depth, 1
+// at the near plane and 0 at the far one (Rust: `shadows::face_depth`); the comparison
+// sampler passes where the point's depth is at least the stored (nearest) caster's.
 fn shadow_face_depth(depth: f32, near: f32, far: f32) -> f32 {
-    return far * (depth - near) / (depth * (far - near));
+    return near * (far - depth) / (depth * (far - near));
 }
 
 // How much of light `k` (at `light_position`) reaches `position` past the shadow casters, in

@@ -217,8 +217,8 @@ pub use crate::settings::{MAX_CASCADES, SHADOW_FACES, SHADOW_TILE_COLUMNS};
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuCascade {
-    /// The cascade's orthographic projection: x, y ∈ [-1, 1] across its square, z ∈ [0, 1]
-    /// from the casters nearest the light to the far side of the view's slice.
+    /// The cascade's orthographic projection: x, y ∈ [-1, 1] across its square, reverse depth z
+    /// from 1 at the near side (towards the light) to 0 at the far side of the view's slice.
     pub clip_from_world: Mat4,
     /// x, y: the atlas texel at the tile's top left; z: its edge in texels; w: 0.
     pub tile: [u32; 4],
@@ -259,7 +259,8 @@ pub struct GpuShadowLight {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct GpuShadowFace {
-    /// The face's projection: x, y in [-w, w] inside the face, z / w its depth in [0, 1].
+    /// The face's projection: x, y in [-w, w] inside the face, z / w its reverse depth (1 at
+    /// the near plane, 0 at the far one).
     pub clip_from_world: Mat4,
     /// (sx, ox, sy, oy): the face's tile in atlas clip space is x·sx + w·ox, y·sy + w·oy.
     pub atlas: [f32; 4],

@@ -161,8 +161,8 @@ pub struct ShadowSettings {
     pub min_face_size: u32,
     /// Face texels asked per pixel of the light sphere's projected radius.
     pub resolution_scale: f32,
-    /// Edge of each cascade of a directional light (a power of two, at most a third of the
-    /// atlas: a light's cascades share one block of tiles).
+    /// Edge of each cascade of a directional light (a power of two; a light's cascades share
+    /// one block of 3 × 2 tiles, so a smaller atlas gets smaller cascades).
     pub cascade_size: u32,
 }
 
@@ -204,14 +204,6 @@ impl ShadowSettings {
                 self.atlas_size,
                 self.min_face_size,
                 SHADOW_TILE_COLUMNS * self.min_face_size
-            ));
-        }
-        if self.atlas_size < SHADOW_TILE_COLUMNS * self.cascade_size {
-            return Err(format!(
-                "shadows.atlas_size {} cannot hold a directional light's cascades at shadows.cascade_size {} ({} texels wide)",
-                self.atlas_size,
-                self.cascade_size,
-                SHADOW_TILE_COLUMNS * self.cascade_size
             ));
         }
         if !(self.resolution_scale.is_finite() && self.resolution_scale > 0.0) {

@@ -38,18 +38,21 @@ pub const SHADOW_ATLAS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth3
 pub const SHADOW_TILE_ROWS: u32 = SHADOW_FACES / SHADOW_TILE_COLUMNS;
 
 /// The faces' near plane as a fraction of the light's range (a point nearer the light than
-/// that is never shadowed).
-pub const SHADOW_NEAR_FRACTION: f32 = 1e-3;
+/// that is never shadowed). Reverse depth keeps float precision at every distance, so the
+/// near plane can sit this close: 0.1 mm for a range of 10, 10 cm for a range of 10⁴.
+pub const SHADOW_NEAR_FRACTION: f32 = 1e-5;
 
 /// The smallest atlas edge: an atlas grows from it in powers of two as the lights ask.
 pub const MIN_ATLAS_SIZE: u32 = 256;
 
 pub use crate::settings::{ShadowReport, ShadowSettings};
 
-/// The depth face `f` stores at distance `depth` along its axis: 0 at `near`, 1 at `far`
-/// (`shadow_face_depth` in `shaders/common/shadows.wgsl`).
+/// The depth face `f` stores at distance `depth` along its axis: reverse depth, 1 at `near`,
+/// 0 at `far`, so a float keeps its precision out to the range (`shadow_face_depth` in
+/// `shaders/common/shadows.wgsl`). The atlas is cleared to 0 and keeps the greatest depth
+/// (the nearest caster); a point is lit where its depth is at least the stored one.
 pub fn face_depth(depth: f32, near: f32, far: f32) -> f32 {
-    far * (depth - near) / (depth * (far - near))
+    near * (far - depth) / (depth * (far - near))
 }
 
 /// Axis (0 = x) and direction (+1 or -1) face `face` looks along.
@@ -65,8 +68,8 @@ pub fn face_clip_from_world(light: Vec3, face: u32, near: f32, far: f32) -> Mat4
     let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
     let row = |i: usize, s: f32| (Vec3::AXES[i] * s).extend(-s * light[i]);
     let w = row(axis, sign);
-    let k = far / (far - near);
-    let z = w * k - Vec4::W * (k * near);
+    let k = near / (far - near);
+    let z = Vec4::W * (k * far) - w * k;
     Mat4::from_cols(row(a, 1.0), row(b, 1.0), z, w).transpose()
 }
 
@@ -269,6 +272,13 @@ pub fn plan_atlas(requests: &[ShadowRequest], max_atlas: u32, min_edge: u32) -> 
     AtlasPlan { dropped, ..placed(&granted, &order, atlas, spots) }
 }
 
+/// The largest atlas a frame may use: `requested`, or the largest power of two the device's
+/// textures (`max_texture` texels) allow when that is smaller, and whether the device limited it.
+pub fn atlas_limit(requested: u32, max_texture: u32) -> (u32, bool) {
+    let device = 1u32 << (31 - max_texture.max(1).leading_zeros());
+    (requested.min(device), device < requested)
+}
+
 /// The planes (`n·p + d ≥ 0` inside) of a reverse-Z view frustum `clip_from_world`: left,
 /// right, bottom, top and near. The far plane is left out (it may be at infinity), so the
 /// volume is conservative.
@@ -404,7 +414,9 @@ pub struct ViewSlice {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CascadeFit {
     /// Orthographic along the light: x, y ∈ [-1, 1] over a square that holds the slice's
-    /// bounding sphere, z ∈ [0, 1] from the casters nearest the light to the sphere's far side.
+    /// bounding sphere, z from 1 at the near side (the casters nearest the light, or the
+    /// sphere's near side when depth is clamped) to 0 at the sphere's far side (reverse depth,
+    /// like the cube faces).
     pub clip_from_world: Mat4,
     /// Width of one of the cascade's texels in world units.
     pub texel: f32,
@@ -415,14 +427,17 @@ pub struct CascadeFit {
 /// Fits a cascade of `edge` texels for light travelling along `direction` to `slice` of the
 /// view through `camera` (of aspect `aspect`): the slice's eight corners' bounding sphere, its
 /// radius rounded up to 1/16 unit and its centre snapped to whole texels across the light, so
-/// the map keeps its size and texel grid as the camera turns and moves (no shimmering edges);
-/// its depth reaches back to every caster in `casters`.
+/// the map keeps its size and texel grid as the camera turns and moves (no shimmering edges).
+/// Its depth spans the sphere when the shadow pass clamps depth (`casters` is `None`: a caster
+/// nearer the light than the sphere is clamped onto its near side and still shadows it, and
+/// the depth range stays the sphere's however large the world), else it reaches back to every
+/// caster in `casters`.
 pub fn fit_cascade(
     camera: &ExtractedCamera,
     aspect: f32,
     slice: ViewSlice,
     direction: Vec3,
-    casters: &Aabb,
+    casters: Option<&Aabb>,
     edge: u32,
 ) -> CascadeFit {
     let projection = camera.projection.sanitized();
@@ -455,17 +470,18 @@ pub fn fit_cascade(
     // Distance along the light is -z in its frame: the sphere spans -c.z ± radius, and the
     // casters nearest the light are at the smallest distance.
     let mut nearest = -c.z - radius;
-    if !casters.is_empty() {
+    if let Some(casters) = casters.filter(|b| !b.is_empty()) {
         let b = casters.transformed(&light_from_world);
         nearest = nearest.min(-b.max.z);
     }
     let farthest = -c.z + radius;
     let range = (farthest - nearest).max(1e-6);
+    // Reverse depth: z = (farthest - distance) / range, and distance = -z in the light's frame.
     let scale = Mat4::from_cols(
         Vec4::new(1.0 / radius, 0.0, 0.0, 0.0),
         Vec4::new(0.0, 1.0 / radius, 0.0, 0.0),
-        Vec4::new(0.0, 0.0, -1.0 / range, 0.0),
-        Vec4::new(-cx / radius, -cy / radius, -nearest / range, 1.0),
+        Vec4::new(0.0, 0.0, 1.0 / range, 0.0),
+        Vec4::new(-cx / radius, -cy / radius, farthest / range, 1.0),
     );
     CascadeFit { clip_from_world: scale * light_from_world, texel, depth_range: range }
 }
@@ -521,6 +537,9 @@ pub struct ShadowResources {
     /// The device draws clip distances (`Features::CLIP_DISTANCES`); otherwise the shadow
     /// pass discards the fragments outside each face's tile.
     pub clip_distances: bool,
+    /// The device clamps depth instead of clipping it (`Features::DEPTH_CLIP_CONTROL`): the
+    /// shadow pass clamps, so a cascade's depth range is its slice's sphere alone.
+    pub clamps_depth: bool,
     max_texture: u32,
     gpu_lights: Vec<GpuShadowLight>,
     gpu_directional: Vec<GpuDirectionalShadow>,
@@ -540,7 +559,8 @@ impl ShadowResources {
                 label: Some("shadow_sampler"),
                 mag_filter: wgpu::FilterMode::Linear,
                 min_filter: wgpu::FilterMode::Linear,
-                compare: Some(wgpu::CompareFunction::LessEqual),
+                // Reverse depth: lit where the point is at least as near as the stored caster.
+                compare: Some(wgpu::CompareFunction::GreaterEqual),
                 ..Default::default()
             }),
             lights: GrowableBuffer::new(
@@ -573,6 +593,7 @@ impl ShadowResources {
             active: false,
             generation: 0,
             clip_distances: gpu.device.features().contains(wgpu::Features::CLIP_DISTANCES),
+            clamps_depth: gpu.device.features().contains(wgpu::Features::DEPTH_CLIP_CONTROL),
             max_texture: gpu.max_texture_size(),
             gpu_lights: Vec::new(),
             gpu_directional: vec![GpuDirectionalShadow::default(); MAX_DIRECTIONAL_LIGHTS as usize],
@@ -580,6 +601,12 @@ impl ShadowResources {
             by_mesh: Vec::new(),
             requests: Vec::new(),
         }
+    }
+
+    /// Caps the atlas at `texels` (rounded down to a power of two) as a device whose textures
+    /// are that small would; the device's own limit still applies.
+    pub fn limit_texture_size(&mut self, texels: u32) {
+        self.max_texture = self.max_texture.min(texels.max(1));
     }
 
     /// The atlas texture, once a frame had a casting light.
@@ -653,21 +680,23 @@ impl ShadowResources {
         let view = camera.map(|(c, size)| (c, size.x.max(1) as f32 / size.y.max(1) as f32));
         for (i, light) in directional.iter().enumerate() {
             if light.shadow.is_some() && view.is_some() {
-                let edge = settings.cascade_size.max(settings.min_face_size);
+                // At most a third of the largest atlas (the block is 3 tiles wide).
+                let widest = atlas_limit(settings.atlas_size, self.max_texture).0 / SHADOW_TILE_COLUMNS;
+                let widest = 1u32 << (31 - widest.max(1).leading_zeros());
+                let edge = settings.cascade_size.max(settings.min_face_size).min(widest);
                 let caster = ShadowCaster::Directional(i as u32);
                 self.requests.push(ShadowRequest { caster, edge, importance: f32::MAX });
             }
         }
         // The largest power of two the device's textures allow.
-        let device_limit = 1u32 << (31 - self.max_texture.max(1).leading_zeros());
-        let max_atlas = settings.atlas_size.min(device_limit);
+        let (max_atlas, limited) = atlas_limit(settings.atlas_size, self.max_texture);
         self.plan = plan_atlas(
             &self.requests,
             max_atlas,
             settings.min_face_size.min(max_atlas / SHADOW_TILE_COLUMNS).max(1),
         );
         self.report.casting_lights = self.requests.len() as u32 + self.report.unseen_lights;
-        self.report.atlas_limited_by_device = device_limit < settings.atlas_size;
+        self.report.atlas_limited_by_device = limited;
         self.report.downgraded_lights = self.plan.downgraded;
         self.report.dropped_lights = self.plan.dropped;
         if self.plan.placements.is_empty() {
@@ -756,7 +785,8 @@ impl ShadowResources {
                     };
                     for (c, &far) in bounds.iter().enumerate() {
                         let slice = ViewSlice { near: config.near_bound(c), far };
-                        let fit = fit_cascade(camera, aspect, slice, light.direction, &casters, p.edge);
+                        let reach = (!self.clamps_depth).then_some(&casters);
+                        let fit = fit_cascade(camera, aspect, slice, light.direction, reach, p.edge);
                         let (tx, ty) = tile_of(p, c as u32);
                         gpu.cascades[c] = GpuCascade {
                             clip_from_world: fit.clip_from_world,
@@ -864,8 +894,8 @@ mod tests {
                 &Aabb { min: light - ahead + light - 0.1, max: light - ahead + light + 0.1 }
             ));
         }
-        assert_eq!(face_depth(near, near, far), 0.0);
-        assert!((face_depth(far, near, far) - 1.0).abs() < 1e-6);
+        assert!((face_depth(near, near, far) - 1.0).abs() < 1e-6);
+        assert_eq!(face_depth(far, near, far), 0.0);
     }
 
     #[test]
@@ -896,7 +926,7 @@ mod tests {
         let casters = Aabb { min: Vec3::new(-50.0, -1.0, -50.0), max: Vec3::new(50.0, 30.0, 50.0) };
         let slice = ViewSlice { near: 2.0, far: 10.0 };
         let cam = camera(Vec3::new(1.0, 2.0, 3.0));
-        let fit = fit_cascade(&cam, 16.0 / 9.0, slice, direction, &casters, 1024);
+        let fit = fit_cascade(&cam, 16.0 / 9.0, slice, direction, Some(&casters), 1024);
         let inside = |p: Vec3| {
             let c = fit.clip_from_world.transform_point3(p);
             c.x.abs() <= 1.0 + 1e-4 && c.y.abs() <= 1.0 + 1e-4 && (-1e-4..=1.0 + 1e-4).contains(&c.z)
@@ -908,10 +938,15 @@ mod tests {
                 assert!(inside(p), "slice point {p} at {d}");
             }
         }
-        // A caster high above the slice, towards the light, is still in front of the map.
+        // A caster high above the slice, towards the light, is still in front of the map (z at
+        // most 1); with depth clamped it lies beyond the near side, and is clamped onto it.
         let centre = cam.world_from_view.transform_point3(Vec3::new(0.0, 0.0, -6.0));
         let above = centre - direction * ((29.0 - centre.y) / -direction.y);
-        assert!(fit.clip_from_world.transform_point3(above).z >= -1e-4);
+        assert!(fit.clip_from_world.transform_point3(above).z <= 1.0 + 1e-4);
+        let clamped = fit_cascade(&cam, 16.0 / 9.0, slice, direction, None, 1024);
+        assert!(clamped.clip_from_world.transform_point3(above).z > 1.0);
+        assert!((clamped.clip_from_world.transform_point3(centre).z - 0.5).abs() < 0.2);
+        assert!(clamped.depth_range < fit.depth_range);
         assert!(box_meets_clip(&fit.clip_from_world, &Aabb { min: above - 0.1, max: above + 0.1 }));
         assert!(!box_meets_clip(&fit.clip_from_world, &Aabb { min: centre + 100.0, max: centre + 101.0 }));
         assert!((fit.texel - fit.depth_range).abs() > 0.0 && fit.texel > 0.0);
@@ -921,12 +956,21 @@ mod tests {
             16.0 / 9.0,
             slice,
             direction,
-            &casters,
+            Some(&casters),
             1024,
         );
         assert_eq!(moved.texel, fit.texel);
         let shift = (moved.clip_from_world.w_axis.x - fit.clip_from_world.w_axis.x) / 2.0 * 1024.0;
         assert!((shift - shift.round()).abs() < 1e-2, "a shift of {shift} texels");
+    }
+
+    #[test]
+    fn a_device_with_small_textures_caps_the_atlas_and_says_so() {
+        assert_eq!(atlas_limit(8192, 16384), (8192, false));
+        assert_eq!(atlas_limit(8192, 8192), (8192, false));
+        assert_eq!(atlas_limit(8192, 4096), (4096, true));
+        assert_eq!(atlas_limit(8192, 3000), (2048, true), "a power of two below the limit");
+        assert_eq!(atlas_limit(8192, 0), (1, true));
     }
 
     /// Lights and faces no view sees are found (and nothing a view sees is lost).

@@ -16,6 +16,9 @@ use crate::shadows::SHADOW_ATLAS_FORMAT;
 pub struct ShadowMapsKey {
     /// Faces are cut to their tiles by clip distances; otherwise by discarding fragments.
     pub clip_distances: bool,
+    /// Depth is clamped, not clipped (`Features::DEPTH_CLIP_CONTROL`): casters nearer the
+    /// light than a cascade's near side land on it (pancaking).
+    pub clamps_depth: bool,
 }
 
 impl PipelineKey for ShadowMapsKey {
@@ -52,11 +55,15 @@ impl ShadowMapsPipeline {
                 buffers: &[Some(vertex_layout())],
             },
             // Both sides cast: a single-sided mesh seen from behind by the light still blocks it.
-            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: None,
+                unclipped_depth: key.clamps_depth,
+                ..Default::default()
+            },
             depth_stencil: Some(wgpu::DepthStencilState {
                 format: SHADOW_ATLAS_FORMAT,
                 depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
+                depth_compare: Some(wgpu::CompareFunction::Greater),
                 stencil: Default::default(),
                 bias: Default::default(),
             }),
@@ -95,7 +102,8 @@ impl Pass for ShadowMapsPass {
         let Some(atlas) = shadows.atlas_view() else {
             return Ok(());
         };
-        let key = ShadowMapsKey { clip_distances: shadows.clip_distances };
+        let key =
+            ShadowMapsKey { clip_distances: shadows.clip_distances, clamps_depth: shadows.clamps_depth };
         let device = &ctx.gpu.device;
         let pipeline = ctx.pipelines.get_or_create(key, |k| ShadowMapsPipeline::new(device, k))?;
         let bind_group = ctx.bind_group(
@@ -115,7 +123,7 @@ impl Pass for ShadowMapsPass {
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: atlas,
                 depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
+                    load: wgpu::LoadOp::Clear(0.0),
                     store: wgpu::StoreOp::Store,
                 }),
                 stencil_ops: None,
