@@ -5,10 +5,15 @@
 // - fs_depth: the linearised view distance (near white, far black; log scale so both near
 //   and far detail show);
 // - fs_surface: albedo, world-space normal (n * 0.5 + 0.5), metallic, roughness (PBR surfaces;
-//   others black), emitted radiance (clamped to 1) or ambient occlusion, from the Full G-buffer.
+//   others black), emitted radiance (clamped to 1) or ambient occlusion, from the Full G-buffer;
+// - fs_shadow_atlas: the shadow atlas fitted to the view (white near a light, grey at its range,
+//   black where nothing was drawn);
+// - fs_shadow_lod: the face edge the casting lights reaching each pixel got, as a heatmap.
 //!include common/view.wgsl
 //!include common/clusters.wgsl
 //!include common/fullscreen.wgsl
+//!include common/lights.wgsl
+//!include common/shadow_types.wgsl
 
 struct DebugParams {
     mode: u32,
@@ -29,6 +34,9 @@ struct DebugParams {
 @group(0) @binding(6) var gbuffer_normal: texture_2d<f32>;
 @group(0) @binding(7) var gbuffer_emissive: texture_2d<f32>;
 @group(0) @binding(8) var gbuffer_position: texture_2d<f32>;
+@group(0) @binding(10) var<storage, read> debug_lights: array<GpuPointLight>;
+@group(0) @binding(11) var<storage, read> debug_shadow_lights: array<GpuShadowLight>;
+@group(0) @binding(12) var debug_shadow_atlas: texture_depth_2d;
 
 const BACKGROUND = vec4<f32>(0.02, 0.02, 0.02, 1.0);
 
@@ -135,4 +143,59 @@ fn fs_surface(in: FullscreenOut) -> @location(0) vec4<f32> {
         color = vec3<f32>(saturate(emissive.a));
     }
     return vec4<f32>(color, 1.0);
+}
+
+@fragment
+fn fs_shadow_atlas(in: FullscreenOut) -> @location(0) vec4<f32> {
+    // The square atlas, as large as the view allows, centred.
+    let size = view.viewport.xy;
+    let side = min(size.x, size.y);
+    let local = (in.position.xy - 0.5 * (size - vec2<f32>(side))) / side;
+    if any(local < vec2<f32>(0.0)) || any(local >= vec2<f32>(1.0)) {
+        return BACKGROUND;
+    }
+    let dims = textureDimensions(debug_shadow_atlas);
+    let texel = min(vec2<u32>(local * vec2<f32>(dims)), dims - vec2<u32>(1u));
+    let d = textureLoad(debug_shadow_atlas, texel, 0);
+    if d <= 0.0 {
+        return vec4<f32>(0.0, 0.0, 0.0, 1.0); // nothing drawn
+    }
+    // Reverse depth is about near / distance: five decades from the near plane (white) to the
+    // range (grey).
+    let t = saturate(-log2(d) / (5.0 * log2(10.0)));
+    return vec4<f32>(vec3<f32>(1.0 - 0.8 * t), 1.0);
+}
+
+@fragment
+fn fs_shadow_lod(in: FullscreenOut) -> @location(0) vec4<f32> {
+    let px = vec2<i32>(in.position.xy);
+    let z = textureLoad(depth, px, 0);
+    if z <= 0.0 {
+        return BACKGROUND;
+    }
+    let clip = vec4<f32>(in.uv.x * 2.0 - 1.0, 1.0 - in.uv.y * 2.0, z, 1.0);
+    let world = view.world_from_clip * clip;
+    let position = world.xyz / world.w;
+    // Every light (a debug view: no lists), those with a map that reach the point.
+    var sum = 0.0;
+    var casting = 0u;
+    for (var k = 0u; k < min(view.light_count, arrayLength(&debug_lights)); k++) {
+        let light = debug_lights[k].position_radius;
+        if attenuation(distance(light.xyz, position), light.w) <= 0.0 || k >= arrayLength(&debug_shadow_lights) {
+            continue;
+        }
+        // Edge 0: the light has no map this frame (it does not cast, or was dropped: counted
+        // in the frame's shadow report).
+        let shadow = debug_shadow_lights[k];
+        if shadow.tile.z == 0u {
+            continue;
+        }
+        sum += log2(max(f32(shadow.tile.z), 1.0));
+        casting++;
+    }
+    if casting == 0u {
+        return vec4<f32>(0.12, 0.12, 0.12, 1.0);
+    }
+    // log2 16 = 4 (blue) to log2 512 = 9 (red).
+    return vec4<f32>(heat((sum / f32(casting) - 4.0) / 5.0), 1.0);
 }

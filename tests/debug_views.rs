@@ -74,7 +74,8 @@ fn render(debug: DebugView, settings: RenderSettings) -> HeadlessFrame {
 #[test]
 fn every_debug_view_renders_its_data() {
     let _gpu = gpu();
-    for mode in DebugViewMode::ALL.into_iter().filter(|&m| m != DebugViewMode::None) {
+    // The shadow views need casting lights: tests/shadows.rs.
+    for mode in DebugViewMode::ALL.into_iter().filter(|&m| m != DebugViewMode::None && !m.uses_shadows()) {
         let mut settings =
             RenderSettings { pipeline: PipelineKind::ClusteredForward, ..RenderSettings::default() };
         if mode == DebugViewMode::Overflow {

@@ -519,3 +519,34 @@ fn a_full_atlas_and_a_small_device_lower_resolutions_and_count_every_light() {
     assert_eq!(s.maps_rendered + s.dropped_lights + s.unseen_lights, 300, "{s:?}");
     assert!(s.downgraded_lights > 0, "{s:?}");
 }
+
+/// The plate scene's point light through a debug view.
+fn debug_frame(mode: DebugViewMode, shadows: bool) -> HeadlessFrame {
+    let scene = plate_scene();
+    render_headless(SIZE, 1, move |app| {
+        app.insert_resource(DebugView::new(mode)).add_systems(Startup, move |mut commands: Commands| {
+            spawn_scene(&mut commands, &scene, true, SIZE.x as f32 / SIZE.y as f32);
+            point_at(&mut commands, LIGHT, 8.0, shadows);
+        });
+    })
+    .unwrap_or_else(|e| panic!("{mode:?}: {e}"))
+}
+
+/// The shadow views show the atlas (its drawn tiles brighter than the cleared rest) and the
+/// face edge of the lights reaching each pixel (one light of 512 texels: the hottest colour
+/// wherever it reaches); without a map, the background alone.
+#[test]
+fn the_shadow_debug_views_show_the_atlas_and_the_resolution() {
+    let _gpu = gpu();
+    let atlas = debug_frame(DebugViewMode::ShadowAtlas, true);
+    let bright = atlas.image.pixels().filter(|p| p[0] > 100).count();
+    assert!(bright > 100, "the atlas view shows few drawn texels ({bright})");
+    let lod = debug_frame(DebugViewMode::ShadowLod, true);
+    let red = lod.image.pixels().filter(|p| p[0] > 200 && p[1] < 80 && p[2] < 80).count();
+    assert!(red > 2000, "few pixels show the light's 512-texel faces ({red})");
+    for mode in [DebugViewMode::ShadowAtlas, DebugViewMode::ShadowLod] {
+        let none = debug_frame(mode, false);
+        let first = *none.image.get_pixel(0, 0);
+        assert!(none.image.pixels().all(|p| *p == first), "{mode:?} without shadows is not the background");
+    }
+}

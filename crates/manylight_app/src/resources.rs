@@ -55,6 +55,12 @@ impl DebugView {
             DebugViewMode::Emissive => "emitted radiance (linear, clamped to 1)".into(),
             DebugViewMode::Occlusion => "ambient occlusion: white = none, black = full".into(),
             DebugViewMode::Depth => "linear view depth, log scale: white near → black far".into(),
+            DebugViewMode::ShadowAtlas => {
+                "shadow atlas: each light's 3 × 2 block of cube faces (white near the light → grey at its range, black = empty)".into()
+            }
+            DebugViewMode::ShadowLod => {
+                "shadow resolution: mean log2 face edge of the casting lights reaching the pixel, blue 16 → red 512".into()
+            }
             DebugViewMode::Overflow => format!(
                 "cluster overflow: red = list hit the cap; green = fill (of the cap, or of {} without one)",
                 self.heatmap_max

@@ -144,6 +144,8 @@ pub fn shared_u32_constants() -> Vec<(&'static str, u32)> {
         ("DEBUG_NORMAL", DebugView::Normal.gpu_id()),
         ("DEBUG_DEPTH", DebugView::Depth.gpu_id()),
         ("DEBUG_OVERFLOW", DebugView::Overflow.gpu_id()),
+        ("DEBUG_SHADOW_ATLAS", DebugView::ShadowAtlas.gpu_id()),
+        ("DEBUG_SHADOW_LOD", DebugView::ShadowLod.gpu_id()),
         ("DEBUG_METALLIC", DebugView::Metallic.gpu_id()),
         ("DEBUG_ROUGHNESS", DebugView::Roughness.gpu_id()),
         ("DEBUG_EMISSIVE", DebugView::Emissive.gpu_id()),

@@ -29,6 +29,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("common/cluster_lists.wgsl", include_str!("../../../shaders/common/cluster_lists.wgsl")),
     ("common/light_lists.wgsl", include_str!("../../../shaders/common/light_lists.wgsl")),
     ("common/point_lights.wgsl", include_str!("../../../shaders/common/point_lights.wgsl")),
+    ("common/shadow_types.wgsl", include_str!("../../../shaders/common/shadow_types.wgsl")),
     ("common/shadows.wgsl", include_str!("../../../shaders/common/shadows.wgsl")),
     ("shadow_maps.wgsl", include_str!("../../../shaders/shadow_maps.wgsl")),
     ("shadow_probe.wgsl", include_str!("../../../shaders/shadow_probe.wgsl")),

@@ -167,11 +167,18 @@ pub enum DebugViewMode {
     Emissive,
     /// Ambient occlusion (white: none).
     Occlusion,
+    /// The shadow atlas, fitted to the view: every light's block of tiles (white near the
+    /// light, grey at its range on a log scale, black where nothing was drawn).
+    ShadowAtlas,
+    /// The face edge each pixel's shadowed lights got, as a heatmap: blue at 16 texels, red at
+    /// 512 (the mean of their log2 over the lights with a map that reach the pixel; grey where
+    /// none does).
+    ShadowLod,
 }
 
 impl DebugViewMode {
     /// Every view, in CLI order.
-    pub const ALL: [DebugViewMode; 13] = [
+    pub const ALL: [DebugViewMode; 15] = [
         DebugViewMode::None,
         DebugViewMode::Albedo,
         DebugViewMode::Normal,
@@ -185,6 +192,8 @@ impl DebugViewMode {
         DebugViewMode::SliceY,
         DebugViewMode::SliceZ,
         DebugViewMode::Overflow,
+        DebugViewMode::ShadowAtlas,
+        DebugViewMode::ShadowLod,
     ];
 
     /// Name used on the command line.
@@ -203,6 +212,8 @@ impl DebugViewMode {
             DebugViewMode::Roughness => "roughness",
             DebugViewMode::Emissive => "emissive",
             DebugViewMode::Occlusion => "occlusion",
+            DebugViewMode::ShadowAtlas => "shadow-atlas",
+            DebugViewMode::ShadowLod => "shadow-lod",
         }
     }
 
@@ -239,6 +250,12 @@ impl DebugViewMode {
                 | DebugViewMode::Emissive
                 | DebugViewMode::Occlusion
         )
+    }
+
+    /// True for views that show the frame's shadow maps: the frame is planned as without a
+    /// debug view (shadow pass and shading included), and the view replaces the tone map.
+    pub fn uses_shadows(self) -> bool {
+        matches!(self, DebugViewMode::ShadowAtlas | DebugViewMode::ShadowLod)
     }
 
     /// The next view (wrapping), for key-driven cycling.
@@ -654,6 +671,7 @@ impl RenderView {
         self.camera.is_some()
             && match self.settings.debug_view {
                 DebugViewMode::None => self.settings.pipeline.uses_clusters() && has_lights,
+                view if view.uses_shadows() => self.settings.pipeline.uses_clusters() && has_lights,
                 view => view.uses_clusters(),
             }
     }

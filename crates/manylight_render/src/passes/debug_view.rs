@@ -4,10 +4,15 @@
 //! - cluster views (light-count heatmap with a legend bar, cluster x / y / z index, overflow):
 //!   depth + the cluster lists;
 //! - depth: the linearised view distance;
-//! - surface views (albedo, normal): the Full G-buffer.
+//! - surface views (albedo, normal): the Full G-buffer;
+//! - shadow views: the atlas (`shadow-atlas`), or the lights and their shadow table
+//!   (`shadow-lod`), after a frame planned as without a debug view. A frame without a shadow
+//!   map shows the background.
 
 use super::common::{draw_fullscreen, fullscreen_pipeline, storage_entry, texture_entry, uniform_entry};
-use super::{CLUSTERS, DEPTH, GBUFFER_ALBEDO, GBUFFER_EMISSIVE, GBUFFER_NORMAL, GBUFFER_POSITION};
+use super::{
+    CLUSTERS, DEPTH, GBUFFER_ALBEDO, GBUFFER_EMISSIVE, GBUFFER_NORMAL, GBUFFER_POSITION, SHADOW_ATLAS,
+};
 use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{OUTPUT, Pass, PassContext, ResourceName};
@@ -21,11 +26,17 @@ enum Family {
     Clusters,
     Depth,
     Surface,
+    ShadowAtlas,
+    ShadowLod,
 }
 
 impl Family {
     fn of(mode: DebugViewMode) -> Family {
-        if mode.uses_surfaces() {
+        if mode == DebugViewMode::ShadowAtlas {
+            Family::ShadowAtlas
+        } else if mode == DebugViewMode::ShadowLod {
+            Family::ShadowLod
+        } else if mode.uses_surfaces() {
             Family::Surface
         } else if mode.uses_clusters() {
             Family::Clusters
@@ -71,6 +82,14 @@ impl DebugViewPipeline {
                 entries.extend([5, 6, 7, 8].map(|b| texture_entry(b, unfiltered)));
                 "fs_surface"
             }
+            Family::ShadowAtlas => {
+                entries.push(texture_entry(12, wgpu::TextureSampleType::Depth));
+                "fs_shadow_atlas"
+            }
+            Family::ShadowLod => {
+                entries.extend([storage_entry(10, fragment, true), storage_entry(11, fragment, true)]);
+                "fs_shadow_lod"
+            }
         };
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("debug_view"),
@@ -105,6 +124,9 @@ pub struct DebugViewPass {
     /// Light count drawn as the hottest colour of the heatmap (and a full cluster of the
     /// overflow view when there is no cap).
     pub heatmap_max: u32,
+    /// The frame draws shadow maps ([`PlanInputs::shades_shadows`]): the shadow views read
+    /// them; without, they show the background.
+    pub shadows: bool,
 }
 
 impl Pass for DebugViewPass {
@@ -118,6 +140,9 @@ impl Pass for DebugViewPass {
             Family::Surface => {
                 vec![DEPTH, GBUFFER_ALBEDO, GBUFFER_NORMAL, GBUFFER_EMISSIVE, GBUFFER_POSITION]
             }
+            // After the shadow pass, when the frame has one.
+            Family::ShadowAtlas | Family::ShadowLod if self.shadows => vec![DEPTH, SHADOW_ATLAS],
+            Family::ShadowAtlas | Family::ShadowLod => Vec::new(),
         }
     }
     fn writes(&self) -> Vec<ResourceName> {
@@ -125,6 +150,28 @@ impl Pass for DebugViewPass {
     }
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
         let family = Family::of(self.view);
+        let shadows = ctx.shadows.filter(|s| s.active && self.shadows);
+        if matches!(family, Family::ShadowAtlas | Family::ShadowLod) && shadows.is_none() {
+            // No shadow map this frame: the background alone.
+            let output = ctx.texture(OUTPUT)?;
+            ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("debug_view"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: output,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color { r: 0.02, g: 0.02, b: 0.02, a: 1.0 }),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            return Ok(());
+        }
         let format = ctx.output_format;
         let device = &ctx.gpu.device;
         let key = DebugViewKey { family, format };
@@ -155,6 +202,19 @@ impl Pass for DebugViewPass {
                 (7, Binding::Texture(ctx.texture(GBUFFER_EMISSIVE)?)),
                 (8, Binding::Texture(ctx.texture(GBUFFER_POSITION)?)),
             ]),
+            Family::ShadowAtlas => {
+                let atlas = shadows.and_then(|s| s.atlas_view()).ok_or_else(|| {
+                    RenderError::Graph("shadow-atlas: the frame's shadows have no atlas".into())
+                })?;
+                bindings.push((12, Binding::Texture(atlas)));
+            }
+            Family::ShadowLod => {
+                let table = shadows
+                    .map(|s| s.lights.buffer())
+                    .ok_or_else(|| RenderError::Graph("shadow-lod: the frame has no shadow table".into()))?;
+                bindings
+                    .extend([(10, Binding::Buffer(ctx.scene.lights.buffer())), (11, Binding::Buffer(table))]);
+            }
         }
         let bind_group = ctx.bind_group_numbered("debug_view", &pipeline.layout, &bindings);
         let output = ctx.texture(OUTPUT)?;
@@ -168,6 +228,10 @@ impl Pass for DebugViewPass {
 pub fn plan(p: &PlanInputs<'_>, out: &mut Vec<Box<dyn Pass>>) {
     let s = p.settings();
     if !p.shows_image() {
-        out.push(Box::new(DebugViewPass { view: s.debug_view, heatmap_max: s.debug_heatmap_max }));
+        out.push(Box::new(DebugViewPass {
+            view: s.debug_view,
+            heatmap_max: s.debug_heatmap_max,
+            shadows: p.shades_shadows(),
+        }));
     }
 }

@@ -1,0 +1,32 @@
+// The shadow tables' structs (Rust: `GpuShadowLight`, `GpuCascade`, `GpuDirectionalShadow`),
+// apart from their bindings: the shading passes bind them in group 0 (common/shadows.wgsl),
+// the debug views in their own group.
+
+// Rust: `GpuShadowLight`.
+struct GpuShadowLight {
+    // xy: top-left atlas texel of the light's block of face tiles (SHADOW_TILE_COLUMNS per
+    // row); z: a face tile's edge in texels, 0 when the light has no shadow map; w: 0
+    tile: vec4<u32>,
+    // x: near plane, y: far plane (the light's range), z: depth bias (world units),
+    // w: normal bias (face texels)
+    params: vec4<f32>,
+};
+
+// Rust: `GpuCascade`.
+struct GpuCascade {
+    // x, y ∈ [-1, 1] across the cascade's square, z ∈ [0, 1] through its depth range
+    clip_from_world: mat4x4<f32>,
+    // xy: top-left atlas texel of the tile, z: its edge in texels, w: 0
+    tile: vec4<u32>,
+    // x: far bound (view distance), y: a texel's width (world), z: depth range (world), w: 0
+    params: vec4<f32>,
+};
+
+// Rust: `GpuDirectionalShadow`.
+struct GpuDirectionalShadow {
+    cascades: array<GpuCascade, MAX_CASCADES>,
+    // x: cascades in use (0: no shadow)
+    count: vec4<u32>,
+    // x: depth bias (world units), y: normal bias (texels of the cascade)
+    bias: vec4<f32>,
+};
