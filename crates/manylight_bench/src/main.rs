@@ -33,6 +33,7 @@ mod plot;
 mod post;
 mod progress;
 mod report;
+use report::Report;
 mod shadow_error;
 mod soak;
 mod views;
@@ -125,6 +126,11 @@ struct ReportArgs {
     /// Also write the results as CSV and PNG figures into this folder.
     #[arg(long)]
     plot: Option<PathBuf>,
+    /// The shadow section instead (`report`): shadow settings — none, atlas sizes, resolution
+    /// policies — every light casting, each with its frame time, visibility error and FLIP
+    /// against the shadow reference (`report_shadows.csv` and its figures with `--plot`).
+    #[arg(long)]
+    shadows: bool,
 }
 
 #[derive(clap::Args)]
@@ -789,7 +795,7 @@ fn write_plots(dir: &std::path::Path, name: &str, csv: &str) -> Result<()> {
     let path = dir.join(format!("{name}.csv"));
     std::fs::write(&path, csv).with_context(|| format!("cannot write {}", path.display()))?;
     eprintln!("wrote {}", path.display());
-    for figure in plot::figures(csv, dir)? {
+    for figure in plot::figures_named(csv, dir, Some(name))? {
         eprintln!("wrote {}", figure.display());
     }
     Ok(())
@@ -820,10 +826,16 @@ fn report_cmd(args: ReportArgs) -> Result<()> {
     check_lights(scene.lights.len().saturating_add(args.lights), "--lights")?;
     let base = report_base(&args);
     let name = scene_name(&args.scene);
-    let report = report::run(&scene, &name, args.lights, args.size, args.frames.max(1), base)?;
+    let (frames, size) = (args.frames.max(1), args.size);
+    let (report, csv_name) = if args.shadows {
+        let shadows = report::shadows(&scene, &name, args.lights, size, frames, base)?;
+        (Report { markdown: format!("## Shadows\n\n{}", shadows.markdown), ..shadows }, "report_shadows")
+    } else {
+        (report::run(&scene, &name, args.lights, size, frames, base)?, "report")
+    };
     print!("{}", report.markdown);
     if let Some(dir) = &args.plot {
-        write_plots(dir, "report", &report.csv)?;
+        write_plots(dir, csv_name, &report.csv)?;
     }
     Ok(())
 }

@@ -586,13 +586,20 @@ impl Kind {
 
 /// Draws every figure `csv` (the text a command wrote) calls for into `dir` and returns the
 /// files written: frame time and culling ratio against light count (bench), accuracy against
-/// time (report), per-pass GPU time and memory per configuration (all three).
+/// time (report), per-pass GPU time and memory per configuration (all three). The files are
+/// named after the kind of CSV (`bench_frame_time.png`, `report_accuracy_vs_time.png`, …).
 pub fn figures(csv: &str, dir: &Path) -> Result<Vec<PathBuf>> {
+    figures_named(csv, dir, None)
+}
+
+/// [`figures`], the files named `{prefix}_…` instead of after the kind of CSV.
+pub fn figures_named(csv: &str, dir: &Path, prefix: Option<&str>) -> Result<Vec<PathBuf>> {
     let table = Table::parse(csv)?;
     if table.rows.is_empty() {
         bail!("the CSV has no rows to plot");
     }
     let kind = Kind::of(&table)?;
+    let prefix = prefix.unwrap_or(kind.prefix());
     // The tallest figures grow with the rows they show (one bar per configuration, one key
     // line per point): checked before anything is drawn.
     figure_height(200, 44, bar_rows(&table).0.len(), 450)?;
@@ -601,7 +608,7 @@ pub fn figures(csv: &str, dir: &Path) -> Result<Vec<PathBuf>> {
     }
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let setting = table.setting();
-    let file = |name: &str| dir.join(format!("{}_{name}.png", kind.prefix()));
+    let file = |name: &str| dir.join(format!("{prefix}_{name}.png"));
     let mut written = Vec::new();
     if kind == Kind::Bench {
         let path = file("frame_time");

@@ -428,3 +428,169 @@ fn csv(rows: &[ReportRow], scene: &str, size: UVec2, adapter: &str) -> Result<St
     }
     Ok(String::from_utf8(w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?)?)
 }
+
+/// The shadow settings `report --shadows` compares: none, then the atlas sizes and resolution
+/// policies (at the default atlas), every light of the scene and the rig casting.
+fn shadow_configurations(base: FrameSettings) -> Vec<(String, FrameSettings)> {
+    let with = |f: &dyn Fn(&mut manylight_render::ShadowSettings)| {
+        let mut s = base;
+        f(&mut s.render.shadows);
+        s
+    };
+    vec![
+        ("shadows off".to_string(), with(&|s| s.enabled = false)),
+        ("atlas 2048".into(), with(&|s| s.atlas_size = 2048)),
+        ("atlas 4096 (default)".into(), with(&|_| {})),
+        ("atlas 8192".into(), with(&|s| s.atlas_size = 8192)),
+        ("faces ×0.5".into(), with(&|s| s.resolution_scale = 0.5)),
+        ("faces ×2".into(), with(&|s| s.resolution_scale = 2.0)),
+        ("faces at most 128".into(), with(&|s| s.max_face_size = 128)),
+    ]
+}
+
+/// One shadow setting's result.
+struct ShadowRow {
+    name: String,
+    frame_ms: f64,
+    report: FrameReport,
+    accuracy: crate::shadow_error::ShadowAccuracy,
+}
+
+/// What shadows cost and how far each setting is from exact visibility: for each of
+/// [`shadow_configurations`], the median frame time of `frames` timed frames and the last
+/// frame's visibility error and FLIP against the shadow reference
+/// (`crate::shadow_error::measure_shadows`), `lights` rig lights all casting, clustered forward,
+/// each setting on a renderer of its own.
+pub fn shadows(
+    scene: &Scene,
+    scene_name: &str,
+    lights: usize,
+    size: UVec2,
+    frames: u32,
+    base: FrameSettings,
+) -> Result<Report> {
+    let mut adapter = String::new();
+    let rig = light_rig(lights, scene.bounds(), 1)?;
+    let occluders = crate::shadow_error::occluders(scene);
+    let base = FrameSettings {
+        render: RenderSettings { pipeline: PipelineKind::ClusteredForward, ..base.render },
+        ..base
+    };
+    let configs = shadow_configurations(base);
+    let mut progress = Progress::new(configs.len() as u64, "shadow settings");
+    let mut rows = Vec::new();
+    for (name, settings) in configs {
+        progress.set_message(name.clone());
+        // A renderer each: the atlas never shrinks, so a setting after a larger one would draw
+        // into (and clear) the larger atlas.
+        let mut renderer = HeadlessRenderer::new()?;
+        adapter = renderer.render_world.gpu().info.name.clone();
+        let casting = |f: u64| {
+            let mut snap = snapshot(scene, &rig, 0.0, size, settings, f);
+            crate::direct::cast_every_shadow(&mut snap);
+            snap
+        };
+        let (frame_ms, report, _) = measure_snapshots(&mut renderer, frames, casting)?;
+        let accuracy = crate::shadow_error::measure_shadows(&mut renderer, casting(0), &occluders)?;
+        progress
+            .step(|| format!("{name}: {frame_ms:.0} ms, visibility error {:.4}", accuracy.visibility_error));
+        rows.push(ShadowRow { name, frame_ms, report, accuracy });
+    }
+    progress.finish();
+    let context = format!(
+        "{scene_name}, {lights} rig lights (and the scene's own) all casting, {}x{}, clustered forward, \
+         {adapter}; 2×2 comparison filter; every map drawn every frame (no caching)",
+        size.x, size.y
+    );
+    Ok(Report {
+        markdown: shadow_markdown(&rows, &context),
+        csv: shadow_csv(&rows, scene_name, size, &adapter)?,
+    })
+}
+
+fn shadow_markdown(rows: &[ShadowRow], context: &str) -> String {
+    let mut out = String::new();
+    let _ = writeln!(out, "{context}\n");
+    let _ = writeln!(
+        out,
+        "| setting | frame ms | × off | shadow pass ms | atlas MiB | maps / smaller than asked / none | visibility error | false shadow | light leak | FLIP vs shadow reference |"
+    );
+    let _ = writeln!(out, "|---|---:|---:|---:|---:|---|---:|---:|---:|---:|");
+    let off_ms = rows.first().map_or(f64::NAN, |r| r.frame_ms);
+    for r in rows {
+        let s = r.report.shadows.unwrap_or_default();
+        let pass = r.report.passes.iter().find(|p| p.name == "shadow_maps").and_then(|p| p.gpu_ms);
+        let a = &r.accuracy;
+        let _ = writeln!(
+            out,
+            "| {} | {:.0} | {:.2}× | {} | {:.0} | {} / {} / {} | {:.4} | {:.4} | {:.4} | {:.4} |",
+            r.name,
+            r.frame_ms,
+            r.frame_ms / off_ms,
+            pass.map_or("–".to_string(), |ms| format!("{ms:.0}")),
+            crate::bench::mib(s.atlas_bytes),
+            s.maps_rendered,
+            s.downgraded_lights,
+            s.dropped_lights,
+            a.visibility_error,
+            a.false_shadow,
+            a.light_leak,
+            a.flip.mean
+        );
+    }
+    out
+}
+
+/// The shadow rows as CSV: `flip_mean` is FLIP against the shadow reference, so `plot` draws
+/// the accuracy-against-time figure of the settings.
+fn shadow_csv(rows: &[ShadowRow], scene: &str, size: UVec2, adapter: &str) -> Result<String> {
+    let pass_names = crate::bench::pass_names(rows.iter().map(|r| &r.report));
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut header: Vec<String> = [
+        "adapter",
+        "scene",
+        "width",
+        "height",
+        "configuration",
+        "frame_ms_median",
+        "flip_mean",
+        "flip_p99",
+        "visibility_error",
+        "false_shadow",
+        "light_leak",
+        "shadow_maps_rendered",
+        "shadow_atlas_bytes",
+        "downgraded_lights",
+        "dropped_lights",
+        "transient_mib",
+    ]
+    .map(String::from)
+    .to_vec();
+    header.extend(pass_names.iter().map(|p| format!("{p}_gpu_ms")));
+    w.write_record(&header)?;
+    for r in rows {
+        let s = r.report.shadows.unwrap_or_default();
+        let a = &r.accuracy;
+        let mut record = vec![
+            adapter.to_string(),
+            scene.to_string(),
+            size.x.to_string(),
+            size.y.to_string(),
+            r.name.clone(),
+            format!("{:.3}", r.frame_ms),
+            format!("{:.6}", a.flip.mean),
+            format!("{:.6}", a.flip.p99),
+            format!("{:.6}", a.visibility_error),
+            format!("{:.6}", a.false_shadow),
+            format!("{:.6}", a.light_leak),
+            s.maps_rendered.to_string(),
+            s.atlas_bytes.to_string(),
+            s.downgraded_lights.to_string(),
+            s.dropped_lights.to_string(),
+            format!("{:.2}", crate::bench::mib(r.report.transient_bytes)),
+        ];
+        record.extend(crate::bench::pass_times(&r.report, &pass_names));
+        w.write_record(&record)?;
+    }
+    Ok(String::from_utf8(w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?)?)
+}

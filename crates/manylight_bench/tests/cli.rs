@@ -297,6 +297,98 @@ fn report_writes_csv_and_figures() {
     }
 }
 
+/// The shadow measurements: `render --shadow-oracle` prints and records the visibility error,
+/// `bench --shadow-oracle` fills its CSV columns, `report --shadows` writes its section, CSV
+/// and figures.
+#[test]
+fn shadow_measurements_come_out_of_render_bench_and_report() {
+    let _gpu = GPU.lock().unwrap_or_else(|e| e.into_inner());
+    let dir = root().join("target/cli-tests");
+    std::fs::create_dir_all(&dir).expect("mkdir");
+    let json = dir.join("shadows.json");
+    let reference = dir.join("shadow_reference.png");
+    let out = manylight(&[
+        "render",
+        "--lights",
+        "8",
+        "--size",
+        "64x48",
+        "--shadows",
+        "on",
+        "--shadow-oracle",
+        "--shadow-reference",
+        reference.to_str().expect("utf-8"),
+        "--out",
+        dir.join("shadows.png").to_str().expect("utf-8"),
+        "--stats-json",
+        json.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("shadow oracle: visibility error"));
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).expect("json")).expect("valid");
+    let error = stats["shadow_oracle"]["visibility_error"].as_f64().expect("visibility_error");
+    assert!((0.0..0.1).contains(&error), "{error}");
+    assert!(stats["shadow_oracle"]["contributing_pairs"].as_u64().is_some_and(|n| n > 0));
+    assert!(stats["last_frame"]["shadows"]["maps_rendered"].as_u64().is_some_and(|n| n > 0));
+    assert_eq!(image::open(&reference).expect("reference").to_rgba8().dimensions(), (64, 48));
+
+    let csv = dir.join("shadows_bench.csv");
+    let out = manylight(&[
+        "bench",
+        "--pipelines",
+        "clustered-forward",
+        "--lights",
+        "8",
+        "--size",
+        "64x48",
+        "--frames",
+        "1",
+        "--warmup",
+        "0",
+        "--shadows",
+        "off,on",
+        "--shadow-oracle",
+        "--out",
+        csv.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(&csv).expect("csv");
+    let mut rows = csv::Reader::from_reader(text.as_bytes());
+    let header = rows.headers().expect("header").clone();
+    let at = |name: &str| header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no {name}"));
+    let records: Vec<csv::StringRecord> = rows.records().map(|r| r.expect("row")).collect();
+    assert_eq!(records.len(), 2, "{text}");
+    let errors: Vec<f64> =
+        records.iter().map(|r| r[at("visibility_error")].parse().expect("a number")).collect();
+    assert!(errors.iter().all(|e| (0.0..=1.0).contains(e)), "{errors:?}");
+    assert_eq!(&records[1][at("shadows")], "on");
+    assert!(records[1][at("flip_vs_shadow_reference")].parse::<f64>().is_ok());
+
+    let plots = dir.join("report-shadow-plots");
+    let _ = std::fs::remove_dir_all(&plots);
+    let out = manylight(&[
+        "report",
+        "--lights",
+        "8",
+        "--size",
+        "48x32",
+        "--frames",
+        "1",
+        "--shadows",
+        "--plot",
+        plots.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let (_, shadows) = stdout.split_once("## Shadows").expect("the shadow section");
+    let table_rows = shadows.lines().filter(|l| l.starts_with("| ") && !l.starts_with("| setting")).count();
+    let text = std::fs::read_to_string(plots.join("report_shadows.csv")).expect("report_shadows.csv");
+    assert_eq!(text.lines().count() - 1, table_rows, "{text}\n{shadows}");
+    assert!(text.lines().nth(1).is_some_and(|l| l.contains("shadows off")), "{text}");
+    assert_figures(&plots, &["report_shadows_accuracy_vs_time", "report_shadows_passes"]);
+}
+
 /// Arguments that used to allocate before any limit was checked (`--lights 4294967295` aborted
 /// on a 240 GB allocation, `--lights 18446744073709551615` panicked with "capacity overflow",
 /// `--lights 10000000` reached 2.9 GB spawning entities past lavapipe's 2 796 202-light

@@ -147,12 +147,12 @@ pub struct ShadowSettings {
     /// Lights that cast shadows cast them; `false` renders every light unshadowed (no atlas, no
     /// pass), whatever the lights say. A camera's shadows checkbox.
     pub enabled: bool,
-    /// Largest edge of the atlas in texels (a power of two; default 8192, 256 MiB at most,
+    /// Largest edge of the atlas in texels (a power of two; default 4096, 64 MiB at most,
     /// reached only when the lights ask for that much: the atlas grows from 256 as they do).
     /// A device with a smaller `max_texture_dimension_2d` gets its own limit, counted in
-    /// [`ShadowReport::atlas_limited_by_device`]. At 1 000 lights in the default hall 4096
-    /// leaves 2.8 % of light–pixel pairs on the wrong side of the shadow, 8192 0.6 %
-    /// (docs/benchmarks.md, "Shadows").
+    /// [`ShadowReport::atlas_limited_by_device`]. At 1 000 lights in the default hall at
+    /// 1280×720, 4096 leaves 0.7 % of light–pixel pairs on the wrong side of the shadow, 8192
+    /// 0.3 % at a tenth more frame time (docs/benchmarks.md, "Shadows").
     pub atlas_size: u32,
     /// Largest face edge a light gets (a power of two).
     pub max_face_size: u32,
@@ -170,7 +170,7 @@ impl Default for ShadowSettings {
     fn default() -> Self {
         ShadowSettings {
             enabled: true,
-            atlas_size: 8192,
+            atlas_size: 4096,
             max_face_size: 512,
             min_face_size: 16,
             resolution_scale: 1.0,
