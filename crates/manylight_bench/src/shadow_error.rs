@@ -79,7 +79,8 @@ pub fn measure_shadows(
     // lights and the camera only), which the probes read.
     let (oracle, _) = oracle_snapshot(renderer, snapshot.clone())?;
     let lists = oracle.pixel_light_lists.clone().context("the oracle made no lists")?;
-    let lights: Vec<&ExtractedPointLight> = snapshot.lights.iter().filter(|l| l.is_valid()).collect();
+    let lights: Vec<&ExtractedPointLight> =
+        manylight_render::lights::buffered_lights(&snapshot.lights).map(|(_, l)| l).collect();
 
     let world_from_clip =
         camera.world_from_view * camera.projection.matrix(size.x as f32 / size.y as f32).inverse();

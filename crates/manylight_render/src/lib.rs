@@ -11,6 +11,7 @@ pub mod gpu_types;
 pub mod graph;
 pub mod inflight;
 pub mod layouts;
+pub mod lights;
 pub mod passes;
 pub mod pipelines;
 pub mod plan;

@@ -10,6 +10,9 @@ use crate::gpu_types::{
     SHADING_GLOBAL, TEXTURE_SLOT_BASE_COLOR, TEXTURE_SLOT_EMISSIVE, TEXTURE_SLOT_METALLIC_ROUGHNESS,
     TEXTURE_SLOT_NORMAL, TEXTURE_SLOT_OCCLUSION, ViewUniform,
 };
+use crate::lights::{
+    bounding_sphere, buffered_lights, gpu_directional_light, gpu_point_light, viewed_directional_lights,
+};
 use crate::pool::GrowableBuffer;
 use crate::snapshot::{FrameSnapshot, RenderView, aspect};
 use glam::{Mat4, Vec4};
@@ -578,35 +581,14 @@ impl SceneResources {
         // Lights: invalid ones (NaN, inf, negative) are dropped and counted, never uploaded.
         // Both light Vecs keep their allocation from frame to frame.
         self.gpu_lights.clear();
-        self.gpu_lights.extend(snapshot.lights.iter().filter(|l| l.is_valid()).map(|l| {
-            // A point light: no direction, falloff scale 0 and offset 1 (1 everywhere).
-            let (direction, scale, offset) = match &l.spot {
-                Some(cone) => {
-                    let (scale, offset) = cone.scale_offset();
-                    (cone.sanitized().direction, scale, offset)
-                }
-                None => (glam::Vec3::ZERO, 0.0, 1.0),
-            };
-            GpuPointLight {
-                position_radius: l.position.extend(l.radius).to_array(),
-                color: (l.color * l.intensity).extend(offset).to_array(),
-                spot: direction.extend(scale).to_array(),
-            }
-        }));
+        self.gpu_lights.extend(buffered_lights(&snapshot.lights).map(|(_, l)| gpu_point_light(l)));
         self.invalid_lights = (snapshot.lights.len() - self.gpu_lights.len()) as u32;
         // Directional lights: the first MAX_DIRECTIONAL_LIGHTS valid ones, in the view uniform.
-        let valid = snapshot.directional_lights.iter().filter(|l| l.is_valid());
-        let (mut count, mut valid_count) = (0usize, 0u32);
-        for l in valid {
-            valid_count += 1;
-            if let Some(slot) = self.directional.get_mut(count) {
-                let direction = l.direction.normalize();
-                *slot = GpuDirectionalLight {
-                    direction: direction.extend(0.0).to_array(),
-                    color: (l.color * l.illuminance).extend(0.0).to_array(),
-                };
-                count += 1;
-            }
+        let valid_count = snapshot.directional_lights.iter().filter(|l| l.is_valid()).count() as u32;
+        let mut count = 0usize;
+        for (i, l) in viewed_directional_lights(&snapshot.directional_lights) {
+            self.directional[i as usize] = gpu_directional_light(l);
+            count += 1;
         }
         self.invalid_lights += snapshot.directional_lights.len() as u32 - valid_count;
         self.directional_count = count as u32;
@@ -618,8 +600,7 @@ impl SceneResources {
             );
         }
         self.light_spheres.clear();
-        self.light_spheres
-            .extend(snapshot.lights.iter().filter(|l| l.is_valid()).map(|l| l.bounding_sphere()));
+        self.light_spheres.extend(buffered_lights(&snapshot.lights).map(|(_, l)| bounding_sphere(l)));
         self.light_count = self.gpu_lights.len() as u32;
         let light_bytes: &[u8] = if self.gpu_lights.is_empty() {
             PLACEHOLDER_LIGHT

@@ -26,6 +26,7 @@ use crate::gpu_types::{
     GpuCascade, GpuDirectionalShadow, GpuShadowDraw, GpuShadowFace, GpuShadowLight, MAX_DIRECTIONAL_LIGHTS,
     SHADOW_FACES, SHADOW_TILE_COLUMNS,
 };
+use crate::lights::{bounding_sphere, buffered_lights, viewed_directional_lights};
 use crate::pool::GrowableBuffer;
 use crate::resources::SceneResources;
 use crate::snapshot::{ExtractedCamera, ExtractedDirectionalLight, FrameSnapshot};
@@ -656,12 +657,11 @@ impl ShadowResources {
         // Requests, by the light's index in the light buffer (the valid lights in order).
         self.requests.clear();
         let frustums = view_frustums(snapshot);
-        let valid = snapshot.lights.iter().filter(|l| l.is_valid());
-        for (k, light) in valid.enumerate() {
+        for (k, light) in buffered_lights(&snapshot.lights) {
             if light.shadow.is_none() || light.radius <= 0.0 {
                 continue;
             }
-            let (center, radius) = light.bounding_sphere();
+            let (center, radius) = bounding_sphere(light);
             // A light no view sees lights no visible pixel: no map.
             if !sphere_in_view(&frustums, center, radius) {
                 self.report.unseen_lights += 1;
@@ -671,17 +671,13 @@ impl ShadowResources {
             let wanted = projected_radius(camera, center, radius).map(|p| p * settings.resolution_scale);
             let edge = edge_for(wanted, settings.min_face_size, settings.max_face_size);
             let importance = edge_for(wanted, 1, 1 << 30) as f32;
-            self.requests.push(ShadowRequest { caster: ShadowCaster::Point(k as u32), edge, importance });
+            self.requests.push(ShadowRequest { caster: ShadowCaster::Point(k), edge, importance });
         }
         // Directional lights, by their index in the view uniform (the first
         // MAX_DIRECTIONAL_LIGHTS valid ones), cascades at their set size, kept before any
         // point light when the atlas is full.
-        let directional: Vec<&ExtractedDirectionalLight> = snapshot
-            .directional_lights
-            .iter()
-            .filter(|l| l.is_valid())
-            .take(MAX_DIRECTIONAL_LIGHTS as usize)
-            .collect();
+        let directional: Vec<&ExtractedDirectionalLight> =
+            viewed_directional_lights(&snapshot.directional_lights).map(|(_, l)| l).collect();
         let view = camera.map(|(c, size)| (c, size.x.max(1) as f32 / size.y.max(1) as f32));
         for (i, light) in directional.iter().enumerate() {
             if light.shadow.is_some() && view.is_some() {
@@ -713,7 +709,7 @@ impl ShadowResources {
         // The light table: every light of the buffer, edge 0 where it has no map.
         self.gpu_lights.clear();
         self.gpu_lights.resize(scene.light_count.max(1) as usize, GpuShadowLight::default());
-        let lights: Vec<_> = snapshot.lights.iter().filter(|l| l.is_valid()).collect();
+        let lights: Vec<_> = buffered_lights(&snapshot.lights).map(|(_, l)| l).collect();
         self.gpu_faces.clear();
         for list in &mut self.by_mesh {
             list.1.clear();
@@ -758,7 +754,7 @@ impl ShadowResources {
                             atlas: tile_transform(tx, ty, p.edge, atlas),
                         });
                     }
-                    let (center, radius) = light.bounding_sphere();
+                    let (center, radius) = bounding_sphere(light);
                     let seen: Vec<bool> = (0..SHADOW_FACES)
                         .map(|face| face_in_view(&frustums, light.position, face, light.radius))
                         .collect();

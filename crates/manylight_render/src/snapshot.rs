@@ -549,16 +549,6 @@ impl Default for ShadowBias {
 }
 
 impl ExtractedPointLight {
-    /// The sphere that holds every point the light can reach: the light's own sphere, or the
-    /// smaller one around a spot light's cone ([`SpotCone::bounding_sphere`]). The cluster
-    /// build culls with it.
-    pub fn bounding_sphere(&self) -> (Vec3, f32) {
-        match &self.spot {
-            Some(cone) => cone.bounding_sphere(self.position, self.radius),
-            None => (self.position, self.radius),
-        }
-    }
-
     /// True when every parameter is finite, the radius and intensity are not negative, and the
     /// emitted colour (`color × intensity`) does not overflow to infinity.
     pub fn is_valid(&self) -> bool {

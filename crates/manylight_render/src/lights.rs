@@ -1,0 +1,135 @@
+//! Lights in one place: what kind a light is, what it can reach, how it is packed for the
+//! shaders, and which lights the frame's buffers hold. The light buffer holds the frame's valid
+//! point and spot lights in order ([`buffered_lights`]); the view uniform the first
+//! [`MAX_DIRECTIONAL_LIGHTS`] valid directional lights ([`viewed_directional_lights`]); a
+//! light's index there is its index everywhere (cluster lists, the shadow table, probes).
+//! Clustering culls with [`bounding_sphere`], the shaders read [`gpu_point_light`]'s fields
+//! through `shaders/common/lights.wgsl` (its twin: the same packing and attenuation), and the
+//! shadows take their lights from the same two functions, so a new light kind or a new reach
+//! is made here once.
+
+use crate::gpu_types::{GpuDirectionalLight, GpuPointLight, MAX_DIRECTIONAL_LIGHTS};
+use crate::snapshot::{ExtractedDirectionalLight, ExtractedPointLight};
+use glam::Vec3;
+
+/// The kinds of light the renderer draws.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum LightKind {
+    /// Light from a point in every direction, within a range.
+    Point,
+    /// Light from a point inside a cone, within a range.
+    Spot,
+    /// Light travelling one way everywhere (the sun).
+    Directional,
+}
+
+impl LightKind {
+    /// The kind of a point or spot light.
+    pub fn of(light: &ExtractedPointLight) -> LightKind {
+        if light.spot.is_some() { LightKind::Spot } else { LightKind::Point }
+    }
+}
+
+/// The sphere (centre, radius) that holds every point `light` can reach: its range around it,
+/// or the smaller sphere around a spot light's cone ([`manylight_core::SpotCone::bounding_sphere`]).
+pub fn bounding_sphere(light: &ExtractedPointLight) -> (Vec3, f32) {
+    match (LightKind::of(light), &light.spot) {
+        (LightKind::Spot, Some(cone)) => cone.bounding_sphere(light.position, light.radius),
+        _ => (light.position, light.radius),
+    }
+}
+
+/// `light` as the shaders read it (`GpuPointLight` in `shaders/common/lights.wgsl`): a point
+/// light has no direction, falloff scale 0 and offset 1 (1 everywhere).
+pub fn gpu_point_light(light: &ExtractedPointLight) -> GpuPointLight {
+    let (direction, scale, offset) = match &light.spot {
+        Some(cone) => {
+            let (scale, offset) = cone.scale_offset();
+            (cone.sanitized().direction, scale, offset)
+        }
+        None => (Vec3::ZERO, 0.0, 1.0),
+    };
+    GpuPointLight {
+        position_radius: light.position.extend(light.radius).to_array(),
+        color: (light.color * light.intensity).extend(offset).to_array(),
+        spot: direction.extend(scale).to_array(),
+    }
+}
+
+/// `light` as the view uniform holds it.
+pub fn gpu_directional_light(light: &ExtractedDirectionalLight) -> GpuDirectionalLight {
+    GpuDirectionalLight {
+        direction: light.direction.normalize().extend(0.0).to_array(),
+        color: (light.color * light.illuminance).extend(0.0).to_array(),
+    }
+}
+
+/// The lights the light buffer holds, with their index in it: the valid ones, in order.
+pub fn buffered_lights(lights: &[ExtractedPointLight]) -> impl Iterator<Item = (u32, &ExtractedPointLight)> {
+    lights.iter().filter(|l| l.is_valid()).enumerate().map(|(i, l)| (i as u32, l))
+}
+
+/// The directional lights the view uniform holds, with their index in it: the first
+/// [`MAX_DIRECTIONAL_LIGHTS`] valid ones.
+pub fn viewed_directional_lights(
+    lights: &[ExtractedDirectionalLight],
+) -> impl Iterator<Item = (u32, &ExtractedDirectionalLight)> {
+    lights
+        .iter()
+        .filter(|l| l.is_valid())
+        .take(MAX_DIRECTIONAL_LIGHTS as usize)
+        .enumerate()
+        .map(|(i, l)| (i as u32, l))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use manylight_core::SpotCone;
+
+    fn light(spot: Option<SpotCone>) -> ExtractedPointLight {
+        ExtractedPointLight {
+            position: Vec3::new(1.0, 2.0, 3.0),
+            color: Vec3::ONE,
+            intensity: 2.0,
+            radius: 4.0,
+            spot,
+            shadow: None,
+        }
+    }
+
+    #[test]
+    fn a_light_knows_its_kind_reach_and_packing() {
+        let point = light(None);
+        assert_eq!(LightKind::of(&point), LightKind::Point);
+        assert_eq!(bounding_sphere(&point), (point.position, 4.0));
+        let packed = gpu_point_light(&point);
+        assert_eq!(packed.position_radius, [1.0, 2.0, 3.0, 4.0]);
+        assert_eq!(packed.color, [2.0, 2.0, 2.0, 1.0], "a point light's falloff offset is 1");
+        assert_eq!(packed.spot, [0.0; 4]);
+        let cone = SpotCone { direction: Vec3::NEG_Y, inner_angle: 0.2, outer_angle: 0.4 };
+        let spot = light(Some(cone));
+        assert_eq!(LightKind::of(&spot), LightKind::Spot);
+        let (_, r) = bounding_sphere(&spot);
+        assert!(r < 4.0, "a narrow cone's sphere is smaller than the range: {r}");
+        assert_eq!(gpu_point_light(&spot).spot[1], -1.0);
+    }
+
+    #[test]
+    fn buffers_hold_the_valid_lights_in_order() {
+        let mut lights = vec![light(None); 4];
+        lights[1].position = Vec3::NAN;
+        let held: Vec<u32> = buffered_lights(&lights).map(|(i, _)| i).collect();
+        assert_eq!(held, [0, 1, 2]);
+        let sun = ExtractedDirectionalLight {
+            direction: Vec3::NEG_Y,
+            color: Vec3::ONE,
+            illuminance: 1.0,
+            shadow: None,
+        };
+        let mut suns = vec![sun; MAX_DIRECTIONAL_LIGHTS as usize + 2];
+        suns[0].direction = Vec3::ZERO;
+        assert_eq!(viewed_directional_lights(&suns).count(), MAX_DIRECTIONAL_LIGHTS as usize);
+        assert_eq!(gpu_directional_light(&sun).direction, [0.0, -1.0, 0.0, 0.0]);
+    }
+}
