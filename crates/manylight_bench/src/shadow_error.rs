@@ -209,6 +209,63 @@ fn without_entries(lists: &ClusterAssignment, removed: &[u32]) -> ClusterAssignm
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::{Mat4, UVec2, Vec3, Vec4};
+    use manylight_render::{ExtractedPointLight, FrameSettings, PipelineKind, ShadowBias};
+    use manylight_scene::{SceneCamera, SceneInstance, camera_looking_at, shapes::cuboid};
+
+    /// A floor under a camera and four lights above it: nothing stands between a light and a
+    /// surface.
+    fn open_floor() -> (Scene, Vec<ExtractedPointLight>) {
+        let grey =
+            manylight_core::MaterialData { base_color: Vec4::new(0.7, 0.7, 0.7, 1.0), ..Default::default() };
+        let scene = Scene {
+            name: "floor".into(),
+            meshes: vec![std::sync::Arc::new(cuboid("floor", Vec3::new(8.0, 0.2, 8.0), 1.0))],
+            materials: vec![std::sync::Arc::new(grey)],
+            instances: vec![SceneInstance {
+                mesh: 0,
+                material: 0,
+                transform: Mat4::from_translation(Vec3::new(0.0, -0.1, 0.0)),
+            }],
+            cameras: vec![SceneCamera {
+                transform: camera_looking_at(Vec3::new(0.0, 4.0, 4.0), Vec3::ZERO),
+                projection: Default::default(),
+            }],
+            ..Scene::default()
+        };
+        let lights = [(-1.5, -1.0), (1.5, -1.0), (0.0, 1.0), (0.5, 0.0)]
+            .map(|(x, z)| ExtractedPointLight {
+                position: Vec3::new(x, 1.0, z),
+                color: Vec3::ONE,
+                intensity: 2.0,
+                radius: 4.0,
+                spot: None,
+                shadow: Some(ShadowBias::POINT),
+            })
+            .to_vec();
+        (scene, lights)
+    }
+
+    /// Where nothing occludes, the shadow reference is naive forward's image, shadow maps make
+    /// no pair wrong, and nothing is blocked.
+    #[test]
+    fn the_shadow_reference_equals_naive_forward_where_nothing_occludes() {
+        let (scene, lights) = open_floor();
+        let occluders = occluders(&scene);
+        let mut settings = FrameSettings::default();
+        settings.render.pipeline = PipelineKind::NaiveForward;
+        let size = UVec2::new(128, 96);
+        let mut renderer = HeadlessRenderer::new().expect("a GPU adapter (lavapipe in CI)");
+        for shadows in [false, true] {
+            settings.render.shadows.enabled = shadows;
+            let snapshot = manylight_app::scene::scene_snapshot(&scene, lights.clone(), size, settings, 0);
+            let a = measure_shadows(&mut renderer, snapshot, &occluders).expect("measured");
+            assert!(a.contributing_pairs > 10_000, "{}", a.contributing_pairs);
+            assert_eq!(a.blocked_pairs, 0, "shadows {shadows}");
+            assert!(a.visibility_error < 1e-3, "shadows {shadows}: {}", a.visibility_error);
+            assert!(a.flip.mean < 0.002, "shadows {shadows}: FLIP {}", a.flip.mean);
+        }
+    }
 
     #[test]
     fn removing_entries_keeps_the_others_in_order() {
