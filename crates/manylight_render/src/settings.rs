@@ -150,9 +150,8 @@ pub struct ShadowSettings {
     /// Largest edge of the atlas in texels (a power of two; default 4096, 64 MiB at most,
     /// reached only when the lights ask for that much: the atlas grows from 256 as they do).
     /// A device with a smaller `max_texture_dimension_2d` gets its own limit, counted in
-    /// [`ShadowReport::atlas_limited_by_device`]. At 1 000 lights in the default hall at
-    /// 1280×720, 4096 leaves 0.7 % of light–pixel pairs on the wrong side of the shadow, 8192
-    /// 0.3 % at a tenth more frame time (docs/benchmarks.md, "Shadows").
+    /// [`ShadowReport::atlas_limited_by_device`]. What each size costs and how close it comes
+    /// to exact visibility: `manylight report --shadows` (docs/benchmarks.md, "Shadows").
     pub atlas_size: u32,
     /// Largest face edge a light gets (a power of two).
     pub max_face_size: u32,

@@ -239,9 +239,8 @@ pub fn plan_atlas(requests: &[ShadowRequest], max_atlas: u32, min_edge: u32) -> 
         atlas *= 2;
     }
     // Halve every edge (down to the smallest) until the blocks fit: each light keeps its share
-    // of the room. (Halving only the largest first took the lights that asked less down with
-    // them: 2.8 % of pairs wrong instead of 0.7 % at 1 000 lights in a 4096 atlas,
-    // docs/benchmarks.md, "Shadows".)
+    // of the room, where halving only the largest first would take the lights that asked less
+    // down with them (docs/benchmarks.md, "Shadows").
     let mut granted: Vec<u32> = order.iter().map(|r| r.edge).collect();
     loop {
         let largest = granted.iter().copied().max().unwrap_or(min_edge);
