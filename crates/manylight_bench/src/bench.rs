@@ -72,6 +72,33 @@ pub fn shading_ms(report: &FrameReport) -> Option<f64> {
     (!times.is_empty()).then(|| times.iter().sum())
 }
 
+/// The leading columns of a CSV with one row per configuration (`report`, `report --shadows`,
+/// `post`), then `columns`, then one `{pass}_gpu_ms` column per pass of `passes`.
+pub(crate) fn configuration_header(columns: &[&str], passes: &[String]) -> Vec<String> {
+    ["adapter", "scene", "width", "height", "configuration"]
+        .iter()
+        .chain(columns)
+        .map(|c| c.to_string())
+        .chain(passes.iter().map(|p| format!("{p}_gpu_ms")))
+        .collect()
+}
+
+/// The leading fields of a row of [`configuration_header`]'s CSV.
+pub(crate) fn configuration_fields(
+    adapter: &str,
+    scene: &str,
+    size: UVec2,
+    configuration: &str,
+) -> Vec<String> {
+    vec![
+        adapter.to_string(),
+        scene.to_string(),
+        size.x.to_string(),
+        size.y.to_string(),
+        configuration.to_string(),
+    ]
+}
+
 /// The median of `v` (the upper one of an even count; NaN when empty).
 pub(crate) fn median(v: &[f64]) -> f64 {
     let mut s = v.to_vec();

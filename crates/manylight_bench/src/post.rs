@@ -200,34 +200,18 @@ fn csv(rows: &[PostRow], scene: &str, size: UVec2, adapter: &str) -> Result<Stri
         }
     }
     let mut w = csv::Writer::from_writer(Vec::new());
-    let mut header: Vec<String> = [
-        "adapter",
-        "scene",
-        "width",
-        "height",
-        "configuration",
-        "frame_ms_median",
-        "vs_none_ms",
-        "post_passes_ms",
-        "transient_mib",
-    ]
-    .map(String::from)
-    .to_vec();
-    header.extend(names.iter().map(|n| format!("{n}_gpu_ms")));
-    w.write_record(&header)?;
+    let names: Vec<String> = names.iter().map(|n| n.to_string()).collect();
+    let columns = ["frame_ms_median", "vs_none_ms", "post_passes_ms", "transient_mib"];
+    w.write_record(crate::bench::configuration_header(&columns, &names))?;
     let none = rows.first().map_or(f64::NAN, |r| r.frame_ms);
     for r in rows {
-        let mut record = vec![
-            adapter.to_string(),
-            scene.to_string(),
-            size.x.to_string(),
-            size.y.to_string(),
-            r.name.to_string(),
+        let mut record = crate::bench::configuration_fields(adapter, scene, size, r.name);
+        record.extend([
             format!("{:.3}", r.frame_ms),
             format!("{:.3}", r.frame_ms - none),
             format!("{:.3}", r.post_gpu_ms),
             format!("{:.3}", crate::bench::mib(r.transient_bytes)),
-        ];
+        ]);
         record.extend(
             names.iter().map(|n| {
                 r.passes.iter().find(|p| p.0 == *n).map_or(String::new(), |p| format!("{:.3}", p.1))

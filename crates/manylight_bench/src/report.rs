@@ -363,40 +363,31 @@ fn markdown(rows: &[ReportRow], context: &str) -> String {
 fn csv(rows: &[ReportRow], scene: &str, size: UVec2, adapter: &str) -> Result<String> {
     let pass_names = crate::bench::pass_names(rows.iter().map(|r| &r.report));
     let mut w = csv::Writer::from_writer(Vec::new());
-    let mut header: Vec<String> = [
-        "adapter",
-        "scene",
-        "width",
-        "height",
-        "configuration",
-        "pipeline",
-        "gbuffer",
-        "gbuffer_bytes_per_pixel",
-        "normal_codec",
-        "flip_mean",
-        "flip_p99",
-        "dropped_pairs",
-        "frame_ms_median",
-        "speedup",
-        "shading_ms",
-        "shading_vs_oracle",
-        "transient_mib",
-        "cluster_buffer_mib",
-        "untrusted_passes",
-    ]
-    .map(String::from)
-    .to_vec();
-    header.extend(pass_names.iter().map(|p| format!("{p}_gpu_ms")));
+    let header = crate::bench::configuration_header(
+        &[
+            "pipeline",
+            "gbuffer",
+            "gbuffer_bytes_per_pixel",
+            "normal_codec",
+            "flip_mean",
+            "flip_p99",
+            "dropped_pairs",
+            "frame_ms_median",
+            "speedup",
+            "shading_ms",
+            "shading_vs_oracle",
+            "transient_mib",
+            "cluster_buffer_mib",
+            "untrusted_passes",
+        ],
+        &pass_names,
+    );
     w.write_record(&header)?;
     let naive_ms = rows.first().map_or(f64::NAN, |r| r.frame_ms);
     for r in rows {
         let deferred = r.settings.filter(|s| s.pipeline.is_deferred());
-        let mut record = vec![
-            adapter.to_string(),
-            scene.to_string(),
-            size.x.to_string(),
-            size.y.to_string(),
-            r.name.clone(),
+        let mut record = crate::bench::configuration_fields(adapter, scene, size, &r.name);
+        record.extend([
             r.report.pipeline.clone(),
             deferred.map_or(String::new(), |s| s.gbuffer.name().to_string()),
             deferred.map_or(String::new(), |s| s.gbuffer.bytes_per_pixel().to_string()),
@@ -422,7 +413,7 @@ fn csv(rows: &[ReportRow], scene: &str, size: UVec2, adapter: &str) -> Result<St
                 .map(|p| p.name.as_str())
                 .collect::<Vec<_>>()
                 .join(";"),
-        ];
+        ]);
         record.extend(crate::bench::pass_times(&r.report, &pass_names));
         w.write_record(&record)?;
     }
@@ -546,37 +537,28 @@ fn shadow_markdown(rows: &[ShadowRow], context: &str) -> String {
 fn shadow_csv(rows: &[ShadowRow], scene: &str, size: UVec2, adapter: &str) -> Result<String> {
     let pass_names = crate::bench::pass_names(rows.iter().map(|r| &r.report));
     let mut w = csv::Writer::from_writer(Vec::new());
-    let mut header: Vec<String> = [
-        "adapter",
-        "scene",
-        "width",
-        "height",
-        "configuration",
-        "frame_ms_median",
-        "flip_mean",
-        "flip_p99",
-        "visibility_error",
-        "false_shadow",
-        "light_leak",
-        "shadow_maps_rendered",
-        "shadow_atlas_bytes",
-        "downgraded_lights",
-        "dropped_lights",
-        "transient_mib",
-    ]
-    .map(String::from)
-    .to_vec();
-    header.extend(pass_names.iter().map(|p| format!("{p}_gpu_ms")));
+    let header = crate::bench::configuration_header(
+        &[
+            "frame_ms_median",
+            "flip_mean",
+            "flip_p99",
+            "visibility_error",
+            "false_shadow",
+            "light_leak",
+            "shadow_maps_rendered",
+            "shadow_atlas_bytes",
+            "downgraded_lights",
+            "dropped_lights",
+            "transient_mib",
+        ],
+        &pass_names,
+    );
     w.write_record(&header)?;
     for r in rows {
         let s = r.report.shadows.unwrap_or_default();
         let a = &r.accuracy;
-        let mut record = vec![
-            adapter.to_string(),
-            scene.to_string(),
-            size.x.to_string(),
-            size.y.to_string(),
-            r.name.clone(),
+        let mut record = crate::bench::configuration_fields(adapter, scene, size, &r.name);
+        record.extend([
             format!("{:.3}", r.frame_ms),
             format!("{:.6}", a.flip.mean),
             format!("{:.6}", a.flip.p99),
@@ -588,7 +570,7 @@ fn shadow_csv(rows: &[ShadowRow], scene: &str, size: UVec2, adapter: &str) -> Re
             s.downgraded_lights.to_string(),
             s.dropped_lights.to_string(),
             format!("{:.2}", crate::bench::mib(r.report.transient_bytes)),
-        ];
+        ]);
         record.extend(crate::bench::pass_times(&r.report, &pass_names));
         w.write_record(&record)?;
     }
