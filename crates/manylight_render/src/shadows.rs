@@ -678,18 +678,17 @@ impl ShadowResources {
         let directional: Vec<&ExtractedDirectionalLight> =
             viewed_directional_lights(&snapshot.directional_lights).map(|(_, l)| l).collect();
         let view = camera.map(|(c, size)| (c, size.x.max(1) as f32 / size.y.max(1) as f32));
+        // The largest power of two the device's textures allow.
+        let (max_atlas, limited) = atlas_limit(settings.atlas_size, self.max_texture);
+        // A cascade is at most a third of the atlas (a block is 3 tiles wide).
+        let widest = 1u32 << (31 - (max_atlas / SHADOW_TILE_COLUMNS).max(1).leading_zeros());
         for (i, light) in directional.iter().enumerate() {
             if light.shadow.is_some() && view.is_some() {
-                // At most a third of the largest atlas (the block is 3 tiles wide).
-                let widest = atlas_limit(settings.atlas_size, self.max_texture).0 / SHADOW_TILE_COLUMNS;
-                let widest = 1u32 << (31 - widest.max(1).leading_zeros());
                 let edge = settings.cascade_size.max(settings.min_face_size).min(widest);
                 let caster = ShadowCaster::Directional(i as u32);
                 self.requests.push(ShadowRequest { caster, edge, importance: f32::MAX });
             }
         }
-        // The largest power of two the device's textures allow.
-        let (max_atlas, limited) = atlas_limit(settings.atlas_size, self.max_texture);
         self.plan = plan_atlas(
             &self.requests,
             max_atlas,
