@@ -73,38 +73,44 @@ impl Kind {
 }
 
 fn render(kind: Kind, shadows: bool, settings: RenderSettings) -> HeadlessFrame {
-    let scene = plate_scene();
+    render_scene(&plate_scene(), kind.spawn(), shadows, settings)
+}
+
+/// Spawns a light, casting or not.
+type SpawnLight = fn(&mut Commands, bool);
+
+impl Kind {
+    /// The plate scene's light of this kind: at [`LIGHT`], or travelling along [`SUN`].
+    fn spawn(self) -> SpawnLight {
+        match self {
+            Kind::Point => |c, shadows| point_at(c, LIGHT, 8.0, shadows),
+            Kind::Spot => |c, shadows| {
+                let light = SpotLight {
+                    intensity: 150.0,
+                    range: 8.0,
+                    inner_angle: 0.9,
+                    outer_angle: 1.2,
+                    shadows_enabled: shadows,
+                    ..Default::default()
+                };
+                c.spawn((Transform::from_translation(LIGHT).looking_to(Vec3::NEG_Y, Vec3::Z), light));
+            },
+            Kind::Directional => |c, shadows| {
+                let light =
+                    DirectionalLight { illuminance: 3.0, shadows_enabled: shadows, ..Default::default() };
+                c.spawn((Transform::default().looking_to(SUN, Vec3::Z), light));
+            },
+        }
+    }
+}
+
+/// `scene` with the light `spawn` makes, through `settings`.
+fn render_scene(scene: &Scene, spawn: SpawnLight, shadows: bool, settings: RenderSettings) -> HeadlessFrame {
+    let scene = scene.clone();
     let frame = render_headless(SIZE, 1, move |app| {
         app.insert_resource(settings).add_systems(Startup, move |mut commands: Commands| {
             spawn_scene(&mut commands, &scene, true, SIZE.x as f32 / SIZE.y as f32);
-            let at = Transform::from_translation(LIGHT);
-            match kind {
-                Kind::Point => {
-                    let light = PointLight {
-                        intensity: 150.0,
-                        range: 8.0,
-                        shadows_enabled: shadows,
-                        ..Default::default()
-                    };
-                    commands.spawn((at, light));
-                }
-                Kind::Spot => {
-                    let light = SpotLight {
-                        intensity: 150.0,
-                        range: 8.0,
-                        inner_angle: 0.9,
-                        outer_angle: 1.2,
-                        shadows_enabled: shadows,
-                        ..Default::default()
-                    };
-                    commands.spawn((at.looking_to(Vec3::NEG_Y, Vec3::Z), light));
-                }
-                Kind::Directional => {
-                    let light =
-                        DirectionalLight { illuminance: 3.0, shadows_enabled: shadows, ..Default::default() };
-                    commands.spawn((Transform::default().looking_to(SUN, Vec3::Z), light));
-                }
-            }
+            spawn(&mut commands, shadows);
         });
     })
     .unwrap_or_else(|e| panic!("render failed: {e}"));
@@ -209,15 +215,7 @@ fn visibility_error(
 fn a_plate_shadows_the_floor_where_the_oracle_says_for_every_light_kind() {
     let _gpu = gpu();
     let naive = RenderSettings { pipeline: PipelineKind::NaiveForward, ..RenderSettings::default() };
-    let ambient = {
-        let scene = plate_scene();
-        render_headless(SIZE, 1, move |app| {
-            app.insert_resource(naive).add_systems(Startup, move |mut commands: Commands| {
-                spawn_scene(&mut commands, &scene, true, SIZE.x as f32 / SIZE.y as f32);
-            });
-        })
-        .expect("the unlit scene renders")
-    };
+    let ambient = render_scene(&plate_scene(), |_, _| {}, false, naive);
     for kind in [Kind::Point, Kind::Spot, Kind::Directional] {
         let on = render(kind, true, naive);
         let off = render(kind, false, naive);
@@ -291,22 +289,10 @@ fn a_light_that_starts_and_stops_casting_renders_every_frame() {
     assert_similar("toggled shadows", &always.image, &toggled.image, STRICT);
 }
 
-/// Spawns a hard case's light, casting or not.
-type SpawnLight = fn(&mut Commands, bool);
-
 /// `scene` with the light `spawn` makes, through naive forward.
 fn render_case(scene: &Scene, spawn: SpawnLight, shadows: bool) -> HeadlessFrame {
-    let scene = scene.clone();
     let naive = RenderSettings { pipeline: PipelineKind::NaiveForward, ..RenderSettings::default() };
-    let frame = render_headless(SIZE, 1, move |app| {
-        app.insert_resource(naive).add_systems(Startup, move |mut commands: Commands| {
-            spawn_scene(&mut commands, &scene, true, SIZE.x as f32 / SIZE.y as f32);
-            spawn(&mut commands, shadows);
-        });
-    })
-    .unwrap_or_else(|e| panic!("render failed: {e}"));
-    support::assert_finite(&frame);
-    frame
+    render_scene(scene, spawn, shadows, naive)
 }
 
 /// A light where shadow maps usually break, checked against the oracle.
