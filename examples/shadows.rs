@@ -101,10 +101,11 @@ fn run_headless(lights: usize, out_dir: PathBuf) -> anyhow::Result<()> {
         println!("{} ({} lights, frame {:.1} ms GPU)", path.display(), report.light_count, gpu_ms[i]);
         if let Some(s) = report.shadows {
             println!(
-                "  {} casting lights: {} maps, {} unseen; atlas {}x{} {:.0} % used; {} lights got smaller \
-                 maps than asked, {} none",
+                "  {} casting lights: {} maps drawn, {} cached, {} unseen; atlas {}x{} {:.0} % used; {} \
+                 lights got smaller maps than asked, {} none",
                 s.casting_lights,
                 s.maps_rendered,
+                s.maps_cached,
                 s.unseen_lights,
                 s.atlas_size,
                 s.atlas_size,

@@ -52,6 +52,19 @@ fn vs_main(@location(0) position: vec3<f32>, @builtin(instance_index) draw_index
     return out;
 }
 
+// Clears face `face_index`'s tile to the far depth (0: reverse depth) before it is drawn
+// again while the atlas keeps other maps: two triangles over the face's square.
+@vertex
+fn vs_clear(@builtin(vertex_index) corner: u32, @builtin(instance_index) face_index: u32) -> @builtin(position) vec4<f32> {
+    let corners = array<vec2<f32>, 6>(
+        vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, -1.0), vec2<f32>(-1.0, 1.0),
+        vec2<f32>(-1.0, 1.0), vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0),
+    );
+    let c = corners[corner % 6u];
+    let atlas = shadow_faces[face_index].atlas;
+    return vec4<f32>(c.x * atlas.x + atlas.y, c.y * atlas.z + atlas.w, 0.0, 1.0);
+}
+
 //!if CLIP_DISTANCES
 //!else
 @fragment

@@ -30,5 +30,5 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         probed[i] = 1.0;
         return;
     }
-    probed[i] = shadow_visibility(k, lights[k].position_radius.xyz, probe.position, probe.normal);
+    probed[i] = shadow_visibility(k, probe.position, probe.normal);
 }

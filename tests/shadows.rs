@@ -536,3 +536,129 @@ fn the_shadow_debug_views_show_the_atlas_and_the_resolution() {
         assert!(none.image.pixels().all(|p| *p == first), "{mode:?} without shadows is not the background");
     }
 }
+
+/// Three casting lights over the plate scene, each moved `shift` along x: one above the plate
+/// (its map holds the plate) and two in far corners whose spheres miss it.
+fn three_lights(shift: f32) -> Vec<manylight::render::ExtractedPointLight> {
+    [Vec3::new(0.0, 2.0, 0.0), Vec3::new(-3.0, 0.5, -3.0), Vec3::new(3.0, 0.5, -3.0)]
+        .into_iter()
+        .map(|at| manylight::render::ExtractedPointLight {
+            position: at + Vec3::X * shift,
+            color: Vec3::ONE,
+            intensity: 4.0,
+            radius: if at.y > 1.0 { 3.0 } else { 1.0 },
+            spot: None,
+            shadow: Some(manylight::render::ShadowBias::POINT),
+        })
+        .collect()
+}
+
+/// One frame of `scene` lit by `lights` on `renderer`: its shadow report and image.
+fn frame_of(
+    renderer: &mut manylight::app::render_world::HeadlessRenderer,
+    scene: &Scene,
+    lights: Vec<manylight::render::ExtractedPointLight>,
+    settings: manylight::render::FrameSettings,
+    frame: u64,
+) -> (manylight::render::ShadowReport, image::RgbaImage) {
+    let snapshot = manylight::app::scene::scene_snapshot(scene, lights, SIZE, settings, frame);
+    let (report, image) = renderer.render(snapshot, true).expect("the frame renders");
+    (report.shadows.expect("a shadow report"), image.expect("the image"))
+}
+
+/// The image of `scene` lit by `lights` from a renderer of its own, every map drawn.
+fn drawn_anew(scene: &Scene, lights: Vec<manylight::render::ExtractedPointLight>) -> image::RgbaImage {
+    let mut renderer = manylight::app::render_world::HeadlessRenderer::new().expect("a GPU");
+    let mut settings = manylight::render::FrameSettings::default();
+    settings.render.shadows.cache_maps = false;
+    frame_of(&mut renderer, scene, lights, settings, 0).1
+}
+
+/// Still lights keep their maps (no draw, the same image); a caster that moves draws again only
+/// the map it is in, and the frame is the one every map drawn anew gives.
+#[test]
+fn still_lights_keep_their_maps_and_a_moving_caster_redraws_only_its_light() {
+    let _gpu = gpu();
+    let scene = plate_scene();
+    let settings = manylight::render::FrameSettings::default();
+    let mut renderer = manylight::app::render_world::HeadlessRenderer::new().expect("a GPU");
+    let (first, first_image) = frame_of(&mut renderer, &scene, three_lights(0.0), settings, 0);
+    assert_eq!((first.maps_rendered, first.maps_cached, first.unseen_lights), (3, 0, 0), "{first:?}");
+    let (second, second_image) = frame_of(&mut renderer, &scene, three_lights(0.0), settings, 1);
+    assert_eq!((second.maps_rendered, second.maps_cached, second.instance_faces), (0, 3, 0), "{second:?}");
+    assert_eq!(first_image, second_image, "cached maps change the image");
+
+    let mut moved = scene.clone();
+    moved.instances[1].transform = Mat4::from_translation(Vec3::new(0.3, 1.0, 0.0));
+    let (third, third_image) = frame_of(&mut renderer, &moved, three_lights(0.0), settings, 2);
+    assert_eq!((third.maps_rendered, third.maps_cached, third.maps_stale), (1, 2, 0), "{third:?}");
+    assert_similar("cached_maps_moved_plate", &drawn_anew(&moved, three_lights(0.0)), &third_image, STRICT);
+}
+
+/// Past the redraw budget, changed maps keep an earlier frame's map, counted (new lights are
+/// drawn whatever the budget); once the lights stop, every map is drawn again within as many
+/// frames as it takes, and the frame is the one every map drawn anew gives.
+#[test]
+fn a_redraw_budget_keeps_the_rest_stale_and_catches_up() {
+    let _gpu = gpu();
+    let scene = plate_scene();
+    let mut settings = manylight::render::FrameSettings::default();
+    settings.render.shadows.max_redrawn_maps = Some(1);
+    let mut renderer = manylight::app::render_world::HeadlessRenderer::new().expect("a GPU");
+    let counts = |s: manylight::render::ShadowReport| (s.maps_rendered, s.maps_cached, s.maps_stale);
+    let mut frame = |shift: f32, f: u64| frame_of(&mut renderer, &scene, three_lights(shift), settings, f);
+    assert_eq!(counts(frame(0.0, 0).0), (3, 0, 0));
+    assert_eq!(counts(frame(0.1, 1).0), (1, 0, 2));
+    assert_eq!(counts(frame(0.1, 2).0), (1, 1, 1));
+    assert_eq!(counts(frame(0.1, 3).0), (1, 2, 0));
+    let (last, image) = frame(0.1, 4);
+    assert_eq!(counts(last), (0, 3, 0));
+    assert_similar("redraw_budget_caught_up", &drawn_anew(&scene, three_lights(0.1)), &image, STRICT);
+}
+
+/// The plate scene seen by two cameras side by side (the same camera, each half the width),
+/// lit by the casting point light, each camera with its shadows checkbox as given.
+fn two_cameras(left: bool, right: bool) -> HeadlessFrame {
+    let half = UVec2::new(SIZE.x / 2, SIZE.y);
+    let frame = render_headless(SIZE, 1, move |app| {
+        app.add_systems(Startup, move |mut commands: Commands| {
+            spawn_scene(&mut commands, &plate_scene(), false, 1.0);
+            point_at(&mut commands, LIGHT, 8.0, true);
+            for (x, shadows) in [(0, left), (half.x, right)] {
+                let viewport = Viewport { physical_position: UVec2::new(x, 0), physical_size: half };
+                commands.spawn((
+                    Transform::from_matrix(camera_looking_at(EYE, Vec3::ZERO)),
+                    Camera3d,
+                    Camera { viewport: Some(viewport), order: x as isize, ..default() },
+                    CameraShadows { enabled: shadows },
+                ));
+            }
+        });
+    })
+    .unwrap_or_else(|e| panic!("render failed: {e}"));
+    support::assert_finite(&frame);
+    frame
+}
+
+/// Each camera has its own shadows checkbox: the camera whose box is off shades unshadowed and
+/// the other keeps its shadows (the maps drawn once for the frame); with every box off the
+/// frame draws no map.
+#[test]
+fn each_camera_has_its_own_shadows_checkbox() {
+    let _gpu = gpu();
+    let half = |frame: &HeadlessFrame, right: bool| {
+        let x = if right { SIZE.x / 2 } else { 0 };
+        image::imageops::crop_imm(&frame.image, x, 0, SIZE.x / 2, SIZE.y).to_image()
+    };
+    let both = two_cameras(true, true);
+    let mixed = two_cameras(true, false);
+    let none = two_cameras(false, false);
+    assert_eq!(half(&both, false), half(&both, true), "the two cameras see the same image");
+    assert_eq!(half(&mixed, false), half(&both, false), "the camera with shadows lost them");
+    assert_eq!(half(&mixed, true), half(&none, true), "the camera without shadows shades with them");
+    assert_ne!(half(&mixed, true), half(&mixed, false), "the plate casts no shadow");
+    let report = |f: &HeadlessFrame| f.stats.last.clone().expect("a report");
+    let mixed_shadows = report(&mixed).shadows.expect("a shadow report");
+    assert_eq!(mixed_shadows.maps_rendered, 1, "{mixed_shadows:?}");
+    assert!(report(&none).shadows.is_none() && !report(&none).passes.iter().any(|p| p.name == "shadow_maps"));
+}

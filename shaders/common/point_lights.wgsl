@@ -22,7 +22,7 @@ fn shade_light(s: SurfaceParams, position: vec3<f32>, view_dir: vec3<f32>, k: u3
     // Only a light that adds something (in front of the surface, inside its cone) pays for the
     // map lookup.
     if any(radiance > vec3<f32>(0.0)) {
-        return radiance * shadow_visibility(k, lights[k].position_radius.xyz, position, s.normal);
+        return radiance * shadow_visibility(k, position, s.normal);
     }
 //!endif
     return radiance;

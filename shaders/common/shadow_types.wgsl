@@ -10,6 +10,9 @@ struct GpuShadowLight {
     // x: near plane, y: far plane (the light's range), z: depth bias (world units),
     // w: normal bias (face texels)
     params: vec4<f32>,
+    // xyz: where the light was when its map was drawn (the test's origin; an earlier frame's
+    // position for a map kept past the frame's redraw budget), w: 0
+    origin: vec4<f32>,
 };
 
 // Rust: `GpuCascade`.

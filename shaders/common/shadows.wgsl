@@ -18,17 +18,19 @@ fn shadow_face_depth(depth: f32, near: f32, far: f32) -> f32 {
     return near * (far - depth) / (depth * (far - near));
 }
 
-// How much of light `k` (at `light_position`) reaches `position` past the shadow casters, in
-// [0, 1]: its shadow map's 2×2 comparison-filtered test, or 1 when it has none. `normal` is
-// the surface's; the test is made from a point pushed off the surface towards the light by
-// the normal bias (in face texels at this distance) and moved the depth bias nearer to it,
-// so a surface does not shadow itself.
-fn shadow_visibility(k: u32, light_position: vec3<f32>, position: vec3<f32>, normal: vec3<f32>) -> f32 {
+// How much of light `k` reaches `position` past the shadow casters, in [0, 1]: its shadow
+// map's 2×2 comparison-filtered test, or 1 when it has none. The test looks from where the
+// light was when its map was drawn (`origin`: the light's position unless the map was kept
+// past the frame's redraw budget). `normal` is the surface's; the test is made from a point
+// pushed off the surface towards the light by the normal bias (in face texels at this
+// distance) and moved the depth bias nearer to it, so a surface does not shadow itself.
+fn shadow_visibility(k: u32, position: vec3<f32>, normal: vec3<f32>) -> f32 {
     let shadow = shadow_lights[k];
     let size = shadow.tile.z;
     if size == 0u {
         return 1.0;
     }
+    let light_position = shadow.origin.xyz;
     let edge = f32(size);
     let to_light = light_position - position;
     // A face spans 90°: at distance d one of its texels is 2·d / edge wide.

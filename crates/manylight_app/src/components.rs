@@ -3,6 +3,8 @@
 use bevy_ecs::prelude::*;
 use glam::{Mat4, Quat, Vec3};
 use manylight_core::{MaterialData, MeshData};
+/// A camera's shadows checkbox (`enabled: false`: its view is shaded unshadowed).
+pub use manylight_render::settings::CameraShadows;
 /// How a directional light's shadow splits the view (Bevy's `CascadeShadowConfig`): a
 /// component on the light's entity.
 pub use manylight_render::settings::{CascadeShadowConfig, CascadeShadowConfigBuilder};

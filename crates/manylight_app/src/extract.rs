@@ -3,13 +3,14 @@
 
 use crate::backend::{RenderBackend, record_results};
 use crate::components::{
-    Bloom, Camera, Camera3d, CameraDebugView, CascadeShadowConfig, DirectionalLight, Exposure,
+    Bloom, Camera, Camera3d, CameraDebugView, CameraShadows, CascadeShadowConfig, DirectionalLight, Exposure,
     GlobalTransform, InheritedVisibility, LightAnimation, Material, Mesh3d, MotionBlur, PointLight,
     Projection, RenderTarget, SpotLight, Transform,
 };
 use crate::resources::{DebugView, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize};
 use bevy_app::AppExit;
 use bevy_ecs::prelude::*;
+use bevy_ecs::query::QueryData;
 use bevy_time::Time;
 use glam::Mat4;
 use manylight_core::{MaterialData, SpotCone, candela_from_lumens};
@@ -31,16 +32,27 @@ pub struct ExtractState {
 
 /// What extract reads of a camera: which one, placement, projection, target and order, and
 /// its opt-in effects.
-pub type CameraItem = (
-    Entity,
-    &'static GlobalTransform,
-    &'static Projection,
-    Option<&'static Camera>,
-    Option<&'static Bloom>,
-    Option<&'static MotionBlur>,
-    Option<&'static CameraDebugView>,
-    Option<&'static Exposure>,
-);
+#[derive(QueryData)]
+pub struct CameraItem {
+    /// The camera's entity (its last frame's matrix is kept by it).
+    pub entity: Entity,
+    /// Where it looks from.
+    pub transform: &'static GlobalTransform,
+    /// Its projection.
+    pub projection: &'static Projection,
+    /// Target, viewport, order and whether it is active (the default without one).
+    pub camera: Option<&'static Camera>,
+    /// Bloom on its image.
+    pub bloom: Option<&'static Bloom>,
+    /// Motion blur on its image.
+    pub motion_blur: Option<&'static MotionBlur>,
+    /// Its own debug view.
+    pub debug_view: Option<&'static CameraDebugView>,
+    /// Its exposure.
+    pub exposure: Option<&'static Exposure>,
+    /// Its shadows checkbox (shadows shown without one).
+    pub shadows: Option<&'static CameraShadows>,
+}
 
 /// What extract reads of a mesh entity (hidden ones are skipped).
 pub type MeshItem = (
@@ -77,8 +89,9 @@ pub fn build_snapshot(
     let mut views: Vec<ExtractedView> = Vec::with_capacity(cameras.iter().len());
     // Last frame's cameras; the map is rebuilt from this frame's, so removed ones go.
     let prev_cameras = std::mem::take(&mut state.prev_cameras);
-    for (entity, t, projection, camera, bloom, motion_blur, debug, exposure) in cameras.iter() {
-        let camera = camera.copied().unwrap_or_default();
+    for item in cameras.iter() {
+        let (entity, t) = (item.entity, item.transform);
+        let camera = item.camera.copied().unwrap_or_default();
         if !camera.is_active {
             continue;
         }
@@ -96,16 +109,17 @@ pub fn build_snapshot(
                     let (_, rotation, translation) = t.to_scale_rotation_translation();
                     Mat4::from_rotation_translation(rotation, translation)
                 },
-                projection: projection.params(),
+                projection: item.projection.params(),
                 prev_clip_from_world: None,
-                bloom: bloom.copied(),
-                motion_blur: motion_blur.copied(),
-                exposure: exposure.copied(),
+                bloom: item.bloom.copied(),
+                motion_blur: item.motion_blur.copied(),
+                exposure: item.exposure.copied(),
             },
             target,
             rect,
-            debug_view: debug.map(|d| d.0),
+            debug_view: item.debug_view.map(|d| d.0),
             order: camera.order,
+            shadows: item.shadows.is_none_or(|s| s.enabled),
         };
         // Last frame's camera at this frame's size: a resize alone moves no pixel, so motion
         // blur does not smear the first frame after one.

@@ -27,7 +27,7 @@ pub mod window;
 
 pub use backend::RenderFailed;
 pub use components::{
-    Bloom, Camera, Camera3d, CameraDebugView, CascadeShadowConfig, CascadeShadowConfigBuilder,
+    Bloom, Camera, Camera3d, CameraDebugView, CameraShadows, CascadeShadowConfig, CascadeShadowConfigBuilder,
     DirectionalLight, Exposure, GlobalTransform, InheritedVisibility, LightAnimation, Material, Mesh3d,
     MotionBlur, OrthographicProjection, PerspectiveProjection, PointLight, Projection, RenderImage,
     RenderTarget, SpotLight, Transform, Viewport, Visibility,
@@ -47,10 +47,10 @@ pub mod prelude {
     }
 
     pub use crate::components::{
-        Bloom, Camera, Camera3d, CameraDebugView, CascadeShadowConfig, CascadeShadowConfigBuilder,
-        DirectionalLight, Exposure, GlobalTransform, InheritedVisibility, LightAnimation, Material, Mesh3d,
-        MotionBlur, OrthographicProjection, PerspectiveProjection, PointLight, Projection, RenderImage,
-        RenderTarget, SpotLight, Transform, Viewport, Visibility,
+        Bloom, Camera, Camera3d, CameraDebugView, CameraShadows, CascadeShadowConfig,
+        CascadeShadowConfigBuilder, DirectionalLight, Exposure, GlobalTransform, InheritedVisibility,
+        LightAnimation, Material, Mesh3d, MotionBlur, OrthographicProjection, PerspectiveProjection,
+        PointLight, Projection, RenderImage, RenderTarget, SpotLight, Transform, Viewport, Visibility,
     };
     pub use crate::plugin::{ManyLightPlugin, ManyLightSet};
     pub use crate::resources::{

@@ -36,45 +36,42 @@ pub struct RenderSchedule;
 #[derive(Resource, Default)]
 pub struct CurrentSnapshot(pub FrameSnapshot);
 
-/// The view being rendered (its camera, image size and settings), whether the frame has
-/// lights to shade it with, whether it draws blended materials, and whether it brings its own
-/// per-pixel light lists (`FrameSnapshot::pixel_light_lists`), and whether a light casts a
-/// shadow (`FrameSnapshot::casts_shadows`).
+/// The view being rendered and what the frame holds that its plan depends on.
 #[derive(Resource, Clone, Copy, Debug)]
-pub struct CurrentView(pub RenderView, pub bool, pub bool, pub bool, pub bool);
+pub struct CurrentView {
+    /// Its camera, image size and settings (its shadows checkbox applied).
+    pub view: RenderView,
+    /// The frame has a valid light to shade with.
+    pub has_lights: bool,
+    /// The frame draws blended materials.
+    pub has_blended: bool,
+    /// The frame brings its own per-pixel light lists (`FrameSnapshot::pixel_light_lists`).
+    pub has_pixel_lists: bool,
+    /// The frame draws shadow maps (`FrameSnapshot::casts_shadows`) and this view shows them.
+    pub casts_shadows: bool,
+}
 
 impl CurrentView {
     /// View `index` of `snapshot`.
     pub fn of(snapshot: &FrameSnapshot, index: usize) -> CurrentView {
-        CurrentView(
-            snapshot.render_view(index),
-            snapshot.has_lights(),
-            snapshot.has_blended(),
-            snapshot.pixel_light_lists.is_some(),
-            snapshot.casts_shadows(),
-        )
-    }
-
-    fn has_lights(&self) -> bool {
-        self.1
-    }
-
-    fn has_blended(&self) -> bool {
-        self.2
-    }
-
-    fn has_pixel_lists(&self) -> bool {
-        self.3
+        let view = snapshot.render_view(index);
+        CurrentView {
+            casts_shadows: snapshot.casts_shadows() && view.settings.render.shadows.enabled,
+            view,
+            has_lights: snapshot.has_lights(),
+            has_blended: snapshot.has_blended(),
+            has_pixel_lists: snapshot.pixel_light_lists.is_some(),
+        }
     }
 
     /// The plan's inputs for this view.
     fn plan_inputs(&self, accumulation: wgpu::TextureFormat) -> PlanInputs<'_> {
         PlanInputs {
-            view: &self.0,
-            has_lights: self.has_lights(),
-            has_blended: self.has_blended(),
-            has_pixel_lists: self.has_pixel_lists(),
-            casts_shadows: self.4,
+            view: &self.view,
+            has_lights: self.has_lights,
+            has_blended: self.has_blended,
+            has_pixel_lists: self.has_pixel_lists,
+            casts_shadows: self.casts_shadows,
             accumulation,
         }
     }
@@ -381,9 +378,9 @@ impl RenderWorld {
             ViewTarget::Texture { .. } => manylight_render::HEADLESS_FORMAT,
         };
         self.view_images.retain(|&(w, h, f), _| {
-            plans
-                .iter()
-                .any(|p| !p.whole && (p.view.0.size.x, p.view.0.size.y, format_of(p.target)) == (w, h, f))
+            plans.iter().any(|p| {
+                !p.whole && (p.view.view.size.x, p.view.view.size.y, format_of(p.target)) == (w, h, f)
+            })
         });
         let mut cleared: Vec<ViewTarget> = Vec::with_capacity(plans.len());
         let mut reports = Vec::with_capacity(plans.len());
@@ -401,7 +398,7 @@ impl RenderWorld {
                 }
                 cleared.push(plan.target);
             }
-            let size = plan.view.0.size;
+            let size = plan.view.view.size;
             if size.x == 0 || size.y == 0 {
                 continue;
             }
@@ -413,7 +410,7 @@ impl RenderWorld {
                 copy_into(&gpu, image, target_view.texture(), rect)?;
             }
             let view_report = ViewReport {
-                index: plan.view.0.index,
+                index: plan.view.view.index,
                 order: plan.order,
                 target: target_name(plan.target),
                 width: size.x,
@@ -648,7 +645,7 @@ fn prepare(
     mut outcome: ResMut<FrameOutcome>,
 ) {
     let options = view.plan_inputs(manylight_render::resources::HDR_FORMAT).list_options();
-    if let Err(e) = renderer.0.prepare_view(&view.0, view.has_lights(), options) {
+    if let Err(e) = renderer.0.prepare_view(&view.view, view.has_lights, options) {
         outcome.error.get_or_insert(e);
     }
 }
@@ -676,7 +673,7 @@ fn execute(
     if outcome.error.is_some() {
         return;
     }
-    match renderer.0.execute(&graph.0, &snapshot.0, &view.0, &target.view, target.format) {
+    match renderer.0.execute(&graph.0, &snapshot.0, &view.view, &target.view, target.format) {
         Ok(report) => outcome.report = Some(report),
         Err(e) => outcome.error = Some(e),
     }

@@ -393,7 +393,7 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
          max_per_cluster,mean_per_non_empty,dropped_pairs,culling_ratio,transient_mib,cluster_buffer_mib,\
          list_entry_bound,tile_entries,tile_entry_bound,list_bound_cpu_ms,shading_ms,shading_vs_oracle,\
          coarse_tiles,coarse_entries,depth_bounded_ratio,cluster_depth_gpu_ms,light_refine_gpu_ms,\
-         zbinned_ratio,shadows,shadow_maps_rendered,shadow_maps_cached,shadow_atlas_bytes,shadow_gpu_ms,\
+         zbinned_ratio,shadows,shadow_maps_rendered,shadow_maps_cached,shadow_maps_stale,shadow_atlas_bytes,shadow_gpu_ms,\
          visibility_error,flip_vs_shadow_reference\n",
     );
     for r in rows {
@@ -410,7 +410,7 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
         let vs_oracle = shading.zip(oracle).filter(|&(_, o)| o > 0.0).map(|(s, o)| s / o);
         let _ = writeln!(
             out,
-            "\"{adapter}\",\"{scene}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "\"{adapter}\",\"{scene}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             match (r.oracle, r.pipeline.is_deferred()) {
                 (true, false) => "oracle-forward",
                 (true, true) => "oracle-deferred",
@@ -457,6 +457,7 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
             if r.shadows { "on" } else { "off" },
             r.last.shadows.map_or(0, |s| s.maps_rendered),
             r.last.shadows.map_or(0, |s| s.maps_cached),
+            r.last.shadows.map_or(0, |s| s.maps_stale),
             r.last.shadows.map_or(0, |s| s.atlas_bytes),
             pass_ms(&r.last, "shadow_maps"),
             r.shadow_accuracy.map_or(String::new(), |a| format!("{:.5}", a.visibility_error)),

@@ -127,8 +127,9 @@ struct ReportArgs {
     #[arg(long)]
     plot: Option<PathBuf>,
     /// The shadow section instead (`report`): shadow settings — none, atlas sizes, resolution
-    /// policies — every light casting, each with its frame time, visibility error and FLIP
-    /// against the shadow reference (`report_shadows.csv` and its figures with `--plot`).
+    /// policies, redraw budgets with moving lights, caching with still ones — every light
+    /// casting, each with its frame time, visibility error and FLIP against the shadow
+    /// reference (`report_shadows.csv` and its figures with `--plot`).
     #[arg(long)]
     shadows: bool,
 }
@@ -332,6 +333,14 @@ struct ShadowArgs {
     /// Edge of each cascade of a directional light (a power of two).
     #[arg(long, default_value_t = manylight_render::ShadowSettings::default().cascade_size)]
     shadow_cascade_size: u32,
+    /// `on` (default): a light's map is kept from the frame before when neither the light nor
+    /// the casters near it changed; `off`: every map is drawn every frame (the same image).
+    #[arg(long, default_value = "on", value_parser = parse_on_off, action = clap::ArgAction::Set)]
+    shadow_cache_maps: bool,
+    /// Most point or spot light maps drawn again per frame when their light or casters changed
+    /// (default: all); the least important others keep an earlier frame's map, counted.
+    #[arg(long)]
+    shadow_max_redrawn_maps: Option<u32>,
 }
 
 impl ShadowArgs {
@@ -344,6 +353,8 @@ impl ShadowArgs {
             min_face_size: self.shadow_min_face,
             resolution_scale: self.shadow_resolution_scale,
             cascade_size: self.shadow_cascade_size,
+            cache_maps: self.shadow_cache_maps,
+            max_redrawn_maps: self.shadow_max_redrawn_maps,
         };
         s.check_values()
             .map_err(|e| anyhow::anyhow!("--{}", e.replace("shadows.", "shadow-").replace('_', "-")))?;

@@ -420,22 +420,37 @@ fn csv(rows: &[ReportRow], scene: &str, size: UVec2, adapter: &str) -> Result<St
     Ok(String::from_utf8(w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?)?)
 }
 
+/// One setting of `report --shadows`.
+struct ShadowConfiguration {
+    name: String,
+    settings: FrameSettings,
+    /// The rig stands still (every frame at time 0): what caching keeps; otherwise it moves at
+    /// 60 frames a second and every map changes every frame.
+    still: bool,
+}
+
 /// The shadow settings `report --shadows` compares: none, then the atlas sizes and resolution
-/// policies (at the default atlas), every light of the scene and the rig casting.
-fn shadow_configurations(base: FrameSettings) -> Vec<(String, FrameSettings)> {
-    let with = |f: &dyn Fn(&mut manylight_render::ShadowSettings)| {
-        let mut s = base;
-        f(&mut s.render.shadows);
-        s
+/// policies (at the default atlas) with moving lights, then caching with still lights and the
+/// redraw budget with moving ones; every light of the scene and the rig casting.
+fn shadow_configurations(base: FrameSettings) -> Vec<ShadowConfiguration> {
+    let with = |name: &str, still: bool, f: &dyn Fn(&mut manylight_render::ShadowSettings)| {
+        let mut settings = base;
+        f(&mut settings.render.shadows);
+        ShadowConfiguration { name: name.to_string(), settings, still }
     };
     vec![
-        ("shadows off".to_string(), with(&|s| s.enabled = false)),
-        ("atlas 2048".into(), with(&|s| s.atlas_size = 2048)),
-        ("atlas 4096 (default)".into(), with(&|_| {})),
-        ("atlas 8192".into(), with(&|s| s.atlas_size = 8192)),
-        ("faces ×0.5".into(), with(&|s| s.resolution_scale = 0.5)),
-        ("faces ×2".into(), with(&|s| s.resolution_scale = 2.0)),
-        ("faces at most 128".into(), with(&|s| s.max_face_size = 128)),
+        with("shadows off", false, &|s| s.enabled = false),
+        with("atlas 2048", false, &|s| s.atlas_size = 2048),
+        with("atlas 4096 (default)", false, &|_| {}),
+        with("atlas 8192", false, &|s| s.atlas_size = 8192),
+        with("faces ×0.5", false, &|s| s.resolution_scale = 0.5),
+        with("faces ×2", false, &|s| s.resolution_scale = 2.0),
+        with("faces at most 128", false, &|s| s.max_face_size = 128),
+        with("at most 256 maps redrawn", false, &|s| s.max_redrawn_maps = Some(256)),
+        with("at most 64 maps redrawn", false, &|s| s.max_redrawn_maps = Some(64)),
+        with("still lights, shadows off", true, &|s| s.enabled = false),
+        with("still lights, maps cached (default)", true, &|_| {}),
+        with("still lights, no caching", true, &|s| s.cache_maps = false),
     ]
 }
 
@@ -470,19 +485,22 @@ pub fn shadows(
     let configs = shadow_configurations(base);
     let mut progress = Progress::new(configs.len() as u64, "shadow settings");
     let mut rows = Vec::new();
-    for (name, settings) in configs {
+    for ShadowConfiguration { name, settings, still } in configs {
         progress.set_message(name.clone());
         // A renderer each: the atlas never shrinks, so a setting after a larger one would draw
         // into (and clear) the larger atlas.
         let mut renderer = HeadlessRenderer::new()?;
         adapter = renderer.render_world.gpu().info.name.clone();
         let casting = |f: u64| {
-            let mut snap = snapshot(scene, &rig, 0.0, size, settings, f);
+            let time = if still { 0.0 } else { f as f32 / 60.0 };
+            let mut snap = snapshot(scene, &rig, time, size, settings, f);
             crate::direct::cast_every_shadow(&mut snap);
             snap
         };
         let (frame_ms, report, _) = measure_snapshots(&mut renderer, frames, casting)?;
-        let accuracy = crate::shadow_error::measure_shadows(&mut renderer, casting(0), &occluders)?;
+        // The frame after the timed ones, as caching and the budget leave it.
+        let accuracy =
+            crate::shadow_error::measure_shadows(&mut renderer, casting(u64::from(frames) + 1), &occluders)?;
         progress
             .step(|| format!("{name}: {frame_ms:.0} ms, visibility error {:.4}", accuracy.visibility_error));
         rows.push(ShadowRow { name, frame_ms, report, accuracy });
@@ -490,7 +508,8 @@ pub fn shadows(
     progress.finish();
     let context = format!(
         "{scene_name}, {lights} rig lights (and the scene's own) all casting, {}x{}, clustered forward, \
-         {adapter}; 2×2 comparison filter; every map drawn every frame (no caching)",
+         {adapter}; 2×2 comparison filter; lights moving at 60 frames a second unless still \
+         (× off: against the first row of the same motion); the last frame's figures",
         size.x, size.y
     );
     Ok(Report {
@@ -504,23 +523,28 @@ fn shadow_markdown(rows: &[ShadowRow], context: &str) -> String {
     let _ = writeln!(out, "{context}\n");
     let _ = writeln!(
         out,
-        "| setting | frame ms | × off | shadow pass ms | atlas MiB | maps / smaller than asked / none | visibility error | false shadow | light leak | FLIP vs shadow reference |"
+        "| setting | frame ms | × off | shadow pass ms | atlas MiB | maps drawn / cached / stale | smaller than asked / none | visibility error | false shadow | light leak | FLIP vs shadow reference |"
     );
-    let _ = writeln!(out, "|---|---:|---:|---:|---:|---|---:|---:|---:|---:|");
-    let off_ms = rows.first().map_or(f64::NAN, |r| r.frame_ms);
+    let _ = writeln!(out, "|---|---:|---:|---:|---:|---|---|---:|---:|---:|---:|");
+    let mut off_ms = f64::NAN;
     for r in rows {
+        if !r.report.shadows.is_some_and(|s| s.casting_lights > 0) {
+            off_ms = r.frame_ms;
+        }
         let s = r.report.shadows.unwrap_or_default();
         let pass = r.report.passes.iter().find(|p| p.name == "shadow_maps").and_then(|p| p.gpu_ms);
         let a = &r.accuracy;
         let _ = writeln!(
             out,
-            "| {} | {:.0} | {:.2}× | {} | {:.0} | {} / {} / {} | {:.4} | {:.4} | {:.4} | {:.4} |",
+            "| {} | {:.0} | {:.2}× | {} | {:.0} | {} / {} / {} | {} / {} | {:.4} | {:.4} | {:.4} | {:.4} |",
             r.name,
             r.frame_ms,
             r.frame_ms / off_ms,
             pass.map_or("–".to_string(), |ms| format!("{ms:.0}")),
             crate::bench::mib(s.atlas_bytes),
             s.maps_rendered,
+            s.maps_cached,
+            s.maps_stale,
             s.downgraded_lights,
             s.dropped_lights,
             a.visibility_error,
@@ -546,6 +570,8 @@ fn shadow_csv(rows: &[ShadowRow], scene: &str, size: UVec2, adapter: &str) -> Re
             "false_shadow",
             "light_leak",
             "shadow_maps_rendered",
+            "shadow_maps_cached",
+            "shadow_maps_stale",
             "shadow_atlas_bytes",
             "downgraded_lights",
             "dropped_lights",
@@ -566,6 +592,8 @@ fn shadow_csv(rows: &[ShadowRow], scene: &str, size: UVec2, adapter: &str) -> Re
             format!("{:.6}", a.false_shadow),
             format!("{:.6}", a.light_leak),
             s.maps_rendered.to_string(),
+            s.maps_cached.to_string(),
+            s.maps_stale.to_string(),
             s.atlas_bytes.to_string(),
             s.downgraded_lights.to_string(),
             s.dropped_lights.to_string(),

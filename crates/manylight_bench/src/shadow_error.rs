@@ -73,11 +73,14 @@ pub fn measure_shadows(
 ) -> Result<ShadowAccuracy> {
     let camera = *snapshot.camera().context("the frame has no camera to measure")?;
     let size = snapshot.viewport.max(UVec2::ONE);
+    // The oracle's lists come from a render without shadows (its depth is the same), so the
+    // atlas and light table the probes read are the measured frame's: the frame after the
+    // renderer's last one, as the caching and the redraw budget left it.
+    let mut unshadowed = snapshot.clone();
+    unshadowed.settings.shadows.enabled = false;
+    let (oracle, _) = oracle_snapshot(renderer, unshadowed)?;
     let (_, frame) = renderer.render(snapshot.clone(), true)?;
     let image = frame.context("the frame was not read back")?;
-    // The oracle's render leaves the same shadow atlas as the frame's (the plan depends on the
-    // lights and the camera only), which the probes read.
-    let (oracle, _) = oracle_snapshot(renderer, snapshot.clone())?;
     let lists = oracle.pixel_light_lists.clone().context("the oracle made no lists")?;
     let lights: Vec<&ExtractedPointLight> =
         manylight_render::lights::buffered_lights(&snapshot.lights).map(|(_, l)| l).collect();

@@ -254,6 +254,9 @@ pub struct GpuShadowLight {
     /// x: the faces' near plane, y: their far plane (the light's range), z: depth bias (world
     /// units along the ray), w: normal bias (texels of the face at the receiver).
     pub params: [f32; 4],
+    /// xyz: where the light was when its map was drawn, the origin of the test (an earlier
+    /// frame's position for a map kept past `ShadowSettings::max_redrawn_maps`); w: 0.
+    pub origin: [f32; 4],
 }
 
 /// One cube face of a shadow map as the shadow pass draws it (`GpuShadowFace` in

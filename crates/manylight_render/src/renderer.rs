@@ -120,6 +120,9 @@ impl Renderer {
         options: crate::clusters::ListOptions,
     ) -> Result<(), RenderError> {
         self.scene.prepare_view(&self.gpu, view);
+        // A view whose camera's shadows checkbox is off binds and shades without shadows.
+        let shadows = self.shadows.bindings().filter(|_| view.settings.render.shadows.enabled);
+        self.scene.bind_view(&self.gpu, shadows);
         if view.needs_clusters(has_lights) {
             if self.clusters.len() <= view.index {
                 self.clusters.resize_with(view.index + 1, || None);

@@ -185,6 +185,8 @@ pub struct Draw {
     pub center: glam::Vec3,
     /// World-space box around the mesh's bounds (the shadow pass culls with it).
     pub world_bounds: manylight_core::Aabb,
+    /// The instance's transform (a cached shadow map is drawn again when it changes).
+    pub world_from_local: Mat4,
 }
 
 /// Layout of group 0 of every scene pass: the view uniform (0), the point and spot lights (1),
@@ -260,6 +262,9 @@ pub struct ShadowBindings<'a> {
     pub generation: u64,
 }
 
+/// A group 0 and the generations of the buffers (lights, instances, shadows) it was made from.
+type BoundView = ((u64, u64, u64), wgpu::BindGroup);
+
 /// Scene data on the GPU for the current frame.
 pub struct SceneResources {
     /// Layout of group 0 this frame: view uniform, lights, instances, and the shadow bindings
@@ -323,7 +328,8 @@ pub struct SceneResources {
     /// The adapter filters anisotropically (`DownlevelFlags::ANISOTROPIC_FILTERING`).
     anisotropic: bool,
     frame: u64,
-    bound_generations: (u64, u64, u64),
+    /// Group 0 without (0) and with (1) the shadow bindings.
+    bound: [Option<BoundView>; 2],
     max_texture_size: u32,
     uploads: u64,
 }
@@ -460,7 +466,7 @@ impl SceneResources {
             samplers: HashMap::new(),
             anisotropic,
             frame: 0,
-            bound_generations: (0, 0, 0),
+            bound: [None, None],
             max_texture_size: gpu.max_texture_size(),
             uploads: 0,
         }
@@ -500,9 +506,11 @@ impl SceneResources {
         })
     }
 
-    /// Binds group 0 for the frame (after [`SceneResources::prepare`] and the shadows'
-    /// `prepare`): with the shadow atlas, its sampler and light table when `shadows` is active,
-    /// else without them. Re-created only when a buffer, the atlas or the shadow state changed.
+    /// Binds group 0 for a view (after [`SceneResources::prepare`] and the shadows'
+    /// `prepare`): with the shadow atlas, its sampler and light table when `shadows` is given,
+    /// else without them. A group with and one without are kept, so views that differ only in
+    /// their shadows checkbox switch between them; each is re-created only when a buffer or
+    /// the atlas changed.
     pub fn bind_view(&mut self, gpu: &GpuContext, shadows: Option<ShadowBindings<'_>>) {
         let active = shadows.is_some();
         let generations = (
@@ -510,21 +518,24 @@ impl SceneResources {
             self.instances.generation(),
             shadows.as_ref().map_or(0, |s| s.generation + 1),
         );
-        if generations == self.bound_generations {
-            return;
+        let layout = if active { &self.shadowed_view_layout } else { &self.plain_view_layout };
+        let slot = &mut self.bound[usize::from(active)];
+        if slot.as_ref().is_none_or(|(g, _)| *g != generations) {
+            let group = Self::make_view_bind_group(
+                gpu,
+                layout,
+                &self.view_buffer,
+                &self.lights,
+                &self.instances,
+                shadows.as_ref(),
+            );
+            *slot = Some((generations, group));
+        }
+        if let Some((_, group)) = slot {
+            self.view_bind_group = group.clone();
         }
         self.shadows_active = active;
-        self.view_layout =
-            if active { self.shadowed_view_layout.clone() } else { self.plain_view_layout.clone() };
-        self.view_bind_group = Self::make_view_bind_group(
-            gpu,
-            &self.view_layout,
-            &self.view_buffer,
-            &self.lights,
-            &self.instances,
-            shadows.as_ref(),
-        );
-        self.bound_generations = generations;
+        self.view_layout = layout.clone();
     }
 
     /// Writes the view constants of `view` (before each view's submission: the views of a
@@ -635,7 +646,16 @@ impl SceneResources {
             let center = inst.world_from_local.transform_point3(local_center);
             let instance = instance_data.len() as u32;
             let world_bounds = local_bounds.transformed(&inst.world_from_local);
-            self.draws.push(Draw { mesh, material, instance, order, variant, center, world_bounds });
+            self.draws.push(Draw {
+                mesh,
+                material,
+                instance,
+                order,
+                variant,
+                center,
+                world_bounds,
+                world_from_local: inst.world_from_local,
+            });
             instance_data.push(gpu_instance);
         }
         self.draws.sort_by_key(|d| d.order);

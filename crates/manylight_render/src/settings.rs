@@ -163,6 +163,17 @@ pub struct ShadowSettings {
     /// Edge of each cascade of a directional light (a power of two; a light's cascades share
     /// one block of 3 × 2 tiles, so a smaller atlas gets smaller cascades).
     pub cascade_size: u32,
+    /// Keep a light's map from the frame before when nothing it holds changed: the light (its
+    /// position, range, block in the atlas and the faces a view meets) and the casters drawn
+    /// into it (their meshes and transforms). Cached maps cost no draw; turning this off draws
+    /// every map every frame (the same image).
+    pub cache_maps: bool,
+    /// Most point or spot light maps drawn again in a frame when their light or casters
+    /// changed (`None`: every one). The rest, least important (smallest on screen) first, keep
+    /// the map of an earlier frame and are tested from where their light was when it was drawn
+    /// (counted in [`ShadowReport::maps_stale`]). Lights new to the atlas or moved in it, and
+    /// directional lights, are always drawn.
+    pub max_redrawn_maps: Option<u32>,
 }
 
 impl Default for ShadowSettings {
@@ -174,6 +185,8 @@ impl Default for ShadowSettings {
             min_face_size: 16,
             resolution_scale: 1.0,
             cascade_size: 1024,
+            cache_maps: true,
+            max_redrawn_maps: None,
         }
     }
 }
@@ -211,7 +224,27 @@ impl ShadowSettings {
                 self.resolution_scale
             ));
         }
+        if self.max_redrawn_maps == Some(0) {
+            return Err("shadows.max_redrawn_maps must be at least 1 (None draws every changed map)".into());
+        }
         Ok(())
+    }
+}
+
+/// A camera's shadows checkbox: with `enabled: false` its view shades every light unshadowed
+/// (composed without shadow lookups or the atlas binding) while other cameras keep theirs; the
+/// frame draws no shadow map when no camera shows shadows. A camera without the component
+/// shows them. With the `bevy` feature it is a component of the camera's entity.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "bevy", derive(bevy_ecs::component::Component))]
+pub struct CameraShadows {
+    /// The view shows the shadows of the lights that cast them.
+    pub enabled: bool,
+}
+
+impl Default for CameraShadows {
+    fn default() -> Self {
+        CameraShadows { enabled: true }
     }
 }
 
@@ -221,7 +254,7 @@ pub struct ShadowReport {
     /// Lights that asked for a shadow.
     pub casting_lights: u32,
     /// Lights whose maps were drawn this frame (a point or spot light's six faces, a
-    /// directional light's cascades).
+    /// directional light's cascades); the others in the atlas are cached or stale.
     pub maps_rendered: u32,
     /// Cascades drawn for the directional lights.
     pub cascades_rendered: u32,
@@ -230,8 +263,13 @@ pub struct ShadowReport {
     pub unseen_lights: u32,
     /// Cube faces of mapped lights that no view sees: left undrawn (no visible pixel reads them).
     pub unseen_faces: u32,
-    /// Lights whose maps were kept from an earlier frame (maps are drawn every frame: 0).
+    /// Lights whose maps were kept from the frame before because nothing they hold changed
+    /// ([`ShadowSettings::cache_maps`]): no draw.
     pub maps_cached: u32,
+    /// Lights whose light or casters changed but whose map was kept from an earlier frame
+    /// because [`ShadowSettings::max_redrawn_maps`] were drawn already: tested from where the
+    /// light was when its map was drawn.
+    pub maps_stale: u32,
     /// (instance, face) pairs drawn.
     pub instance_faces: u32,
     /// Draw calls of the shadow pass (one per mesh).

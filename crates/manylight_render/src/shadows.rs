@@ -32,6 +32,10 @@ use crate::resources::SceneResources;
 use crate::snapshot::{ExtractedCamera, ExtractedDirectionalLight, FrameSnapshot};
 use glam::{Mat4, UVec2, Vec3, Vec4};
 use manylight_core::{Aabb, ProjectionKind};
+use std::collections::HashMap;
+use std::hash::{DefaultHasher, Hash, Hasher};
+use std::ops::Range;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Depth format of the shadow atlas.
 pub const SHADOW_ATLAS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -165,7 +169,7 @@ pub struct ShadowPlacement {
 /// The frame's atlas: every placed light, and what did not fit.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct AtlasPlan {
-    /// Placed lights, largest faces first.
+    /// Placed lights, largest faces first (then by light).
     pub placements: Vec<ShadowPlacement>,
     /// Atlas edge in texels.
     pub atlas_size: u32,
@@ -212,10 +216,10 @@ fn pack_rows(edges: impl Iterator<Item = u32>, atlas: u32) -> Option<Vec<(u32, u
 /// the least important lights left out. Cost: O(n log n) to sort, then O(n) per halving
 /// (at most log2 of the largest edge).
 pub fn plan_atlas(requests: &[ShadowRequest], max_atlas: u32, min_edge: u32) -> AtlasPlan {
+    // Largest first, then by light: a light keeps its block from frame to frame while the
+    // lights before it keep their edges, so its map can be cached.
     let mut order: Vec<ShadowRequest> = requests.to_vec();
-    order.sort_by(|a, b| {
-        b.edge.cmp(&a.edge).then(b.importance.total_cmp(&a.importance)).then(a.caster.cmp(&b.caster))
-    });
+    order.sort_by(|a, b| b.edge.cmp(&a.edge).then(a.caster.cmp(&b.caster)));
     let placed = |granted: &[u32], order: &[ShadowRequest], atlas: u32, spots: Vec<(u32, u32)>| AtlasPlan {
         placements: order
             .iter()
@@ -250,13 +254,11 @@ pub fn plan_atlas(requests: &[ShadowRequest], max_atlas: u32, min_edge: u32) -> 
         for g in granted.iter_mut().filter(|g| **g > min_edge) {
             *g /= 2;
         }
-        // Halving can reorder requests of equal granted edge only by importance, which the
-        // sort already follows within each asked edge; re-sort to keep rows largest first.
+        // Halving at the smallest edge brings lights of different asks together; re-sort to
+        // keep rows largest first.
         let mut paired: Vec<(ShadowRequest, u32)> =
             order.iter().copied().zip(granted.iter().copied()).collect();
-        paired.sort_by(|(a, ga), (b, gb)| {
-            gb.cmp(ga).then(b.importance.total_cmp(&a.importance)).then(a.caster.cmp(&b.caster))
-        });
+        paired.sort_by(|(a, ga), (b, gb)| gb.cmp(ga).then(a.caster.cmp(&b.caster)));
         order = paired.iter().map(|(r, _)| *r).collect();
         granted = paired.iter().map(|(_, g)| *g).collect();
         if pack_rows(granted.iter().copied(), atlas).is_some() {
@@ -272,6 +274,7 @@ pub fn plan_atlas(requests: &[ShadowRequest], max_atlas: u32, min_edge: u32) -> 
     let kept = order.len().min(capacity);
     let dropped = (order.len() - kept) as u32;
     order.truncate(kept);
+    order.sort_by_key(|r| r.caster);
     let granted = vec![min_edge; kept];
     let spots = pack_rows(granted.iter().copied(), atlas).unwrap_or_default();
     AtlasPlan { dropped, ..placed(&granted, &order, atlas, spots) }
@@ -293,11 +296,12 @@ pub fn frustum_planes(clip_from_world: &Mat4) -> [Vec4; 5] {
     [r3 + r0, r3 - r0, r3 + r1, r3 - r1, r3 - r2]
 }
 
-/// The frustums of every view of `snapshot` (each at its rectangle's aspect).
+/// The frustums of every view of `snapshot` that shows shadows (each at its rectangle's aspect).
 pub fn view_frustums(snapshot: &FrameSnapshot) -> Vec<[Vec4; 5]> {
     snapshot
         .views
         .iter()
+        .filter(|v| v.shadows)
         .map(|v| {
             let size = v.rect_in(v.target_size(snapshot.viewport)).size.max(UVec2::ONE);
             frustum_planes(&v.camera.clip_from_world(size))
@@ -346,11 +350,7 @@ fn grow_most_important(
 ) -> Vec<(u32, u32)> {
     let by_size = |g: &[u32], order: &[ShadowRequest]| {
         let mut idx: Vec<usize> = (0..order.len()).collect();
-        idx.sort_by(|&a, &b| {
-            g[b].cmp(&g[a])
-                .then(order[b].importance.total_cmp(&order[a].importance))
-                .then(order[a].caster.cmp(&order[b].caster))
-        });
+        idx.sort_by(|&a, &b| g[b].cmp(&g[a]).then(order[a].caster.cmp(&order[b].caster)));
         idx
     };
     for _ in 0..GROW_ROUNDS {
@@ -512,6 +512,58 @@ pub struct ShadowMeshDraws {
     pub count: u32,
 }
 
+/// What a map in the atlas holds, kept from the frame that drew it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct CachedMap {
+    /// Its block's top-left texel: a map is reused only where it lies.
+    x: u32,
+    y: u32,
+    /// Its face edge.
+    edge: u32,
+    /// Hash of the light and the casters it was drawn from.
+    content: u64,
+    /// The light table's entry it was drawn with (its origin and depth range).
+    light: GpuShadowLight,
+}
+
+/// What a placed map gets this frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum MapState {
+    /// Drawn (its tiles cleared first when other maps are kept).
+    Draw,
+    /// Unchanged since the frame before: kept.
+    Cached,
+    /// Changed, but past the redraw budget: the earlier map is kept.
+    Stale,
+}
+
+/// An opaque draw as the shadow pass sees it.
+struct OpaqueDraw<'a> {
+    draw: &'a crate::resources::Draw,
+    /// Index of its mesh's list of pairs.
+    slot: usize,
+    /// Hash of its mesh and transform.
+    content: u64,
+}
+
+/// A placed map's faces, casters and content, gathered before deciding whether to draw it.
+#[derive(Clone, Debug)]
+struct MapWork {
+    placement: ShadowPlacement,
+    content: u64,
+    /// The light table's entry (point and spot lights).
+    light: GpuShadowLight,
+    /// The directional table's entry and its index.
+    directional: Option<(u32, GpuDirectionalShadow)>,
+    /// Its faces in `ShadowResources::work_faces`.
+    faces: Range<usize>,
+    /// Its (mesh slot, pair with the face's index within the map) in
+    /// `ShadowResources::work_draws`.
+    draws: Range<usize>,
+    importance: f32,
+    state: MapState,
+}
+
 /// The shadow atlas and the buffers of its pass, kept across frames.
 pub struct ShadowResources {
     /// The atlas (created on the first frame with a casting light, grown when a frame needs a
@@ -545,6 +597,19 @@ pub struct ShadowResources {
     /// The device clamps depth instead of clipping it (`Features::DEPTH_CLIP_CONTROL`): the
     /// shadow pass clamps, so a cascade's depth range is its slice's sphere alone.
     pub clamps_depth: bool,
+    /// Some maps of the atlas are kept this frame: the pass loads the atlas and clears the
+    /// tiles it draws, instead of clearing the whole atlas.
+    pub clears_tiles: bool,
+    /// Faces drawn this frame: the first `faces_drawn` of `faces`.
+    pub faces_drawn: u32,
+    /// Set when a frame has maps to draw, taken by the first view's shadow pass.
+    pending_draw: AtomicBool,
+    /// The maps the atlas holds, by light.
+    cache: HashMap<ShadowCaster, CachedMap>,
+    next_cache: HashMap<ShadowCaster, CachedMap>,
+    work: Vec<MapWork>,
+    work_faces: Vec<GpuShadowFace>,
+    work_draws: Vec<(usize, GpuShadowDraw)>,
     max_texture: u32,
     gpu_lights: Vec<GpuShadowLight>,
     gpu_directional: Vec<GpuDirectionalShadow>,
@@ -599,6 +664,14 @@ impl ShadowResources {
             generation: 0,
             clip_distances: gpu.device.features().contains(wgpu::Features::CLIP_DISTANCES),
             clamps_depth: gpu.device.features().contains(wgpu::Features::DEPTH_CLIP_CONTROL),
+            clears_tiles: false,
+            faces_drawn: 0,
+            pending_draw: AtomicBool::new(false),
+            cache: HashMap::new(),
+            next_cache: HashMap::new(),
+            work: Vec::new(),
+            work_faces: Vec::new(),
+            work_draws: Vec::new(),
             max_texture: gpu.max_texture_size(),
             gpu_lights: Vec::new(),
             gpu_directional: vec![GpuDirectionalShadow::default(); MAX_DIRECTIONAL_LIGHTS as usize],
@@ -645,8 +718,15 @@ impl ShadowResources {
         snapshot: &FrameSnapshot,
     ) -> Result<(), RenderError> {
         let settings = snapshot.settings.shadows;
+        // Maps planned for a frame whose views drew none (no view shaded lights) are not in
+        // the atlas.
+        if self.pending_draw.swap(false, Ordering::Relaxed) {
+            self.cache.clear();
+        }
         self.report = ShadowReport::default();
         self.active = false;
+        self.clears_tiles = false;
+        self.faces_drawn = 0;
         self.mesh_draws.clear();
         if !snapshot.casts_shadows() {
             self.plan = AtlasPlan::default();
@@ -712,7 +792,8 @@ impl ShadowResources {
         for list in &mut self.by_mesh {
             list.1.clear();
         }
-        // Each opaque draw with the slot of its mesh's pairs, found once a frame.
+        // Each opaque draw with the slot of its mesh's pairs and a hash of what it draws (its
+        // mesh and transform), found once a frame.
         let mut opaque = Vec::new();
         for d in scene.draws.iter().filter(|d| !d.variant.blend) {
             let slot = match self.by_mesh.iter().position(|(m, _)| *m == d.mesh) {
@@ -722,32 +803,47 @@ impl ShadowResources {
                     self.by_mesh.len() - 1
                 }
             };
-            opaque.push((d, slot));
+            let mut hash = DefaultHasher::new();
+            d.mesh.hash(&mut hash);
+            d.world_from_local.to_cols_array().map(f32::to_bits).hash(&mut hash);
+            opaque.push(OpaqueDraw { draw: d, slot, content: hash.finish() });
         }
         // What a cascade's depth range must reach back to: every opaque draw.
         let mut casters = Aabb::EMPTY;
-        for (d, _) in &opaque {
-            if !d.world_bounds.is_empty() {
-                casters.extend(d.world_bounds.min);
-                casters.extend(d.world_bounds.max);
+        for o in &opaque {
+            if !o.draw.world_bounds.is_empty() {
+                casters.extend(o.draw.world_bounds.min);
+                casters.extend(o.draw.world_bounds.max);
             }
         }
         self.gpu_directional.fill(GpuDirectionalShadow::default());
+        let importance: HashMap<ShadowCaster, f32> =
+            self.requests.iter().map(|r| (r.caster, r.importance)).collect();
+
+        // Each placed map's faces, casters and content, before deciding whether to draw it.
+        let mut work = std::mem::take(&mut self.work);
+        work.clear();
+        self.work_faces.clear();
+        self.work_draws.clear();
         for p in &self.plan.placements {
-            let first_face = self.gpu_faces.len() as u32;
+            let (faces, draws) = (self.work_faces.len(), self.work_draws.len());
+            let mut content = DefaultHasher::new();
+            let mut light_entry = GpuShadowLight::default();
+            let mut directional_entry = None;
             match p.caster {
                 ShadowCaster::Point(k) => {
                     let light = lights[k as usize];
                     let bias = light.shadow.unwrap_or_default();
                     let far = light.radius;
                     let near = far * SHADOW_NEAR_FRACTION;
-                    self.gpu_lights[k as usize] = GpuShadowLight {
+                    light_entry = GpuShadowLight {
                         tile: [p.x, p.y, p.edge, 0],
                         params: [near, far, bias.depth, bias.normal],
+                        origin: light.position.extend(0.0).to_array(),
                     };
                     for face in 0..SHADOW_FACES {
                         let (tx, ty) = tile_of(p, face);
-                        self.gpu_faces.push(GpuShadowFace {
+                        self.work_faces.push(GpuShadowFace {
                             clip_from_world: face_clip_from_world(light.position, face, near, far),
                             atlas: tile_transform(tx, ty, p.edge, atlas),
                         });
@@ -757,15 +853,18 @@ impl ShadowResources {
                         .map(|face| face_in_view(&frustums, light.position, face, light.radius))
                         .collect();
                     self.report.unseen_faces += seen.iter().filter(|s| !**s).count() as u32;
-                    for &(d, slot) in &opaque {
-                        if !sphere_meets_box(center, radius, &d.world_bounds) {
+                    (light.position.to_array().map(f32::to_bits), far.to_bits(), &seen).hash(&mut content);
+                    for o in &opaque {
+                        if !sphere_meets_box(center, radius, &o.draw.world_bounds) {
                             continue;
                         }
                         for face in 0..SHADOW_FACES {
-                            if seen[face as usize] && box_meets_face(light.position, face, &d.world_bounds) {
-                                self.by_mesh[slot]
-                                    .1
-                                    .push(GpuShadowDraw { instance: d.instance, face: first_face + face });
+                            if seen[face as usize]
+                                && box_meets_face(light.position, face, &o.draw.world_bounds)
+                            {
+                                let draw = GpuShadowDraw { instance: o.draw.instance, face };
+                                self.work_draws.push((o.slot, draw));
+                                (o.content, face).hash(&mut content);
                             }
                         }
                     }
@@ -792,24 +891,112 @@ impl ShadowResources {
                             tile: [tx, ty, p.edge, 0],
                             params: [far, fit.texel, fit.depth_range, 0.0],
                         };
-                        self.gpu_faces.push(GpuShadowFace {
+                        self.work_faces.push(GpuShadowFace {
                             clip_from_world: fit.clip_from_world,
                             atlas: tile_transform(tx, ty, p.edge, atlas),
                         });
-                        for &(d, slot) in &opaque {
-                            if box_meets_clip(&fit.clip_from_world, &d.world_bounds) {
-                                self.by_mesh[slot].1.push(GpuShadowDraw {
-                                    instance: d.instance,
-                                    face: first_face + c as u32,
-                                });
+                        fit.clip_from_world.to_cols_array().map(f32::to_bits).hash(&mut content);
+                        for o in &opaque {
+                            if box_meets_clip(&fit.clip_from_world, &o.draw.world_bounds) {
+                                let draw = GpuShadowDraw { instance: o.draw.instance, face: c as u32 };
+                                self.work_draws.push((o.slot, draw));
+                                (o.content, c).hash(&mut content);
                             }
                         }
                     }
-                    self.gpu_directional[i as usize] = gpu;
-                    self.report.cascades_rendered += bounds.len() as u32;
+                    directional_entry = Some((i, gpu));
                 }
             }
+            work.push(MapWork {
+                placement: *p,
+                content: content.finish(),
+                light: light_entry,
+                directional: directional_entry,
+                faces: faces..self.work_faces.len(),
+                draws: draws..self.work_draws.len(),
+                importance: importance.get(&p.caster).copied().unwrap_or(0.0),
+                state: MapState::Draw,
+            });
         }
+
+        // Which maps to draw: a map whose block and content are unchanged is kept; past the
+        // redraw budget, the changed point and spot light maps least important keep theirs.
+        let budget = settings.max_redrawn_maps.map_or(usize::MAX, |n| n as usize);
+        let mut changed = Vec::new();
+        for (i, w) in work.iter_mut().enumerate() {
+            let p = w.placement;
+            let kept = self.cache.get(&p.caster).filter(|c| (c.x, c.y, c.edge) == (p.x, p.y, p.edge));
+            match kept {
+                Some(c) if settings.cache_maps && c.content == w.content => w.state = MapState::Cached,
+                Some(_) if matches!(p.caster, ShadowCaster::Point(_)) => changed.push(i),
+                _ => {}
+            }
+        }
+        if changed.len() > budget {
+            changed.sort_by(|&a, &b| {
+                work[b]
+                    .importance
+                    .total_cmp(&work[a].importance)
+                    .then(work[a].placement.caster.cmp(&work[b].placement.caster))
+            });
+            for &i in &changed[budget..] {
+                work[i].state = MapState::Stale;
+            }
+        }
+
+        self.next_cache.clear();
+        for w in &work {
+            let p = w.placement;
+            let mut entry = w.light;
+            match w.state {
+                MapState::Draw => {
+                    let first_face = self.gpu_faces.len() as u32;
+                    self.gpu_faces.extend_from_slice(&self.work_faces[w.faces.clone()]);
+                    for &(slot, d) in &self.work_draws[w.draws.clone()] {
+                        self.by_mesh[slot]
+                            .1
+                            .push(GpuShadowDraw { instance: d.instance, face: first_face + d.face });
+                    }
+                    self.report.maps_rendered += 1;
+                    if w.directional.is_some() {
+                        self.report.cascades_rendered += w.faces.len() as u32;
+                    }
+                    let map = CachedMap { x: p.x, y: p.y, edge: p.edge, content: w.content, light: w.light };
+                    self.next_cache.insert(p.caster, map);
+                }
+                MapState::Cached => {
+                    self.report.maps_cached += 1;
+                    let map = CachedMap { x: p.x, y: p.y, edge: p.edge, content: w.content, light: w.light };
+                    self.next_cache.insert(p.caster, map);
+                }
+                MapState::Stale => {
+                    // The map of an earlier frame, tested from where it was drawn with today's
+                    // biases.
+                    let Some(&map) = self.cache.get(&p.caster) else { continue };
+                    self.report.maps_stale += 1;
+                    entry = GpuShadowLight {
+                        params: [
+                            map.light.params[0],
+                            map.light.params[1],
+                            w.light.params[2],
+                            w.light.params[3],
+                        ],
+                        ..map.light
+                    };
+                    self.next_cache.insert(p.caster, map);
+                }
+            }
+            if let ShadowCaster::Point(k) = p.caster {
+                self.gpu_lights[k as usize] = entry;
+            }
+            if let Some((i, gpu)) = w.directional {
+                self.gpu_directional[i as usize] = gpu;
+            }
+        }
+        std::mem::swap(&mut self.cache, &mut self.next_cache);
+        self.clears_tiles = work.iter().any(|w| w.state != MapState::Draw);
+        self.work = work;
+
         // Meshes no longer drawn leave the list.
         self.by_mesh.retain(|(mesh, _)| scene.mesh(*mesh).is_some());
         let mut all = Vec::new();
@@ -826,7 +1013,9 @@ impl ShadowResources {
         }
         let mut grew = self.lights.write(gpu, bytemuck::cast_slice(&self.gpu_lights))?;
         grew |= self.directional.write(gpu, bytemuck::cast_slice(&self.gpu_directional))?;
-        grew |= self.faces.write(gpu, bytemuck::cast_slice(&self.gpu_faces))?;
+        if !self.gpu_faces.is_empty() {
+            grew |= self.faces.write(gpu, bytemuck::cast_slice(&self.gpu_faces))?;
+        }
         if !all.is_empty() {
             grew |= self.draws.write(gpu, bytemuck::cast_slice(&all))?;
         }
@@ -834,13 +1023,20 @@ impl ShadowResources {
             self.generation += 1;
         }
         self.active = true;
-        self.report.maps_rendered = self.plan.placements.len() as u32;
+        self.faces_drawn = self.gpu_faces.len() as u32;
+        self.pending_draw.store(self.faces_drawn > 0, Ordering::Relaxed);
         self.report.instance_faces = all.len() as u32;
         self.report.draw_calls = self.mesh_draws.len() as u32;
         self.report.atlas_size = atlas;
         self.report.atlas_bytes = u64::from(atlas).pow(2) * 4;
         self.report.atlas_occupancy = self.plan.occupancy(atlas);
         Ok(())
+    }
+
+    /// True once per frame whose maps need drawing: the first view's shadow pass draws them,
+    /// the frame's other views read them.
+    pub fn take_pending_draw(&self) -> bool {
+        self.pending_draw.swap(false, Ordering::Relaxed)
     }
 
     /// Creates the atlas, or a larger one, when `size` does not fit the current one.
@@ -863,6 +1059,8 @@ impl ShadowResources {
         self.atlas_view = Some(texture.create_view(&Default::default()));
         self.atlas = Some(texture);
         self.generation += 1;
+        // A new texture holds no map.
+        self.cache.clear();
     }
 }
 

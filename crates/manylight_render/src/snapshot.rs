@@ -607,12 +607,22 @@ pub struct ExtractedView {
     /// Render order (lower first, as Bevy's `Camera::order`); views with equal order keep
     /// their order in [`FrameSnapshot::views`]. Reported in [`crate::stats::ViewReport`].
     pub order: isize,
+    /// The view shows shadows (its camera's [`crate::CameraShadows`]); `false` shades it
+    /// unshadowed.
+    pub shadows: bool,
 }
 
 impl ExtractedView {
     /// A view of the whole main target through `camera`.
     pub fn main(camera: ExtractedCamera) -> ExtractedView {
-        ExtractedView { camera, target: ViewTarget::Main, rect: None, debug_view: None, order: 0 }
+        ExtractedView {
+            camera,
+            target: ViewTarget::Main,
+            rect: None,
+            debug_view: None,
+            order: 0,
+            shadows: true,
+        }
     }
 
     /// The size of the view's target, given the main target's.
@@ -761,6 +771,7 @@ impl FrameSnapshot {
         match self.views.get(index) {
             Some(view) => {
                 settings.debug_view = view.debug_view.unwrap_or(settings.debug_view);
+                settings.render.shadows.enabled &= view.shadows;
                 let size = view.rect_in(view.target_size(self.viewport)).size;
                 RenderView { index, camera: Some(view.camera), size, settings }
             }
@@ -813,10 +824,11 @@ impl FrameSnapshot {
         self.lights.iter().any(|l| l.is_valid())
     }
 
-    /// True when the frame draws shadow maps: shadows are enabled and a valid point or spot
-    /// light with a range, or a valid directional light, casts one.
+    /// True when the frame draws shadow maps: shadows are enabled, a view shows them, and a
+    /// valid point or spot light with a range, or a valid directional light, casts one.
     pub fn casts_shadows(&self) -> bool {
         self.settings.shadows.enabled
+            && self.views.iter().any(|v| v.shadows)
             && (self.lights.iter().any(|l| l.shadow.is_some() && l.is_valid() && l.radius > 0.0)
                 || self.directional_lights.iter().any(|l| l.shadow.is_some() && l.is_valid()))
     }

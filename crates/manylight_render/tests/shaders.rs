@@ -121,7 +121,11 @@ fn shared_structs_match_rust() {
         &shadowed,
         "GpuShadowLight",
         size_of::<GpuShadowLight>(),
-        &[("tile", offset_of!(GpuShadowLight, tile)), ("params", offset_of!(GpuShadowLight, params))],
+        &[
+            ("tile", offset_of!(GpuShadowLight, tile)),
+            ("params", offset_of!(GpuShadowLight, params)),
+            ("origin", offset_of!(GpuShadowLight, origin)),
+        ],
     );
     offsets(
         &shadowed,

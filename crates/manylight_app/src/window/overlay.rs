@@ -329,13 +329,24 @@ fn effects_ui(ui: &mut egui::Ui, world: &mut World) {
     }
 }
 
-/// The shadows switch, a switch that makes every light cast, and the last frame's counters.
+/// The frame's shadows switch, each camera's, a switch that makes every light cast, and the
+/// last frame's counters.
 fn shadows_ui(ui: &mut egui::Ui, world: &mut World) {
     if let Some(old) = world.get_resource::<RenderSettings>().copied() {
         let mut s = old;
         ui.checkbox(&mut s.shadows.enabled, "shadows (lights that cast, cast)");
         if s != old {
             *world.resource_mut::<RenderSettings>() = s;
+        }
+    }
+    // Each camera's own checkbox (its `CameraShadows`).
+    let mut cameras = world.query_filtered::<(Entity, Option<&crate::CameraShadows>), With<Camera3d>>();
+    let shown: Vec<(Entity, bool)> =
+        cameras.iter(world).map(|(e, s)| (e, s.is_none_or(|s| s.enabled))).collect();
+    for (i, (camera, enabled)) in shown.into_iter().enumerate() {
+        let mut on = enabled;
+        if ui.checkbox(&mut on, format!("camera {i} shows shadows")).changed() {
+            world.entity_mut(camera).insert(crate::CameraShadows { enabled: on });
         }
     }
     let mut q = world.query::<(
@@ -363,8 +374,14 @@ fn shadows_ui(ui: &mut egui::Ui, world: &mut World) {
     };
     let pass_ms = report.passes.iter().find(|p| p.name == "shadow_maps").and_then(|p| p.gpu_ms);
     ui.monospace(format!(
-        "{} casting, {} maps ({} cascades), {} unseen lights, {} unseen faces",
-        r.casting_lights, r.maps_rendered, r.cascades_rendered, r.unseen_lights, r.unseen_faces
+        "{} casting, maps {} drawn ({} cascades) / {} cached / {} stale, {} unseen lights, {} unseen faces",
+        r.casting_lights,
+        r.maps_rendered,
+        r.cascades_rendered,
+        r.maps_cached,
+        r.maps_stale,
+        r.unseen_lights,
+        r.unseen_faces
     ));
     ui.monospace(format!(
         "atlas {0}×{0} ({1:.0} MiB) {2:.0} % used, {3} instance-faces in {4} draws, {5}",

@@ -1,5 +1,6 @@
-//! The shadow pass: draws every casting light's cube faces into the shadow atlas
-//! ([`crate::shadows`]), one instanced draw per mesh over all (instance, face) pairs.
+//! The shadow pass: draws the casting lights' maps that changed into the shadow atlas
+//! ([`crate::shadows`]), one instanced draw per mesh over all (instance, face) pairs. When the
+//! atlas keeps other maps, it loads the atlas and first clears the tiles it draws.
 
 use super::SHADOW_ATLAS;
 use super::common::vertex_layout;
@@ -25,9 +26,12 @@ impl PipelineKey for ShadowMapsKey {
     type Pipeline = ShadowMapsPipeline;
 }
 
-/// The pipeline of [`ShadowMapsPass`] and the layout of its group 0 (faces, draws, instances).
+/// The pipelines of [`ShadowMapsPass`] and the layout of their group 0 (faces, draws,
+/// instances).
 pub struct ShadowMapsPipeline {
     pipeline: wgpu::RenderPipeline,
+    /// Clears the tiles of the faces drawn (`vs_clear`).
+    clear: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
 }
 
@@ -78,7 +82,29 @@ impl ShadowMapsPipeline {
             multiview_mask: None,
             cache: None,
         });
-        Ok(ShadowMapsPipeline { pipeline, layout })
+        let clear = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("shadow_clear"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_clear"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: SHADOW_ATLAS_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Always),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: None,
+            multiview_mask: None,
+            cache: None,
+        });
+        Ok(ShadowMapsPipeline { pipeline, clear, layout })
     }
 }
 
@@ -96,7 +122,8 @@ impl Pass for ShadowMapsPass {
         vec![SHADOW_ATLAS]
     }
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
-        let Some(shadows) = ctx.shadows.filter(|s| s.active) else {
+        // The first view of a frame draws its maps; the others read them.
+        let Some(shadows) = ctx.shadows.filter(|s| s.active && s.take_pending_draw()) else {
             return Ok(());
         };
         let Some(atlas) = shadows.atlas_view() else {
@@ -123,7 +150,8 @@ impl Pass for ShadowMapsPass {
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: atlas,
                 depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(0.0),
+                    // Reverse depth: 0 is the far plane, where nothing casts.
+                    load: if shadows.clears_tiles { wgpu::LoadOp::Load } else { wgpu::LoadOp::Clear(0.0) },
                     store: wgpu::StoreOp::Store,
                 }),
                 stencil_ops: None,
@@ -132,8 +160,12 @@ impl Pass for ShadowMapsPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&pipeline.pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
+        if shadows.clears_tiles {
+            pass.set_pipeline(&pipeline.clear);
+            pass.draw(0..6, 0..shadows.faces_drawn);
+        }
+        pass.set_pipeline(&pipeline.pipeline);
         for run in &shadows.mesh_draws {
             let Some(mesh) = scene.mesh(run.mesh) else {
                 continue;
