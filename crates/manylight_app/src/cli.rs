@@ -45,6 +45,22 @@ pub fn parse_on_off(s: &str) -> Result<bool, String> {
     }
 }
 
+/// Most shadow maps drawn again per frame (`ShadowSettings::max_redrawn_maps`): `None` for
+/// every changed map.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RedrawBudget(pub Option<u32>);
+
+/// A shadow map redraw budget: `all` (every changed map) or a count of at least 1.
+pub fn parse_redraw_budget(s: &str) -> Result<RedrawBudget, String> {
+    match s {
+        "all" => Ok(RedrawBudget(None)),
+        _ => match s.parse::<u32>() {
+            Ok(n) if n >= 1 => Ok(RedrawBudget(Some(n))),
+            _ => Err(format!("`{s}`: expected all or a count of maps of at least 1")),
+        },
+    }
+}
+
 /// `aabb`, `planes` or `both`.
 pub fn parse_cull(s: &str) -> Result<CullTest, String> {
     named("culling test", s, &CullTest::ALL, CullTest::name)

@@ -11,8 +11,8 @@ use manylight_app::FrameStats;
 use manylight_app::RenderSettings;
 use manylight_app::cli::{
     parse_ambient, parse_bloom_chain, parse_cull, parse_debug_view, parse_ev100, parse_exposure,
-    parse_gbuffer, parse_grid, parse_normal_codec, parse_on_off, parse_pipeline, parse_shading, parse_size,
-    parse_slicing,
+    parse_gbuffer, parse_grid, parse_normal_codec, parse_on_off, parse_pipeline, parse_redraw_budget,
+    parse_shading, parse_size, parse_slicing,
 };
 use manylight_app::headless::{render_headless, save_png};
 use manylight_app::scene::{spawn_light_rig, spawn_scene};
@@ -337,10 +337,10 @@ struct ShadowArgs {
     /// the casters near it changed; `off`: every map is drawn every frame (the same image).
     #[arg(long, default_value = "on", value_parser = parse_on_off, action = clap::ArgAction::Set)]
     shadow_cache_maps: bool,
-    /// Most point or spot light maps drawn again per frame when their light or casters changed
-    /// (default: all); the least important others keep an earlier frame's map, counted.
-    #[arg(long)]
-    shadow_max_redrawn_maps: Option<u32>,
+    /// Most point or spot light maps drawn again per frame when their light or casters changed,
+    /// or `all`; the least important others keep an earlier frame's map, counted.
+    #[arg(long, default_value = "256", value_parser = parse_redraw_budget)]
+    shadow_max_redrawn_maps: manylight_app::cli::RedrawBudget,
 }
 
 impl ShadowArgs {
@@ -354,7 +354,7 @@ impl ShadowArgs {
             resolution_scale: self.shadow_resolution_scale,
             cascade_size: self.shadow_cascade_size,
             cache_maps: self.shadow_cache_maps,
-            max_redrawn_maps: self.shadow_max_redrawn_maps,
+            max_redrawn_maps: self.shadow_max_redrawn_maps.0,
         };
         s.check_values()
             .map_err(|e| anyhow::anyhow!("--{}", e.replace("shadows.", "shadow-").replace('_', "-")))?;

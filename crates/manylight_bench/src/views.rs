@@ -7,7 +7,7 @@ use crate::bench::median;
 use crate::direct::{interleaved, snapshot};
 use anyhow::Result;
 use glam::{Mat4, UVec2};
-use manylight_render::{ExtractedView, FrameReport, FrameSettings, FrameSnapshot, ViewRect, ViewTarget};
+use manylight_render::{ExtractedView, FrameReport, FrameSettings, FrameSnapshot, ViewRect};
 use manylight_scene::{Scene, light_rig};
 use std::fmt::Write as _;
 
@@ -31,11 +31,9 @@ pub fn split(mut snap: FrameSnapshot, count: u32) -> FrameSnapshot {
             let mut c = camera;
             c.world_from_view = camera.world_from_view * Mat4::from_rotation_y(k as f32 * 0.6);
             ExtractedView {
-                camera: c,
-                target: ViewTarget::Main,
                 rect: Some(ViewRect { origin: UVec2::new(k % cols, k / cols) * cell, size: cell }),
-                debug_view: None,
                 order: k as isize,
+                ..ExtractedView::main(c)
             }
         })
         .collect();

@@ -4,6 +4,7 @@
 //! drive it directly. The app crate decides which passes a frame needs.
 #![warn(missing_docs)]
 
+pub mod atlas;
 pub mod bindings;
 pub mod clusters;
 pub mod context;

@@ -169,10 +169,12 @@ pub struct ShadowSettings {
     /// every map every frame (the same image).
     pub cache_maps: bool,
     /// Most point or spot light maps drawn again in a frame when their light or casters
-    /// changed (`None`: every one). The rest, least important (smallest on screen) first, keep
-    /// the map of an earlier frame and are tested from where their light was when it was drawn
-    /// (counted in [`ShadowReport::maps_stale`]). Lights new to the atlas or moved in it, and
-    /// directional lights, are always drawn.
+    /// changed (`None`: every one; default 256). The rest, least important (smallest on
+    /// screen) first, keep the map of an earlier frame and are tested from where their light
+    /// was when it was drawn (counted in [`ShadowReport::maps_stale`]). Lights new to the atlas
+    /// or moved in it, and directional lights, are always drawn. At 1 000 moving lights the
+    /// default draws a third of the maps a frame at the same visibility error as drawing all
+    /// (`manylight report --shadows`, docs/benchmarks.md, "Shadow settings").
     pub max_redrawn_maps: Option<u32>,
 }
 
@@ -186,7 +188,7 @@ impl Default for ShadowSettings {
             resolution_scale: 1.0,
             cascade_size: 1024,
             cache_maps: true,
-            max_redrawn_maps: None,
+            max_redrawn_maps: Some(256),
         }
     }
 }

@@ -21,6 +21,7 @@
 //! A frame without a casting light has no atlas, no shadow pass and no shadow binding: the
 //! shaders are composed without `SHADOWS` ([`crate::shaders::ShaderDefs`]).
 
+use crate::atlas::BlockAllocator;
 use crate::context::{GpuContext, RenderError};
 use crate::gpu_types::{
     GpuCascade, GpuDirectionalShadow, GpuShadowDraw, GpuShadowFace, GpuShadowLight, MAX_DIRECTIONAL_LIGHTS,
@@ -278,6 +279,76 @@ pub fn plan_atlas(requests: &[ShadowRequest], max_atlas: u32, min_edge: u32) -> 
     let granted = vec![min_edge; kept];
     let spots = pack_rows(granted.iter().copied(), atlas).unwrap_or_default();
     AtlasPlan { dropped, ..placed(&granted, &order, atlas, spots) }
+}
+
+/// Places `target`'s lights (their edges from [`plan_atlas`]) in `alloc`'s atlas so that each
+/// keeps its block from the frame before while that block's edge is at most its target and at
+/// least half of it; the others (new lights, lights whose edge moved further) get blocks, most
+/// important first, at their target edge or, where the atlas has no such block free, the
+/// largest free below it (counted as smaller than asked). When a light placed by `target`
+/// finds no block at all, every block is given back and all are placed anew, largest first.
+/// Lights `target` left out are released. Cost: O(n log n).
+pub fn place_stably(
+    alloc: &mut BlockAllocator<ShadowCaster>,
+    target: &AtlasPlan,
+    requests: &[ShadowRequest],
+) -> AtlasPlan {
+    let importance: HashMap<ShadowCaster, f32> = requests.iter().map(|r| (r.caster, r.importance)).collect();
+    let wanted: HashMap<ShadowCaster, u32> = target.placements.iter().map(|p| (p.caster, p.edge)).collect();
+    let held: Vec<ShadowCaster> = alloc.keys().collect();
+    for caster in held {
+        let keep = match (wanted.get(&caster), alloc.block_of(caster)) {
+            (Some(&edge), Some(block)) => block.edge <= edge && block.edge * 2 >= edge,
+            _ => false,
+        };
+        if !keep {
+            alloc.release(caster);
+        }
+    }
+    let mut order: Vec<&ShadowPlacement> = target.placements.iter().collect();
+    order.sort_by(|a, b| {
+        let (ia, ib) = (importance.get(&a.caster).unwrap_or(&0.0), importance.get(&b.caster).unwrap_or(&0.0));
+        ib.total_cmp(ia).then(a.caster.cmp(&b.caster))
+    });
+    let place = |alloc: &mut BlockAllocator<ShadowCaster>, p: &ShadowPlacement| {
+        let mut edge = p.edge.min(alloc.largest_edge());
+        while edge > 0 {
+            if alloc.allocate(p.caster, edge).is_some() {
+                return true;
+            }
+            edge /= 2;
+        }
+        false
+    };
+    let mut homeless = 0;
+    for p in &order {
+        if alloc.block_of(p.caster).is_none() && !place(alloc, p) {
+            homeless += 1;
+        }
+    }
+    if homeless > 0 {
+        // Fragmented: everything anew, largest first (blocks nest, so this packs as tightly as
+        // the root blocks allow).
+        let held: Vec<ShadowCaster> = alloc.keys().collect();
+        for caster in held {
+            alloc.release(caster);
+        }
+        order.sort_by(|a, b| b.edge.cmp(&a.edge).then(a.caster.cmp(&b.caster)));
+        homeless = order.iter().filter(|p| !place(alloc, p)).count();
+    }
+    let placements: Vec<ShadowPlacement> = target
+        .placements
+        .iter()
+        .filter_map(|p| {
+            alloc.block_of(p.caster).map(|b| ShadowPlacement { x: b.x, y: b.y, edge: b.edge, ..*p })
+        })
+        .collect();
+    AtlasPlan {
+        downgraded: placements.iter().filter(|p| p.edge < p.asked).count() as u32,
+        dropped: target.dropped + homeless as u32,
+        atlas_size: target.atlas_size.max(alloc.atlas()),
+        placements,
+    }
 }
 
 /// The largest atlas a frame may use: `requested`, or the largest power of two the device's
@@ -604,6 +675,8 @@ pub struct ShadowResources {
     pub faces_drawn: u32,
     /// Set when a frame has maps to draw, taken by the first view's shadow pass.
     pending_draw: AtomicBool,
+    /// Where each light's block lies, kept from frame to frame.
+    allocator: BlockAllocator<ShadowCaster>,
     /// The maps the atlas holds, by light.
     cache: HashMap<ShadowCaster, CachedMap>,
     next_cache: HashMap<ShadowCaster, CachedMap>,
@@ -667,6 +740,7 @@ impl ShadowResources {
             clears_tiles: false,
             faces_drawn: 0,
             pending_draw: AtomicBool::new(false),
+            allocator: BlockAllocator::new(0, 1),
             cache: HashMap::new(),
             next_cache: HashMap::new(),
             work: Vec::new(),
@@ -769,20 +843,25 @@ impl ShadowResources {
                 self.requests.push(ShadowRequest { caster, edge, importance: f32::MAX });
             }
         }
-        self.plan = plan_atlas(
-            &self.requests,
-            max_atlas,
-            settings.min_face_size.min(max_atlas / SHADOW_TILE_COLUMNS).max(1),
-        );
+        // Each light's edge from the whole frame's needs, then its place: where it was while
+        // its edge holds.
+        let min_edge = settings.min_face_size.min(max_atlas / SHADOW_TILE_COLUMNS).max(1);
+        let target = plan_atlas(&self.requests, max_atlas, min_edge);
         self.report.casting_lights = self.requests.len() as u32 + self.report.unseen_lights;
         self.report.atlas_limited_by_device = limited;
-        self.report.downgraded_lights = self.plan.downgraded;
-        self.report.dropped_lights = self.plan.dropped;
-        if self.plan.placements.is_empty() {
+        if target.placements.is_empty() {
+            self.report.dropped_lights = target.dropped;
+            self.plan = target;
             return Ok(());
         }
-        self.ensure_atlas(gpu, self.plan.atlas_size);
-        let atlas = self.atlas.as_ref().map_or(self.plan.atlas_size, |t| t.width());
+        self.ensure_atlas(gpu, target.atlas_size);
+        let atlas = self.atlas.as_ref().map_or(target.atlas_size, |t| t.width());
+        if !self.allocator.serves(atlas, min_edge) {
+            self.allocator = BlockAllocator::new(atlas, min_edge);
+        }
+        self.plan = place_stably(&mut self.allocator, &target, &self.requests);
+        self.report.downgraded_lights = self.plan.downgraded;
+        self.report.dropped_lights = self.plan.dropped;
 
         // The light table: every light of the buffer, edge 0 where it has no map.
         self.gpu_lights.clear();
@@ -1246,6 +1325,36 @@ mod tests {
                 assert!(apart, "{a:?} overlaps {b:?}");
             }
         }
+    }
+
+    /// A full atlas: 300 lights asking 16 to 256.
+    fn crowd(shift: u32) -> Vec<ShadowRequest> {
+        requests(&(0..300).map(|i| 16 << ((i * 7 + shift) % 5)).collect::<Vec<u32>>())
+    }
+
+    #[test]
+    fn lights_keep_their_blocks_while_their_edges_hold() {
+        let mut alloc = BlockAllocator::new(2048, 16);
+        let first = place_stably(&mut alloc, &plan_atlas(&crowd(0), 2048, 16), &crowd(0));
+        no_overlap(&first);
+        assert_eq!(first.placements.len() + first.dropped as usize, 300);
+        // The same frame again: every light where it was.
+        let again = place_stably(&mut alloc, &plan_atlas(&crowd(0), 2048, 16), &crowd(0));
+        assert_eq!(first.placements, again.placements);
+        // Two lights leave, one arrives and the importances change: the rest stay.
+        let mut next = crowd(0);
+        next.retain(|r| !matches!(r.caster, ShadowCaster::Point(3 | 150)));
+        next.push(ShadowRequest { caster: ShadowCaster::Point(999), edge: 64, importance: 1e6 });
+        for (i, r) in next.iter_mut().enumerate() {
+            r.importance += (i % 3) as f32;
+        }
+        let moved = place_stably(&mut alloc, &plan_atlas(&next, 2048, 16), &next);
+        no_overlap(&moved);
+        let before: HashMap<ShadowCaster, ShadowPlacement> =
+            first.placements.iter().map(|p| (p.caster, *p)).collect();
+        let stayed = moved.placements.iter().filter(|p| before.get(&p.caster) == Some(p)).count();
+        assert!(stayed * 10 >= moved.placements.len() * 9, "{stayed} of {} stayed", moved.placements.len());
+        assert!(moved.placements.iter().any(|p| p.caster == ShadowCaster::Point(999)));
     }
 
     #[test]
