@@ -37,8 +37,9 @@ struct VolumeOut {
 
 @vertex
 fn vs_volume(@location(0) position: vec3<f32>, @builtin(instance_index) light_index: u32) -> VolumeOut {
-    let light = lights[light_index];
-    let world = light.position_radius.xyz + position * light.position_radius.w;
+    // The proxy bounds what the light reaches: a spot light's sphere is its cone's.
+    let bounds = light_bounds(lights[light_index]);
+    let world = bounds.xyz + position * bounds.w;
     var out: VolumeOut;
     out.clip_position = view.clip_from_world * vec4<f32>(world, 1.0);
     out.light_index = light_index;

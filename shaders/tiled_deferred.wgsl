@@ -106,13 +106,14 @@ fn depth_cell(d: f32, r: vec2<f32>) -> u32 {
 
 // True unless the light's depth interval misses every occupied cell of the tile.
 fn light_reaches_tile(light: GpuPointLight, r: vec2<f32>, mask: u32) -> bool {
-    let p = light.position_radius.xyz;
+    let bounds = light_bounds(light);
+    let p = bounds.xyz;
     let z_row = vec3<f32>(view.view_from_world[0].z, view.view_from_world[1].z, view.view_from_world[2].z);
     let d = gbuffer_view_distance(p);
     // Reach along the view axis, widened by the radius inflation of the cluster tests and by
     // a bound on the rounding of both view distances (their terms' magnitudes times 1e-5).
     let magnitude = dot(abs(z_row), abs(p)) + abs(view.view_from_world[3].z);
-    let reach = light.position_radius.w * length(z_row) * RADIUS_INFLATION + 1e-5 * (magnitude + abs(d));
+    let reach = bounds.w * length(z_row) * RADIUS_INFLATION + 1e-5 * (magnitude + abs(d));
     let lo = d - reach;
     let hi = d + reach;
     // Written as "not outside" so that a NaN keeps the light.

@@ -8,6 +8,7 @@ use glam::{Mat4, Vec4};
 use manylight::app::headless::{HeadlessFrame, render_headless};
 use manylight::core::shadow_oracle::{LightSource, OccluderSet, ShadowQuery};
 use manylight::prelude::*;
+use manylight::render::ShadowFilteringMethod;
 use manylight::scene::shapes::cuboid;
 use manylight::scene::{SceneCamera, SceneInstance, camera_looking_at};
 use std::sync::Arc;
@@ -227,6 +228,14 @@ fn a_plate_shadows_the_floor_where_the_oracle_says_for_every_light_kind() {
             "{kind:?}: {:.2} % of the floor's pixels disagree with the oracle",
             error * 100.0
         );
+        // The wider filter softens the edge by a texel: it stays within the same bound.
+        let mut gaussian = naive;
+        gaussian.shadows.filter = ShadowFilteringMethod::Gaussian;
+        let soft = render(kind, true, gaussian);
+        let soft_error = visibility_error(kind, &soft, &off, &ambient);
+        eprintln!("{kind:?}, Gaussian filter: visibility error {:.3} %", soft_error * 100.0);
+        assert!(soft_error < 0.005, "{kind:?}, Gaussian filter: {:.2} % disagree", soft_error * 100.0);
+        assert_ne!(soft.image, on.image, "{kind:?}: the filter changes nothing");
         let report = on.stats.last.as_ref().and_then(|r| r.shadows).expect("a shadow report");
         assert_eq!((report.casting_lights, report.maps_rendered, report.dropped_lights), (1, 1, 0));
         let cascades = if let Kind::Directional = kind { 4 } else { 0 };

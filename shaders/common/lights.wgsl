@@ -17,6 +17,29 @@ fn spot_attenuation(cos_angle: f32, scale: f32, offset: f32) -> f32 {
     return t * t;
 }
 
+// The sphere (xyz: centre, w: radius) holding every point `light` reaches (Rust:
+// `lights::bounding_sphere`): its range's sphere, or for a spot light the smaller sphere around
+// its cone. The cone's outer cosine is where the falloff reaches 0 (-offset / scale); the
+// radius is widened by one part in 10⁴ for the rounding of that quotient.
+fn light_bounds(light: GpuPointLight) -> vec4<f32> {
+    let range = light.position_radius.w;
+    let scale = light.spot.w;
+    if !(scale > 0.0) {
+        return light.position_radius;
+    }
+    let cos_outer = clamp(-light.color.a / scale, 0.0, 1.0);
+    var along = range * cos_outer;
+    var radius = range * sqrt(max(1.0 - cos_outer * cos_outer, 0.0));
+    if cos_outer >= 0.70710678 {
+        along = range / (2.0 * cos_outer);
+        radius = along;
+    }
+    if radius * (1.0 + 1e-4) >= range {
+        return light.position_radius;
+    }
+    return vec4<f32>(light.position_radius.xyz + light.spot.xyz * along, radius * (1.0 + 1e-4));
+}
+
 fn attenuation(distance: f32, radius: f32) -> f32 {
     if !(radius > 0.0) || distance >= radius {
         return 0.0;

@@ -5,7 +5,8 @@
 // Rust: `GpuShadowLight`.
 struct GpuShadowLight {
     // xy: top-left atlas texel of the light's block of face tiles (SHADOW_TILE_COLUMNS per
-    // row); z: a face tile's edge in texels, 0 when the light has no shadow map; w: 0
+    // row); z: a face tile's edge in texels, 0 when the light has no shadow map; w: the filter
+    // (0: hardware 2×2, 1: Gaussian 3×3)
     tile: vec4<u32>,
     // x: near plane, y: far plane (the light's range), z: depth bias (world units),
     // w: normal bias (face texels)
@@ -19,7 +20,7 @@ struct GpuShadowLight {
 struct GpuCascade {
     // x, y ∈ [-1, 1] across the cascade's square, z ∈ [0, 1] through its depth range
     clip_from_world: mat4x4<f32>,
-    // xy: top-left atlas texel of the tile, z: its edge in texels, w: 0
+    // xy: top-left atlas texel of the tile, z: its edge in texels, w: the filter (as above)
     tile: vec4<u32>,
     // x: far bound (view distance), y: a texel's width (world), z: depth range (world), w: 0
     params: vec4<f32>,

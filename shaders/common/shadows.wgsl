@@ -11,6 +11,24 @@
 @group(0) @binding(5) var<storage, read> shadow_lights: array<GpuShadowLight>;
 @group(0) @binding(6) var<storage, read> directional_shadows: array<GpuDirectionalShadow>;
 
+// The comparison-filtered test of the tile whose top-left atlas texel is `origin` and edge
+// `edge`, at `local` texels from its corner: one bilinear comparison (`method` 0, 2×2 texels)
+// or four half a texel apart (`method` 1, a 3×3 tent). Samples stay inside the tile.
+fn shadow_compare(origin: vec2<f32>, edge: f32, local: vec2<f32>, reference: f32, method: u32) -> f32 {
+    let size = vec2<f32>(textureDimensions(shadow_atlas));
+    let lo = vec2<f32>(0.5);
+    let hi = vec2<f32>(edge - 0.5);
+    if method == 0u {
+        return textureSampleCompareLevel(shadow_atlas, shadow_sampler, (origin + clamp(local, lo, hi)) / size, reference);
+    }
+    var sum = 0.0;
+    for (var i = 0u; i < 4u; i++) {
+        let offset = vec2<f32>(f32(i & 1u) - 0.5, f32(i >> 1u) - 0.5);
+        sum += textureSampleCompareLevel(shadow_atlas, shadow_sampler, (origin + clamp(local + offset, lo, hi)) / size, reference);
+    }
+    return 0.25 * sum;
+}
+
 // The depth a face stores for a point `depth` along its axis: a reverse perspective depth, 1
 // at the near plane and 0 at the far one (Rust: `shadows::face_depth`); the comparison
 // sampler passes where the point's depth is at least the stored (nearest) caster's.
@@ -19,7 +37,7 @@ fn shadow_face_depth(depth: f32, near: f32, far: f32) -> f32 {
 }
 
 // How much of light `k` reaches `position` past the shadow casters, in [0, 1]: its shadow
-// map's 2×2 comparison-filtered test, or 1 when it has none. The test looks from where the
+// map's comparison-filtered test (`shadow_compare`), or 1 when it has none. The test looks from where the
 // light was when its map was drawn (`origin`: the light's position unless the map was kept
 // past the frame's redraw budget). `normal` is the surface's; the test is made from a point
 // pushed off the surface towards the light by the normal bias (in face texels at this
@@ -51,16 +69,15 @@ fn shadow_visibility(k: u32, position: vec3<f32>, normal: vec3<f32>) -> f32 {
         f32(shadow.tile.x + (face % SHADOW_TILE_COLUMNS) * size),
         f32(shadow.tile.y + (face / SHADOW_TILE_COLUMNS) * size),
     );
-    // u to the right, v up; tile rows run down. The filter's 2×2 texels stay in the tile.
-    let local = clamp(vec2<f32>(0.5 + 0.5 * uv.x, 0.5 - 0.5 * uv.y) * edge, vec2<f32>(0.5), vec2<f32>(edge - 0.5));
-    let atlas_uv = (origin + local) / vec2<f32>(textureDimensions(shadow_atlas));
+    // u to the right, v up; tile rows run down.
+    let local = vec2<f32>(0.5 + 0.5 * uv.x, 0.5 - 0.5 * uv.y) * edge;
     let near = shadow.params.x;
     let reference = shadow_face_depth(max(depth - shadow.params.z, near), near, shadow.params.y);
-    return textureSampleCompareLevel(shadow_atlas, shadow_sampler, atlas_uv, reference);
+    return shadow_compare(origin, edge, local, reference, shadow.tile.w);
 }
 
 // How much of directional light `i` (travelling along the unit `direction`) reaches
-// `position`, `view_distance` from the camera along its axis: the 2×2 comparison-filtered test
+// `position`, `view_distance` from the camera along its axis: the comparison-filtered test
 // of the first cascade whose far bound lies beyond the point, or 1 past the last cascade or
 // when the light casts no shadow. The biases work as for point lights, in the cascade's
 // texels and along the light's direction.
@@ -89,7 +106,6 @@ fn directional_shadow_visibility(
     let p = position + facing * (bias.y * cascade.params.y) + to_light * bias.x;
     let clip = cascade.clip_from_world * vec4<f32>(p, 1.0);
     let edge = f32(cascade.tile.z);
-    let local = clamp(vec2<f32>(0.5 + 0.5 * clip.x, 0.5 - 0.5 * clip.y) * edge, vec2<f32>(0.5), vec2<f32>(edge - 0.5));
-    let atlas_uv = (vec2<f32>(cascade.tile.xy) + local) / vec2<f32>(textureDimensions(shadow_atlas));
-    return textureSampleCompareLevel(shadow_atlas, shadow_sampler, atlas_uv, saturate(clip.z));
+    let local = vec2<f32>(0.5 + 0.5 * clip.x, 0.5 - 0.5 * clip.y) * edge;
+    return shadow_compare(vec2<f32>(cascade.tile.xy), edge, local, saturate(clip.z), cascade.tile.w);
 }

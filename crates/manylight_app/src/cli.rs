@@ -45,6 +45,16 @@ pub fn parse_on_off(s: &str) -> Result<bool, String> {
     }
 }
 
+/// `hardware2x2` or `gaussian`.
+pub fn parse_shadow_filter(s: &str) -> Result<manylight_render::ShadowFilteringMethod, String> {
+    named(
+        "shadow filter",
+        s,
+        &manylight_render::ShadowFilteringMethod::ALL,
+        manylight_render::ShadowFilteringMethod::name,
+    )
+}
+
 /// Most shadow maps drawn again per frame (`ShadowSettings::max_redrawn_maps`): `None` for
 /// every changed map.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -341,6 +341,10 @@ struct ShadowArgs {
     /// or `all`; the least important others keep an earlier frame's map, counted.
     #[arg(long, default_value = "256", value_parser = parse_redraw_budget)]
     shadow_max_redrawn_maps: manylight_app::cli::RedrawBudget,
+    /// Filter of every shadow lookup: hardware2x2 (one bilinear comparison) or gaussian (four,
+    /// a 3×3 tent).
+    #[arg(long, default_value = "hardware2x2", value_parser = manylight_app::cli::parse_shadow_filter)]
+    shadow_filter: manylight_render::ShadowFilteringMethod,
 }
 
 impl ShadowArgs {
@@ -355,6 +359,7 @@ impl ShadowArgs {
             cascade_size: self.shadow_cascade_size,
             cache_maps: self.shadow_cache_maps,
             max_redrawn_maps: self.shadow_max_redrawn_maps.0,
+            filter: self.shadow_filter,
         };
         s.check_values()
             .map_err(|e| anyhow::anyhow!("--{}", e.replace("shadows.", "shadow-").replace('_', "-")))?;

@@ -446,6 +446,9 @@ fn shadow_configurations(base: FrameSettings) -> Vec<ShadowConfiguration> {
         with("faces ×0.5", false, &|s| s.resolution_scale = 0.5),
         with("faces ×2", false, &|s| s.resolution_scale = 2.0),
         with("faces at most 128", false, &|s| s.max_face_size = 128),
+        with("Gaussian filter (3×3)", false, &|s| {
+            s.filter = manylight_render::ShadowFilteringMethod::Gaussian
+        }),
         with("every changed map redrawn", false, &|s| s.max_redrawn_maps = None),
         with("at most 64 maps redrawn", false, &|s| s.max_redrawn_maps = Some(64)),
         with("still lights, shadows off", true, &|s| s.enabled = false),
@@ -511,7 +514,7 @@ pub fn shadows(
     progress.finish();
     let context = format!(
         "{scene_name}, {lights} rig lights (and the scene's own) all casting, {}x{}, clustered forward, \
-         {adapter}; 2×2 comparison filter; lights moving at 60 frames a second unless still \
+         {adapter}; hardware 2×2 filter unless said; lights moving at 60 frames a second unless still \
          (× off: against the first row of the same motion); the last frame's figures",
         size.x, size.y
     );

@@ -222,7 +222,8 @@ pub struct GpuCascade {
     /// The cascade's orthographic projection: x, y ∈ [-1, 1] across its square, reverse depth z
     /// from 1 at the near side (towards the light) to 0 at the far side of the view's slice.
     pub clip_from_world: Mat4,
-    /// x, y: the atlas texel at the tile's top left; z: its edge in texels; w: 0.
+    /// x, y: the atlas texel at the tile's top left; z: its edge in texels; w: the filter
+    /// (`ShadowFilteringMethod::gpu_id`).
     pub tile: [u32; 4],
     /// x: the far bound (view distance) up to which it is used; y: a texel's width in world
     /// units; z: its depth range in world units; w: 0.
@@ -249,7 +250,8 @@ pub struct GpuDirectionalShadow {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuShadowLight {
     /// x, y: the atlas texel at the top left of the light's block of face tiles; z: a face
-    /// tile's edge in texels, 0 when the light has no shadow map this frame; w: 0.
+    /// tile's edge in texels, 0 when the light has no shadow map this frame; w: the filter
+    /// (`ShadowFilteringMethod::gpu_id`).
     pub tile: [u32; 4],
     /// x: the faces' near plane, y: their far plane (the light's range), z: depth bias (world
     /// units along the ray), w: normal bias (texels of the face at the receiver).

@@ -35,7 +35,7 @@ pub use plan::PlanInputs;
 pub use planner::FramePlanner;
 pub use readback::{HEADLESS_FORMAT, HeadlessTarget};
 pub use renderer::Renderer;
-pub use settings::{CameraShadows, CascadeShadowConfig, CascadeShadowConfigBuilder};
+pub use settings::{CameraShadows, CascadeShadowConfig, CascadeShadowConfigBuilder, ShadowFilteringMethod};
 pub use shadows::{ShadowReport, ShadowSettings};
 pub use snapshot::{
     BloomChain, BloomSettings, ClusterSettings, DEFAULT_COARSE_TILES, DebugViewMode, DirectionalShadow,

@@ -176,6 +176,8 @@ pub struct ShadowSettings {
     /// default draws a third of the maps a frame at the same visibility error as drawing all
     /// (`manylight report --shadows`, docs/benchmarks.md, "Shadow settings").
     pub max_redrawn_maps: Option<u32>,
+    /// The filter of every lookup.
+    pub filter: ShadowFilteringMethod,
 }
 
 impl Default for ShadowSettings {
@@ -189,6 +191,7 @@ impl Default for ShadowSettings {
             cascade_size: 1024,
             cache_maps: true,
             max_redrawn_maps: Some(256),
+            filter: ShadowFilteringMethod::Hardware2x2,
         }
     }
 }
@@ -230,6 +233,40 @@ impl ShadowSettings {
             return Err("shadows.max_redrawn_maps must be at least 1 (None draws every changed map)".into());
         }
         Ok(())
+    }
+}
+
+/// How a shadow map is filtered where it is read (Bevy's `ShadowFilteringMethod`, as a frame
+/// setting).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum ShadowFilteringMethod {
+    /// One comparison sample: the hardware's bilinear 2 × 2 filter.
+    #[default]
+    Hardware2x2,
+    /// Four comparison samples half a texel apart: a 3 × 3 texel tent (weights 1 2 1), softer
+    /// edges for four lookups.
+    Gaussian,
+}
+
+impl ShadowFilteringMethod {
+    /// Every method.
+    pub const ALL: [ShadowFilteringMethod; 2] =
+        [ShadowFilteringMethod::Hardware2x2, ShadowFilteringMethod::Gaussian];
+
+    /// Name used on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            ShadowFilteringMethod::Hardware2x2 => "hardware2x2",
+            ShadowFilteringMethod::Gaussian => "gaussian",
+        }
+    }
+
+    /// The id the shaders read (`GpuShadowLight::tile.w`, `GpuCascade::tile.w`).
+    pub fn gpu_id(self) -> u32 {
+        match self {
+            ShadowFilteringMethod::Hardware2x2 => 0,
+            ShadowFilteringMethod::Gaussian => 1,
+        }
     }
 }
 

@@ -916,7 +916,7 @@ impl ShadowResources {
                     let far = light.radius;
                     let near = far * SHADOW_NEAR_FRACTION;
                     light_entry = GpuShadowLight {
-                        tile: [p.x, p.y, p.edge, 0],
+                        tile: [p.x, p.y, p.edge, settings.filter.gpu_id()],
                         params: [near, far, bias.depth, bias.normal],
                         origin: light.position.extend(0.0).to_array(),
                     };
@@ -967,7 +967,7 @@ impl ShadowResources {
                         let (tx, ty) = tile_of(p, c as u32);
                         gpu.cascades[c] = GpuCascade {
                             clip_from_world: fit.clip_from_world,
-                            tile: [tx, ty, p.edge, 0],
+                            tile: [tx, ty, p.edge, settings.filter.gpu_id()],
                             params: [far, fit.texel, fit.depth_range, 0.0],
                         };
                         self.work_faces.push(GpuShadowFace {
@@ -1054,13 +1054,14 @@ impl ShadowResources {
                     let Some(&map) = self.cache.get(&p.caster) else { continue };
                     self.report.maps_stale += 1;
                     entry = GpuShadowLight {
+                        tile: w.light.tile,
                         params: [
                             map.light.params[0],
                             map.light.params[1],
                             w.light.params[2],
                             w.light.params[3],
                         ],
-                        ..map.light
+                        origin: map.light.origin,
                     };
                     self.next_cache.insert(p.caster, map);
                 }
