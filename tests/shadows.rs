@@ -671,3 +671,46 @@ fn each_camera_has_its_own_shadows_checkbox() {
     assert_eq!(mixed_shadows.maps_rendered, 1, "{mixed_shadows:?}");
     assert!(report(&none).shadows.is_none() && !report(&none).passes.iter().any(|p| p.name == "shadow_maps"));
 }
+
+/// A thousand casting lights moving every frame: every light is counted every frame (drawn,
+/// kept, kept stale, left out or unseen), the redraw budget holds, and the frame stays close to
+/// the one every map drawn anew gives.
+#[test]
+fn a_thousand_moving_shadowed_lights_are_all_accounted_for() {
+    let _gpu = gpu();
+    let scene = plate_scene();
+    let lights = |shift: f32| -> Vec<manylight::render::ExtractedPointLight> {
+        (0..1000)
+            .map(|i| manylight::render::ExtractedPointLight {
+                position: Vec3::new(
+                    (i % 40) as f32 * 0.2 - 3.9 + shift,
+                    1.3 + (i / 400) as f32 * 0.4,
+                    (i / 40 % 10) as f32 * 0.8 - 3.6,
+                ),
+                color: Vec3::ONE,
+                intensity: 0.05,
+                radius: 2.0,
+                spot: None,
+                shadow: Some(manylight::render::ShadowBias::POINT),
+            })
+            .collect()
+    };
+    let settings = manylight::render::FrameSettings::default();
+    let budget = settings.render.shadows.max_redrawn_maps.expect("a default budget");
+    let mut renderer = manylight::app::render_world::HeadlessRenderer::new().expect("a GPU");
+    let mut last = None;
+    for f in 0..4u64 {
+        let (s, image) = frame_of(&mut renderer, &scene, lights(f as f32 * 0.02), settings, f);
+        let counted = s.maps_rendered + s.maps_cached + s.maps_stale + s.dropped_lights + s.unseen_lights;
+        assert_eq!((s.casting_lights, counted), (1000, 1000), "frame {f}: {s:?}");
+        // Past the first frame the budget's maps are drawn, and the few lights whose block
+        // changed with their size (they have no map to keep).
+        if f > 0 {
+            assert!(s.maps_rendered >= budget && s.maps_rendered < budget + 50, "frame {f}: {s:?}");
+            assert!(s.maps_stale > 0, "frame {f}: {s:?}");
+        }
+        last = Some(image);
+    }
+    let fresh = drawn_anew(&scene, lights(0.06));
+    assert_similar("thousand_moving_lights", &fresh, &last.expect("frames"), COMPACT);
+}

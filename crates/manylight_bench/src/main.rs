@@ -586,7 +586,7 @@ fn measure_shadow_accuracy(
     println!(
         "shadow oracle: visibility error {:.4} (false shadow {:.4}, light leak {:.4}) over {} \
          contributing light-pixel pairs ({} blocked, {} tested on the wrong side); FLIP against \
-         the shadow reference: mean {:.4}, p99 {:.4}",
+         the shadow reference: mean {:.4}, p99 {:.4}; the oracle cast {} rays in {:.0} ms",
         a.visibility_error,
         a.false_shadow,
         a.light_leak,
@@ -594,7 +594,9 @@ fn measure_shadow_accuracy(
         a.blocked_pairs,
         a.wrong_pairs,
         a.flip.mean,
-        a.flip.p99
+        a.flip.p99,
+        a.rays,
+        a.ray_cast_ms
     );
     Ok(a)
 }
@@ -740,6 +742,8 @@ fn render(args: RenderArgs) -> Result<()> {
                 "light_leak": a.light_leak,
                 "flip_vs_shadow_reference": a.flip.mean,
                 "flip_vs_shadow_reference_p99": a.flip.p99,
+                "rays": a.rays,
+                "ray_cast_ms": a.ray_cast_ms,
             });
         }
         if let Some(e) = culling {

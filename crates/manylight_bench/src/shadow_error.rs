@@ -40,6 +40,11 @@ pub struct ShadowAccuracy {
     pub visibility_error: f64,
     /// Contributing pairs whose test is on the wrong side of one half.
     pub wrong_pairs: u64,
+    /// Segments the oracle cast (every listed pair with a surface, reached or not).
+    pub rays: u64,
+    /// Wall time of casting them against the BVH on every core: what ray-traced shadows
+    /// would cost this frame on this CPU.
+    pub ray_cast_ms: f64,
     /// The part of `visibility_error` from pairs the light reaches but the test shadows
     /// (acne, over-wide filtering), over all contributing pairs.
     pub false_shadow: f64,
@@ -123,7 +128,9 @@ pub fn measure_shadows(
             });
         }
     }
+    let cast = std::time::Instant::now();
     let visible = occluders.visibility(&queries);
+    let ray_cast_ms = cast.elapsed().as_secs_f64() * 1e3;
     let probe_inputs: Vec<ShadowProbe> = entries
         .iter()
         .zip(&queries)
@@ -166,6 +173,8 @@ pub fn measure_shadows(
         blocked_pairs,
         visibility_error: per_pair(false_shadow + light_leak),
         wrong_pairs: wrong,
+        rays: queries.len() as u64,
+        ray_cast_ms,
         false_shadow: per_pair(false_shadow),
         light_leak: per_pair(light_leak),
         flip,
