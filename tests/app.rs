@@ -221,7 +221,7 @@ fn user_systems_before_extract_show_in_the_same_frame() {
                     commands.spawn((Transform::from_xyz(0.0, 2.0, 0.0), PointLight::default(), Added));
                 }
             })
-            .before(ManyLightSet::Extract),
+            .before(ManyLightSystems::Extract),
         );
     app.update();
     let report = stats(&app).last.expect("a report");

@@ -192,7 +192,7 @@ pub fn build_snapshot(
     snapshot
 }
 
-/// The extract system (runs in `Last`, in [`crate::ManyLightSet::Extract`]): takes the
+/// The extract system (runs in `Last`, in [`crate::ManyLightSystems::Extract`]): takes the
 /// snapshot and hands it to the renderer; [`collect_results`] runs right after it.
 #[allow(clippy::too_many_arguments)]
 pub fn extract_and_render(

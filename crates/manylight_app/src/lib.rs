@@ -32,7 +32,7 @@ pub use components::{
     MotionBlur, OrthographicProjection, PerspectiveProjection, PointLight, Projection, RenderImage,
     RenderTarget, SpotLight, Transform, Viewport, Visibility,
 };
-pub use plugin::{HEADLESS_TIME_STEP, HeadlessConfig, ManyLightPlugin, ManyLightSet, OutputMode};
+pub use plugin::{HEADLESS_TIME_STEP, HeadlessConfig, ManyLightPlugin, ManyLightSystems, OutputMode};
 pub use resources::{
     DebugView, FrameStats, FrameTotals, FramesInFlight, HeadlessCapture, LightControls, RenderFailure,
     RenderSettings, RenderedImages, ViewportSize,
@@ -52,7 +52,7 @@ pub mod prelude {
         LightAnimation, Material, Mesh3d, MotionBlur, OrthographicProjection, PerspectiveProjection,
         PointLight, Projection, RenderImage, RenderTarget, SpotLight, Transform, Viewport, Visibility,
     };
-    pub use crate::plugin::{ManyLightPlugin, ManyLightSet};
+    pub use crate::plugin::{ManyLightPlugin, ManyLightSystems};
     pub use crate::resources::{
         DebugView, FrameStats, HeadlessCapture, LightControls, RenderSettings, RenderedImages,
     };

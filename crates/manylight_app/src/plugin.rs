@@ -22,7 +22,7 @@ pub const HEADLESS_TIME_STEP: Duration = Duration::from_nanos(16_666_667);
 
 /// Public system sets, so user systems can be ordered around the plugin's.
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum ManyLightSet {
+pub enum ManyLightSystems {
     /// `Update`: the plugin's own animation (light rigs). User systems that move things can
     /// run before or after it.
     Animate,
@@ -149,10 +149,13 @@ impl Plugin for ManyLightPlugin {
             .add_message::<crate::backend::RenderFailed>()
             .init_resource::<crate::window::WindowRequests>()
             .init_resource::<crate::window::PressedKeys>()
-            .configure_sets(Update, ManyLightSet::Animate)
-            .configure_sets(Last, ManyLightSet::Extract)
-            .add_systems(Update, animate_lights.in_set(ManyLightSet::Animate))
-            .add_systems(Last, (extract_and_render, collect_results).chain().in_set(ManyLightSet::Extract));
+            .configure_sets(Update, ManyLightSystems::Animate)
+            .configure_sets(Last, ManyLightSystems::Extract)
+            .add_systems(Update, animate_lights.in_set(ManyLightSystems::Animate))
+            .add_systems(
+                Last,
+                (extract_and_render, collect_results).chain().in_set(ManyLightSystems::Extract),
+            );
         match &self.mode {
             OutputMode::Window(config) => {
                 let config = config.clone();

@@ -68,7 +68,7 @@ fn shadow_code_and_bindings_appear_only_with_shadows() {
 
 #[test]
 fn every_wgsl_file_on_disk_is_embedded() {
-    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shaders");
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/shaders");
     let mut stack = vec![std::path::PathBuf::from(root)];
     let mut found = Vec::new();
     while let Some(dir) = stack.pop() {
