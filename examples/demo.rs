@@ -16,7 +16,7 @@ use manylight::app::RenderFailure;
 use manylight::app::cli::{parse_on_off, parse_pipeline};
 use manylight::app::headless::save_png;
 use manylight::app::window::WindowConfig;
-use manylight::core::light_count::check_app_lights;
+use manylight::math::light_count::check_app_lights;
 use manylight::prelude::*;
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -11,8 +11,8 @@
 
 use clap::Parser;
 use manylight::app::window::WindowConfig;
-use manylight::core::Aabb;
-use manylight::core::light_count::check_app_lights;
+use manylight::math::Aabb;
+use manylight::math::light_count::check_app_lights;
 use manylight::prelude::*;
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -8,7 +8,7 @@
 //! 30 frames headless and writes the last one (and the security camera's own image beside it,
 //! as `out.camera.png`).
 
-use manylight::core::TextureData;
+use manylight::math::TextureData;
 use manylight::prelude::*;
 use std::sync::Arc;
 

@@ -14,7 +14,7 @@ use manylight::app::RenderFailure;
 use manylight::app::headless::save_png;
 use manylight::app::scene::set_shadows;
 use manylight::app::window::WindowConfig;
-use manylight::core::light_count::check_app_lights;
+use manylight::math::light_count::check_app_lights;
 use manylight::prelude::*;
 use std::path::PathBuf;
 use std::process::ExitCode;

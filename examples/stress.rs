@@ -28,7 +28,7 @@
 use anyhow::{Result, bail};
 use clap::Parser;
 use manylight::app::cli::{parse_on_off, parse_pipeline, parse_size};
-use manylight::core::{Aabb, lumens_from_candela};
+use manylight::math::{Aabb, lumens_from_candela};
 use manylight::prelude::*;
 use manylight::scene::{AnimatedLight, SHELL_LIGHT_RANGE, SHELL_RADIUS, light_rig, sphere_shell_lights};
 use std::path::PathBuf;

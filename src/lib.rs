@@ -1,6 +1,7 @@
 //! manylight: rendering scenes lit by thousands of moving point lights, as a `bevy_app` plugin
-//! on wgpu. Five pipelines produce the same image: naive forward (the reference), tiled
-//! Forward+, clustered forward (the default), clustered deferred and deferred light volumes.
+//! on wgpu. Six pipelines produce the same image: naive forward (the reference), tiled
+//! Forward+, clustered forward (the default), clustered deferred, tiled deferred (in compute)
+//! and deferred light volumes.
 //!
 //! Add [`prelude::ManyLightPlugin`] to an `App`, spawn entities with `Transform`, `Camera3d`,
 //! `PointLight`, `Mesh3d` and `Material`, and run: you get a window, or a headless image.
@@ -8,7 +9,9 @@
 #![warn(missing_docs)]
 
 pub use manylight_app as app;
-pub use manylight_core as core;
+/// Pure math and plain data (`manylight_core`): clusters, lights, materials, meshes, codecs and
+/// the oracles; named `math` so that it does not shadow Rust's `core` in paths.
+pub use manylight_core as math;
 pub use manylight_render as render;
 pub use manylight_scene as scene;
 

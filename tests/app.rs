@@ -339,7 +339,7 @@ fn extreme_projections_render_finite_images() {
     let projections = [
         (1e-6, 1e-6, 1000.0),
         (std::f32::consts::PI - 1e-6, 0.1, 1000.0),
-        (manylight::core::camera::MAX_FOV_Y, 0.1, 1000.0),
+        (manylight::math::camera::MAX_FOV_Y, 0.1, 1000.0),
         (0.0, 0.0, 0.0),
         (1.0, 1e-6, f32::INFINITY),
         (1.0, 1e30, f32::NAN),
@@ -363,7 +363,7 @@ fn extreme_projections_render_finite_images() {
         .unwrap_or_else(|e| panic!("fov {fov_y} near {near} far {far}: {e}"));
         support::assert_finite(&frame);
         let report = frame.stats.last.as_ref().expect("a report");
-        let valid = (1e-6..=manylight::core::camera::MAX_FOV_Y).contains(&fov_y) && near > 0.0 && far > near; // an infinite far plane is valid and kept
+        let valid = (1e-6..=manylight::math::camera::MAX_FOV_Y).contains(&fov_y) && near > 0.0 && far > near; // an infinite far plane is valid and kept
         assert_eq!(report.sanitized_cameras, u32::from(!valid), "fov {fov_y} near {near} far {far}");
     }
 }

@@ -6,8 +6,8 @@ mod support;
 use glam::{UVec2, Vec3};
 use manylight::app::render_world::HeadlessRenderer;
 use manylight::app::scene::extracted_light;
-use manylight::core::Projection;
-use manylight::core::cluster::{ClusterAssignment, CullTest, GridConfig, ZSlicing, assign_lights};
+use manylight::math::Projection;
+use manylight::math::cluster::{ClusterAssignment, CullTest, GridConfig, ZSlicing, assign_lights};
 use manylight::prelude::*;
 use manylight::render::{ClusterSettings, ExtractedPointLight, FrameReport, FrameSettings, FrameSnapshot};
 use support::gpu;
@@ -337,7 +337,7 @@ fn lists_sized_before_submission_never_overflow_or_rerender() {
 
 #[test]
 fn culling_efficiency_finds_no_missing_light_and_clusters_beat_tiles() {
-    use manylight::core::efficiency::culling_efficiency;
+    use manylight::math::efficiency::culling_efficiency;
     let _gpu = gpu();
     let mut r = HeadlessRenderer::new().expect("adapter");
     let scene = default_scene();
@@ -493,7 +493,7 @@ fn spot_light_lists_equal_the_cpu_reference_and_are_tighter_than_point_lights() 
 /// The rig's lights as spot lights pointing every which way, with cones from a hair's width to
 /// a hemisphere.
 fn spot_rig(points: &[ExtractedPointLight]) -> Vec<ExtractedPointLight> {
-    use manylight::core::SpotCone;
+    use manylight::math::SpotCone;
     points
         .iter()
         .enumerate()
@@ -518,7 +518,7 @@ fn spot_rig(points: &[ExtractedPointLight]) -> Vec<ExtractedPointLight> {
 /// and on the hard cases among 512 rig lights.
 #[test]
 fn exact_pixel_lists_shade_the_naive_image() {
-    use manylight::core::efficiency::{culling_efficiency, exact_pixel_lists, pixel_grid};
+    use manylight::math::efficiency::{culling_efficiency, exact_pixel_lists, pixel_grid};
     let _gpu = gpu();
     let mut r = HeadlessRenderer::new().expect("adapter");
     let scene = default_scene();
@@ -654,7 +654,7 @@ fn tiled_deferred_shades_what_clustered_deferred_shades() {
 /// ones (after the G-buffer).
 #[test]
 fn depth_bounded_lists_keep_every_contributing_light() {
-    use manylight::core::efficiency::culling_efficiency;
+    use manylight::math::efficiency::culling_efficiency;
     let _gpu = gpu();
     let mut r = HeadlessRenderer::new().expect("adapter");
     let size = UVec2::new(160, 96);
@@ -745,7 +745,7 @@ fn depth_bounded_lists_keep_every_contributing_light() {
 #[test]
 fn refined_lists_keep_every_contributing_light() {
     use manylight::app::prelude::GBufferLayout;
-    use manylight::core::efficiency::{Refinement, culling_efficiency, pixel_grid, refined_lists};
+    use manylight::math::efficiency::{Refinement, culling_efficiency, pixel_grid, refined_lists};
     use manylight::render::gpu_types::{REFINE_EDGE, REFINED_FALLBACK, REFINED_LIST_SLOTS};
     let _gpu = gpu();
     let mut r = HeadlessRenderer::new().expect("adapter");

@@ -18,9 +18,9 @@ use manylight::app::headless::{HeadlessFrame, render_headless};
 use manylight::app::render_world::HeadlessRenderer;
 use manylight::app::scene::{extracted_light, scene_snapshot};
 use manylight::app::{DebugView, FrameStats};
-use manylight::core::TextureData;
-use manylight::core::camera::linearize_depth_reverse_z;
-use manylight::core::cluster::assign_lights;
+use manylight::math::TextureData;
+use manylight::math::camera::linearize_depth_reverse_z;
+use manylight::math::cluster::assign_lights;
 use manylight::prelude::*;
 use manylight::render::{ClusterSettings, FrameSettings};
 use support::{STRICT, assert_matches_reference, gpu};
@@ -253,7 +253,7 @@ fn the_depth_view_scales_to_the_far_plane_or_to_the_lights_reach() {
     let camera = scene.camera_or_fit(SIZE.x as f32 / SIZE.y as f32);
     let mut renderer = HeadlessRenderer::new().expect("adapter");
     for far in [60.0, f32::INFINITY] {
-        let projection = manylight::core::Projection { far, ..camera.projection };
+        let projection = manylight::math::Projection { far, ..camera.projection };
         scene.cameras = vec![manylight::scene::SceneCamera { projection, ..camera }];
         let settings = FrameSettings {
             render: RenderSettings { pipeline: PipelineKind::ClusteredForward, ..Default::default() },
@@ -264,11 +264,11 @@ fn the_depth_view_scales_to_the_far_plane_or_to_the_lights_reach() {
         let (_, image) = renderer.render(snapshot, true).expect("renders");
         let image = image.expect("image");
         let r = renderer.render_world.renderer();
-        let spheres = manylight::core::cluster::to_view_space(
+        let spheres = manylight::math::cluster::to_view_space(
             camera.transform.inverse(),
             lights.iter().map(|l| (l.position, l.radius)),
         );
-        let reach = manylight::core::cluster::farthest_reach(spheres);
+        let reach = manylight::math::cluster::farthest_reach(spheres);
         let scale_far = projection.finite_for(reach).far;
         assert!(scale_far.is_finite() && scale_far > projection.near, "far {far}: scale to {scale_far}");
         let (w, h, depth) = r.read_depth().expect("depth readback").expect("a depth buffer");

@@ -9,7 +9,7 @@ mod support;
 
 use glam::{Mat4, Vec4};
 use manylight::app::RenderSettings;
-use manylight::core::{MaterialData, Projection};
+use manylight::math::{MaterialData, Projection};
 use manylight::prelude::*;
 use manylight::scene::shapes::cuboid;
 use manylight::scene::{SceneCamera, SceneInstance, SceneLight, camera_looking_at, studio_lights};
@@ -158,13 +158,13 @@ fn single_sided_faces_seen_from_behind_are_not_drawn() {
 
 /// A 2 × 2 quad in the xy plane facing +z, every vertex's two uv sets from `uv0` and `uv1`
 /// of its corner (u along +x, v along -y in `[0, 1]`).
-fn uv_quad(uv0: impl Fn(Vec2) -> Vec2, uv1: impl Fn(Vec2) -> Vec2) -> manylight::core::MeshData {
+fn uv_quad(uv0: impl Fn(Vec2) -> Vec2, uv1: impl Fn(Vec2) -> Vec2) -> manylight::math::MeshData {
     let corners = [Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, 0.0)];
     let positions: Vec<Vec3> =
         corners.iter().map(|c| Vec3::new(c.x * 2.0 - 1.0, 1.0 - c.y * 2.0, 0.0)).collect();
     let normals = [Vec3::Z; 4];
     let uvs: Vec<Vec2> = corners.iter().map(|&c| uv0(c)).collect();
-    let mut mesh = manylight::core::MeshData::from_attributes(
+    let mut mesh = manylight::math::MeshData::from_attributes(
         "uv quad",
         &positions,
         Some(&normals),
@@ -177,7 +177,7 @@ fn uv_quad(uv0: impl Fn(Vec2) -> Vec2, uv1: impl Fn(Vec2) -> Vec2) -> manylight:
 }
 
 /// A 16 × 16 texture with no symmetry: red along x, green along y, a blue diagonal stripe.
-fn asymmetric_texture() -> Arc<manylight::core::TextureData> {
+fn asymmetric_texture() -> Arc<manylight::math::TextureData> {
     let mut rgba8 = Vec::new();
     for y in 0..16u8 {
         for x in 0..16u8 {
@@ -185,7 +185,7 @@ fn asymmetric_texture() -> Arc<manylight::core::TextureData> {
             rgba8.extend_from_slice(&[x * 16, y * 16, stripe, 255]);
         }
     }
-    Arc::new(manylight::core::TextureData {
+    Arc::new(manylight::math::TextureData {
         label: "asymmetric".into(),
         width: 16,
         height: 16,
@@ -200,7 +200,7 @@ fn asymmetric_texture() -> Arc<manylight::core::TextureData> {
 /// quad sampled without them.
 #[test]
 fn texture_transforms_and_the_second_uv_set_match_pre_transformed_uvs() {
-    use manylight::core::{MaterialTexture, UvChannel};
+    use manylight::math::{MaterialTexture, UvChannel};
     let _gpu = gpu();
     let base = MaterialTexture::gltf_uv_transform(Vec2::new(0.25, 0.5), 0.7, Vec2::new(1.5, -0.8));
     let emissive = MaterialTexture::gltf_uv_transform(Vec2::new(0.1, 0.3), -1.2, Vec2::new(0.6, 2.0));
@@ -210,7 +210,7 @@ fn texture_transforms_and_the_second_uv_set_match_pre_transformed_uvs() {
         uv_transform: transform,
         ..MaterialTexture::new(image.clone())
     };
-    let scene = |mesh: manylight::core::MeshData, base_texture, emissive_texture| {
+    let scene = |mesh: manylight::math::MeshData, base_texture, emissive_texture| {
         let material = MaterialData {
             label: "transformed".into(),
             base_color_texture: Some(base_texture),
@@ -270,9 +270,9 @@ fn emitting_quad(z: f32, emissive: Vec3, alpha: f32) -> (MaterialData, Mat4) {
         base_color: Vec4::new(0.0, 0.0, 0.0, alpha),
         emissive,
         alpha_mode: if alpha < 1.0 {
-            manylight::core::AlphaMode::Blend
+            manylight::math::AlphaMode::Blend
         } else {
-            manylight::core::AlphaMode::Opaque
+            manylight::math::AlphaMode::Opaque
         },
         ..MaterialData::default()
     };

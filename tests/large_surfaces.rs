@@ -10,7 +10,7 @@ mod support;
 
 use glam::{Mat4, Vec4};
 use manylight::app::RenderSettings;
-use manylight::core::{Projection, Vertex};
+use manylight::math::{Projection, Vertex};
 use manylight::prelude::*;
 use manylight::scene::{SceneCamera, SceneInstance, SceneLight, camera_looking_at};
 use std::sync::Arc;
@@ -251,7 +251,7 @@ fn analytic_floor(extent: f64, far: f64, settings: &RenderSettings) -> image::Rg
                 }
                 let ratio2 = (d / r) * (d / r);
                 let window = (1.0 - ratio2 * ratio2).clamp(0.0, 1.0);
-                let min_d = f64::from(manylight::core::LIGHT_MIN_DISTANCE);
+                let min_d = f64::from(manylight::math::LIGHT_MIN_DISTANCE);
                 let att = window * window / (d * d).max(min_d * min_d);
                 let l = scale(to_light, 1.0 / d);
                 let n_dot_l = dot(n, l).max(0.0);

@@ -6,7 +6,7 @@ mod support;
 
 use glam::Vec4;
 use manylight::app::headless::render_headless;
-use manylight::core::{MaterialData, MeshData, TextureData, Vertex};
+use manylight::math::{MaterialData, MeshData, TextureData, Vertex};
 use manylight::prelude::*;
 use manylight::render::GpuContext;
 use std::sync::Arc;

@@ -424,7 +424,7 @@ fn the_transparent_pass_runs_only_for_blended_materials() {
             s.settings.debug_view = DebugViewMode::None;
         }
         let material = std::sync::Arc::make_mut(&mut s.instances[0].material);
-        material.alpha_mode = manylight::core::AlphaMode::Blend;
+        material.alpha_mode = manylight::math::AlphaMode::Blend;
         plan_passes(s).expect("plan")
     };
     use PipelineKind::*;

@@ -5,7 +5,7 @@
 mod support;
 
 use manylight::app::headless::{HeadlessFrame, render_headless};
-use manylight::core::image_metrics::flip_compare;
+use manylight::math::image_metrics::flip_compare;
 use manylight::prelude::*;
 use support::gpu;
 

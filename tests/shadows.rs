@@ -6,7 +6,7 @@ mod support;
 
 use glam::{Mat4, Vec4};
 use manylight::app::headless::{HeadlessFrame, render_headless};
-use manylight::core::shadow_oracle::{LightSource, OccluderSet, ShadowQuery};
+use manylight::math::shadow_oracle::{LightSource, OccluderSet, ShadowQuery};
 use manylight::prelude::*;
 use manylight::render::ShadowFilteringMethod;
 use manylight::scene::shapes::cuboid;

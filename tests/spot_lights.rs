@@ -5,7 +5,7 @@
 mod support;
 
 use manylight::app::RenderSettings;
-use manylight::core::SpotCone;
+use manylight::math::SpotCone;
 use manylight::prelude::*;
 use manylight::scene::light_rig;
 use support::{COMPACT, STRICT, assert_similar, flip, gpu, render_scene};

@@ -6,7 +6,7 @@ mod support;
 
 use manylight::app::RenderSettings;
 use manylight::app::headless::render_headless;
-use manylight::core::lumens_from_candela;
+use manylight::math::lumens_from_candela;
 use manylight::prelude::*;
 use manylight::scene::SceneLight;
 use support::{STRICT, assert_similar, gpu};

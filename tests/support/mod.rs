@@ -4,7 +4,7 @@
 #![allow(dead_code)]
 
 use image::RgbaImage;
-use manylight::core::image_metrics::{FlipStats, flip_compare};
+use manylight::math::image_metrics::{FlipStats, flip_compare};
 use std::path::PathBuf;
 use std::sync::{Mutex, MutexGuard, OnceLock};
 
