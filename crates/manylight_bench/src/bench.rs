@@ -394,7 +394,7 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
          list_entry_bound,tile_entries,tile_entry_bound,list_bound_cpu_ms,shading_ms,shading_vs_oracle,\
          coarse_tiles,coarse_entries,depth_bounded_ratio,cluster_depth_gpu_ms,light_refine_gpu_ms,\
          zbinned_ratio,shadows,shadow_maps_rendered,shadow_maps_cached,shadow_maps_stale,shadow_atlas_bytes,shadow_gpu_ms,\
-         visibility_error,flip_vs_shadow_reference\n",
+         visibility_error,flip_vs_shadow_reference,frame_ms_min,frame_ms_max\n",
     );
     for r in rows {
         let c = r.last.clusters.as_ref();
@@ -410,7 +410,7 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
         let vs_oracle = shading.zip(oracle).filter(|&(_, o)| o > 0.0).map(|(s, o)| s / o);
         let _ = writeln!(
             out,
-            "\"{adapter}\",\"{scene}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "\"{adapter}\",\"{scene}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.3},{:.3}",
             match (r.oracle, r.pipeline.is_deferred()) {
                 (true, false) => "oracle-forward",
                 (true, true) => "oracle-deferred",
@@ -462,6 +462,8 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
             pass_ms(&r.last, "shadow_maps"),
             r.shadow_accuracy.map_or(String::new(), |a| format!("{:.5}", a.visibility_error)),
             r.shadow_accuracy.map_or(String::new(), |a| format!("{:.5}", a.flip_vs_reference)),
+            r.frame_ms.iter().copied().fold(f64::INFINITY, f64::min),
+            r.frame_ms.iter().copied().fold(0.0, f64::max),
         );
     }
     out

@@ -425,7 +425,8 @@ struct ClusterArgs {
     #[arg(long, default_value = "octa16", value_parser = parse_normal_codec)]
     normal_codec: NormalCodec,
     /// Debug view: none, albedo, normal, metallic, roughness, emissive, occlusion, depth,
-    /// light-count, slice-x, slice-y, slice-z or overflow (replaces tone mapping).
+    /// light-count, slice-x, slice-y, slice-z, overflow, shadow-atlas or shadow-lod (replaces
+    /// tone mapping).
     #[arg(long, default_value = "none", value_parser = parse_debug_view)]
     debug_view: DebugViewMode,
     /// Anisotropic filtering of every texture: at most N samples per pixel footprint, 1 to 16

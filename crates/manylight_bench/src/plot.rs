@@ -121,6 +121,49 @@ impl Table {
 /// Points of a line chart: one series per label, in order of first appearance.
 pub type Series = Vec<(String, Vec<(f64, f64)>)>;
 
+/// The spread of a measured point: its lowest and highest value around the plotted one (drawn
+/// as a bar between them).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpreadPoint {
+    /// Where it is on the x axis.
+    pub x: f64,
+    /// The lowest value.
+    pub lo: f64,
+    /// The plotted value (the median).
+    pub mid: f64,
+    /// The highest value.
+    pub hi: f64,
+}
+
+/// Spreads of a line chart's points, by series label.
+pub type Spread = Vec<(String, Vec<SpreadPoint>)>;
+
+/// The spread of `mid` between the columns `lo` and `hi` over `lights`, one series per
+/// configuration, where a row has all three and more than one frame (a one-frame row has no
+/// spread to show).
+pub fn spread_over_lights(table: &Table, mid: &str, lo: &str, hi: &str) -> Spread {
+    let mut spread: Spread = Vec::new();
+    for row in &table.rows {
+        let values = (
+            table.number(row, "lights"),
+            table.number(row, lo),
+            table.number(row, mid),
+            table.number(row, hi),
+        );
+        let (Some(x), Some(lo), Some(mid), Some(hi)) = values else { continue };
+        if x <= 0.0 || lo <= 0.0 || table.number(row, "frames").is_some_and(|f| f < 2.0) {
+            continue;
+        }
+        let label = table.label(row);
+        let point = SpreadPoint { x, lo, mid, hi };
+        match spread.iter_mut().find(|(l, _)| *l == label) {
+            Some((_, points)) => points.push(point),
+            None => spread.push((label, vec![point])),
+        }
+    }
+    spread
+}
+
 /// One horizontal stacked bar: its label and its segments (name, value).
 pub type Bar = (String, Vec<(String, f64)>);
 
@@ -313,33 +356,65 @@ fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
     (lo / pad)..(hi * pad)
 }
 
-/// A line chart of `series` over a log x axis (and a log or linear y axis).
+/// A line chart of `series` over a log x axis (and a log or linear y axis), with each point's
+/// spread in `spread` (by series label) drawn as a bar from its lowest to its highest value.
 fn line_chart(
     path: &Path,
     title: &str,
     x_desc: &str,
     y_desc: &str,
-    series: &Series,
+    (series, spread): (&Series, &Spread),
     log_y: bool,
 ) -> Result<()> {
     save(path, (1280, 800), |root| {
         let xs = log_range(series.iter().flat_map(|(_, p)| p.iter().map(|p| p.0)));
-        let ys: Vec<f64> = series.iter().flat_map(|(_, p)| p.iter().map(|p| p.1)).collect();
+        let mut ys: Vec<f64> = series.iter().flat_map(|(_, p)| p.iter().map(|p| p.1)).collect();
+        ys.extend(spread.iter().flat_map(|(_, p)| p.iter().flat_map(|s| [s.lo, s.hi])));
         let mut chart = ChartBuilder::on(root);
         chart.caption(title, (FONT, 28)).margin(24).x_label_area_size(70).y_label_area_size(100);
-        if log_y {
-            let mut chart = chart
-                .build_cartesian_2d(xs.log_scale(), log_range(ys.into_iter()).log_scale())
-                .map_err(drawing)?;
-            mesh(&mut chart, x_desc, y_desc)?;
+        // Values within one decade read better on a linear axis: a log axis labels too few.
+        let (lo, hi) = ys
+            .iter()
+            .filter(|v| **v > 0.0)
+            .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
+        if log_y && hi > 10.0 * lo {
+            let y_range = log_range(ys.into_iter());
+            let axes = Axes { x_log: Some(xs.clone()), y_log: Some(y_range.clone()) };
+            let mut chart = chart.build_cartesian_2d(xs.log_scale(), y_range.log_scale()).map_err(drawing)?;
+            mesh(&mut chart, x_desc, y_desc, axes)?;
+            draw_spread(&mut chart, series, spread)?;
             draw_lines(&mut chart, series)
         } else {
             let top = ys.iter().fold(0.0f64, |m, v| m.max(*v)) * 1.1;
+            let axes = Axes { x_log: Some(xs.clone()), y_log: None };
             let mut chart = chart.build_cartesian_2d(xs.log_scale(), 0.0..top.max(1.0)).map_err(drawing)?;
-            mesh(&mut chart, x_desc, y_desc)?;
+            mesh(&mut chart, x_desc, y_desc, axes)?;
+            draw_spread(&mut chart, series, spread)?;
             draw_lines(&mut chart, series)
         }
     })
+}
+
+/// Draws each point's spread as a vertical bar in its series' colour.
+fn draw_spread<'a, X, Y>(
+    chart: &mut ChartContext<'a, BitMapBackend<'a>, Cartesian2d<X, Y>>,
+    series: &Series,
+    spread: &Spread,
+) -> Result<()>
+where
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    for (label, points) in spread {
+        let Some(i) = series.iter().position(|(l, _)| l == label) else { continue };
+        let c = color(i);
+        chart
+            .draw_series(
+                points.iter().map(|p| PathElement::new(vec![(p.x, p.lo), (p.x, p.hi)], c.stroke_width(2))),
+            )
+            .map_err(drawing)?;
+    }
+    Ok(())
 }
 
 /// Draws each series as a line with dots, and the legend.
@@ -377,19 +452,62 @@ where
         .map_err(drawing)
 }
 
+/// A log axis's label at `v` over `range`: decades always; 2 and 5 between them only where the
+/// axis spans at most two decades (more would collide); nothing elsewhere. Values are written
+/// as plain numbers (1000, 0.01) and as powers of ten past six digits (1e5).
+pub fn log_label(v: f64, range: &std::ops::Range<f64>) -> String {
+    if v.is_nan() || v <= 0.0 {
+        return String::new();
+    }
+    let exponent = v.log10().floor();
+    let mantissa = v / 10f64.powf(exponent);
+    let near = |m: f64| (mantissa - m).abs() < 1e-6 * m || (mantissa - 10.0 * m).abs() < 1e-5 * m;
+    let decades = (range.end / range.start.max(f64::MIN_POSITIVE)).log10();
+    let shown = near(1.0) || (decades <= 2.0 && (near(2.0) || near(5.0)));
+    if !shown {
+        return String::new();
+    }
+    let rounded = 10f64.powf(exponent) * mantissa.round();
+    if !(1e-4..1e6).contains(&rounded) {
+        format!("{}e{}", mantissa.round() as u32, exponent as i32)
+    } else if rounded >= 1.0 {
+        format!("{}", rounded.round() as u64)
+    } else {
+        format!("{}", (rounded * 1e4).round() / 1e4)
+    }
+}
+
+/// Axis ranges of a chart, for [`mesh`]: `Some` marks a log axis (its labels from
+/// [`log_label`]).
+struct Axes {
+    x_log: Option<std::ops::Range<f64>>,
+    y_log: Option<std::ops::Range<f64>>,
+}
+
 fn mesh<'a, X, Y>(
     chart: &mut ChartContext<'a, BitMapBackend<'a>, Cartesian2d<X, Y>>,
     x_desc: &str,
     y_desc: &str,
+    axes: Axes,
 ) -> Result<()>
 where
     X: Ranged<ValueType = f64> + ValueFormatter<f64>,
     Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
 {
+    let x_format = |v: &f64| match &axes.x_log {
+        Some(r) => log_label(*v, r),
+        None => X::format(v),
+    };
+    let y_format = |v: &f64| match &axes.y_log {
+        Some(r) => log_label(*v, r),
+        None => Y::format(v),
+    };
     chart
         .configure_mesh()
         .x_desc(x_desc)
         .y_desc(y_desc)
+        .x_label_formatter(&x_format)
+        .y_label_formatter(&y_format)
         .label_style((FONT, 18))
         .axis_desc_style((FONT, 22))
         .light_line_style(RGBColor(235, 235, 235))
@@ -501,9 +619,10 @@ fn accuracy_chart(path: &Path, title: &str, points: &[AccuracyPoint]) -> Result<
             .margin(20)
             .x_label_area_size(70)
             .y_label_area_size(100)
-            .build_cartesian_2d(xs.log_scale(), (ys.start.min(FLOOR * 0.7)..ys.end).log_scale())
+            .build_cartesian_2d(xs.clone().log_scale(), (ys.start.min(FLOOR * 0.7)..ys.end).log_scale())
             .map_err(drawing)?;
-        mesh(&mut chart, "frame time (ms, median)", "FLIP mean vs reference (0 drawn at 1e-5)")?;
+        let axes = Axes { x_log: Some(xs.clone()), y_log: Some(ys.start.min(FLOOR * 0.7)..ys.end) };
+        mesh(&mut chart, "frame time (ms, median)", "FLIP mean vs reference (0 drawn at 1e-5)", axes)?;
         let front = pareto_front(points);
         let at = |p: &AccuracyPoint| (p.frame_ms, p.flip_mean.max(FLOOR));
         chart
@@ -613,12 +732,17 @@ pub fn figures_named(csv: &str, dir: &Path, prefix: Option<&str>) -> Result<Vec<
     if kind == Kind::Bench {
         let path = file("frame_time");
         let series = series_over_lights(&table, "frame_ms_median");
+        let spread = spread_over_lights(&table, "frame_ms_median", "frame_ms_min", "frame_ms_max");
         line_chart(
             &path,
             &format!("Frame time vs lights — {setting}"),
             "lights",
-            "frame time (ms, median)",
-            &series,
+            if spread.is_empty() {
+                "frame time (ms, median)"
+            } else {
+                "frame time (ms, median; bars: min–max)"
+            },
+            (&series, &spread),
             true,
         )?;
         written.push(path);
@@ -630,7 +754,7 @@ pub fn figures_named(csv: &str, dir: &Path, prefix: Option<&str>) -> Result<Vec<
                 &format!("Culling ratio vs lights — {setting}"),
                 "lights",
                 "light–pixel pairs evaluated ÷ contributing",
-                &culling,
+                (&culling, &Vec::new()),
                 false,
             )?;
             written.push(path);
@@ -704,6 +828,29 @@ mod tests {
     /// A CSV of 200 000 configurations at one light count would ask for a figure 8.8 million
     /// pixels tall (and, with `u32` sizes, wrap past 2^32 at larger counts): refused, naming
     /// the limit, before any buffer is allocated.
+    #[test]
+    fn log_axes_label_decades_and_minor_ticks_only_where_they_fit() {
+        let wide = 10.0..200_000.0;
+        let labels: Vec<String> = [10.0, 20.0, 60.0, 100.0, 1000.0, 5000.0, 100_000.0, 1e6]
+            .iter()
+            .map(|&v| log_label(v, &wide))
+            .collect();
+        assert_eq!(labels, ["10", "", "", "100", "1000", "", "100000", "1e6"]);
+        let narrow = 10.0..300.0;
+        let labels: Vec<String> = [20.0, 50.0, 60.0, 0.02].iter().map(|&v| log_label(v, &narrow)).collect();
+        assert_eq!(labels, ["20", "50", "", "0.02"]);
+    }
+
+    #[test]
+    fn the_spread_comes_from_rows_of_several_frames() {
+        let csv = "pipeline,lights,frames,frame_ms_median,frame_ms_min,frame_ms_max\n\
+                   naive,16,5,10,9,12\nnaive,64,1,20,20,20\nforward-plus,16,5,8,7,9\n";
+        let t = Table::parse(csv).expect("table");
+        let s = spread_over_lights(&t, "frame_ms_median", "frame_ms_min", "frame_ms_max");
+        assert_eq!(s.len(), 2);
+        assert_eq!(s[0].1, vec![SpreadPoint { x: 16.0, lo: 9.0, mid: 10.0, hi: 12.0 }]);
+    }
+
     #[test]
     fn figures_too_tall_for_their_rows_are_refused() {
         let mut csv = BENCH.lines().next().expect("header").to_string();
