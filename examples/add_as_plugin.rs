@@ -13,14 +13,20 @@ struct Orbiting;
 fn setup(mut commands: Commands) {
     // The embedded hall: meshes, materials, six warm lights and a camera.
     spawn_scene(&mut commands, &default_scene(), true, 16.0 / 9.0);
-    for (x, z, color) in [(-13.0, -2.5, Vec3::new(1.0, 0.1, 0.05)), (-9.0, 2.5, Vec3::new(0.1, 0.3, 1.0))] {
+    for (x, z, color) in
+        [(-13.0, -2.5, Color::linear_rgb(1.0, 0.1, 0.05)), (-9.0, 2.5, Color::linear_rgb(0.1, 0.3, 1.0))]
+    {
         commands.spawn((
             Transform::from_xyz(x, 1.0, z),
             PointLight { color, intensity: 750.0, range: 6.0, ..PointLight::default() },
         ));
     }
-    let green =
-        PointLight { color: Vec3::new(0.2, 1.0, 0.3), intensity: 750.0, range: 6.0, ..PointLight::default() };
+    let green = PointLight {
+        color: Color::linear_rgb(0.2, 1.0, 0.3),
+        intensity: 750.0,
+        range: 6.0,
+        ..PointLight::default()
+    };
     commands.spawn((Transform::from_xyz(-6.0, 1.5, 0.0), green, Orbiting));
     // A spot light over the nave, pointing down its -Z (here: straight down).
     commands.spawn((
@@ -30,7 +36,7 @@ fn setup(mut commands: Commands) {
     // Dim moonlight from above and to the side, reaching every surface that faces it.
     commands.spawn((
         Transform::default().looking_to(Vec3::new(0.3, -1.0, 0.4), Vec3::Y),
-        DirectionalLight { color: Vec3::new(0.6, 0.7, 1.0), illuminance: 0.15, ..Default::default() },
+        DirectionalLight { color: Color::linear_rgb(0.6, 0.7, 1.0), illuminance: 0.15, ..Default::default() },
     ));
 }
 

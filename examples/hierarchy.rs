@@ -32,7 +32,13 @@ fn setup(mut commands: Commands) {
         .clamp(Vec3::ZERO, Vec3::ONE);
         commands.spawn((
             Transform::from_xyz(2.5 * angle.cos(), 0.3 * (3.0 * angle).sin(), 2.5 * angle.sin()),
-            PointLight { color, intensity: 500.0, range: 4.0, radius: 0.05, ..Default::default() },
+            PointLight {
+                color: manylight::app::from_linear_rgb(color),
+                intensity: 500.0,
+                range: 4.0,
+                radius: 0.05,
+                ..Default::default()
+            },
             ChildOf(hub),
         ));
     }

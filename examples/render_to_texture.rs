@@ -62,7 +62,7 @@ fn setup(mut commands: Commands) {
     // A lamp that lights the screen.
     commands.spawn((
         Transform::from_xyz(-13.5, 2.0, 0.0),
-        PointLight { color: Vec3::ONE, intensity: 125.0, range: 6.0, ..default() },
+        PointLight { color: Color::WHITE, intensity: 125.0, range: 6.0, ..default() },
     ));
 }
 

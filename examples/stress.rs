@@ -140,7 +140,7 @@ pub fn animate_lights(
     let t = time.elapsed_secs();
     for (light, mut transform, mut point) in &mut lights {
         transform.translation = light.0.position_at(t); // orbit in XZ + bob in Y
-        point.color = light.0.color_at(t); // hue drift + flicker
+        point.color = manylight::app::from_linear_rgb(light.0.color_at(t)); // hue drift + flicker
         point.range = light.0.radius * controls.radius_scale;
     }
 }
@@ -182,7 +182,7 @@ pub fn sync_light_count(
             (
                 Transform::from_translation(l.position),
                 PointLight {
-                    color: l.color,
+                    color: manylight::app::from_linear_rgb(l.color),
                     intensity: lumens_from_candela(l.intensity),
                     range: l.radius * scale,
                     radius: 0.0,
@@ -200,7 +200,7 @@ pub fn sync_light_count(
             (
                 Transform::from_translation(a.position_at(0.0)),
                 PointLight {
-                    color: a.color_at(0.0),
+                    color: manylight::app::from_linear_rgb(a.color_at(0.0)),
                     intensity: lumens_from_candela(a.intensity),
                     range: a.radius * scale,
                     radius: 0.0,

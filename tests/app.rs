@@ -120,7 +120,11 @@ fn invalid_lights_are_dropped_and_counted_and_the_image_stays_finite() {
             // Finite colour and intensity whose product overflows to infinity.
             commands.spawn((
                 Transform::from_xyz(0.0, 1.0, 0.0),
-                PointLight { color: Vec3::splat(1e30), intensity: 1e30, ..PointLight::default() },
+                PointLight {
+                    color: Color::linear_rgb(1e30, 1e30, 1e30),
+                    intensity: 1e30,
+                    ..PointLight::default()
+                },
             ));
             // Valid edge cases: range 0 (lights nothing) and a huge range.
             commands.spawn((

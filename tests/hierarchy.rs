@@ -24,7 +24,7 @@ fn next_frame(app: &mut App) -> image::RgbaImage {
 /// A bright light that makes a visible spot on the default scene's floor.
 fn spot_light() -> PointLight {
     PointLight {
-        color: Vec3::new(1.0, 0.3, 0.1),
+        color: Color::linear_rgb(1.0, 0.3, 0.1),
         intensity: 1000.0,
         range: 5.0,
         radius: 0.0,

@@ -160,7 +160,7 @@ fn set_point(app: &mut App, p: Point) {
             world.spawn((
                 Transform::from_translation(l.position),
                 PointLight {
-                    color: l.color,
+                    color: manylight::app::from_linear_rgb(l.color),
                     intensity: l.intensity,
                     range: l.radius,
                     radius: 0.0,

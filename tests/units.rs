@@ -64,7 +64,13 @@ fn point_light_lumens_are_scene_light_candela() {
             let intensity = lumens_from_candela(l.intensity);
             commands.spawn((
                 Transform::from_translation(l.position),
-                PointLight { color: l.color, intensity, range: l.radius, radius: 0.0, ..Default::default() },
+                PointLight {
+                    color: manylight::app::from_linear_rgb(l.color),
+                    intensity,
+                    range: l.radius,
+                    radius: 0.0,
+                    ..Default::default()
+                },
             ));
         }
         commands.spawn((camera(), Camera3d));

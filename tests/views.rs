@@ -27,7 +27,8 @@ fn scene(commands: &mut Commands) {
     for i in 0..48 {
         let x = -18.0 + 36.0 * (i as f32 + 0.5) / 48.0;
         let z = if i % 2 == 0 { -4.0 } else { 4.0 };
-        let color = Vec3::new(1.0, 0.4 + 0.5 * (i % 3) as f32 / 2.0, 0.2 + 0.6 * (i % 5) as f32 / 4.0);
+        let color =
+            Color::linear_rgb(1.0, 0.4 + 0.5 * (i % 3) as f32 / 2.0, 0.2 + 0.6 * (i % 5) as f32 / 4.0);
         commands.spawn((
             Transform::from_xyz(x, 0.6, z),
             PointLight { color, intensity: 400.0, range: 4.0, radius: 0.0, ..Default::default() },

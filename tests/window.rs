@@ -78,7 +78,7 @@ fn spawn_small_scene(mut commands: Commands) {
     }
     for i in 0..8 {
         let a = i as f32 / 8.0 * std::f32::consts::TAU;
-        let color = Vec3::new(0.5 + 0.5 * a.cos(), 0.5 + 0.5 * a.sin(), 0.6);
+        let color = Color::linear_rgb(0.5 + 0.5 * a.cos(), 0.5 + 0.5 * a.sin(), 0.6);
         commands.spawn((
             Transform::from_xyz(3.0 * a.cos(), 1.5, 3.0 * a.sin()),
             PointLight { color, intensity: 50.0, range: 6.0, radius: 0.0, ..Default::default() },

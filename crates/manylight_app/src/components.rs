@@ -1,5 +1,7 @@
 //! The components a user spawns: where things are, what is drawn, what emits light.
 
+pub use bevy_color::Color;
+use bevy_color::LinearRgba;
 use bevy_ecs::prelude::*;
 use glam::{Mat4, Quat, Vec3};
 use manylight_core::{MaterialData, MeshData};
@@ -12,6 +14,17 @@ use manylight_render::snapshot::{DirectionalShadow, ShadowBias};
 use std::sync::Arc;
 
 pub use bevy_transform::components::{GlobalTransform, Transform};
+
+/// `color`'s linear RGB, as the shading multiplies it with a light's intensity.
+pub fn linear_rgb(color: Color) -> Vec3 {
+    let c = LinearRgba::from(color);
+    Vec3::new(c.red, c.green, c.blue)
+}
+
+/// A light colour from linear RGB (glTF's and the light rigs' colours are linear).
+pub fn from_linear_rgb(rgb: Vec3) -> Color {
+    Color::linear_rgb(rgb.x, rgb.y, rgb.z)
+}
 
 /// Decomposes a matrix (e.g. a glTF node's world matrix) into a [`Transform`]. Unlike
 /// `Transform::from_matrix`, a singular matrix (a zero scale on some axes, of the node or a
@@ -244,11 +257,26 @@ impl Projection {
 /// the emitter. With a camera without [`Exposure`], a few hundred lumens light a room-sized
 /// scene (glTF's and the Khronos viewer's scale); Bevy's default of a million lumens wants
 /// [`Exposure::BLENDER`].
+///
+/// ```
+/// use manylight_app::prelude::*;
+/// let mut world = World::new();
+/// // Warm light, 3 m reach, casting a shadow.
+/// let light = PointLight {
+///     color: Color::srgb(1.0, 0.8, 0.6),
+///     intensity: 800.0,
+///     range: 3.0,
+///     shadows_enabled: true,
+///     ..default()
+/// };
+/// world.spawn((Transform::from_xyz(0.0, 2.0, 0.0), light));
+/// assert!(light.shadow().is_some());
+/// ```
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
 #[require(Transform, Visibility)]
 pub struct PointLight {
-    /// Linear RGB colour.
-    pub color: Vec3,
+    /// Colour (Bevy's `Color`, in any space; the shading uses its linear RGB).
+    pub color: Color,
     /// Luminous power in lumens (multiplies `color`).
     pub intensity: f32,
     /// Distance at which the contribution reaches exactly zero (the light's sphere of
@@ -283,7 +311,7 @@ impl PointLight {
 impl Default for PointLight {
     fn default() -> Self {
         Self {
-            color: Vec3::ONE,
+            color: Color::WHITE,
             intensity: 800.0,
             range: 10.0,
             radius: 0.0,
@@ -303,8 +331,8 @@ impl Default for PointLight {
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
 #[require(Transform, Visibility)]
 pub struct SpotLight {
-    /// Linear RGB colour.
-    pub color: Vec3,
+    /// Colour (Bevy's `Color`, in any space; the shading uses its linear RGB).
+    pub color: Color,
     /// Luminous power in lumens (multiplies `color`).
     pub intensity: f32,
     /// Distance at which the contribution reaches exactly zero.
@@ -339,7 +367,7 @@ impl SpotLight {
 impl Default for SpotLight {
     fn default() -> Self {
         Self {
-            color: Vec3::ONE,
+            color: Color::WHITE,
             intensity: 800.0,
             range: 10.0,
             radius: 0.0,
@@ -359,8 +387,8 @@ impl Default for SpotLight {
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
 #[require(Transform, Visibility)]
 pub struct DirectionalLight {
-    /// Linear RGB colour.
-    pub color: Vec3,
+    /// Colour (Bevy's `Color`, in any space; the shading uses its linear RGB).
+    pub color: Color,
     /// Illuminance in lux, multiplying `color`.
     pub illuminance: f32,
     /// Casts shadows: cascades of orthographic maps fitted to the view, split as the entity's
@@ -390,7 +418,7 @@ impl DirectionalLight {
 impl Default for DirectionalLight {
     fn default() -> Self {
         Self {
-            color: Vec3::ONE,
+            color: Color::WHITE,
             illuminance: 1.0,
             shadows_enabled: false,
             shadow_depth_bias: Self::DEFAULT_SHADOW_DEPTH_BIAS,

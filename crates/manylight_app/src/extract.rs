@@ -5,7 +5,7 @@ use crate::backend::{RenderBackend, record_results};
 use crate::components::{
     Bloom, Camera, Camera3d, CameraDebugView, CameraShadows, CascadeShadowConfig, DirectionalLight, Exposure,
     GlobalTransform, InheritedVisibility, LightAnimation, Material, Mesh3d, MotionBlur, PointLight,
-    Projection, RenderTarget, SpotLight, Transform,
+    Projection, RenderTarget, SpotLight, Transform, from_linear_rgb, linear_rgb,
 };
 use crate::resources::{DebugView, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize};
 use bevy_app::AppExit;
@@ -151,17 +151,17 @@ pub fn build_snapshot(
         // directional one. Point and spot lights come in lumens (Bevy's unit) and render in
         // candela.
         let (color, lumens, range, cone, shadow) = match (point, spot, directional) {
-            (Some(l), ..) => (l.color, l.intensity, l.range, None, l.shadow()),
+            (Some(l), ..) => (linear_rgb(l.color), l.intensity, l.range, None, l.shadow()),
             (None, Some(l), _) => {
                 let direction = t.forward().into();
                 let cone = SpotCone { direction, inner_angle: l.inner_angle, outer_angle: l.outer_angle };
-                (l.color, l.intensity, l.range, Some(cone), l.shadow())
+                (linear_rgb(l.color), l.intensity, l.range, Some(cone), l.shadow())
             }
             (None, None, Some(l)) => {
                 let direction = t.forward().into();
                 directional_lights.push(ExtractedDirectionalLight {
                     direction,
-                    color: l.color,
+                    color: linear_rgb(l.color),
                     illuminance: l.illuminance,
                     shadow: l.shadow(cascades.copied().unwrap_or_default()),
                 });
@@ -235,6 +235,6 @@ pub fn animate_lights(
     let t = time.elapsed_secs();
     for (anim, mut transform, mut light) in &mut lights {
         transform.translation = anim.0.position_at(t);
-        light.color = anim.0.color_at(t);
+        light.color = from_linear_rgb(anim.0.color_at(t));
     }
 }

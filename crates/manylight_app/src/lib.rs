@@ -28,9 +28,9 @@ pub mod window;
 pub use backend::RenderFailed;
 pub use components::{
     Bloom, Camera, Camera3d, CameraDebugView, CameraShadows, CascadeShadowConfig, CascadeShadowConfigBuilder,
-    DirectionalLight, Exposure, GlobalTransform, InheritedVisibility, LightAnimation, Material, Mesh3d,
-    MotionBlur, OrthographicProjection, PerspectiveProjection, PointLight, Projection, RenderImage,
-    RenderTarget, SpotLight, Transform, Viewport, Visibility,
+    Color, DirectionalLight, Exposure, GlobalTransform, InheritedVisibility, LightAnimation, Material,
+    Mesh3d, MotionBlur, OrthographicProjection, PerspectiveProjection, PointLight, Projection, RenderImage,
+    RenderTarget, SpotLight, Transform, Viewport, Visibility, from_linear_rgb, linear_rgb,
 };
 pub use plugin::{HEADLESS_TIME_STEP, HeadlessConfig, ManyLightPlugin, ManyLightSystems, OutputMode};
 pub use resources::{
@@ -48,7 +48,7 @@ pub mod prelude {
 
     pub use crate::components::{
         Bloom, Camera, Camera3d, CameraDebugView, CameraShadows, CascadeShadowConfig,
-        CascadeShadowConfigBuilder, DirectionalLight, Exposure, GlobalTransform, InheritedVisibility,
+        CascadeShadowConfigBuilder, Color, DirectionalLight, Exposure, GlobalTransform, InheritedVisibility,
         LightAnimation, Material, Mesh3d, MotionBlur, OrthographicProjection, PerspectiveProjection,
         PointLight, Projection, RenderImage, RenderTarget, SpotLight, Transform, Viewport, Visibility,
     };

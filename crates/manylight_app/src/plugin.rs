@@ -52,6 +52,20 @@ pub enum OutputMode {
 }
 
 /// The manylight plugin: windowed by default, or headless with a size.
+///
+/// ```no_run
+/// use manylight_app::prelude::*;
+/// // A window with the embedded hall and a thousand animated lights, every one casting.
+/// App::new()
+///     .add_plugins(ManyLightPlugin::default())
+///     .add_systems(Startup, |mut commands: Commands| {
+///         let hall = manylight_scene::default_scene();
+///         spawn_scene(&mut commands, &hall, true, 16.0 / 9.0);
+///         spawn_light_rig(&mut commands, 1000, hall.bounds(), 1).expect("a rig that fits");
+///     })
+///     .add_systems(PostStartup, |world: &mut World| manylight_app::scene::set_shadows(world, true))
+///     .run();
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct ManyLightPlugin {
     /// Window or headless.

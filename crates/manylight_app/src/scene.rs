@@ -2,7 +2,7 @@
 
 use crate::components::{
     Camera3d, DirectionalLight, LightAnimation, Material, Mesh3d, PointLight, Projection, SpotLight,
-    Transform, Visibility, transform_from_matrix,
+    Transform, Visibility, from_linear_rgb, transform_from_matrix,
 };
 use bevy_ecs::name::Name;
 use bevy_ecs::prelude::*;
@@ -79,7 +79,11 @@ pub fn spawn_scene(commands: &mut Commands, scene: &Scene, spawn_camera: bool, a
     for l in &scene.directional_lights {
         let rotation =
             Quat::from_rotation_arc(Vec3::NEG_Z, l.direction.try_normalize().unwrap_or(Vec3::NEG_Z));
-        let light = DirectionalLight { color: l.color, illuminance: l.illuminance, ..Default::default() };
+        let light = DirectionalLight {
+            color: from_linear_rgb(l.color),
+            illuminance: l.illuminance,
+            ..Default::default()
+        };
         commands.spawn((Transform::from_rotation(rotation), light, ChildOf(root)));
     }
     if spawn_camera && !camera_placed {
@@ -118,7 +122,8 @@ fn spawn_instance(
 /// hangs from a glTF node (`on_node`) already points down that node's -Z.
 fn spawn_light(commands: &mut Commands, light: &SceneLight, local: Transform, on_node: bool, parent: Entity) {
     // Scene lights are in candela (glTF); the components in lumens (Bevy).
-    let (color, intensity, range) = (light.color, lumens_from_candela(light.intensity), light.radius);
+    let (color, intensity, range) =
+        (from_linear_rgb(light.color), lumens_from_candela(light.intensity), light.radius);
     match &light.spot {
         None => {
             let point = PointLight { color, intensity, range, radius: 0.0, ..Default::default() };
@@ -168,7 +173,7 @@ pub fn spawn_light_rig(
         commands.spawn((
             Transform::from_translation(anim.position_at(0.0)),
             PointLight {
-                color: anim.color_at(0.0),
+                color: from_linear_rgb(anim.color_at(0.0)),
                 intensity: lumens_from_candela(anim.intensity),
                 range: anim.radius,
                 radius: 0.0,
