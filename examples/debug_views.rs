@@ -1,7 +1,7 @@
 //! Debug views toggled at run time by a system: the embedded hall with 256 animated lights.
 //!
 //! `cargo run --release --example debug_views` opens a window. Keys: Right / Space next view,
-//! Left previous view, 0–8 pick a view, `b` toggles bloom, `m` toggles motion blur, `c` toggles
+//! Left previous view, 0–9 pick one of the first ten views (the others by Right / Left), `b` toggles bloom, `m` toggles motion blur, `c` toggles
 //! a per-cluster cap of 8 (so the overflow view has something to show), Esc quits. Each change
 //! logs one line saying what the view shows and how to read its colours (the light-count view
 //! also draws its scale along the bottom edge).
