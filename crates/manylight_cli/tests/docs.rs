@@ -582,7 +582,7 @@ fn classify(words: &[String], subs: &[String]) -> Seg {
             && !words.iter().any(|w| w == "--example")
             && words.windows(2).any(|p| {
                 (p[0] == "--bin" && p[1] == "manylight")
-                    || ((p[0] == "-p" || p[0] == "--package") && p[1] == "manylight_bench")
+                    || ((p[0] == "-p" || p[0] == "--package") && p[1] == "manylight_cli")
             });
         if !runs_cli {
             return Seg::Other;
@@ -1445,7 +1445,7 @@ fn extraction_understands_the_doc_conventions() {
     assert_eq!(segs[0], strings(&["manylight", "bench", "--depth-bounds", "off", "--out", "a_off.csv"]));
     assert_eq!(segs[1], strings(&["tee", "x"]));
     let spans =
-        code_spans("see `cargo run -p manylight_bench --bin manylight --\n report --shadows` and ``a ` b``");
+        code_spans("see `cargo run -p manylight_cli --bin manylight --\n report --shadows` and ``a ` b``");
     assert_eq!(spans.len(), 2);
     assert_eq!(spans[1].2, "a ` b");
 }
