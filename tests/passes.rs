@@ -370,7 +370,11 @@ fn a_pass_added_by_one_registration_line_runs_in_its_place() {
     // The one registration line.
     assert_eq!(pipeline(point), PipelineKind::ClusteredForward);
     let shading = "clustered_forward";
-    renderer.render_world.planner_mut().insert_after(shading, "red_tint", red_tint::plan);
+    renderer
+        .render_world
+        .planner_mut()
+        .insert_after(shading, "red_tint", red_tint::plan)
+        .expect("a shading stage");
     let (tinted, tinted_image) = renderer.render(snapshot(), true).expect("renders");
     let names = tinted.pass_names();
     let at = |n: &str| names.iter().position(|p| *p == n).unwrap_or_else(|| panic!("{n} missing: {names:?}"));

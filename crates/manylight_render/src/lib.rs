@@ -32,7 +32,7 @@ pub use context::{GpuContext, GpuCounts, NO_ADAPTER_HELP, RenderError};
 pub use graph::{OUTPUT, Pass, PassContext, RenderGraph, ResourceName, TextureSpec};
 pub use inflight::{DEFAULT_FRAMES_IN_FLIGHT, MAX_FRAMES_IN_FLIGHT};
 pub use plan::PlanInputs;
-pub use planner::FramePlanner;
+pub use planner::{FramePlanner, StageError};
 pub use readback::{HEADLESS_FORMAT, HeadlessTarget};
 pub use renderer::Renderer;
 pub use settings::{CameraShadows, CascadeShadowConfig, CascadeShadowConfigBuilder, ShadowFilteringMethod};

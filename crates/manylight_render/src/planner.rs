@@ -38,12 +38,42 @@ impl Default for FramePlanner {
     }
 }
 
+/// Why a stage could not be added.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum StageError {
+    /// No stage has the name it was to follow.
+    #[error("no stage `{after}` to add `{name}` after (stages: {known})")]
+    UnknownStage {
+        /// The name asked for.
+        after: String,
+        /// The stage that was to be added.
+        name: &'static str,
+        /// The stages there are, in order.
+        known: String,
+    },
+    /// A stage of that name exists already.
+    #[error("a stage `{0}` exists already")]
+    Duplicate(&'static str),
+}
+
 impl FramePlanner {
-    /// Adds stage `name` right after stage `after` (at the end when there is none of that
-    /// name).
-    pub fn insert_after(&mut self, after: &str, name: &'static str, planner: Planner) {
-        let at = self.stages.iter().position(|(n, _)| *n == after).map_or(self.stages.len(), |i| i + 1);
-        self.stages.insert(at, (name, planner));
+    /// Adds stage `name` right after stage `after`; refused, naming the stages there are, when
+    /// there is no stage `after`, or when a stage is called `name` already.
+    pub fn insert_after(
+        &mut self,
+        after: &str,
+        name: &'static str,
+        planner: Planner,
+    ) -> Result<(), StageError> {
+        if self.stages.iter().any(|(n, _)| *n == name) {
+            return Err(StageError::Duplicate(name));
+        }
+        let Some(i) = self.stages.iter().position(|(n, _)| *n == after) else {
+            let known = self.stages.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ");
+            return Err(StageError::UnknownStage { after: after.to_string(), name, known });
+        };
+        self.stages.insert(i + 1, (name, planner));
+        Ok(())
     }
 
     /// The passes `inputs` call for, stage after stage.
@@ -61,5 +91,29 @@ impl FramePlanner {
         for pass in self.passes(inputs) {
             graph.add_boxed(pass);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn nothing(_: &PlanInputs<'_>, _: &mut Vec<Box<dyn Pass>>) {}
+
+    #[test]
+    fn a_stage_goes_after_a_known_one_and_never_silently_elsewhere() {
+        let mut planner = FramePlanner::default();
+        planner.insert_after("tonemap", "vignette", nothing).expect("tonemap is a stage");
+        let names: Vec<&str> = planner.stages.iter().map(|(n, _)| *n).collect();
+        let at = names.iter().position(|n| *n == "vignette").expect("added");
+        assert_eq!(names[at - 1], "tonemap");
+        let unknown = planner.insert_after("tone_map", "grain", nothing).unwrap_err();
+        assert!(matches!(&unknown, StageError::UnknownStage { after, .. } if after == "tone_map"));
+        assert!(unknown.to_string().contains("tonemap"), "{unknown}");
+        assert_eq!(
+            planner.insert_after("bloom", "vignette", nothing),
+            Err(StageError::Duplicate("vignette"))
+        );
+        assert_eq!(planner.stages.len(), STAGES.len() + 1);
     }
 }
