@@ -34,7 +34,7 @@ pub struct TextureSpec {
 }
 
 /// One pass of the graph.
-pub trait Pass: Send + Sync {
+pub trait Pass: std::any::Any + Send + Sync {
     /// Name, also the wgpu label (snake_case).
     fn name(&self) -> &'static str;
     /// Resources read.
@@ -51,6 +51,11 @@ pub trait Pass: Send + Sync {
     }
     /// Records the pass.
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError>;
+}
+
+/// True when `pass` is a `P`: the renderer asks a plan for a pass by its type, not its name.
+pub fn is<P: Pass>(pass: &dyn Pass) -> bool {
+    (pass as &dyn std::any::Any).is::<P>()
 }
 
 /// What a pass sees while it records.

@@ -195,12 +195,15 @@ impl Renderer {
         output_format: wgpu::TextureFormat,
     ) -> Result<FrameReport, RenderError> {
         let passes: Vec<&dyn Pass> = graph.compile()?.into_iter().map(|i| graph.pass(i)).collect();
-        let names: Vec<&str> = passes.iter().map(|p| p.name()).collect();
-        let builds_clusters = names.contains(&"cluster_build");
+        let has = |is: fn(&dyn Pass) -> bool| passes.iter().any(|p| is(*p));
+        let builds_clusters = has(crate::graph::is::<crate::passes::cluster_build::ClusterBuildPass>);
         let loop_limited = crate::gpu_types::has_loop_limit(&self.gpu.info);
         // Naive forward loops over every light, four per iteration.
         let naive_iterations = u64::from(self.scene.light_count).div_ceil(4);
-        if loop_limited && names.contains(&"forward") && naive_iterations > u64::from(LAVAPIPE_LOOP_LIMIT) {
+        if loop_limited
+            && has(crate::graph::is::<crate::passes::forward::ForwardPass>)
+            && naive_iterations > u64::from(LAVAPIPE_LOOP_LIMIT)
+        {
             return Err(RenderError::LoopLimit {
                 what: format!("naive forward's loop over {} lights", self.scene.light_count),
                 iterations: naive_iterations,
@@ -353,7 +356,7 @@ impl Renderer {
             });
         }
         // The view's counters go to the frame's read-back slot, after the passes wrote them.
-        let tonemapped = passes.iter().any(|p| p.name() == crate::passes::tonemap::TONEMAP);
+        let tonemapped = passes.iter().any(|p| crate::graph::is::<crate::passes::tonemap::TonemapPass>(*p));
         self.ring.end_view(
             &mut encoder,
             clusters.filter(|_| builds_clusters).map(|c| c.counters_buffer()),
