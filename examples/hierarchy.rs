@@ -7,6 +7,8 @@
 //! `cargo run --release --example hierarchy -- --headless out.png --frames 30` renders 30
 //! frames headless (1/60 s apart) and writes the last one.
 
+mod support;
+
 use manylight::prelude::*;
 
 /// The top of the hierarchy: slides back and forth along the hall.
@@ -58,6 +60,6 @@ fn spin(time: Res<Time>, mut hubs: Query<&mut Transform, With<Hub>>) {
 
 fn main() -> AppExit {
     tracing_subscriber::fmt().with_env_filter("warn,winit=error,manylight_app=info").init();
-    let plugin = manylight::app::cli::ExampleArgs::from_env("hierarchy.png").plugin();
+    let plugin = support::ExampleArgs::from_env().plugin("hierarchy.png");
     App::new().add_plugins(plugin).add_systems(Startup, setup).add_systems(Update, (slide, spin)).run()
 }

@@ -9,6 +9,8 @@
 //! as `out.camera.png`).
 
 use manylight::math::TextureData;
+mod support;
+
 use manylight::prelude::*;
 use std::sync::Arc;
 
@@ -108,10 +110,12 @@ fn save_feed(path: std::path::PathBuf) -> impl FnMut(Res<SecurityFeed>, Res<Rend
 
 fn main() -> AppExit {
     tracing_subscriber::fmt().with_env_filter("warn,winit=error,manylight_app=info").init();
-    let args = manylight::app::cli::ExampleArgs::from_env("render_to_texture.png");
+    let args = support::ExampleArgs::from_env();
     let mut app = App::new();
-    app.add_plugins(args.plugin()).add_systems(Startup, setup).add_systems(Update, show_on_screen);
-    if let Some(output) = args.headless {
+    app.add_plugins(args.plugin("render_to_texture.png"))
+        .add_systems(Startup, setup)
+        .add_systems(Update, show_on_screen);
+    if let Some(output) = args.output("render_to_texture.png") {
         app.add_systems(Last, save_feed(output));
     }
     app.run()

@@ -13,6 +13,8 @@
 //! `cargo run --release --example split_screen -- --headless out.png --frames 30` renders 30
 //! frames headless and writes the last one.
 
+mod support;
+
 use manylight::prelude::*;
 
 /// Which quarter a camera takes: (column, row).
@@ -72,6 +74,6 @@ fn circle(time: Res<Time>, mut cameras: Query<&mut Transform, With<Circling>>) {
 
 fn main() -> AppExit {
     tracing_subscriber::fmt().with_env_filter("warn,winit=error,manylight_app=info").init();
-    let plugin = manylight::app::cli::ExampleArgs::from_env("split_screen.png").plugin();
+    let plugin = support::ExampleArgs::from_env().plugin("split_screen.png");
     App::new().add_plugins(plugin).add_systems(Startup, setup).add_systems(Update, (layout, circle)).run()
 }

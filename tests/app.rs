@@ -2,6 +2,10 @@
 //! `FrameStats`. Runs on a real device (lavapipe in CI).
 
 mod support;
+// The examples' shared command line; this test reads it, the examples use the rest.
+#[allow(dead_code)]
+#[path = "../examples/support/mod.rs"]
+mod example_support;
 
 use manylight::app::headless::{finish_frames, render_headless};
 use manylight::app::{FrameStats, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize};
@@ -391,4 +395,20 @@ fn a_target_beyond_the_device_limit_is_refused_with_the_limit_named() {
         message.contains("max_texture_dimension_2d") && message.contains(&limit.to_string()),
         "{message}"
     );
+}
+
+/// The windowed examples' command line: a window by default, `--headless` with or without a
+/// path, `--frames`; a misspelt flag is refused, not ignored.
+#[test]
+fn examples_read_their_command_line_with_clap() {
+    use clap::Parser;
+    use example_support::ExampleArgs;
+    let parse = |s: &str| ExampleArgs::try_parse_from(s.split_whitespace());
+    let window = parse("ex").expect("no arguments");
+    assert_eq!((window.output("x.png"), window.frames), (None, 30));
+    let default = parse("ex --headless --frames 5").expect("headless without a path");
+    assert_eq!((default.output("x.png"), default.frames), (Some("x.png".into()), 5));
+    let named = parse("ex --frames 2 --headless o.png").expect("headless with a path");
+    assert_eq!((named.output("x.png"), named.frames), (Some("o.png".into()), 2));
+    assert!(parse("ex --frame 2").is_err() && parse("ex --frames two").is_err());
 }

@@ -159,22 +159,6 @@ mod tests {
     }
 
     #[test]
-    fn example_args_read_headless_output_and_frames() {
-        let args = |s: &str| s.split_whitespace().map(String::from).collect::<Vec<_>>();
-        let parse = |s: &str| ExampleArgs::parse(&args(s), "x.png");
-        assert_eq!(parse("ex"), ExampleArgs { headless: None, frames: 30 });
-        assert_eq!(parse("ex --headless"), ExampleArgs { headless: Some("x.png".into()), frames: 30 });
-        assert_eq!(
-            parse("ex --headless --frames 5"),
-            ExampleArgs { headless: Some("x.png".into()), frames: 5 }
-        );
-        assert_eq!(
-            parse("ex --frames 2 --headless o.png"),
-            ExampleArgs { headless: Some("o.png".into()), frames: 2 }
-        );
-    }
-
-    #[test]
     fn names_round_trip_and_errors_list_the_choices() {
         for p in PipelineKind::ALL {
             assert_eq!(parse_pipeline(p.name()), Ok(p));
@@ -184,46 +168,5 @@ mod tests {
         assert!(err.contains("full, packed, compact"), "{err}");
         assert_eq!(parse_size("1280x720"), Ok(UVec2::new(1280, 720)));
         assert!(parse_size("0x720").is_err() && parse_grid("1x2").is_err());
-    }
-}
-
-/// The options the windowed examples share: `--headless OUT.png` renders headless at 1280×720
-/// instead of opening a window and writes the last frame to `OUT.png`; `--frames N` sets how
-/// many frames (default 30, 1/60 s apart).
-#[derive(Clone, Debug, PartialEq)]
-pub struct ExampleArgs {
-    /// The PNG a headless run writes; `None` opens a window.
-    pub headless: Option<std::path::PathBuf>,
-    /// Frames a headless run renders.
-    pub frames: u32,
-}
-
-impl ExampleArgs {
-    /// Reads the process arguments; `default_output` is the PNG when `--headless` has no path.
-    pub fn from_env(default_output: &str) -> ExampleArgs {
-        ExampleArgs::parse(&std::env::args().collect::<Vec<_>>(), default_output)
-    }
-
-    /// Reads `args` (the program name first).
-    pub fn parse(args: &[String], default_output: &str) -> ExampleArgs {
-        let value = |flag: &str| {
-            args.iter().position(|a| a == flag).and_then(|i| args.get(i + 1)).filter(|v| !v.starts_with("--"))
-        };
-        let headless = args
-            .iter()
-            .any(|a| a == "--headless")
-            .then(|| value("--headless").map_or_else(|| default_output.into(), std::path::PathBuf::from));
-        let frames = value("--frames").and_then(|s| s.parse().ok()).unwrap_or(30);
-        ExampleArgs { headless, frames }
-    }
-
-    /// The plugin: headless at 1280×720 writing [`ExampleArgs::headless`], or a window.
-    pub fn plugin(&self) -> crate::ManyLightPlugin {
-        match &self.headless {
-            Some(path) => crate::ManyLightPlugin::headless(UVec2::new(1280, 720))
-                .with_frames(self.frames)
-                .with_output(path.clone()),
-            None => crate::ManyLightPlugin::default(),
-        }
     }
 }
