@@ -142,26 +142,27 @@ pub type Spread = Vec<(String, Vec<SpreadPoint>)>;
 /// configuration, where a row has all three and more than one frame (a one-frame row has no
 /// spread to show).
 pub fn spread_over_lights(table: &Table, mid: &str, lo: &str, hi: &str) -> Spread {
-    let mut spread: Spread = Vec::new();
+    by_configuration(table, |row| {
+        let x = table.number(row, "lights")?;
+        let (lo, mid, hi) = (table.number(row, lo)?, table.number(row, mid)?, table.number(row, hi)?);
+        let several = table.number(row, "frames").is_none_or(|f| f >= 2.0);
+        (x > 0.0 && lo > 0.0 && several).then_some(SpreadPoint { x, lo, mid, hi })
+    })
+}
+
+/// The points `point` takes from the rows, one series per configuration label, in order of
+/// first appearance (rows it returns `None` for are left out).
+fn by_configuration<T>(table: &Table, point: impl Fn(&[String]) -> Option<T>) -> Vec<(String, Vec<T>)> {
+    let mut series: Vec<(String, Vec<T>)> = Vec::new();
     for row in &table.rows {
-        let values = (
-            table.number(row, "lights"),
-            table.number(row, lo),
-            table.number(row, mid),
-            table.number(row, hi),
-        );
-        let (Some(x), Some(lo), Some(mid), Some(hi)) = values else { continue };
-        if x <= 0.0 || lo <= 0.0 || table.number(row, "frames").is_some_and(|f| f < 2.0) {
-            continue;
-        }
+        let Some(p) = point(row) else { continue };
         let label = table.label(row);
-        let point = SpreadPoint { x, lo, mid, hi };
-        match spread.iter_mut().find(|(l, _)| *l == label) {
-            Some((_, points)) => points.push(point),
-            None => spread.push((label, vec![point])),
+        match series.iter_mut().find(|(l, _)| *l == label) {
+            Some((_, points)) => points.push(p),
+            None => series.push((label, vec![p])),
         }
     }
-    spread
+    series
 }
 
 /// One horizontal stacked bar: its label and its segments (name, value).
@@ -170,18 +171,10 @@ pub type Bar = (String, Vec<(String, f64)>);
 /// `y` against `lights`, one series per configuration (rows without a positive `y` or light
 /// count are left out, so a log axis can show them).
 pub fn series_over_lights(table: &Table, y: &str) -> Series {
-    let mut series: Series = Vec::new();
-    for row in &table.rows {
-        let (Some(x), Some(v)) = (table.number(row, "lights"), table.number(row, y)) else { continue };
-        if x <= 0.0 || v <= 0.0 {
-            continue;
-        }
-        let label = table.label(row);
-        match series.iter_mut().find(|(l, _)| *l == label) {
-            Some((_, points)) => points.push((x, v)),
-            None => series.push((label, vec![(x, v)])),
-        }
-    }
+    let mut series = by_configuration(table, |row| {
+        let (x, v) = (table.number(row, "lights")?, table.number(row, y)?);
+        (x > 0.0 && v > 0.0).then_some((x, v))
+    });
     for (_, points) in &mut series {
         points.sort_by(|a, b| a.0.total_cmp(&b.0));
     }
