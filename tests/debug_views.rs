@@ -47,7 +47,7 @@ fn scene() -> Scene {
     for (i, material) in scene.materials.iter_mut().enumerate() {
         let m = std::sync::Arc::make_mut(material);
         if i == 0 {
-            m.emissive = Vec3::new(1.0, 0.5, 0.2);
+            m.emissive = LinearRgba::rgb(1.0, 0.5, 0.2);
         } else {
             m.occlusion_texture = Some(occlusion.clone().into());
         }

@@ -7,7 +7,7 @@
 
 mod support;
 
-use glam::{Mat4, Vec4};
+use glam::Mat4;
 use manylight::app::RenderSettings;
 use manylight::math::{MaterialData, Projection};
 use manylight::prelude::*;
@@ -86,7 +86,7 @@ fn every_pipeline_matches_naive_forward_on_gltf_materials() {
 fn box_scene(sx: f32, double_sided: bool) -> Scene {
     let material = MaterialData {
         label: "box".into(),
-        base_color: Vec4::new(0.8, 0.6, 0.4, 1.0),
+        base_color: Color::linear_rgb(0.8, 0.6, 0.4),
         double_sided,
         ..MaterialData::default()
     };
@@ -214,7 +214,7 @@ fn texture_transforms_and_the_second_uv_set_match_pre_transformed_uvs() {
         let material = MaterialData {
             label: "transformed".into(),
             base_color_texture: Some(base_texture),
-            emissive: Vec3::splat(0.5),
+            emissive: LinearRgba::rgb(0.5, 0.5, 0.5),
             emissive_texture: Some(emissive_texture),
             ..MaterialData::default()
         };
@@ -267,8 +267,8 @@ fn texture_transforms_and_the_second_uv_set_match_pre_transformed_uvs() {
 fn emitting_quad(z: f32, emissive: Vec3, alpha: f32) -> (MaterialData, Mat4) {
     let material = MaterialData {
         label: format!("quad at {z}"),
-        base_color: Vec4::new(0.0, 0.0, 0.0, alpha),
-        emissive,
+        base_color: Color::linear_rgba(0.0, 0.0, 0.0, alpha),
+        emissive: LinearRgba::from_vec3(emissive),
         alpha_mode: if alpha < 1.0 {
             manylight::math::AlphaMode::Blend
         } else {

@@ -8,7 +8,7 @@
 
 mod support;
 
-use glam::{Mat4, Vec4};
+use glam::Mat4;
 use manylight::app::RenderSettings;
 use manylight::math::{Projection, Vertex};
 use manylight::prelude::*;
@@ -172,7 +172,7 @@ fn lights() -> Vec<SceneLight> {
 fn floor_material() -> MaterialData {
     MaterialData {
         label: "floor".into(),
-        base_color: Vec4::new(0.8, 0.8, 0.8, 1.0),
+        base_color: Color::linear_rgb(0.8, 0.8, 0.8),
         shininess: 32.0,
         specular: 0.5,
         ..MaterialData::default()
@@ -224,7 +224,7 @@ fn analytic_floor(extent: f64, far: f64, settings: &RenderSettings) -> image::Rg
     let tan = (0.5 * f64::from(cam.projection.fov_y)).tan();
     let aspect = f64::from(SIZE.x) / f64::from(SIZE.y);
     let material = floor_material();
-    let albedo = v(material.base_color.truncate());
+    let albedo = v(material.base_color_linear().truncate());
     let (shininess, specular) = (f64::from(material.shininess), f64::from(material.specular));
     let aces = |x: f64| ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0);
     let srgb = |c: f64| if c <= 0.0031308 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };

@@ -4,7 +4,6 @@
 
 mod support;
 
-use glam::Vec4;
 use manylight::app::headless::render_headless;
 use manylight::math::{MaterialData, MeshData, TextureData, Vertex};
 use manylight::prelude::*;
@@ -43,7 +42,7 @@ fn render_with(mesh: MeshData) -> Result<manylight::app::headless::HeadlessFrame
                 Transform::IDENTITY,
                 Mesh3d(mesh.clone()),
                 Material(Arc::new(MaterialData {
-                    base_color: Vec4::new(0.9, 0.2, 0.1, 1.0),
+                    base_color: Color::linear_rgb(0.9, 0.2, 0.1),
                     ..Default::default()
                 })),
             ));

@@ -6,6 +6,11 @@
 
 mod support;
 
+// The custom_pass example's vignette: a pass an app adds from outside the crates.
+#[allow(dead_code)]
+#[path = "../examples/custom_pass.rs"]
+mod custom_pass;
+
 use manylight::app::render_world::plan_passes;
 use manylight::app::scene::scene_snapshot;
 use manylight::app::{DebugView, FrameStats};
@@ -370,11 +375,13 @@ fn a_pass_added_by_one_registration_line_runs_in_its_place() {
     // The one registration line.
     assert_eq!(pipeline(point), PipelineKind::ClusteredForward);
     let shading = "clustered_forward";
-    renderer
-        .render_world
-        .planner_mut()
-        .insert_after(shading, "red_tint", red_tint::plan)
+    let mut stages = manylight::render::FramePlanner::default();
+    stages
+        .insert_after::<manylight::render::passes::ClusteredForwardPass>(manylight::render::Stage::new::<
+            red_tint::RedTint,
+        >(red_tint::plan))
         .expect("a shading stage");
+    renderer.render_world.set_stages(&std::sync::Arc::new(stages));
     let (tinted, tinted_image) = renderer.render(snapshot(), true).expect("renders");
     let names = tinted.pass_names();
     let at = |n: &str| names.iter().position(|p| *p == n).unwrap_or_else(|| panic!("{n} missing: {names:?}"));
@@ -534,4 +541,74 @@ fn the_shadow_pass_runs_only_where_a_light_casts_and_lights_are_shaded() {
         sun.directional_lights[0].shadow = None;
         assert_eq!(plan_passes(sun).unwrap(), expected(unlit), "{unlit:?}");
     }
+}
+
+/// The custom_pass example, headless at 128×64 (two 64×64 cameras side by side), its right
+/// camera carrying `vignette` if any: its image and the last frame's report.
+fn render_custom_pass(
+    vignette: Option<custom_pass::Vignette>,
+) -> (image::RgbaImage, manylight::render::FrameReport) {
+    let frame = manylight::app::headless::render_headless(UVec2::new(128, 64), 1, move |app| {
+        app.add_systems(Startup, move |mut commands: Commands| custom_pass::setup(&mut commands, vignette))
+            .add_systems(Update, custom_pass::layout);
+        custom_pass::add_vignette(app).expect("tone mapping is a stage");
+    })
+    .unwrap_or_else(|e| panic!("render failed: {e}"));
+    support::assert_finite(&frame);
+    (frame.image, frame.stats.last.expect("a report"))
+}
+
+/// An app's own pass (the custom_pass example: its WGSL, its camera component, its stage before
+/// tone mapping, the HDR image swapped through `post_process_write`) runs only for the camera
+/// that carries its component: only that camera's pixels change, darker towards the corners,
+/// and the other camera runs exactly the passes it runs without the app's pass.
+#[test]
+fn an_app_pass_runs_only_for_the_camera_that_carries_its_component() {
+    let _gpu = gpu();
+    let (plain, plain_report) = render_custom_pass(None);
+    let (vignetted, report) = render_custom_pass(Some(custom_pass::Vignette { strength: 1.0, radius: 0.2 }));
+    let half =
+        |img: &image::RgbaImage, right: u32| image::imageops::crop_imm(img, right * 64, 0, 64, 64).to_image();
+    assert_eq!(half(&plain, 0), half(&vignetted, 0), "the camera without a Vignette changed");
+    let luma = |img: &image::RgbaImage, x: u32, y: u32| {
+        let p = img.get_pixel(x, y).0;
+        u32::from(p[0]) + u32::from(p[1]) + u32::from(p[2])
+    };
+    let corners = |img: &image::RgbaImage| -> u32 {
+        [(64, 0), (127, 0), (64, 63), (127, 63)].iter().map(|&(x, y)| luma(img, x, y)).sum()
+    };
+    assert!(
+        corners(&vignetted) * 4 < corners(&plain),
+        "corners not darkened: {} against {}",
+        corners(&vignetted),
+        corners(&plain)
+    );
+    let centre = |img: &image::RgbaImage| luma(img, 96, 32);
+    assert!(centre(&vignetted).abs_diff(centre(&plain)) <= 3, "the centre changed");
+    let passes = |r: &manylight::render::FrameReport, view: usize| r.views[view].passes.clone();
+    assert_eq!(passes(&report, 0), passes(&plain_report, 0), "the plain camera ran another pass");
+    let right = passes(&report, 1);
+    let at = |n: &str| right.iter().position(|p| p == n).unwrap_or_else(|| panic!("{n} missing: {right:?}"));
+    assert!(at("vignette") + 1 == at("tonemap"), "{right:?}");
+    assert_eq!(right.len(), passes(&plain_report, 1).len() + 1, "{right:?}");
+}
+
+/// An app's WGSL is composed with the library's includes and validates with naga (no GPU); an
+/// include the library does not have is an error naming it.
+#[test]
+fn an_app_shader_composes_with_the_library_includes_and_validates() {
+    let code = manylight::render::shaders::compose_source("custom_pass.wgsl", custom_pass::VIGNETTE_WGSL)
+        .expect("composes");
+    let module =
+        naga::front::wgsl::parse_str(&code).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&code)));
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("custom_pass.wgsl: {e:?}"));
+    let entries: Vec<&str> = module.entry_points.iter().map(|e| e.name.as_str()).collect();
+    assert_eq!(entries, ["fullscreen_vs", "fs_vignette"]);
+    let missing = manylight::render::shaders::compose_source("mine.wgsl", "//!include common/nothing.wgsl\n");
+    assert!(
+        matches!(&missing, Err(manylight::render::shaders::ShaderError::Unknown(f)) if f == "common/nothing.wgsl"),
+        "{missing:?}"
+    );
 }

@@ -85,7 +85,7 @@ fn spheres() -> Scene {
         for (column, roughness) in ROUGHNESS.into_iter().enumerate() {
             scene.materials.push(Arc::new(MaterialData {
                 label: format!("metallic {metallic} roughness {roughness}"),
-                base_color: BASE_COLOR.extend(1.0),
+                base_color: Color::linear_rgb(BASE_COLOR.x, BASE_COLOR.y, BASE_COLOR.z),
                 metallic,
                 roughness,
                 ..MaterialData::default()

@@ -4,7 +4,7 @@
 
 mod support;
 
-use glam::{Mat4, Vec4};
+use glam::Mat4;
 use manylight::app::headless::{HeadlessFrame, render_headless};
 use manylight::math::shadow_oracle::{LightSource, OccluderSet, ShadowQuery};
 use manylight::prelude::*;
@@ -22,7 +22,7 @@ const FLOOR: f32 = 4.0;
 
 /// A floor (top at y = 0), a 1 × 1 plate at y = 1 and the camera looking down at them.
 fn plate_scene() -> Scene {
-    let white = MaterialData { base_color: Vec4::new(0.8, 0.8, 0.8, 1.0), ..MaterialData::default() };
+    let white = MaterialData { base_color: Color::linear_rgb(0.8, 0.8, 0.8), ..MaterialData::default() };
     Scene {
         name: "plate".into(),
         meshes: vec![

@@ -7,8 +7,9 @@ use crate::render_world::{DeviceLoss, SinkFrame};
 use crate::resources::{FrameStats, HeadlessCapture, RenderFailure, RenderedImages};
 use bevy_ecs::prelude::*;
 use crossbeam_channel::{Receiver, Sender, bounded, unbounded};
-use manylight_render::{FrameReport, FrameSnapshot, RenderError, RenderTextureId};
+use manylight_render::{FramePlanner, FrameReport, FrameSnapshot, RenderError, RenderTextureId};
 use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::Arc;
 use std::thread::JoinHandle;
 
 /// What rendering a frame gives back: the reports of the frames whose GPU figures arrived
@@ -52,6 +53,13 @@ pub trait FrameSink: Send + Sync + 'static {
     /// (then every frame in flight is waited for); returns the reports that have arrived.
     fn render_frame(&mut self, snapshot: FrameSnapshot, readback: bool) -> Result<SinkFrame, RenderError>;
 
+    /// The stages the next frames are planned with (the built-in ones and the app's; each frame
+    /// brings them, as an `Arc` that changes only when the app adds a stage). Sinks that plan
+    /// no frames ignore them.
+    fn set_stages(&mut self, stages: &Arc<FramePlanner>) {
+        let _ = stages;
+    }
+
     /// Waits for the frames in flight and returns their reports (at shutdown).
     fn drain(&mut self) -> Result<Vec<FrameReport>, RenderError> {
         Ok(Vec::new())
@@ -73,6 +81,10 @@ pub trait FrameSink: Send + Sync + 'static {
 impl FrameSink for crate::render_world::HeadlessRenderer {
     fn render_frame(&mut self, snapshot: FrameSnapshot, readback: bool) -> Result<SinkFrame, RenderError> {
         self.render_in_flight(snapshot, readback)
+    }
+
+    fn set_stages(&mut self, stages: &Arc<FramePlanner>) {
+        self.render_world.set_stages(stages);
     }
 
     fn drain(&mut self) -> Result<Vec<FrameReport>, RenderError> {
@@ -99,9 +111,11 @@ pub(crate) fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
 
 /// Renders one frame, turning a panic of the renderer into an error like any other failed
 /// frame (the app ends on it; the render thread stops).
-fn render_caught(sink: &mut dyn FrameSink, snapshot: FrameSnapshot, readback: bool) -> FrameResult {
+fn render_caught(sink: &mut dyn FrameSink, frame: Frame) -> FrameResult {
+    let Frame { snapshot, readback, stages } = frame;
     let frame_index = snapshot.frame_index;
-    match catch_unwind(AssertUnwindSafe(|| sink.render_frame(snapshot, readback))) {
+    sink.set_stages(&stages);
+    match catch_unwind(AssertUnwindSafe(|| sink.render_frame(*snapshot, readback))) {
         Ok(result) => result
             .map(|SinkFrame { reports, image }| RenderedFrame {
                 frame_index,
@@ -126,8 +140,17 @@ fn drain_caught(sink: &mut dyn FrameSink, last_frame: u64) -> Option<FrameResult
     }
 }
 
+/// One frame handed to the renderer.
+struct Frame {
+    snapshot: Box<FrameSnapshot>,
+    /// Its image is read back.
+    readback: bool,
+    /// The stages it is planned with.
+    stages: Arc<FramePlanner>,
+}
+
 enum ToRenderThread {
-    Frame(Box<FrameSnapshot>, bool),
+    Frame(Frame),
     LoseDevice(DeviceLoss),
 }
 
@@ -149,15 +172,15 @@ impl RenderThread {
             let mut last_frame = 0;
             let mut failed = false;
             while let Ok(message) = frame_rx.recv() {
-                let (snapshot, readback) = match message {
-                    ToRenderThread::Frame(snapshot, readback) => (snapshot, readback),
+                let frame = match message {
+                    ToRenderThread::Frame(frame) => frame,
                     ToRenderThread::LoseDevice(when) => {
                         sink.lose_device(when);
                         continue;
                     }
                 };
-                last_frame = snapshot.frame_index;
-                let result = render_caught(sink.as_mut(), *snapshot, readback);
+                last_frame = frame.snapshot.frame_index;
+                let result = render_caught(sink.as_mut(), frame);
                 failed = result.is_err();
                 if result_tx.send(result).is_err() || failed {
                     break;
@@ -215,19 +238,18 @@ impl RenderBackend {
         RenderBackend::Sync { sink, pending: Vec::new(), last_frame: 0 }
     }
 
-    /// Hands a snapshot over (renders it now in sync mode).
-    pub fn submit(&mut self, snapshot: FrameSnapshot, readback: bool) {
+    /// Hands a snapshot over, to be planned with `stages` (renders it now in sync mode).
+    pub fn submit(&mut self, snapshot: FrameSnapshot, readback: bool, stages: Arc<FramePlanner>) {
+        let frame = Frame { snapshot: Box::new(snapshot), readback, stages };
         match self {
             RenderBackend::Pending => {}
             RenderBackend::Sync { sink, pending, last_frame } => {
-                *last_frame = snapshot.frame_index;
-                pending.push(render_caught(sink.as_mut(), snapshot, readback));
+                *last_frame = frame.snapshot.frame_index;
+                pending.push(render_caught(sink.as_mut(), frame));
             }
             RenderBackend::Pipelined(thread) => {
-                let sent = thread
-                    .frames
-                    .as_ref()
-                    .is_some_and(|tx| tx.send(ToRenderThread::Frame(Box::new(snapshot), readback)).is_ok());
+                let sent =
+                    thread.frames.as_ref().is_some_and(|tx| tx.send(ToRenderThread::Frame(frame)).is_ok());
                 if !sent {
                     tracing::debug!("render thread has stopped; frame dropped");
                 }

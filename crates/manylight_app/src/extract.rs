@@ -8,6 +8,7 @@ use crate::components::{
     Projection, RenderTarget, SpotLight, Transform, from_linear_rgb, linear_rgb,
 };
 use crate::resources::{DebugView, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize};
+use crate::stages::{ExtractedCameraComponents, RenderStages};
 use bevy_app::AppExit;
 use bevy_ecs::prelude::*;
 use bevy_ecs::query::QueryData;
@@ -16,7 +17,7 @@ use glam::Mat4;
 use manylight_core::{MaterialData, SpotCone, candela_from_lumens};
 use manylight_render::{
     ExtractedCamera, ExtractedDirectionalLight, ExtractedInstance, ExtractedPointLight, ExtractedView,
-    FrameSnapshot, ViewRect, ViewTarget,
+    FrameSnapshot, ViewComponents, ViewRect, ViewTarget,
 };
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -28,6 +29,8 @@ pub struct ExtractState {
     prev_cameras: HashMap<Entity, ExtractedCamera>,
     frame_index: u64,
     default_material: Option<Arc<MaterialData>>,
+    /// The built-in stages, for an app without a [`RenderStages`] resource.
+    default_stages: Arc<manylight_render::FramePlanner>,
 }
 
 /// What extract reads of a camera: which one, placement, projection, target and order, and
@@ -85,6 +88,7 @@ pub fn build_snapshot(
     cameras: &Query<CameraItem, With<Camera3d>>,
     meshes: &Query<MeshItem>,
     lights: &Query<LightItem>,
+    mut camera_components: Option<&mut HashMap<Entity, ViewComponents>>,
 ) -> FrameSnapshot {
     let mut views: Vec<ExtractedView> = Vec::with_capacity(cameras.iter().len());
     // Last frame's cameras; the map is rebuilt from this frame's, so removed ones go.
@@ -120,6 +124,7 @@ pub fn build_snapshot(
             debug_view: item.debug_view.map(|d| d.0),
             order: camera.order,
             shadows: item.shadows.is_none_or(|s| s.enabled),
+            components: camera_components.as_mut().and_then(|c| c.remove(&entity)).unwrap_or_default(),
         };
         // Last frame's camera at this frame's size: a resize alone moves no pixel, so motion
         // blur does not smear the first frame after one.
@@ -127,6 +132,10 @@ pub fn build_snapshot(
         view.camera.prev_clip_from_world = prev_cameras.get(&entity).map(|p| p.clip_from_world(size));
         state.prev_cameras.insert(entity, view.camera);
         views.push(view);
+    }
+    // Components of cameras that rendered nothing this frame are not kept for the next.
+    if let Some(components) = camera_components {
+        components.clear();
     }
     // Lower order first; equal orders keep query order.
     views.sort_by_key(|v| v.order);
@@ -206,12 +215,17 @@ pub fn extract_and_render(
     mut backend: ResMut<RenderBackend>,
     capture: Res<HeadlessCapture>,
     failure: Res<RenderFailure>,
+    (stages, mut components): (Option<Res<RenderStages>>, Option<ResMut<ExtractedCameraComponents>>),
 ) {
     if failure.0.is_some() {
         return;
     }
-    let snapshot = build_snapshot(&mut state, viewport.0, &settings, &debug, &cameras, &meshes, &lights);
-    backend.submit(snapshot, capture.enabled);
+    let components = components.as_mut().map(|c| &mut c.0);
+    let snapshot =
+        build_snapshot(&mut state, viewport.0, &settings, &debug, &cameras, &meshes, &lights, components);
+    // The stages travel with each frame (an `Arc`, shared until the app changes them).
+    let stages = stages.map_or_else(|| state.default_stages.clone(), |s| s.0.clone());
+    backend.submit(snapshot, capture.enabled, stages);
 }
 
 /// Stores the frames that finished since the last update ([`crate::backend::record_results`])

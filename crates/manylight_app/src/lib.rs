@@ -22,6 +22,7 @@ pub mod plugin;
 pub mod render_world;
 pub mod resources;
 pub mod scene;
+pub mod stages;
 pub mod visibility;
 pub mod window;
 
@@ -57,6 +58,7 @@ pub mod prelude {
         DebugView, FrameStats, HeadlessCapture, LightControls, RenderSettings, RenderedImages,
     };
     pub use crate::scene::{spawn_light_rig, spawn_scene};
+    pub use crate::stages::{ExtractCameraComponentPlugin, ManyLightAppExt, RenderStages};
     pub use crate::window::{Overlay, PressedKeys, WindowConfig, WindowRequests};
     pub use bevy_app::prelude::*;
     pub use bevy_ecs::prelude::*;
@@ -64,6 +66,11 @@ pub mod prelude {
     pub use glam::{Quat, UVec2, Vec2, Vec3};
     pub use manylight_core::cluster::{CullTest, GridConfig, ZSlicing};
     pub use manylight_core::codec::NormalCodec;
-    pub use manylight_core::{LightCountError, MaterialData, MeshData, ShadingModel};
-    pub use manylight_render::{BloomChain, ClusterSettings, DebugViewMode, GBufferLayout, PipelineKind};
+    pub use manylight_core::{
+        ColorToComponents, LightCountError, LinearRgba, MaterialData, MeshData, ShadingModel,
+    };
+    pub use manylight_render::{
+        BloomChain, ClusterSettings, DebugViewMode, GBufferLayout, Pass, PassContext, PipelineKind,
+        PlanInputs, RenderError, ResourceName, Stage, StageError, TextureSpec,
+    };
 }

@@ -160,6 +160,7 @@ impl Plugin for ManyLightPlugin {
             .init_resource::<FrameStats>()
             .init_resource::<crate::resources::RenderedImages>()
             .init_resource::<RenderFailure>()
+            .init_resource::<crate::stages::RenderStages>()
             .add_message::<crate::backend::RenderFailed>()
             .init_resource::<crate::window::WindowRequests>()
             .init_resource::<crate::window::PressedKeys>()

@@ -12,9 +12,10 @@ use bevy_ecs::schedule::ScheduleLabel;
 use manylight_render::passes::LightVolumesPass;
 use manylight_render::{
     FramePlanner, FrameReport, FrameSnapshot, GpuContext, HeadlessTarget, PipelineKind, PlanInputs,
-    RenderError, RenderGraph, RenderTextureId, RenderView, Renderer, ViewReport, ViewTarget,
+    RenderError, RenderGraph, RenderTextureId, RenderView, Renderer, ViewComponents, ViewReport, ViewTarget,
 };
 use std::collections::HashMap;
+use std::sync::Arc;
 
 /// The ordered steps of one rendered frame.
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -37,7 +38,7 @@ pub struct RenderSchedule;
 pub struct CurrentSnapshot(pub FrameSnapshot);
 
 /// The view being rendered and what the frame holds that its plan depends on.
-#[derive(Resource, Clone, Copy, Debug)]
+#[derive(Resource, Clone, Debug)]
 pub struct CurrentView {
     /// Its camera, image size and settings (its shadows checkbox applied).
     pub view: RenderView,
@@ -49,6 +50,8 @@ pub struct CurrentView {
     pub has_pixel_lists: bool,
     /// The frame draws shadow maps (`FrameSnapshot::casts_shadows`) and this view shows them.
     pub casts_shadows: bool,
+    /// Components an app extracted from the view's camera for its own passes.
+    pub components: ViewComponents,
 }
 
 impl CurrentView {
@@ -61,6 +64,7 @@ impl CurrentView {
             has_lights: snapshot.has_lights(),
             has_blended: snapshot.has_blended(),
             has_pixel_lists: snapshot.pixel_light_lists.is_some(),
+            components: snapshot.views.get(index).map(|v| v.components.clone()).unwrap_or_default(),
         }
     }
 
@@ -68,6 +72,7 @@ impl CurrentView {
     fn plan_inputs(&self, accumulation: wgpu::TextureFormat) -> PlanInputs<'_> {
         PlanInputs {
             view: &self.view,
+            components: &self.components,
             has_lights: self.has_lights,
             has_blended: self.has_blended,
             has_pixel_lists: self.has_pixel_lists,
@@ -190,7 +195,7 @@ impl RenderWorld {
         world.init_resource::<CurrentSnapshot>();
         world.init_resource::<FrameGraph>();
         world.init_resource::<FrameOutcome>();
-        world.init_resource::<Planner>();
+        world.init_resource::<Stages>();
         let mut schedule = Schedule::new(RenderSchedule);
         schedule.configure_sets((RenderSet::Prepare, RenderSet::Graph, RenderSet::Execute).chain());
         schedule.add_systems(prepare.in_set(RenderSet::Prepare));
@@ -237,9 +242,9 @@ impl RenderWorld {
         let losses = std::mem::take(&mut self.losses);
         let frames_in_flight = self.renderer().frames_in_flight();
         let recoveries = self.recoveries;
-        let planner = self.world.resource::<Planner>().clone();
+        let stages = self.world.resource::<Stages>().0.clone();
         *self = RenderWorld::with_frames_in_flight(gpu, frames_in_flight);
-        self.world.insert_resource(planner);
+        self.world.insert_resource(Stages(stages));
         self.losses = losses;
         self.recoveries = recoveries + 1;
         Ok(())
@@ -269,11 +274,13 @@ impl RenderWorld {
         self.world.resource_mut::<RendererResource>().0.take_reports(wait)
     }
 
-    /// The stages views are planned with: insert a stage of your own
-    /// ([`FramePlanner::insert_after`]) to add a pass to every view that calls for it. A
-    /// recreated device keeps them.
-    pub fn planner_mut(&mut self) -> &mut FramePlanner {
-        &mut self.world.resource_mut::<Planner>().into_inner().0
+    /// Plans the next frames with `stages` (the built-in ones and an app's,
+    /// [`crate::stages::RenderStages`]); unchanged when it is the same `Arc`. A recreated device
+    /// keeps them.
+    pub fn set_stages(&mut self, stages: &Arc<FramePlanner>) {
+        if !Arc::ptr_eq(&self.world.resource::<Stages>().0, stages) {
+            self.world.insert_resource(Stages(stages.clone()));
+        }
     }
 
     /// The renderer, to record a pass outside the graph (the window overlay).
@@ -405,7 +412,7 @@ impl RenderWorld {
             let image = (!plan.whole).then(|| self.view_image(&gpu, size, target_format));
             let draw_into =
                 image.as_ref().map_or_else(|| target_view.clone(), |t| t.create_view(&Default::default()));
-            let report = self.render_view(plan.view, &draw_into, target_format)?;
+            let report = self.render_view(plan.view.clone(), &draw_into, target_format)?;
             if let (Some(image), Some(rect)) = (&image, plan.rect) {
                 copy_into(&gpu, image, target_view.texture(), rect)?;
             }
@@ -614,15 +621,14 @@ fn merge_view_reports(views: Vec<(ViewReport, FrameReport)>, snapshot: &FrameSna
     merged
 }
 
-/// Adds the `Graph` system: the view's plan ([`FramePlanner`]) fills the graph.
+/// Adds the `Graph` system: the view's plan ([`Stages`]) fills the graph.
 fn add_graph_systems(schedule: &mut Schedule) {
     schedule.add_systems(plan_graph.in_set(RenderSet::Graph));
 }
 
-/// The stages a view is planned with (the render crate's [`manylight_render::planner::STAGES`],
-/// plus any an app inserted: [`RenderWorld::planner_mut`]).
+/// The stages views are planned with ([`RenderWorld::set_stages`]).
 #[derive(Resource, Default, Clone, Debug)]
-pub struct Planner(pub FramePlanner);
+pub struct Stages(pub Arc<FramePlanner>);
 
 /// The passes the plan runs for `snapshot`, in order, without a GPU (tests and tools use it
 /// to see what a scene calls for).
@@ -654,12 +660,12 @@ fn prepare(
 fn plan_graph(
     view: Res<CurrentView>,
     renderer: Res<RendererResource>,
-    planner: Res<Planner>,
+    stages: Res<Stages>,
     mut graph: ResMut<FrameGraph>,
 ) {
     let accumulation = LightVolumesPass::accumulation_format(&renderer.0.gpu.device);
     let inputs = view.plan_inputs(accumulation);
-    planner.0.plan_into(&inputs, &mut graph.0);
+    stages.0.plan_into(&inputs, &mut graph.0);
 }
 
 fn execute(

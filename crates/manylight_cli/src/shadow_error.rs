@@ -221,15 +221,17 @@ fn without_entries(lists: &ClusterAssignment, removed: &[u32]) -> ClusterAssignm
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::{Mat4, UVec2, Vec3, Vec4};
+    use glam::{Mat4, UVec2, Vec3};
     use manylight_render::{ExtractedPointLight, FrameSettings, PipelineKind, ShadowBias};
     use manylight_scene::{SceneCamera, SceneInstance, camera_looking_at, shapes::cuboid};
 
     /// A floor under a camera and four lights above it: nothing stands between a light and a
     /// surface.
     fn open_floor() -> (Scene, Vec<ExtractedPointLight>) {
-        let grey =
-            manylight_core::MaterialData { base_color: Vec4::new(0.7, 0.7, 0.7, 1.0), ..Default::default() };
+        let grey = manylight_core::MaterialData {
+            base_color: manylight_core::Color::linear_rgb(0.7, 0.7, 0.7),
+            ..Default::default()
+        };
         let scene = Scene {
             name: "floor".into(),
             meshes: vec![std::sync::Arc::new(cuboid("floor", Vec3::new(8.0, 0.2, 8.0), 1.0))],

@@ -22,6 +22,8 @@ pub mod tonemap;
 pub use attenuation::{
     LIGHT_MIN_DISTANCE, attenuation, candela_from_lumens, lumens_from_candela, radius_for_intensity,
 };
+/// Bevy's colour types, which materials use (`bevy_color`, a standalone crate).
+pub use bevy_color::{Color, ColorToComponents, LinearRgba};
 pub use camera::{Projection, ProjectionKind, linearize_depth_reverse_z};
 pub use light_count::{LightCountError, LightLimit, MAX_LIGHTS, check_light_count};
 pub use material::{

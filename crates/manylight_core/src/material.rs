@@ -1,5 +1,6 @@
 //! Materials and textures as plain data (what the GPU side uploads once, shared as `Arc`s).
 
+use bevy_color::{Color, ColorToComponents, LinearRgba};
 use glam::{Affine2, Vec2, Vec3, Vec4};
 use std::sync::Arc;
 
@@ -244,8 +245,9 @@ impl AlphaMode {
 pub struct MaterialData {
     /// Name for logs and GPU labels.
     pub label: String,
-    /// Linear RGBA multiplier of the base colour texture.
-    pub base_color: Vec4,
+    /// Multiplier of the base colour texture, alpha included (Bevy's `StandardMaterial::base_color`;
+    /// shaded in linear RGB, see [`MaterialData::base_color_linear`]).
+    pub base_color: Color,
     /// Optional sRGB base colour texture.
     pub base_color_texture: Option<MaterialTexture>,
     /// PBR metalness factor (0 dielectric .. 1 metal).
@@ -271,9 +273,9 @@ pub struct MaterialData {
     pub occlusion_texture: Option<MaterialTexture>,
     /// How much of the occlusion applies: `1 + strength * (texel - 1)` (0 = none, 1 = full).
     pub occlusion_strength: f32,
-    /// Linear emitted radiance, added whatever the lights (glTF `emissiveFactor` times
-    /// `KHR_materials_emissive_strength`).
-    pub emissive: Vec3,
+    /// Emitted radiance, added whatever the lights (glTF `emissiveFactor` times
+    /// `KHR_materials_emissive_strength`; Bevy's `StandardMaterial::emissive`). Alpha is unused.
+    pub emissive: LinearRgba,
     /// Optional sRGB emissive texture, multiplied with `emissive`.
     pub emissive_texture: Option<MaterialTexture>,
     /// Drawn from both sides, the normal flipped on back faces; single-sided materials are not
@@ -287,7 +289,7 @@ impl Default for MaterialData {
     fn default() -> Self {
         Self {
             label: "default".into(),
-            base_color: Vec4::ONE,
+            base_color: Color::WHITE,
             base_color_texture: None,
             metallic: 0.0,
             roughness: 0.5,
@@ -299,7 +301,7 @@ impl Default for MaterialData {
             normal_scale: 1.0,
             occlusion_texture: None,
             occlusion_strength: 1.0,
-            emissive: Vec3::ZERO,
+            emissive: LinearRgba::BLACK,
             emissive_texture: None,
             // Procedural scenes are open shells seen from either side; glTF materials say.
             double_sided: true,
@@ -309,6 +311,16 @@ impl Default for MaterialData {
 }
 
 impl MaterialData {
+    /// [`MaterialData::base_color`] in linear RGBA, as the shaders use it.
+    pub fn base_color_linear(&self) -> Vec4 {
+        self.base_color.to_linear().to_vec4()
+    }
+
+    /// [`MaterialData::emissive`] as linear RGB, as the shaders use it.
+    pub fn emissive_rgb(&self) -> Vec3 {
+        self.emissive.to_vec3()
+    }
+
     /// The five texture slots in shader order (`TEXTURE_SLOT_*`: base colour,
     /// metallic-roughness, normal, occlusion, emissive).
     pub fn texture_slots(&self) -> [Option<&MaterialTexture>; 5] {

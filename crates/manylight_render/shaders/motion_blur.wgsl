@@ -1,7 +1,7 @@
 // Camera-motion blur (GPU Gems 3, ch. 27; Rust: crates/manylight_render/src/passes/motion_blur.rs):
 // the pixel's position is rebuilt from depth, projected with last frame's clip-from-world, and
-// the HDR colour is averaged along the screen-space difference. fs_copy writes the result back
-// into the HDR target.
+// the HDR colour is averaged along the screen-space difference, into the second HDR image (the
+// pass swaps the two: `PassContext::post_process_write`).
 //
 // The tap count is a pipeline-override constant, not a uniform: lavapipe (Mesa 22.3) compiles a
 // fresh copy of a shader whose loop count it can read from a uniform buffer at every draw, and
@@ -23,7 +23,6 @@ struct MotionBlurParams {
 @group(0) @binding(1) var<uniform> params: MotionBlurParams;
 @group(0) @binding(2) var hdr: texture_2d<f32>;
 @group(0) @binding(3) var depth: texture_depth_2d;
-@group(0) @binding(4) var blurred: texture_2d<f32>;
 
 // Screen velocity of the surface at `px` in pixels (current minus previous position).
 fn pixel_velocity(px: vec2<i32>, uv: vec2<f32>) -> vec2<f32> {
@@ -65,9 +64,4 @@ fn fs_blur(in: FullscreenOut) -> @location(0) vec4<f32> {
         sum += textureLoad(hdr, p, 0).rgb;
     }
     return vec4<f32>(sum / f32(n), centre.a);
-}
-
-@fragment
-fn fs_copy(in: FullscreenOut) -> @location(0) vec4<f32> {
-    return textureLoad(blurred, vec2<i32>(in.position.xy), 0);
 }

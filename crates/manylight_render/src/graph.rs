@@ -20,6 +20,14 @@ pub type ResourceName = &'static str;
 /// The external resource every frame ends in: the swapchain image or the headless target.
 pub const OUTPUT: ResourceName = "output";
 
+/// The HDR scene colour (`passes::HDR`): the shading passes create it, the post passes filter
+/// it, the tone map reads it.
+pub const HDR: ResourceName = "hdr";
+
+/// The second HDR image, which a post-processing pass writes into while it reads [`HDR`]
+/// ([`PassContext::post_process_write`] swaps the two; `passes::HDR_SWAP`).
+pub const HDR_SWAP: ResourceName = "hdr_swap";
+
 /// A transient texture a pass creates: sized relative to the viewport.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TextureSpec {
@@ -78,6 +86,9 @@ pub struct PassContext<'a> {
     /// Format of [`OUTPUT`].
     pub output_format: wgpu::TextureFormat,
     pub(crate) textures: &'a HashMap<ResourceName, wgpu::TextureView>,
+    /// True once a post-processing pass swapped the HDR image into [`HDR_SWAP`] (the view's
+    /// passes share it: [`PassContext::post_process_write`]).
+    pub(crate) hdr_swapped: &'a std::cell::Cell<bool>,
     pub(crate) timer: Option<&'a wgpu::QuerySet>,
     pub(crate) pass_index: u32,
     pub(crate) stamps: (bool, bool),
@@ -117,11 +128,33 @@ impl<'a> PassContext<'a> {
         self.bindings.uniform(self.gpu, key, contents)
     }
 
-    /// The view of a graph texture (transient or [`OUTPUT`]).
+    /// The view of a graph texture (transient or [`OUTPUT`]). [`HDR`] is the HDR image as the
+    /// passes before left it, wherever [`PassContext::post_process_write`] put it.
     pub fn texture(&self, name: ResourceName) -> Result<&'a wgpu::TextureView, RenderError> {
+        let name = match name {
+            HDR if self.hdr_swapped.get() => HDR_SWAP,
+            HDR_SWAP if self.hdr_swapped.get() => HDR,
+            name => name,
+        };
         self.textures
             .get(name)
             .ok_or_else(|| RenderError::Graph(format!("texture `{name}` was not allocated")))
+    }
+
+    /// For a pass that filters the HDR image (Bevy's `post_process_write`): the image to read
+    /// (`source`) and a texture of the same size and format to write the result into
+    /// (`destination`), which the passes after this one see as [`HDR`]. The pass reads and
+    /// writes `HDR` and creates `passes::post_process_texture()`; it must write every pixel of
+    /// `destination` (a full-screen draw does).
+    pub fn post_process_write(&self) -> Result<PostProcessWrite<'a>, RenderError> {
+        let source = self.texture(HDR)?;
+        let destination = self.texture(HDR_SWAP).map_err(|_| {
+            RenderError::Graph(
+                "post_process_write: the pass does not create `passes::post_process_texture()`".into(),
+            )
+        })?;
+        self.hdr_swapped.set(!self.hdr_swapped.get());
+        Ok(PostProcessWrite { source, destination })
     }
 
     /// Timestamp writes for a render pass; `first`/`last` say whether this wgpu pass opens or
@@ -156,6 +189,16 @@ impl<'a> PassContext<'a> {
             end_of_pass_write_index: last.then_some(self.pass_index * 2 + 1),
         })
     }
+}
+
+/// Where a post-processing pass reads and writes the HDR image
+/// ([`PassContext::post_process_write`]).
+#[derive(Clone, Copy, Debug)]
+pub struct PostProcessWrite<'a> {
+    /// The HDR image as the passes before left it.
+    pub source: &'a wgpu::TextureView,
+    /// Where the pass writes the image; the HDR image of the passes after it.
+    pub destination: &'a wgpu::TextureView,
 }
 
 /// What the order of a graph depends on: each pass's name, reads and writes.

@@ -4,6 +4,10 @@
 //! drive it directly. The app crate decides which passes a frame needs.
 #![warn(missing_docs)]
 
+/// The wgpu this crate renders with, for passes an app writes (the same version, no second
+/// dependency to keep in step).
+pub use wgpu;
+
 pub mod atlas;
 pub mod bindings;
 pub mod clusters;
@@ -29,10 +33,10 @@ pub mod snapshot;
 pub mod stats;
 
 pub use context::{GpuContext, GpuCounts, NO_ADAPTER_HELP, RenderError};
-pub use graph::{OUTPUT, Pass, PassContext, RenderGraph, ResourceName, TextureSpec};
+pub use graph::{OUTPUT, Pass, PassContext, PostProcessWrite, RenderGraph, ResourceName, TextureSpec};
 pub use inflight::{DEFAULT_FRAMES_IN_FLIGHT, MAX_FRAMES_IN_FLIGHT};
 pub use plan::PlanInputs;
-pub use planner::{FramePlanner, StageError};
+pub use planner::{FramePlanner, Stage, StageError, StageId, builtin_stages};
 pub use readback::{HEADLESS_FORMAT, HeadlessTarget};
 pub use renderer::Renderer;
 pub use settings::{CameraShadows, CascadeShadowConfig, CascadeShadowConfigBuilder, ShadowFilteringMethod};
@@ -41,6 +45,6 @@ pub use snapshot::{
     BloomChain, BloomSettings, ClusterSettings, DEFAULT_COARSE_TILES, DebugViewMode, DirectionalShadow,
     Exposure, ExtractedCamera, ExtractedDirectionalLight, ExtractedInstance, ExtractedPointLight,
     ExtractedView, FrameSettings, FrameSnapshot, GBufferLayout, MotionBlurSettings, PipelineKind,
-    RenderSettings, RenderTextureId, RenderView, ShadowBias, ViewRect, ViewTarget,
+    RenderSettings, RenderTextureId, RenderView, ShadowBias, ViewComponents, ViewRect, ViewTarget,
 };
 pub use stats::{FrameReport, PassTiming, ViewReport};

@@ -2,18 +2,20 @@
 //!
 //! Each pass module says, next to its code, when its pass is needed: a `plan` function that
 //! reads the view ([`PlanInputs`]) and adds its pass, or nothing.
-//! [`FramePlanner`](crate::planner::FramePlanner) calls them in the order of
-//! [`STAGES`](crate::planner::STAGES), and the graph then orders the passes by what they read
-//! and write.
+//! [`FramePlanner`](crate::planner::FramePlanner) calls them stage after stage (the
+//! [`builtin_stages`](crate::planner::builtin_stages) and any an app added), and the graph then
+//! orders the passes by what they read and write.
 
 use crate::graph::Pass;
-use crate::snapshot::{DebugViewMode, FrameSettings, PipelineKind, RenderView};
+use crate::snapshot::{DebugViewMode, FrameSettings, PipelineKind, RenderView, ViewComponents};
 
 /// What a view's plan depends on.
 #[derive(Clone, Copy, Debug)]
 pub struct PlanInputs<'a> {
     /// The view: camera, image size, settings.
     pub view: &'a RenderView,
+    /// Components an app extracted from the view's camera (its passes plan from them).
+    pub components: &'a ViewComponents,
     /// The frame has a valid light (`FrameSnapshot::has_lights`).
     pub has_lights: bool,
     /// The frame draws a blended material (`FrameSnapshot::has_blended`).

@@ -1,86 +1,149 @@
-//! The stages a frame is planned with: adding a pass means its module (with its `plan`
-//! function), its WGSL file, and one line in [`STAGES`]; an app can also add a stage at run time
-//! with [`FramePlanner::insert_after`].
+//! The stages a frame is planned with. A stage is a `plan` function (it adds its pass when the
+//! view calls for it) named by the type of the pass it adds ([`StageId`]): adding a built-in
+//! pass means its module (with its `plan` function), its WGSL file and one line in
+//! [`builtin_stages`]; an app adds its own stage before or after any other one by type
+//! ([`FramePlanner::insert_before`], [`FramePlanner::insert_after`]).
 
 use crate::graph::{Pass, RenderGraph};
 use crate::passes;
 use crate::plan::{PlanInputs, Planner};
+use std::any::TypeId;
 
-/// The stages, in order: each pass module's `plan` function.
-pub const STAGES: [(&str, Planner); 16] = [
-    ("shadow_maps", passes::shadow_maps::plan),
-    ("depth_prepass", passes::depth_prepass::plan),
-    ("cluster_depth", passes::cluster_depth::plan),
-    ("cluster_build", passes::cluster_build::plan),
-    ("light_refine", passes::light_refine::plan),
-    ("forward", passes::forward::plan),
-    ("clustered_forward", passes::clustered_forward::plan),
-    ("gbuffer", passes::gbuffer::plan),
-    ("deferred_lighting", passes::deferred_lighting::plan),
-    ("tiled_deferred", passes::tiled_deferred::plan),
-    ("light_volumes", passes::light_volumes::plan),
-    ("transparent", passes::transparent::plan),
-    ("motion_blur", passes::motion_blur::plan),
-    ("bloom", passes::bloom::plan),
-    ("tonemap", passes::tonemap::plan),
-    ("debug_view", passes::debug_view::plan),
-];
+/// Which stage: the type of the pass it adds (of the first pass, for bloom's chain), so a stage
+/// is placed and found by type, never by a string.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct StageId {
+    type_id: TypeId,
+    name: &'static str,
+}
 
-/// The stages a frame is planned with.
+impl StageId {
+    /// The stage whose pass is a `P`.
+    pub fn of<P: Pass>() -> StageId {
+        let full = std::any::type_name::<P>();
+        let name = full.rsplit("::").next().unwrap_or(full);
+        StageId { type_id: TypeId::of::<P>(), name }
+    }
+
+    /// The pass type's name without its module path, for messages.
+    pub fn name(self) -> &'static str {
+        self.name
+    }
+}
+
+/// One stage of the plan: its id and the function that adds its pass when a view calls for it.
+#[derive(Clone, Copy, Debug)]
+pub struct Stage {
+    /// Which stage (the type of the pass it adds).
+    pub id: StageId,
+    /// Adds the stage's passes, or none.
+    pub plan: Planner,
+}
+
+impl Stage {
+    /// The stage of pass type `P`, planned by `plan`.
+    pub fn new<P: Pass>(plan: Planner) -> Stage {
+        Stage { id: StageId::of::<P>(), plan }
+    }
+}
+
+/// The built-in stages, in order.
+pub fn builtin_stages() -> Vec<Stage> {
+    use passes::*;
+    vec![
+        Stage::new::<ShadowMapsPass>(shadow_maps::plan),
+        Stage::new::<DepthPrepass>(depth_prepass::plan),
+        Stage::new::<ClusterDepthPass>(cluster_depth::plan),
+        Stage::new::<ClusterBuildPass>(cluster_build::plan),
+        Stage::new::<LightRefinePass>(light_refine::plan),
+        Stage::new::<ForwardPass>(forward::plan),
+        Stage::new::<ClusteredForwardPass>(clustered_forward::plan),
+        Stage::new::<GBufferPass>(gbuffer::plan),
+        Stage::new::<DeferredLightingPass>(deferred_lighting::plan),
+        Stage::new::<TiledDeferredPass>(tiled_deferred::plan),
+        Stage::new::<LightVolumesPass>(light_volumes::plan),
+        Stage::new::<TransparentPass>(transparent::plan),
+        Stage::new::<MotionBlurPass>(motion_blur::plan),
+        Stage::new::<BloomBrightPass>(bloom::plan),
+        Stage::new::<TonemapPass>(tonemap::plan),
+        Stage::new::<DebugViewPass>(debug_view::plan),
+    ]
+}
+
+/// The stages a frame is planned with: the built-in ones and any an app added.
 #[derive(Clone, Debug)]
 pub struct FramePlanner {
-    stages: Vec<(&'static str, Planner)>,
+    stages: Vec<Stage>,
 }
 
 impl Default for FramePlanner {
     fn default() -> Self {
-        FramePlanner { stages: STAGES.to_vec() }
+        FramePlanner { stages: builtin_stages() }
     }
 }
 
 /// Why a stage could not be added.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum StageError {
-    /// No stage has the name it was to follow.
-    #[error("no stage `{after}` to add `{name}` after (stages: {known})")]
+    /// No stage has the pass type it was to be placed next to.
+    #[error("no stage `{anchor}` to place `{stage}` next to (stages: {known})")]
     UnknownStage {
-        /// The name asked for.
-        after: String,
+        /// The stage it was to be placed next to.
+        anchor: &'static str,
         /// The stage that was to be added.
-        name: &'static str,
+        stage: &'static str,
         /// The stages there are, in order.
         known: String,
     },
-    /// A stage of that name exists already.
+    /// A stage of that pass type exists already.
     #[error("a stage `{0}` exists already")]
     Duplicate(&'static str),
 }
 
 impl FramePlanner {
-    /// Adds stage `name` right after stage `after`; refused, naming the stages there are, when
-    /// there is no stage `after`, or when a stage is called `name` already.
-    pub fn insert_after(
-        &mut self,
-        after: &str,
-        name: &'static str,
-        planner: Planner,
-    ) -> Result<(), StageError> {
-        if self.stages.iter().any(|(n, _)| *n == name) {
-            return Err(StageError::Duplicate(name));
-        }
-        let Some(i) = self.stages.iter().position(|(n, _)| *n == after) else {
-            let known = self.stages.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ");
-            return Err(StageError::UnknownStage { after: after.to_string(), name, known });
-        };
-        self.stages.insert(i + 1, (name, planner));
+    /// Adds `stage` right after the stage of pass type `A`; refused, naming the stages there are,
+    /// when there is none, or when a stage of the same pass type exists already.
+    pub fn insert_after<A: Pass>(&mut self, stage: Stage) -> Result<(), StageError> {
+        let at = self.position(StageId::of::<A>(), stage)?;
+        self.stages.insert(at + 1, stage);
         Ok(())
+    }
+
+    /// Adds `stage` right before the stage of pass type `B` (refused as
+    /// [`FramePlanner::insert_after`] is).
+    pub fn insert_before<B: Pass>(&mut self, stage: Stage) -> Result<(), StageError> {
+        let at = self.position(StageId::of::<B>(), stage)?;
+        self.stages.insert(at, stage);
+        Ok(())
+    }
+
+    /// Where `anchor` is, for adding `stage` next to it.
+    fn position(&self, anchor: StageId, stage: Stage) -> Result<usize, StageError> {
+        if self.contains(stage.id) {
+            return Err(StageError::Duplicate(stage.id.name()));
+        }
+        self.stages.iter().position(|s| s.id == anchor).ok_or_else(|| StageError::UnknownStage {
+            anchor: anchor.name(),
+            stage: stage.id.name(),
+            known: self.stages.iter().map(|s| s.id.name()).collect::<Vec<_>>().join(", "),
+        })
+    }
+
+    /// True when a stage has id `id`.
+    pub fn contains(&self, id: StageId) -> bool {
+        self.stages.iter().any(|s| s.id == id)
+    }
+
+    /// The stages, in order.
+    pub fn stages(&self) -> impl ExactSizeIterator<Item = StageId> + '_ {
+        self.stages.iter().map(|s| s.id)
     }
 
     /// The passes `inputs` call for, stage after stage.
     pub fn passes(&self, inputs: &PlanInputs<'_>) -> Vec<Box<dyn Pass>> {
         let mut out = Vec::new();
-        for (_, planner) in &self.stages {
-            planner(inputs, &mut out);
+        for stage in &self.stages {
+            (stage.plan)(inputs, &mut out);
         }
         out
     }
@@ -97,23 +160,60 @@ impl FramePlanner {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::context::RenderError;
+    use crate::graph::{PassContext, ResourceName};
+    use crate::passes::{BloomBrightPass, ClusteredForwardPass, TonemapPass};
 
     fn nothing(_: &PlanInputs<'_>, _: &mut Vec<Box<dyn Pass>>) {}
 
+    struct Vignette;
+    struct Grain;
+    impl Pass for Vignette {
+        fn name(&self) -> &'static str {
+            "vignette"
+        }
+        fn reads(&self) -> Vec<ResourceName> {
+            Vec::new()
+        }
+        fn writes(&self) -> Vec<ResourceName> {
+            Vec::new()
+        }
+        fn record(&self, _: &mut PassContext<'_>) -> Result<(), RenderError> {
+            Ok(())
+        }
+    }
+    impl Pass for Grain {
+        fn name(&self) -> &'static str {
+            "grain"
+        }
+        fn reads(&self) -> Vec<ResourceName> {
+            Vec::new()
+        }
+        fn writes(&self) -> Vec<ResourceName> {
+            Vec::new()
+        }
+        fn record(&self, _: &mut PassContext<'_>) -> Result<(), RenderError> {
+            Ok(())
+        }
+    }
+
     #[test]
-    fn a_stage_goes_after_a_known_one_and_never_silently_elsewhere() {
+    fn a_stage_goes_next_to_a_known_one_and_never_silently_elsewhere() {
         let mut planner = FramePlanner::default();
-        planner.insert_after("tonemap", "vignette", nothing).expect("tonemap is a stage");
-        let names: Vec<&str> = planner.stages.iter().map(|(n, _)| *n).collect();
-        let at = names.iter().position(|n| *n == "vignette").expect("added");
-        assert_eq!(names[at - 1], "tonemap");
-        let unknown = planner.insert_after("tone_map", "grain", nothing).unwrap_err();
-        assert!(matches!(&unknown, StageError::UnknownStage { after, .. } if after == "tone_map"));
-        assert!(unknown.to_string().contains("tonemap"), "{unknown}");
+        planner.insert_before::<TonemapPass>(Stage::new::<Vignette>(nothing)).expect("tonemap is a stage");
+        let ids: Vec<StageId> = planner.stages().collect();
+        let at = ids.iter().position(|s| *s == StageId::of::<Vignette>()).expect("added");
+        assert_eq!(ids[at - 1], StageId::of::<BloomBrightPass>());
+        assert_eq!(ids[at + 1], StageId::of::<TonemapPass>());
+        // Grain is no stage: placing next to it is refused, naming the stages there are.
+        let unknown = planner.insert_after::<Grain>(Stage::new::<Grain>(nothing)).unwrap_err();
+        assert!(matches!(&unknown, StageError::UnknownStage { anchor: "Grain", .. }), "{unknown}");
+        assert!(unknown.to_string().contains("TonemapPass"), "{unknown}");
         assert_eq!(
-            planner.insert_after("bloom", "vignette", nothing),
-            Err(StageError::Duplicate("vignette"))
+            planner.insert_after::<ClusteredForwardPass>(Stage::new::<Vignette>(nothing)),
+            Err(StageError::Duplicate("Vignette"))
         );
-        assert_eq!(planner.stages.len(), STAGES.len() + 1);
+        assert_eq!(planner.stages().len(), builtin_stages().len() + 1);
+        assert!(planner.contains(StageId::of::<Vignette>()) && !planner.contains(StageId::of::<Grain>()));
     }
 }

@@ -312,6 +312,10 @@ impl Renderer {
         textures.insert(OUTPUT, output.clone());
         for pass in passes {
             for spec in pass.creates() {
+                // Passes may create the same texture (post-processing passes, the HDR swap).
+                if textures.contains_key(spec.name) {
+                    continue;
+                }
                 let scaled = |v: u32| ((v as f32 * spec.scale).round() as u32).max(1);
                 let key = TextureKey {
                     width: scaled(size.x),
@@ -327,6 +331,7 @@ impl Renderer {
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         let mut timings = Vec::with_capacity(passes.len());
         let clusters = self.clusters.get(view.index).and_then(Option::as_ref);
+        let hdr_swapped = std::cell::Cell::new(false);
         for pass in passes {
             let timer = self.ring.timer();
             let mut ctx = PassContext {
@@ -339,6 +344,7 @@ impl Renderer {
                 encoder: &mut encoder,
                 output_format,
                 textures: &textures,
+                hdr_swapped: &hdr_swapped,
                 timer: timer.map(|(query_set, _)| query_set),
                 pass_index: timer.map_or(0, |(_, index)| index),
                 stamps: (false, false),

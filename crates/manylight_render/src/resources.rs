@@ -756,7 +756,7 @@ impl SceneResources {
         }
         let finite_or = |v: f32, default: f32| if v.is_finite() { v } else { default };
         let uniform = GpuMaterial {
-            base_color: material.base_color,
+            base_color: material.base_color_linear(),
             shininess: material.shininess.clamp(1.0, 4096.0),
             specular: material.specular.max(0.0),
             shading_model: material.shading.map_or(SHADING_GLOBAL, |s| s.gpu_id()),
@@ -765,8 +765,8 @@ impl SceneResources {
             roughness: if material.roughness.is_finite() { material.roughness.clamp(0.0, 1.0) } else { 1.0 },
             has_metallic_roughness_texture: material.metallic_roughness_texture.is_some() as u32,
             normal_scale: finite_or(material.normal_scale, 1.0),
-            emissive: if material.emissive.is_finite() {
-                material.emissive.max(glam::Vec3::ZERO)
+            emissive: if material.emissive_rgb().is_finite() {
+                material.emissive_rgb().max(glam::Vec3::ZERO)
             } else {
                 glam::Vec3::ZERO
             },

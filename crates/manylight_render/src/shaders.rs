@@ -123,7 +123,23 @@ pub fn compose(path: &str) -> Result<String, ShaderError> {
 pub fn compose_with(path: &str, defs: ShaderDefs) -> Result<String, ShaderError> {
     let mut body = String::new();
     let mut seen = Vec::new();
-    append(path, defs, &mut body, &mut seen)?;
+    append(path, source(path)?, defs, &mut body, &mut seen)?;
+    Ok(with_preamble(&body))
+}
+
+/// The full WGSL of an app's own shader (`source`, named `label` in errors): its
+/// `//!include` lines bring in the library's files (`common/fullscreen.wgsl`,
+/// `common/view.wgsl`, …; [`SOURCES`]) and it gets the shared constants' preamble, as the
+/// built-in shaders do.
+pub fn compose_source(label: &str, source: &str) -> Result<String, ShaderError> {
+    let mut body = String::new();
+    let mut seen = Vec::new();
+    append(label, source, ShaderDefs::default(), &mut body, &mut seen)?;
+    Ok(with_preamble(&body))
+}
+
+/// `body` with its `enable` directives first, then the constants' preamble, then the rest.
+fn with_preamble(body: &str) -> String {
     let mut out = String::new();
     for line in body.lines().filter(|l| l.starts_with("enable ")) {
         out.push_str(line);
@@ -134,10 +150,18 @@ pub fn compose_with(path: &str, defs: ShaderDefs) -> Result<String, ShaderError>
         out.push_str(line);
         out.push('\n');
     }
-    Ok(out)
+    out
 }
 
-fn append(path: &str, defs: ShaderDefs, out: &mut String, seen: &mut Vec<String>) -> Result<(), ShaderError> {
+/// Appends `text` (the file `path`) to `out` with its `//!if` blocks resolved and its includes
+/// expanded, each file once.
+fn append(
+    path: &str,
+    text: &str,
+    defs: ShaderDefs,
+    out: &mut String,
+    seen: &mut Vec<String>,
+) -> Result<(), ShaderError> {
     if seen.iter().any(|s| s == path) {
         return Ok(());
     }
@@ -145,7 +169,7 @@ fn append(path: &str, defs: ShaderDefs, out: &mut String, seen: &mut Vec<String>
     let problem = |problem: String| ShaderError::Conditional { file: path.to_string(), problem };
     // One entry per open `//!if`: whether its current branch is kept.
     let mut open: Vec<bool> = Vec::new();
-    for line in source(path)?.lines() {
+    for line in text.lines() {
         let trimmed = line.trim();
         if let Some(name) = trimmed.strip_prefix("//!if ") {
             let on =
@@ -166,7 +190,8 @@ fn append(path: &str, defs: ShaderDefs, out: &mut String, seen: &mut Vec<String>
             continue;
         }
         if let Some(include) = trimmed.strip_prefix("//!include ") {
-            append(include.trim(), defs, out, seen)?;
+            let include = include.trim();
+            append(include, source(include)?, defs, out, seen)?;
         } else {
             out.push_str(line);
             out.push('\n');
@@ -176,6 +201,19 @@ fn append(path: &str, defs: ShaderDefs, out: &mut String, seen: &mut Vec<String>
         return Err(problem("`//!if` without `//!endif`".into()));
     }
     Ok(())
+}
+
+/// Creates a shader module from an app's own WGSL ([`compose_source`]).
+pub fn create_module_from_source(
+    device: &wgpu::Device,
+    label: &str,
+    source: &str,
+) -> Result<wgpu::ShaderModule, ShaderError> {
+    let code = compose_source(label, source)?;
+    Ok(device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(code.into()),
+    }))
 }
 
 /// Creates a shader module from the composed source of `path` (every define off).

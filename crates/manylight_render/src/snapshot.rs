@@ -592,9 +592,66 @@ pub struct ViewRect {
     pub size: UVec2,
 }
 
+/// Components an app copied from a view's camera for its own passes (in `manylight_app`,
+/// `ExtractCameraComponentPlugin`), by type: a pass's `plan` function finds its settings here
+/// (`PlanInputs::components`) and adds its pass only to the views that carry them.
+#[derive(Clone, Default)]
+pub struct ViewComponents {
+    entries: Vec<ViewComponent>,
+}
+
+/// One extracted component: its type, its name for messages and its value.
+#[derive(Clone)]
+struct ViewComponent {
+    type_id: std::any::TypeId,
+    name: &'static str,
+    value: Arc<dyn std::any::Any + Send + Sync>,
+}
+
+impl ViewComponents {
+    /// Adds `component`, replacing one of the same type.
+    pub fn insert<C: std::any::Any + Send + Sync>(&mut self, component: C) {
+        let type_id = std::any::TypeId::of::<C>();
+        let entry = ViewComponent { type_id, name: std::any::type_name::<C>(), value: Arc::new(component) };
+        match self.entries.iter_mut().find(|e| e.type_id == type_id) {
+            Some(old) => *old = entry,
+            None => self.entries.push(entry),
+        }
+    }
+
+    /// The component of type `C`, if the camera carried one.
+    pub fn get<C: std::any::Any>(&self) -> Option<&C> {
+        let type_id = std::any::TypeId::of::<C>();
+        self.entries.iter().find(|e| e.type_id == type_id).and_then(|e| e.value.downcast_ref())
+    }
+
+    /// True when no component was extracted.
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+}
+
+impl std::fmt::Debug for ViewComponents {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_list().entries(self.entries.iter().map(|e| e.name)).finish()
+    }
+}
+
+impl PartialEq for ViewComponents {
+    /// The same types holding the same values (the same extracted `Arc`s).
+    fn eq(&self, other: &Self) -> bool {
+        self.entries.len() == other.entries.len()
+            && self
+                .entries
+                .iter()
+                .zip(&other.entries)
+                .all(|(a, b)| a.type_id == b.type_id && Arc::ptr_eq(&a.value, &b.value))
+    }
+}
+
 /// One camera's view of the frame: where it looks from, where its image goes and what it
 /// shows. Views share the frame's lights and instances, which are uploaded once.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ExtractedView {
     /// The camera, with its post-processing components.
     pub camera: ExtractedCamera,
@@ -610,6 +667,8 @@ pub struct ExtractedView {
     /// The view shows shadows (its camera's [`crate::CameraShadows`]); `false` shades it
     /// unshadowed.
     pub shadows: bool,
+    /// Components an app extracted from the camera for its own passes.
+    pub components: ViewComponents,
 }
 
 impl ExtractedView {
@@ -622,6 +681,7 @@ impl ExtractedView {
             debug_view: None,
             order: 0,
             shadows: true,
+            components: ViewComponents::default(),
         }
     }
 

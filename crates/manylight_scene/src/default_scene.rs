@@ -13,7 +13,7 @@ use crate::shapes::{arch, cuboid, cylinder, uv_sphere};
 use crate::textures::{bricks, cloth, floor_tiles, stone};
 use crate::{Scene, SceneCamera, SceneInstance, SceneLight, camera_looking_at};
 use glam::{Mat4, Vec3};
-use manylight_core::{MaterialData, MaterialTexture, MeshData, Projection, ShadingModel, TextureData};
+use manylight_core::{Color, MaterialData, MaterialTexture, MeshData, Projection, ShadingModel, TextureData};
 use std::sync::Arc;
 
 /// Half length (X) and half width (Z) of the hall.
@@ -51,7 +51,7 @@ impl Assembler {
     ) -> usize {
         self.scene.materials.push(Arc::new(MaterialData {
             label: format!("default_scene/{label}"),
-            base_color: color.extend(1.0),
+            base_color: Color::linear_rgb(color.x, color.y, color.z),
             base_color_texture: tex.cloned().map(MaterialTexture::new),
             metallic,
             roughness,

@@ -292,7 +292,7 @@ pub fn studio_lights(count: usize, bounds: Aabb) -> Result<Vec<SceneLight>, Ligh
 pub fn sphere_shell_scene() -> Scene {
     let white = MaterialData {
         label: "sphere_shell/white".into(),
-        base_color: glam::Vec4::ONE,
+        base_color: manylight_core::Color::WHITE,
         ..MaterialData::default()
     };
     Scene {

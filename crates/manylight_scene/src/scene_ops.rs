@@ -105,13 +105,14 @@ impl Scene {
             }
         }
         for (i, m) in self.materials.iter().enumerate() {
-            let finite = m.base_color.is_finite()
+            let emissive = m.emissive_rgb();
+            let finite = m.base_color_linear().is_finite()
                 && m.shininess.is_finite()
                 && m.specular.is_finite()
                 && m.normal_scale.is_finite()
                 && m.occlusion_strength.is_finite()
-                && m.emissive.is_finite()
-                && m.emissive.min_element() >= 0.0;
+                && emissive.is_finite()
+                && emissive.min_element() >= 0.0;
             if !finite {
                 return Err(invalid(format!("material {i} has non-finite or negative parameters")));
             }

@@ -132,7 +132,7 @@ fn damaged_helmet_has_normal_occlusion_and_emissive_maps_and_generated_tangents(
     assert!(m.base_color_texture.as_ref().map(|t| &t.image).is_some_and(|t| t.srgb));
     assert!(m.metallic_roughness_texture.as_ref().map(|t| &t.image).is_some_and(|t| !t.srgb));
     assert_eq!(m.textures().count(), 5);
-    assert_eq!(m.emissive, glam::Vec3::ONE);
+    assert_eq!(m.emissive_rgb(), glam::Vec3::ONE);
     assert_eq!((m.normal_scale, m.occlusion_strength), (1.0, 1.0));
     assert!(!m.double_sided, "the file does not say doubleSided");
     assert_eq!(m.alpha_mode, manylight_core::AlphaMode::Opaque);

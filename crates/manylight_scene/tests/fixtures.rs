@@ -26,7 +26,7 @@ fn a_16_bit_png_texture_is_converted_to_8_bit_srgb() {
     assert_eq!(s.materials.len(), 1);
     let m = &s.materials[0];
     assert_eq!(m.label, "png16");
-    assert_eq!(m.base_color, glam::Vec4::new(1.0, 0.5, 1.0, 1.0));
+    assert_eq!(m.base_color_linear(), glam::Vec4::new(1.0, 0.5, 1.0, 1.0));
     assert_eq!(m.shading, None);
     // roughness 0.5: 2 / 0.0625 - 2 = 30; metallic 0: specular 0.04.
     assert!((m.shininess - 30.0).abs() < 1e-3, "{}", m.shininess);

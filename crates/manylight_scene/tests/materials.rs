@@ -107,15 +107,15 @@ fn emissive_strength_multiplies_the_emissive_factor() {
     let meshes = (0..materials.len()).map(|m| mesh(json!({}), m)).collect();
     let path = sandbox.write_json("emissive.gltf", &triangle_doc(meshes, materials, &[ext]));
     let s = load_ok(&path);
-    assert_eq!(material(&s, "strong").emissive, Vec3::new(4.0, 2.0, 0.0));
-    assert_eq!(material(&s, "plain").emissive, Vec3::new(1.0, 0.5, 0.0));
-    assert_eq!(material(&s, "no strength").emissive, Vec3::new(0.25, 0.5, 1.0));
+    assert_eq!(material(&s, "strong").emissive_rgb(), Vec3::new(4.0, 2.0, 0.0));
+    assert_eq!(material(&s, "plain").emissive_rgb(), Vec3::new(1.0, 0.5, 0.0));
+    assert_eq!(material(&s, "no strength").emissive_rgb(), Vec3::new(0.25, 0.5, 1.0));
     // Unusable strengths are 1; a factor that is infinite as f32 falls back to black.
-    assert_eq!(material(&s, "negative").emissive, Vec3::ONE);
-    assert_eq!(material(&s, "not a number").emissive, Vec3::ONE);
-    assert_eq!(material(&s, "overflowing factor").emissive, Vec3::ZERO);
+    assert_eq!(material(&s, "negative").emissive_rgb(), Vec3::ONE);
+    assert_eq!(material(&s, "not a number").emissive_rgb(), Vec3::ONE);
+    assert_eq!(material(&s, "overflowing factor").emissive_rgb(), Vec3::ZERO);
     let d = material(&s, "default");
-    assert_eq!(d.emissive, Vec3::ZERO);
+    assert_eq!(d.emissive_rgb(), Vec3::ZERO);
     assert!(d.emissive_texture.is_none() && d.normal_texture.is_none() && d.occlusion_texture.is_none());
     // glTF's defaults, not MaterialData::default()'s.
     assert!(!d.double_sided);

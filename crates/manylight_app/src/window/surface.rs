@@ -170,6 +170,10 @@ impl FrameSink for SurfaceSink {
         self.render_recovering(snapshot, readback)
     }
 
+    fn set_stages(&mut self, stages: &std::sync::Arc<manylight_render::FramePlanner>) {
+        self.render_world.set_stages(stages);
+    }
+
     fn drain(&mut self) -> Result<Vec<FrameReport>, RenderError> {
         self.render_world.take_reports(true)
     }

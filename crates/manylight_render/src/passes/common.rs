@@ -191,16 +191,26 @@ pub fn fullscreen_pipeline_with_defs(
     d: &FullscreenPipelineDesc<'_>,
     defs: crate::shaders::ShaderDefs,
 ) -> Result<wgpu::RenderPipeline, RenderError> {
-    let options = || wgpu::PipelineCompilationOptions { constants: d.constants, ..Default::default() };
     let module = crate::shaders::create_module_with(device, d.shader, defs)?;
+    Ok(fullscreen_pipeline_with_module(device, d, &module))
+}
+
+/// [`fullscreen_pipeline_desc`] with a module made already (an app's own shader:
+/// [`crate::shaders::create_module_from_source`]); `d.shader` is not read.
+pub fn fullscreen_pipeline_with_module(
+    device: &wgpu::Device,
+    d: &FullscreenPipelineDesc<'_>,
+    module: &wgpu::ShaderModule,
+) -> wgpu::RenderPipeline {
+    let options = || wgpu::PipelineCompilationOptions { constants: d.constants, ..Default::default() };
     let layout = pipeline_layout(device, d.label, d.layouts);
     let target =
         wgpu::ColorTargetState { format: d.output, blend: d.blend, write_mask: wgpu::ColorWrites::ALL };
-    Ok(device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(d.label),
         layout: Some(&layout),
         vertex: wgpu::VertexState {
-            module: &module,
+            module,
             entry_point: Some("fullscreen_vs"),
             compilation_options: options(),
             buffers: &[],
@@ -209,14 +219,14 @@ pub fn fullscreen_pipeline_with_defs(
         depth_stencil: d.depth.clone(),
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
-            module: &module,
+            module,
             entry_point: Some(d.fragment),
             compilation_options: options(),
             targets: &[Some(target)],
         }),
         multiview_mask: None,
         cache: None,
-    }))
+    })
 }
 
 /// A colour attachment cleared to `clear` and stored.

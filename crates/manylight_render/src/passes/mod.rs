@@ -42,8 +42,19 @@ pub use tiled_deferred::TiledDeferredPass;
 pub use tonemap::TonemapPass;
 pub use transparent::TransparentPass;
 
-/// Graph resource: the HDR scene colour.
-pub const HDR: crate::graph::ResourceName = "hdr";
+pub use crate::graph::{HDR, HDR_SWAP};
+
+/// The texture a post-processing pass lists in [`crate::Pass::creates`] to filter the HDR image
+/// with [`crate::PassContext::post_process_write`]: [`HDR_SWAP`], as the shading passes create
+/// [`HDR`].
+pub fn post_process_texture() -> crate::graph::TextureSpec {
+    crate::graph::TextureSpec {
+        name: HDR_SWAP,
+        format: crate::resources::HDR_FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        scale: 1.0,
+    }
+}
 /// Graph resource: the depth buffer (reverse-Z).
 pub const DEPTH: crate::graph::ResourceName = "depth";
 /// Graph resource: G-buffer position (Full layout).

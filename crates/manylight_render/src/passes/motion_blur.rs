@@ -1,22 +1,21 @@
 //! Camera-motion blur (GPU Gems 3, ch. 27): each pixel's world position is rebuilt from depth,
 //! projected with last frame's clip-from-world, and the HDR image is averaged along the
-//! resulting screen velocity. Two wgpu passes in one graph pass (`shaders/motion_blur.wgsl`):
-//! 1. `fs_blur`: HDR + depth → the `motion_blur` transient;
-//! 2. `fs_copy`: `motion_blur` → HDR, so tone mapping and bloom read the blurred image.
+//! resulting screen velocity (`shaders/motion_blur.wgsl`): `fs_blur` reads the HDR image and
+//! depth and writes the second HDR image, which the passes after it (bloom, tone mapping) read
+//! as HDR ([`PassContext::post_process_write`]).
 //!
 //! The tap count is a pipeline-override constant (one cached pipeline per count): lavapipe
 //! compiles a shader whose loop count comes from a uniform again at every draw and keeps every
-//! copy, which cost 0.84 MB per frame (`manylight soak` found it).
+//! copy (0.84 MB per frame).
 //!
 //! A pixel that moved less than half a pixel keeps its exact colour. When the whole camera did
 //! not move (a still camera, or the first frame, which has no previous matrix) the pass records
 //! nothing at all: the image is the unblurred one and costs no GPU time.
 
 use super::common::{
-    FullscreenPipelineDesc, draw_fullscreen, fullscreen_pipeline, fullscreen_pipeline_desc, texture_entry,
-    uniform_entry,
+    FullscreenPipelineDesc, draw_fullscreen, fullscreen_pipeline_desc, texture_entry, uniform_entry,
 };
-use super::{DEPTH, HDR};
+use super::{DEPTH, HDR, post_process_texture};
 use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
@@ -24,9 +23,6 @@ use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 use crate::resources::HDR_FORMAT;
 pub use crate::settings::MotionBlurSettings;
-
-/// Graph resource: the blurred image before it is copied back into HDR.
-pub const MOTION_BLUR: ResourceName = "motion_blur";
 
 /// Uniforms of `shaders/motion_blur.wgsl` (`MotionBlurParams`); the tap count is the
 /// pipeline's `SAMPLES` override.
@@ -48,12 +44,10 @@ impl PipelineKey for MotionBlurKey {
     type Pipeline = MotionBlurPipeline;
 }
 
-/// The two pipelines of [`MotionBlurPass`] for one tap count.
+/// The pipeline of [`MotionBlurPass`] for one tap count.
 struct MotionBlurPipeline {
     blur: wgpu::RenderPipeline,
     blur_layout: wgpu::BindGroupLayout,
-    copy: wgpu::RenderPipeline,
-    copy_layout: wgpu::BindGroupLayout,
 }
 
 impl MotionBlurPipeline {
@@ -69,10 +63,6 @@ impl MotionBlurPipeline {
                 texture_entry(3, wgpu::TextureSampleType::Depth),
             ],
         });
-        let copy_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("motion_blur_copy"),
-            entries: &[texture_entry(4, unfiltered)],
-        });
         let blur = fullscreen_pipeline_desc(
             device,
             &FullscreenPipelineDesc {
@@ -86,15 +76,7 @@ impl MotionBlurPipeline {
                 constants: &[("SAMPLES", f64::from(samples))],
             },
         )?;
-        let copy = fullscreen_pipeline(
-            device,
-            "motion_blur_copy",
-            "motion_blur.wgsl",
-            &[&copy_layout],
-            "fs_copy",
-            HDR_FORMAT,
-        )?;
-        Ok(MotionBlurPipeline { blur, blur_layout, copy, copy_layout })
+        Ok(MotionBlurPipeline { blur, blur_layout })
     }
 }
 
@@ -125,11 +107,10 @@ impl Pass for MotionBlurPass {
         vec![HDR, DEPTH]
     }
     fn writes(&self) -> Vec<ResourceName> {
-        vec![HDR, MOTION_BLUR]
+        vec![HDR]
     }
     fn creates(&self) -> Vec<TextureSpec> {
-        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
-        vec![TextureSpec { name: MOTION_BLUR, format: HDR_FORMAT, usage, scale: 1.0 }]
+        vec![post_process_texture()]
     }
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
         if !self.camera_moved {
@@ -147,27 +128,27 @@ impl Pass for MotionBlurPass {
             _pad: [0; 2],
         };
         let params = ctx.uniform(("motion_blur", 0), bytemuck::bytes_of(&params));
-        let hdr = ctx.texture(HDR)?;
-        let blurred = ctx.texture(MOTION_BLUR)?;
+        let depth = ctx.texture(DEPTH)?;
+        let target = ctx.post_process_write()?;
         let blur_group = ctx.bind_group(
             "motion_blur",
             &pipeline.blur_layout,
             &[
                 Binding::Buffer(&ctx.scene.view_buffer),
                 Binding::Buffer(&params),
-                Binding::Texture(hdr),
-                Binding::Texture(ctx.texture(DEPTH)?),
+                Binding::Texture(target.source),
+                Binding::Texture(depth),
             ],
         );
-        let copy_group = ctx.bind_group_numbered(
-            "motion_blur_copy",
-            &pipeline.copy_layout,
-            &[(4, Binding::Texture(blurred))],
+        let timestamps = ctx.render_timestamps(true, true);
+        draw_fullscreen(
+            ctx.encoder,
+            "motion_blur",
+            target.destination,
+            timestamps,
+            &pipeline.blur,
+            &[&blur_group],
         );
-        let first = ctx.render_timestamps(true, false);
-        draw_fullscreen(ctx.encoder, "motion_blur", blurred, first, &pipeline.blur, &[&blur_group]);
-        let last = ctx.render_timestamps(false, true);
-        draw_fullscreen(ctx.encoder, "motion_blur_copy", hdr, last, &pipeline.copy, &[&copy_group]);
         Ok(())
     }
 }

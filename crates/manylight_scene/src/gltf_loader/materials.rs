@@ -18,8 +18,8 @@ use glam::{Affine2, Vec2, Vec3, Vec4};
 use gltf::json::validation::Checked;
 use image::{ImageDecoder, ImageFormat, ImageReader, Limits};
 use manylight_core::{
-    AlphaMode, ImageAddressMode, ImageFilterMode, MaterialData, MaterialTexture, TextureData, TextureSampler,
-    UvChannel,
+    AlphaMode, Color, ColorToComponents, ImageAddressMode, ImageFilterMode, LinearRgba, MaterialData,
+    MaterialTexture, TextureData, TextureSampler, UvChannel,
 };
 use serde_json::Value;
 use std::borrow::Cow;
@@ -247,7 +247,7 @@ impl<'a> Ctx<'a> {
         let alpha_mode = self.alpha_mode(index);
         Ok(MaterialData {
             label: m.name.clone().unwrap_or_else(|| format!("material {index}")),
-            base_color: base,
+            base_color: Color::LinearRgba(LinearRgba::from_vec4(base)),
             base_color_texture: texture,
             metallic,
             roughness,
@@ -259,7 +259,7 @@ impl<'a> Ctx<'a> {
             normal_scale,
             occlusion_texture,
             occlusion_strength,
-            emissive,
+            emissive: LinearRgba::from_vec3(emissive),
             emissive_texture,
             double_sided: m.double_sided,
             alpha_mode,
