@@ -64,26 +64,13 @@ fn cs_forward(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
+// From the G-buffer of the layout the shader is composed for (`gbuffer_read`).
+//!if GBUFFER
 @compute @workgroup_size(8, 8)
-fn cs_full(@builtin(global_invocation_id) id: vec3<u32>) {
+fn cs_gbuffer(@builtin(global_invocation_id) id: vec3<u32>) {
     let px = vec2<i32>(id.xy);
     if all(id.xy < textureDimensions(gb_depth)) && gbuffer_depth(px) > 0.0 {
-        mark_cluster_depth(vec2<f32>(id.xy) + 0.5, gbuffer_view_distance(gbuffer_read_full(px).world_position));
+        mark_cluster_depth(vec2<f32>(id.xy) + 0.5, gbuffer_view_distance(gbuffer_read(px).world_position));
     }
 }
-
-@compute @workgroup_size(8, 8)
-fn cs_packed(@builtin(global_invocation_id) id: vec3<u32>) {
-    let px = vec2<i32>(id.xy);
-    if all(id.xy < textureDimensions(gb_depth)) && gbuffer_depth(px) > 0.0 {
-        mark_cluster_depth(vec2<f32>(id.xy) + 0.5, gbuffer_view_distance(gbuffer_read_packed(px).world_position));
-    }
-}
-
-@compute @workgroup_size(8, 8)
-fn cs_compact(@builtin(global_invocation_id) id: vec3<u32>) {
-    let px = vec2<i32>(id.xy);
-    if all(id.xy < textureDimensions(gb_depth)) && gbuffer_depth(px) > 0.0 {
-        mark_cluster_depth(vec2<f32>(id.xy) + 0.5, gbuffer_view_distance(gbuffer_read_compact(px).world_position));
-    }
-}
+//!endif

@@ -25,29 +25,14 @@ fn shade(g: GSurface, frag: vec2<f32>) -> vec4<f32> {
     return vec4<f32>(color, 1.0);
 }
 
+// Composed for the pipeline's G-buffer layout (`gbuffer_read`, common/gbuffer_read.wgsl).
+//!if GBUFFER
 @fragment
-fn fs_full(in: FullscreenOut) -> @location(0) vec4<f32> {
+fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     let px = vec2<i32>(in.position.xy);
     if gbuffer_depth(px) <= 0.0 {
         return clear_color; // background (reverse-Z: cleared to 0)
     }
-    return shade(gbuffer_read_full(px), in.position.xy);
+    return shade(gbuffer_read(px), in.position.xy);
 }
-
-@fragment
-fn fs_packed(in: FullscreenOut) -> @location(0) vec4<f32> {
-    let px = vec2<i32>(in.position.xy);
-    if gbuffer_depth(px) <= 0.0 {
-        return clear_color;
-    }
-    return shade(gbuffer_read_packed(px), in.position.xy);
-}
-
-@fragment
-fn fs_compact(in: FullscreenOut) -> @location(0) vec4<f32> {
-    let px = vec2<i32>(in.position.xy);
-    if gbuffer_depth(px) <= 0.0 {
-        return clear_color;
-    }
-    return shade(gbuffer_read_compact(px), in.position.xy);
-}
+//!endif

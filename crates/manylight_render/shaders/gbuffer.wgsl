@@ -18,25 +18,29 @@
 //!include common/mesh_pass.wgsl
 //!include common/gbuffer_codec.wgsl
 
-struct FullOut {
-    @location(0) position: vec4<f32>,
-    @location(1) normal: vec4<f32>,
-    @location(2) albedo: vec4<f32>,
-    @location(3) emissive: vec4<f32>,
-};
+// The fragment stage writes the layout the shader is composed for (the define GBUFFER_FULL,
+// GBUFFER_PACKED or GBUFFER_COMPACT): one `GBufferOut` and one `fs_main`.
 
 // The emissive target's texel: emitted radiance and occlusion.
 fn emissive_texel(m: MaterialSample) -> vec4<f32> {
     return vec4<f32>(min(m.emissive, vec3<f32>(65504.0)), m.occlusion);
 }
 
+//!if GBUFFER_FULL
+struct GBufferOut {
+    @location(0) position: vec4<f32>,
+    @location(1) normal: vec4<f32>,
+    @location(2) albedo: vec4<f32>,
+    @location(3) emissive: vec4<f32>,
+};
+
 @fragment
-fn fs_full(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> FullOut {
+fn fs_main(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> GBufferOut {
     let p = surface_point(view, in.clip_position.xy, in.camera_offset);
     let m = sample_material(in, front_facing);
     alpha_test(m.base_color);
     let s = m.params;
-    var out: FullOut;
+    var out: GBufferOut;
     out.position = vec4<f32>(p.world_position, f32(s.model));
     let slots = material_slots(s);
     out.normal = vec4<f32>(s.normal, slots.x);
@@ -44,40 +48,44 @@ fn fs_full(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> F
     out.emissive = emissive_texel(m);
     return out;
 }
+//!endif
 
-struct PackedOut {
+//!if GBUFFER_PACKED
+struct GBufferOut {
     @location(0) albedo: vec4<f32>,
     @location(1) position: vec4<f32>,
     @location(2) emissive: vec4<f32>,
 };
 
 @fragment
-fn fs_packed(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> PackedOut {
+fn fs_main(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> GBufferOut {
     let p = surface_point(view, in.clip_position.xy, in.camera_offset);
     let m = sample_material(in, front_facing);
     alpha_test(m.base_color);
     let s = m.params;
     let n = gbuffer_encode_components(s.normal, view.view_from_world);
-    var out: PackedOut;
+    var out: GBufferOut;
     out.albedo = vec4<f32>(gbuffer_pack_albedo_params(s), n.x);
     out.position = vec4<f32>(p.world_position, n.y);
     out.emissive = emissive_texel(m);
     return out;
 }
+//!endif
 
-struct CompactOut {
+//!if GBUFFER_COMPACT
+struct GBufferOut {
     @location(0) surface: vec4<u32>,
     @location(1) emissive: vec4<f32>,
 };
 
 @fragment
-fn fs_compact(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> CompactOut {
+fn fs_main(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> GBufferOut {
     let p = surface_point(view, in.clip_position.xy, in.camera_offset);
     let m = sample_material(in, front_facing);
     alpha_test(m.base_color);
     let s = m.params;
     let clip = view.clip_from_world * vec4<f32>(p.world_position, 1.0);
-    var out: CompactOut;
+    var out: GBufferOut;
     out.surface = vec4<u32>(
         gbuffer_pack_albedo_model(s.albedo, s.model),
         gbuffer_encode_word(s.normal),
@@ -87,3 +95,4 @@ fn fs_compact(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -
     out.emissive = emissive_texel(m);
     return out;
 }
+//!endif

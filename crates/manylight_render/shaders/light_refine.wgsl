@@ -328,8 +328,10 @@ fn cs_forward(@builtin(global_invocation_id) id: vec3<u32>) {
     finish_group(id.xy);
 }
 
+// From the G-buffer of the layout the shader is composed for (`gbuffer_read`).
+//!if GBUFFER
 @compute @workgroup_size(8, 8)
-fn cs_full(@builtin(global_invocation_id) id: vec3<u32>) {
+fn cs_gbuffer(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = textureDimensions(gb_depth);
     for (var q = 0u; q < GROUP_BLOCKS; q++) {
         let b = group_block(id.xy, q);
@@ -337,44 +339,11 @@ fn cs_full(@builtin(global_invocation_id) id: vec3<u32>) {
         for (var i = 0u; i < REFINE_EDGE * REFINE_EDGE && in_blocks(b); i++) {
             let px = block_pixel(b, i);
             if all(px < size) && gbuffer_depth(vec2<i32>(px)) > 0.0 {
-                add_pixel(px, gbuffer_position(gbuffer_read_full(vec2<i32>(px)).world_position));
+                add_pixel(px, gbuffer_position(gbuffer_read(vec2<i32>(px)).world_position));
             }
         }
         close_block(q, in_blocks(b));
     }
     finish_group(id.xy);
 }
-
-@compute @workgroup_size(8, 8)
-fn cs_packed(@builtin(global_invocation_id) id: vec3<u32>) {
-    let size = textureDimensions(gb_depth);
-    for (var q = 0u; q < GROUP_BLOCKS; q++) {
-        let b = group_block(id.xy, q);
-        begin_block();
-        for (var i = 0u; i < REFINE_EDGE * REFINE_EDGE && in_blocks(b); i++) {
-            let px = block_pixel(b, i);
-            if all(px < size) && gbuffer_depth(vec2<i32>(px)) > 0.0 {
-                add_pixel(px, gbuffer_position(gbuffer_read_packed(vec2<i32>(px)).world_position));
-            }
-        }
-        close_block(q, in_blocks(b));
-    }
-    finish_group(id.xy);
-}
-
-@compute @workgroup_size(8, 8)
-fn cs_compact(@builtin(global_invocation_id) id: vec3<u32>) {
-    let size = textureDimensions(gb_depth);
-    for (var q = 0u; q < GROUP_BLOCKS; q++) {
-        let b = group_block(id.xy, q);
-        begin_block();
-        for (var i = 0u; i < REFINE_EDGE * REFINE_EDGE && in_blocks(b); i++) {
-            let px = block_pixel(b, i);
-            if all(px < size) && gbuffer_depth(vec2<i32>(px)) > 0.0 {
-                add_pixel(px, gbuffer_position(gbuffer_read_compact(vec2<i32>(px)).world_position));
-            }
-        }
-        close_block(q, in_blocks(b));
-    }
-    finish_group(id.xy);
-}
+//!endif

@@ -58,56 +58,25 @@ fn one_light(g: GSurface, light_index: u32) -> vec4<f32> {
     return vec4<f32>(shade_light(g.params, g.world_position, view_dir, light_index), 0.0);
 }
 
+// Both read the G-buffer of the layout the shader is composed for (`gbuffer_read`).
+//!if GBUFFER
 @fragment
-fn fs_ambient_full(in: FullscreenOut) -> @location(0) vec4<f32> {
+fn fs_ambient(in: FullscreenOut) -> @location(0) vec4<f32> {
     let px = vec2<i32>(in.position.xy);
     if gbuffer_depth(px) <= 0.0 {
         return clear_color;
     }
-    return ambient(gbuffer_read_full(px));
+    return ambient(gbuffer_read(px));
 }
+//!endif
 
+//!if GBUFFER
 @fragment
-fn fs_ambient_packed(in: FullscreenOut) -> @location(0) vec4<f32> {
-    let px = vec2<i32>(in.position.xy);
-    if gbuffer_depth(px) <= 0.0 {
-        return clear_color;
-    }
-    return ambient(gbuffer_read_packed(px));
-}
-
-@fragment
-fn fs_ambient_compact(in: FullscreenOut) -> @location(0) vec4<f32> {
-    let px = vec2<i32>(in.position.xy);
-    if gbuffer_depth(px) <= 0.0 {
-        return clear_color;
-    }
-    return ambient(gbuffer_read_compact(px));
-}
-
-@fragment
-fn fs_volume_full(in: VolumeOut) -> @location(0) vec4<f32> {
+fn fs_volume(in: VolumeOut) -> @location(0) vec4<f32> {
     let px = vec2<i32>(in.clip_position.xy);
     if gbuffer_depth(px) <= 0.0 {
         return vec4<f32>(0.0); // background: nothing to light
     }
-    return one_light(gbuffer_read_full(px), in.light_index);
+    return one_light(gbuffer_read(px), in.light_index);
 }
-
-@fragment
-fn fs_volume_packed(in: VolumeOut) -> @location(0) vec4<f32> {
-    let px = vec2<i32>(in.clip_position.xy);
-    if gbuffer_depth(px) <= 0.0 {
-        return vec4<f32>(0.0);
-    }
-    return one_light(gbuffer_read_packed(px), in.light_index);
-}
-
-@fragment
-fn fs_volume_compact(in: VolumeOut) -> @location(0) vec4<f32> {
-    let px = vec2<i32>(in.clip_position.xy);
-    if gbuffer_depth(px) <= 0.0 {
-        return vec4<f32>(0.0);
-    }
-    return one_light(gbuffer_read_compact(px), in.light_index);
-}
+//!endif

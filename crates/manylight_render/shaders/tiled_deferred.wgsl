@@ -215,83 +215,33 @@ fn light_own_pixel(own: vec3<i32>, depth: f32, g: GSurface, tile: vec2<u32>, li:
     }
 }
 
-// The entry points differ only in how they read the G-buffer (one per layout). A larger tile
-// (a grid of wider tiles) is visited once per phase, TILED_EDGE pixels apart, reading the
-// surfaces again each time.
-fn pixels_full(phase: u32, tile: vec2<u32>, rect: vec4<u32>, lid: vec2<u32>) {
+//!if GBUFFER
+// A larger tile (a grid of wider tiles) is visited once per phase, TILED_EDGE pixels apart,
+// reading the surfaces again each time (from the G-buffer of the layout the shader is composed
+// for: `gbuffer_read`).
+fn pixels(phase: u32, tile: vec2<u32>, rect: vec4<u32>, lid: vec2<u32>) {
     for (var y = rect.y + lid.y; y < rect.w; y += TILED_EDGE) {
         for (var x = rect.x + lid.x; x < rect.z; x += TILED_EDGE) {
             let px = vec2<i32>(vec2<u32>(x, y));
-            tile_pixel(phase, px, gbuffer_depth(px), gbuffer_read_full(px), tile);
-        }
-    }
-}
-
-fn pixels_packed(phase: u32, tile: vec2<u32>, rect: vec4<u32>, lid: vec2<u32>) {
-    for (var y = rect.y + lid.y; y < rect.w; y += TILED_EDGE) {
-        for (var x = rect.x + lid.x; x < rect.z; x += TILED_EDGE) {
-            let px = vec2<i32>(vec2<u32>(x, y));
-            tile_pixel(phase, px, gbuffer_depth(px), gbuffer_read_packed(px), tile);
-        }
-    }
-}
-
-fn pixels_compact(phase: u32, tile: vec2<u32>, rect: vec4<u32>, lid: vec2<u32>) {
-    for (var y = rect.y + lid.y; y < rect.w; y += TILED_EDGE) {
-        for (var x = rect.x + lid.x; x < rect.z; x += TILED_EDGE) {
-            let px = vec2<i32>(vec2<u32>(x, y));
-            tile_pixel(phase, px, gbuffer_depth(px), gbuffer_read_compact(px), tile);
+            tile_pixel(phase, px, gbuffer_depth(px), gbuffer_read(px), tile);
         }
     }
 }
 
 @compute @workgroup_size(TILED_EDGE, TILED_EDGE)
-fn cs_full(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+fn cs_main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     let rect = tile_rect(wg.xy);
     begin_tile(li);
     if tile_fits(rect) {
         let own = own_pixel(rect, lid.xy);
-        light_own_pixel(own, gbuffer_depth(own.xy), gbuffer_read_full(own.xy), wg.xy, li);
+        light_own_pixel(own, gbuffer_depth(own.xy), gbuffer_read(own.xy), wg.xy, li);
     } else {
-        pixels_full(PHASE_BOUNDS, wg.xy, rect, lid.xy);
+        pixels(PHASE_BOUNDS, wg.xy, rect, lid.xy);
         workgroupBarrier();
-        pixels_full(PHASE_MASK, wg.xy, rect, lid.xy);
+        pixels(PHASE_MASK, wg.xy, rect, lid.xy);
         workgroupBarrier();
         cull_tile(wg.xy, li);
-        pixels_full(PHASE_SHADE, wg.xy, rect, lid.xy);
+        pixels(PHASE_SHADE, wg.xy, rect, lid.xy);
     }
 }
-
-@compute @workgroup_size(TILED_EDGE, TILED_EDGE)
-fn cs_packed(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    let rect = tile_rect(wg.xy);
-    begin_tile(li);
-    if tile_fits(rect) {
-        let own = own_pixel(rect, lid.xy);
-        light_own_pixel(own, gbuffer_depth(own.xy), gbuffer_read_packed(own.xy), wg.xy, li);
-    } else {
-        pixels_packed(PHASE_BOUNDS, wg.xy, rect, lid.xy);
-        workgroupBarrier();
-        pixels_packed(PHASE_MASK, wg.xy, rect, lid.xy);
-        workgroupBarrier();
-        cull_tile(wg.xy, li);
-        pixels_packed(PHASE_SHADE, wg.xy, rect, lid.xy);
-    }
-}
-
-@compute @workgroup_size(TILED_EDGE, TILED_EDGE)
-fn cs_compact(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    let rect = tile_rect(wg.xy);
-    begin_tile(li);
-    if tile_fits(rect) {
-        let own = own_pixel(rect, lid.xy);
-        light_own_pixel(own, gbuffer_depth(own.xy), gbuffer_read_compact(own.xy), wg.xy, li);
-    } else {
-        pixels_compact(PHASE_BOUNDS, wg.xy, rect, lid.xy);
-        workgroupBarrier();
-        pixels_compact(PHASE_MASK, wg.xy, rect, lid.xy);
-        workgroupBarrier();
-        cull_tile(wg.xy, li);
-        pixels_compact(PHASE_SHADE, wg.xy, rect, lid.xy);
-    }
-}
+//!endif

@@ -77,12 +77,30 @@ pub struct ShaderDefs {
     /// (`wgpu::Features::CLIP_DISTANCES`); the shadow pass clips each face to its tile with
     /// them instead of discarding fragments.
     pub clip_distances: bool,
+    /// The G-buffer layout a shader that reads or writes the G-buffer is composed for:
+    /// `GBUFFER` (any layout) and one of `GBUFFER_FULL`, `GBUFFER_PACKED`, `GBUFFER_COMPACT`
+    /// (`common/gbuffer_read.wgsl` gives it `gbuffer_read`, `gbuffer.wgsl` its `GBufferOut`), so
+    /// each pass has one entry point whatever the layout.
+    pub gbuffer: Option<crate::snapshot::GBufferLayout>,
 }
 
 impl ShaderDefs {
+    /// These defines composed for G-buffer `layout`.
+    pub fn with_gbuffer(self, layout: crate::snapshot::GBufferLayout) -> ShaderDefs {
+        ShaderDefs { gbuffer: Some(layout), ..self }
+    }
+
     /// The defines a shader can test, with their state.
-    fn flags(self) -> [(&'static str, bool); 2] {
-        [("SHADOWS", self.shadows), ("CLIP_DISTANCES", self.clip_distances)]
+    fn flags(self) -> [(&'static str, bool); 6] {
+        use crate::snapshot::GBufferLayout;
+        [
+            ("SHADOWS", self.shadows),
+            ("CLIP_DISTANCES", self.clip_distances),
+            ("GBUFFER", self.gbuffer.is_some()),
+            ("GBUFFER_FULL", self.gbuffer == Some(GBufferLayout::Full)),
+            ("GBUFFER_PACKED", self.gbuffer == Some(GBufferLayout::Packed)),
+            ("GBUFFER_COMPACT", self.gbuffer == Some(GBufferLayout::Compact)),
+        ]
     }
 
     fn get(self, name: &str) -> Option<bool> {

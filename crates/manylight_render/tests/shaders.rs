@@ -1,6 +1,7 @@
 //! Every WGSL file parses and validates with naga, and the structs shared with Rust have the
 //! same size and field offsets on both sides. No GPU needed.
 
+use manylight_render::GBufferLayout;
 use manylight_render::gpu_types::{
     GpuCascade, GpuDirectionalShadow, GpuShadowDraw, GpuShadowFace, GpuShadowLight, GpuShadowProbe,
 };
@@ -26,15 +27,61 @@ fn validate_with(path: &str, defs: ShaderDefs) -> naga::Module {
     module
 }
 
+/// No G-buffer layout, then each.
+const GBUFFER_CHOICES: [Option<GBufferLayout>; 4] =
+    [None, Some(GBufferLayout::Full), Some(GBufferLayout::Packed), Some(GBufferLayout::Compact)];
+
 /// Every combination of the defines a shader can be composed with.
 fn all_defs() -> Vec<ShaderDefs> {
     let mut out = Vec::new();
     for shadows in [false, true] {
         for clip_distances in [false, true] {
-            out.push(ShaderDefs { shadows, clip_distances });
+            for gbuffer in GBUFFER_CHOICES {
+                out.push(ShaderDefs { shadows, clip_distances, gbuffer });
+            }
         }
     }
     out
+}
+
+/// The G-buffer layout is chosen when a shader is composed, so no entry point is copied per
+/// layout: none is named after one, and the shaders that read or write the G-buffer have their
+/// G-buffer entry points (`fs_main`, `cs_main`, `cs_gbuffer`, `fs_ambient`, `fs_volume`) only
+/// when composed for a layout.
+#[test]
+fn no_entry_point_is_copied_per_gbuffer_layout() {
+    let mut with_layout = Vec::new();
+    for (path, _) in SOURCES {
+        let plain = validate(path).entry_points.len();
+        for defs in all_defs() {
+            let module = validate_with(path, defs);
+            for ep in &module.entry_points {
+                let lower = ep.name.to_lowercase();
+                assert!(
+                    !lower.split('_').any(|word| ["full", "packed", "compact"].contains(&word)),
+                    "{path}: entry point `{}` is named after a G-buffer layout",
+                    ep.name
+                );
+            }
+            if defs == (ShaderDefs { gbuffer: defs.gbuffer, ..Default::default() })
+                && module.entry_points.len() > plain
+            {
+                with_layout.push(*path);
+            }
+        }
+    }
+    with_layout.dedup();
+    with_layout.sort();
+    with_layout.dedup();
+    let expected = [
+        "cluster_depth.wgsl",
+        "deferred_lighting.wgsl",
+        "gbuffer.wgsl",
+        "light_refine.wgsl",
+        "light_volumes.wgsl",
+        "tiled_deferred.wgsl",
+    ];
+    assert_eq!(with_layout, expected);
 }
 
 #[test]
@@ -326,8 +373,16 @@ fn constants_come_from_rust() {
 fn every_entry_point_compiles_to_spirv() {
     let codecs: Vec<f64> =
         manylight_core::codec::NormalCodec::ALL.iter().map(|c| c.gpu_id() as f64).collect();
-    for (path, _) in SOURCES {
-        let module = validate(path);
+    let composed = SOURCES.iter().flat_map(|(path, _)| {
+        // A shader that reads or writes the G-buffer once per layout, the others once.
+        let plain = compose(path).unwrap();
+        GBUFFER_CHOICES.into_iter().filter_map(move |gbuffer| {
+            let defs = ShaderDefs { gbuffer, ..Default::default() };
+            (gbuffer.is_none() || compose_with(path, defs).unwrap() != plain).then_some((*path, defs))
+        })
+    });
+    for (path, defs) in composed {
+        let module = validate_with(path, defs);
         let info = naga::valid::Validator::new(
             naga::valid::ValidationFlags::all(),
             naga::valid::Capabilities::all(),
@@ -366,7 +421,7 @@ fn every_entry_point_compiles_to_spirv() {
                     Some((ep.stage, &ep.name)),
                     constants,
                 )
-                .unwrap_or_else(|e| panic!("{path} {}: {e}", ep.name));
+                .unwrap_or_else(|e| panic!("{path} {defs:?} {}: {e}", ep.name));
                 let options = naga::back::spv::Options::default();
                 let pipeline =
                     naga::back::spv::PipelineOptions { shader_stage: ep.stage, entry_point: ep.name.clone() };
@@ -376,8 +431,10 @@ fn every_entry_point_compiles_to_spirv() {
                 });
                 match written {
                     Ok(Ok(_)) => {}
-                    Ok(Err(e)) => panic!("{path} {} {constants:?}: {e}", ep.name),
-                    Err(_) => panic!("{path} {} {constants:?}: naga's SPIR-V backend panicked", ep.name),
+                    Ok(Err(e)) => panic!("{path} {defs:?} {} {constants:?}: {e}", ep.name),
+                    Err(_) => {
+                        panic!("{path} {defs:?} {} {constants:?}: naga's SPIR-V backend panicked", ep.name)
+                    }
                 }
             }
         }

@@ -1,5 +1,8 @@
-// Reading the G-buffer back (clustered deferred lighting and light volumes). Group 1 holds the
-// targets of the pipeline's layout; each entry point touches only its own layout's bindings.
+// Reading the G-buffer back (clustered deferred lighting, tiled deferred, light volumes and the
+// passes that bound or refine the light lists by its depth). Group 1 holds the targets of the
+// pipeline's layout; a shader is composed for one layout (the define GBUFFER_FULL,
+// GBUFFER_PACKED or GBUFFER_COMPACT, with GBUFFER), which gives it `gbuffer_read` for that
+// layout, touching only that layout's bindings.
 // Includes the view uniform (group 0, binding 0) too, which decoding needs.
 //!include common/view_binding.wgsl
 //!include common/gbuffer_codec.wgsl
@@ -54,7 +57,9 @@ fn gbuffer_depth(px: vec2<i32>) -> f32 {
     return textureLoad(gb_depth, px, 0);
 }
 
-fn gbuffer_read_full(px: vec2<i32>) -> GSurface {
+//!if GBUFFER_FULL
+// The surface at `px`, from the Full layout.
+fn gbuffer_read(px: vec2<i32>) -> GSurface {
     let p = textureLoad(gb_position, px, 0);
     let n = textureLoad(gb_normal, px, 0);
     let a = textureLoad(gb_albedo, px, 0);
@@ -66,8 +71,11 @@ fn gbuffer_read_full(px: vec2<i32>) -> GSurface {
     g.world_position = p.xyz;
     return with_emissive(g, px);
 }
+//!endif
 
-fn gbuffer_read_packed(px: vec2<i32>) -> GSurface {
+//!if GBUFFER_PACKED
+// The surface at `px`, from the Packed layout.
+fn gbuffer_read(px: vec2<i32>) -> GSurface {
     let a = textureLoad(gb_packed_albedo, px, 0);
     let p = textureLoad(gb_packed_position, px, 0);
     var g: GSurface;
@@ -76,6 +84,7 @@ fn gbuffer_read_packed(px: vec2<i32>) -> GSurface {
     g.world_position = p.xyz;
     return with_emissive(g, px);
 }
+//!endif
 
 // World position of the pixel centre at `uv` (0..1, top-left origin) and reverse-Z `depth`.
 fn gbuffer_position_from_depth(uv: vec2<f32>, depth: f32) -> vec3<f32> {
@@ -84,9 +93,10 @@ fn gbuffer_position_from_depth(uv: vec2<f32>, depth: f32) -> vec3<f32> {
     return world.xyz / world.w;
 }
 
-// The Compact layout at `px`; its position comes from the depth it stores (the shading
-// position's, which the depth buffer only approximates on very large triangles).
-fn gbuffer_read_compact(px: vec2<i32>) -> GSurface {
+//!if GBUFFER_COMPACT
+// The surface at `px`, from the Compact layout; its position comes from the depth it stores
+// (the shading position's, which the depth buffer only approximates on very large triangles).
+fn gbuffer_read(px: vec2<i32>) -> GSurface {
     let g = textureLoad(gb_compact, px, 0);
     let params = unpack2x16float(g.z);
     var out: GSurface;
@@ -98,3 +108,4 @@ fn gbuffer_read_compact(px: vec2<i32>) -> GSurface {
     out.world_position = gbuffer_position_from_depth(uv, bitcast<f32>(g.w));
     return with_emissive(out, px);
 }
+//!endif

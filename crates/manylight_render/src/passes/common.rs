@@ -100,9 +100,20 @@ pub fn mesh_pipeline_with_constants(
     d: &MeshPipelineDesc<'_>,
     constants: &[(&str, f64)],
 ) -> Result<wgpu::RenderPipeline, RenderError> {
+    mesh_pipeline_with_defs(device, d, constants, d.variant.defs())
+}
+
+/// [`mesh_pipeline_with_constants`] with its shader composed with `defs` (the variant's and
+/// more: the G-buffer pass adds its layout).
+pub fn mesh_pipeline_with_defs(
+    device: &wgpu::Device,
+    d: &MeshPipelineDesc<'_>,
+    constants: &[(&str, f64)],
+    defs: crate::shaders::ShaderDefs,
+) -> Result<wgpu::RenderPipeline, RenderError> {
     let constants: Vec<(&str, f64)> = constants.iter().copied().chain(d.variant.constants()).collect();
     let options = || wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
-    let module = crate::shaders::create_module_with(device, d.shader, d.variant.defs())?;
+    let module = crate::shaders::create_module_with(device, d.shader, defs)?;
     let layout = pipeline_layout(device, d.label, d.layouts);
     // Blended variants draw over the target by the fragment's alpha (glTF `BLEND`).
     let targets = color_targets(d.targets, d.variant.blend.then_some(wgpu::BlendState::ALPHA_BLENDING));

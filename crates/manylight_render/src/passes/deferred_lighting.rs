@@ -2,9 +2,7 @@
 //! cluster list into [`HDR`].
 
 use super::common::{FullscreenPipelineDesc, draw_fullscreen, fullscreen_pipeline_with_defs};
-use super::gbuffer_layout::{
-    codec_constants, fragment_entry, gbuffer_read_bind_group, gbuffer_read_layout, gbuffer_reads,
-};
+use super::gbuffer_layout::{codec_constants, gbuffer_read_bind_group, gbuffer_read_layout, gbuffer_reads};
 use super::{CLUSTERS, HDR};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
@@ -53,13 +51,13 @@ impl DeferredLightingPipeline {
                 label: "deferred_lighting",
                 shader: "deferred_lighting.wgsl",
                 layouts: &layouts,
-                fragment: fragment_entry(layout),
+                fragment: "fs_main",
                 output: HDR_FORMAT,
                 blend: None,
                 depth: None,
                 constants: &constants,
             },
-            defs,
+            defs.with_gbuffer(layout),
         )?;
         Ok(DeferredLightingPipeline { pipeline, gbuffer_layout })
     }

@@ -1,8 +1,8 @@
 //! G-buffer pass of clustered deferred: writes each pixel's surface (position or depth,
 //! normal, albedo, shading parameters) in the chosen [`GBufferLayout`].
 
-use super::common::{MeshPipelineDesc, color_attachment, mesh_pipeline_with_constants};
-use super::gbuffer_layout::{codec_constants, fragment_entry, targets};
+use super::common::{MeshPipelineDesc, color_attachment, mesh_pipeline_with_defs};
+use super::gbuffer_layout::{codec_constants, targets};
 use super::scene_draw::{ScenePipeline, record_scene_pass, variant_pipelines};
 use super::{DEPTH, DEPTH_USAGE};
 use crate::context::RenderError;
@@ -37,19 +37,20 @@ impl GBufferPipeline {
     fn new(device: &wgpu::Device, scene: &SceneResources, key: &GBufferKey) -> Result<Self, RenderError> {
         let GBufferKey { layout, codec, variant } = *key;
         let formats: Vec<wgpu::TextureFormat> = targets(layout).iter().map(|&(_, format)| format).collect();
-        let pipeline = mesh_pipeline_with_constants(
+        let pipeline = mesh_pipeline_with_defs(
             device,
             &MeshPipelineDesc {
                 label: "gbuffer",
                 shader: "gbuffer.wgsl",
                 layouts: &[&scene.view_layout, &scene.material_layout],
-                fragment: Some(fragment_entry(layout)),
+                fragment: Some("fs_main"),
                 targets: &formats,
                 depth_write: true,
                 depth_compare: wgpu::CompareFunction::Greater,
                 variant,
             },
             &codec_constants(codec),
+            variant.defs().with_gbuffer(layout),
         )?;
         Ok(GBufferPipeline { pipeline })
     }

@@ -1,11 +1,11 @@
 //! How the deferred passes agree on a G-buffer layout: its targets and formats, the shader
-//! entry points and constants of each layout and codec, and the bind group through which the
+//! defines and constants of each layout and codec, and the bind group through which the
 //! lighting passes read it (`shaders/common/gbuffer_read.wgsl`). Shared by the G-buffer,
 //! deferred-lighting, tiled-deferred and light-volume passes; and where the passes that need
 //! each pixel's shading distance before shading (`cluster_depth`, `light_refine`) read it:
 //! [`DistanceSource`].
 
-use super::common::{compute_pipeline, texture_entry, uniform_entry};
+use super::common::{compute_pipeline_with_defs, texture_entry, uniform_entry};
 use super::{DEPTH, SHADING_DISTANCE};
 use super::{
     GBUFFER_ALBEDO, GBUFFER_COMPACT, GBUFFER_EMISSIVE, GBUFFER_NORMAL, GBUFFER_PACKED_ALBEDO,
@@ -14,6 +14,7 @@ use super::{
 use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{PassContext, ResourceName};
+use crate::shaders::ShaderDefs;
 use crate::snapshot::GBufferLayout;
 use manylight_core::codec::NormalCodec;
 
@@ -44,25 +45,6 @@ pub fn targets(layout: GBufferLayout) -> &'static [(ResourceName, wgpu::TextureF
 /// What a pass that reads the G-buffer of `layout` reads: its targets and [`DEPTH`].
 pub fn gbuffer_reads(layout: GBufferLayout) -> impl Iterator<Item = ResourceName> {
     targets(layout).iter().map(|&(name, _)| name).chain([DEPTH])
-}
-
-/// The fragment entry point of `gbuffer.wgsl` and `deferred_lighting.wgsl` for a layout.
-pub fn fragment_entry(layout: GBufferLayout) -> &'static str {
-    match layout {
-        GBufferLayout::Full => "fs_full",
-        GBufferLayout::Packed => "fs_packed",
-        GBufferLayout::Compact => "fs_compact",
-    }
-}
-
-/// The compute entry point reading a layout's G-buffer, in `tiled_deferred.wgsl`,
-/// `cluster_depth.wgsl` and `light_refine.wgsl`.
-pub fn compute_entry(layout: GBufferLayout) -> &'static str {
-    match layout {
-        GBufferLayout::Full => "cs_full",
-        GBufferLayout::Packed => "cs_packed",
-        GBufferLayout::Compact => "cs_compact",
-    }
 }
 
 /// The `override` constants selecting `codec` in the G-buffer shaders.
@@ -121,8 +103,8 @@ pub fn gbuffer_read_bind_group(
 }
 
 /// Where a pass reads each pixel's shading distance (the `cluster_depth` and `light_refine`
-/// passes; their shaders have one entry point per source: `cs_forward`, `cs_full`, `cs_packed`,
-/// `cs_compact`).
+/// passes; their shaders have one entry point per source: `cs_forward`, and `cs_gbuffer`
+/// composed for the layout).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum DistanceSource {
     /// The depth pre-pass's [`SHADING_DISTANCE`] (forward pipelines).
@@ -151,11 +133,11 @@ impl DistanceSource {
     }
 
     /// The layout of the source's bind group (group 1), the shader entry point and its
-    /// pipeline constants.
+    /// pipeline constants and defines.
     pub fn layout(
         self,
         device: &wgpu::Device,
-    ) -> (wgpu::BindGroupLayout, &'static str, [(&'static str, f64); 1]) {
+    ) -> (wgpu::BindGroupLayout, &'static str, [(&'static str, f64); 1], ShaderDefs) {
         match self {
             DistanceSource::Prepass => {
                 let unfilterable = wgpu::TextureSampleType::Float { filterable: false };
@@ -163,11 +145,14 @@ impl DistanceSource {
                     label: Some("shading_distance"),
                     entries: &[texture_entry(9, unfilterable)],
                 });
-                (layout, "cs_forward", codec_constants(NormalCodec::Octa16))
+                (layout, "cs_forward", codec_constants(NormalCodec::Octa16), ShaderDefs::default())
             }
-            DistanceSource::GBuffer(layout, codec) => {
-                (gbuffer_read_layout(device, layout), compute_entry(layout), codec_constants(codec))
-            }
+            DistanceSource::GBuffer(layout, codec) => (
+                gbuffer_read_layout(device, layout),
+                "cs_gbuffer",
+                codec_constants(codec),
+                ShaderDefs::default().with_gbuffer(layout),
+            ),
         }
     }
 
@@ -209,9 +194,9 @@ impl DistancePipeline {
         [view_layout, pass_layout]: [&wgpu::BindGroupLayout; 2],
         source: DistanceSource,
     ) -> Result<Self, RenderError> {
-        let (source_layout, entry, constants) = source.layout(device);
+        let (source_layout, entry, constants, defs) = source.layout(device);
         let layouts = [view_layout, &source_layout, pass_layout];
-        let pipeline = compute_pipeline(device, label, shader, &layouts, entry, &constants)?;
+        let pipeline = compute_pipeline_with_defs(device, label, shader, &layouts, entry, &constants, defs)?;
         Ok(DistancePipeline { pipeline, source_layout })
     }
 }

@@ -3,7 +3,9 @@
 //! covers (see `shaders/light_volumes.wgsl` for the depth-test rule that lights each pixel once
 //! per light, camera inside the sphere and far-plane crossing included).
 
-use super::common::{FullscreenPipelineDesc, fullscreen_pipeline_desc, texture_entry};
+use super::common::{
+    FullscreenPipelineDesc, fullscreen_pipeline_desc, fullscreen_pipeline_with_defs, texture_entry,
+};
 use super::common::{clear_color, color_attachment, draw_fullscreen};
 use super::gbuffer_layout::{codec_constants, gbuffer_read_bind_group, gbuffer_read_layout, targets};
 use super::{DEPTH, HDR, LIGHT_ACCUM};
@@ -49,14 +51,6 @@ pub struct LightVolumesPipeline {
     index_count: u32,
 }
 
-fn entry_suffix(layout: GBufferLayout) -> &'static str {
-    match layout {
-        GBufferLayout::Full => "full",
-        GBufferLayout::Packed => "packed",
-        GBufferLayout::Compact => "compact",
-    }
-}
-
 impl LightVolumesPipeline {
     fn new(
         gpu: &GpuContext,
@@ -67,7 +61,8 @@ impl LightVolumesPipeline {
         defs: crate::shaders::ShaderDefs,
     ) -> Result<Self, RenderError> {
         let device = &gpu.device;
-        let module = crate::shaders::create_module_with(device, "light_volumes.wgsl", defs)?;
+        let module =
+            crate::shaders::create_module_with(device, "light_volumes.wgsl", defs.with_gbuffer(layout))?;
         let gbuffer_layout = gbuffer_read_layout(device, layout);
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("light_volumes"),
@@ -85,20 +80,20 @@ impl LightVolumesPipeline {
                 bias: Default::default(),
             })
         };
-        let suffix = entry_suffix(layout);
-        let ambient_entry = format!("fs_ambient_{suffix}");
-        let ambient = fullscreen_pipeline_desc(
+        // The ambient pass reads no shadows: its shader is composed without them.
+        let ambient = fullscreen_pipeline_with_defs(
             device,
             &FullscreenPipelineDesc {
                 label: "light_volumes_ambient",
                 shader: "light_volumes.wgsl",
                 layouts: &[view_layout, &gbuffer_layout],
-                fragment: &ambient_entry,
+                fragment: "fs_ambient",
                 output: accumulation,
                 blend: None,
                 depth: depth(wgpu::CompareFunction::Always),
                 constants: &constants,
             },
+            crate::shaders::ShaderDefs::default().with_gbuffer(layout),
         )?;
         // Back faces only, kept where they lie at or behind the stored surface (reverse-Z:
         // LessEqual). Without depth clamping, back faces beyond the far plane would be clipped
@@ -111,7 +106,6 @@ impl LightVolumesPipeline {
             dst_factor: wgpu::BlendFactor::One,
             operation: wgpu::BlendOperation::Add,
         };
-        let volume_entry = format!("fs_volume_{suffix}");
         let volume = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("light_volumes"),
             layout: Some(&pipeline_layout),
@@ -135,7 +129,7 @@ impl LightVolumesPipeline {
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module: &module,
-                entry_point: Some(&volume_entry),
+                entry_point: Some("fs_volume"),
                 compilation_options: options(),
                 targets: &[Some(wgpu::ColorTargetState {
                     format: accumulation,

@@ -3,9 +3,7 @@
 //! workgroup memory and shades its pixels from it into [`HDR`].
 
 use super::common::compute_pipeline_with_defs;
-use super::gbuffer_layout::{
-    codec_constants, compute_entry, gbuffer_read_bind_group, gbuffer_read_layout, gbuffer_reads,
-};
+use super::gbuffer_layout::{codec_constants, gbuffer_read_bind_group, gbuffer_read_layout, gbuffer_reads};
 use super::{CLUSTERS, HDR};
 use crate::bindings::Binding;
 use crate::context::RenderError;
@@ -62,15 +60,15 @@ impl TiledDeferredPipeline {
             }],
         });
         let layouts = [view_layout, &gbuffer_layout, cluster_layout, &output_layout];
-        let (entry, constants) = (compute_entry(layout), codec_constants(codec));
+        let constants = codec_constants(codec);
         let pipeline = compute_pipeline_with_defs(
             device,
             "tiled_deferred",
             "tiled_deferred.wgsl",
             &layouts,
-            entry,
+            "cs_main",
             &constants,
-            defs,
+            defs.with_gbuffer(layout),
         )?;
         Ok(TiledDeferredPipeline { pipeline, gbuffer_layout, output_layout })
     }
