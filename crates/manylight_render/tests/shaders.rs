@@ -440,3 +440,39 @@ fn every_entry_point_compiles_to_spirv() {
         }
     }
 }
+
+/// Each G-buffer target's read binding, as `passes::gbuffer_layout::targets` declares it (the
+/// layout and bind group the lighting passes make come from that table), is the WGSL's: the
+/// variable of that name sits at that binding of group 1 with the texture type the format
+/// needs, and so do the depth and clear-colour bindings.
+#[test]
+fn gbuffer_read_bindings_match_the_rust_table() {
+    use manylight_render::passes::gbuffer_layout::{
+        GBUFFER_READ_CLEAR_COLOR_BINDING, GBUFFER_READ_DEPTH_BINDING, targets,
+    };
+    for layout in [GBufferLayout::Full, GBufferLayout::Packed, GBufferLayout::Compact] {
+        let module = validate_with("deferred_lighting.wgsl", ShaderDefs::default().with_gbuffer(layout));
+        let at = |binding: u32| {
+            module
+                .global_variables
+                .iter()
+                .map(|(_, v)| v)
+                .find(|v| v.binding == Some(naga::ResourceBinding { group: 1, binding }))
+                .unwrap_or_else(|| panic!("{layout:?}: nothing at @group(1) @binding({binding})"))
+        };
+        for t in targets(layout) {
+            let var = at(t.read_binding);
+            assert_eq!(var.name.as_deref(), Some(t.wgsl_name), "{layout:?} {}", t.name);
+            let uint = t.format == wgpu::TextureFormat::Rgba32Uint;
+            let expected = if uint { naga::ScalarKind::Uint } else { naga::ScalarKind::Float };
+            match module.types[var.ty].inner {
+                naga::TypeInner::Image { class: naga::ImageClass::Sampled { kind, .. }, .. } => {
+                    assert_eq!(kind, expected, "{layout:?} {}", t.name)
+                }
+                ref other => panic!("{layout:?} {}: {other:?} is not a sampled texture", t.name),
+            }
+        }
+        assert_eq!(at(GBUFFER_READ_DEPTH_BINDING).name.as_deref(), Some("gb_depth"));
+        assert_eq!(at(GBUFFER_READ_CLEAR_COLOR_BINDING).name.as_deref(), Some("clear_color"));
+    }
+}

@@ -36,7 +36,7 @@ pub struct GBufferPipeline {
 impl GBufferPipeline {
     fn new(device: &wgpu::Device, scene: &SceneResources, key: &GBufferKey) -> Result<Self, RenderError> {
         let GBufferKey { layout, codec, variant } = *key;
-        let formats: Vec<wgpu::TextureFormat> = targets(layout).iter().map(|&(_, format)| format).collect();
+        let formats: Vec<wgpu::TextureFormat> = targets(layout).iter().map(|t| t.format).collect();
         let pipeline = mesh_pipeline_with_defs(
             device,
             &MeshPipelineDesc {
@@ -78,13 +78,13 @@ impl Pass for GBufferPass {
         Vec::new()
     }
     fn writes(&self) -> Vec<ResourceName> {
-        targets(self.layout).iter().map(|&(name, _)| name).chain([DEPTH]).collect()
+        targets(self.layout).iter().map(|t| t.name).chain([DEPTH]).collect()
     }
     fn creates(&self) -> Vec<TextureSpec> {
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
         targets(self.layout)
             .iter()
-            .map(|&(name, format)| TextureSpec { name, format, usage, scale: 1.0 })
+            .map(|t| TextureSpec { name: t.name, format: t.format, usage, scale: 1.0 })
             .chain([TextureSpec { name: DEPTH, format: DEPTH_FORMAT, usage: DEPTH_USAGE, scale: 1.0 }])
             .collect()
     }
@@ -96,8 +96,7 @@ impl Pass for GBufferPass {
             |variant| GBufferKey { layout, codec, variant },
             |k| GBufferPipeline::new(&ctx.gpu.device, scene, k),
         )?;
-        let views =
-            targets(layout).iter().map(|&(name, _)| ctx.texture(name)).collect::<Result<Vec<_>, _>>()?;
+        let views = targets(layout).iter().map(|t| ctx.texture(t.name)).collect::<Result<Vec<_>, _>>()?;
         let depth = ctx.texture(DEPTH)?;
         let attachments: Vec<_> =
             views.iter().map(|view| color_attachment(view, wgpu::Color::TRANSPARENT)).collect();
@@ -126,7 +125,7 @@ mod tests {
     fn bytes_per_pixel_match_the_targets() {
         for layout in GBufferLayout::ALL {
             let targets: u32 =
-                targets(layout).iter().map(|(_, f)| f.block_copy_size(None).unwrap_or(0)).sum();
+                targets(layout).iter().map(|t| t.format.block_copy_size(None).unwrap_or(0)).sum();
             let depth = DEPTH_FORMAT.block_copy_size(Some(wgpu::TextureAspect::DepthOnly)).unwrap_or(0);
             assert_eq!(layout.bytes_per_pixel(), targets + depth, "{layout:?}");
         }

@@ -18,33 +18,66 @@ use crate::shaders::ShaderDefs;
 use crate::snapshot::GBufferLayout;
 use manylight_core::codec::NormalCodec;
 
-/// The G-buffer targets of a layout: name and format. Every layout ends with
-/// [`GBUFFER_EMISSIVE`] (rgba16f: emitted radiance and ambient occlusion).
-pub fn targets(layout: GBufferLayout) -> &'static [(ResourceName, wgpu::TextureFormat)] {
+/// One G-buffer target: the graph resource, its format, and where the lighting passes read it
+/// (group 1 of `shaders/common/gbuffer_read.wgsl`: binding and variable name, which
+/// `tests/shaders.rs` checks against the WGSL).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GBufferTarget {
+    /// The graph resource.
+    pub name: ResourceName,
+    /// Its format (also the G-buffer pass's colour target).
+    pub format: wgpu::TextureFormat,
+    /// Its binding in group 1 of `gbuffer_read.wgsl`.
+    pub read_binding: u32,
+    /// Its variable in `gbuffer_read.wgsl`.
+    pub wgsl_name: &'static str,
+}
+
+const fn target(
+    name: ResourceName,
+    format: wgpu::TextureFormat,
+    read_binding: u32,
+    wgsl_name: &'static str,
+) -> GBufferTarget {
+    GBufferTarget { name, format, read_binding, wgsl_name }
+}
+
+const EMISSIVE: GBufferTarget = target(GBUFFER_EMISSIVE, wgpu::TextureFormat::Rgba16Float, 8, "gb_emissive");
+
+/// Binding of the depth buffer in group 1 of `gbuffer_read.wgsl` (`gb_depth`), every layout.
+pub const GBUFFER_READ_DEPTH_BINDING: u32 = 4;
+/// Binding of the clear colour uniform in group 1 of `gbuffer_read.wgsl` (`clear_color`).
+pub const GBUFFER_READ_CLEAR_COLOR_BINDING: u32 = 5;
+
+// Albedo is rgba16f, not rgba8: 8 bits (even sRGB-encoded) cost FLIP mean 0.015 against naive
+// forward where 16-bit floats give 0.0035 (docs/accuracy.md).
+const FULL: [GBufferTarget; 4] = [
+    target(GBUFFER_POSITION, wgpu::TextureFormat::Rgba32Float, 0, "gb_position"),
+    target(GBUFFER_NORMAL, wgpu::TextureFormat::Rgba16Float, 1, "gb_normal"),
+    target(GBUFFER_ALBEDO, wgpu::TextureFormat::Rgba16Float, 2, "gb_albedo"),
+    EMISSIVE,
+];
+const PACKED: [GBufferTarget; 3] = [
+    target(GBUFFER_PACKED_ALBEDO, wgpu::TextureFormat::Rgba32Float, 6, "gb_packed_albedo"),
+    target(GBUFFER_PACKED_POSITION, wgpu::TextureFormat::Rgba32Float, 7, "gb_packed_position"),
+    EMISSIVE,
+];
+const COMPACT: [GBufferTarget; 2] =
+    [target(GBUFFER_COMPACT, wgpu::TextureFormat::Rgba32Uint, 3, "gb_compact"), EMISSIVE];
+
+/// The G-buffer targets of a layout, in the G-buffer pass's colour-target order. Every layout
+/// ends with [`GBUFFER_EMISSIVE`] (rgba16f: emitted radiance and ambient occlusion).
+pub fn targets(layout: GBufferLayout) -> &'static [GBufferTarget] {
     match layout {
-        // Albedo is rgba16f, not rgba8: with 8 bits (even sRGB-encoded)
-        // the image differed from naive forward by FLIP mean 0.015, with 16-bit floats 0.0035.
-        GBufferLayout::Full => &[
-            (GBUFFER_POSITION, wgpu::TextureFormat::Rgba32Float),
-            (GBUFFER_NORMAL, wgpu::TextureFormat::Rgba16Float),
-            (GBUFFER_ALBEDO, wgpu::TextureFormat::Rgba16Float),
-            (GBUFFER_EMISSIVE, wgpu::TextureFormat::Rgba16Float),
-        ],
-        GBufferLayout::Packed => &[
-            (GBUFFER_PACKED_ALBEDO, wgpu::TextureFormat::Rgba32Float),
-            (GBUFFER_PACKED_POSITION, wgpu::TextureFormat::Rgba32Float),
-            (GBUFFER_EMISSIVE, wgpu::TextureFormat::Rgba16Float),
-        ],
-        GBufferLayout::Compact => &[
-            (GBUFFER_COMPACT, wgpu::TextureFormat::Rgba32Uint),
-            (GBUFFER_EMISSIVE, wgpu::TextureFormat::Rgba16Float),
-        ],
+        GBufferLayout::Full => &FULL,
+        GBufferLayout::Packed => &PACKED,
+        GBufferLayout::Compact => &COMPACT,
     }
 }
 
 /// What a pass that reads the G-buffer of `layout` reads: its targets and [`DEPTH`].
 pub fn gbuffer_reads(layout: GBufferLayout) -> impl Iterator<Item = ResourceName> {
-    targets(layout).iter().map(|&(name, _)| name).chain([DEPTH])
+    targets(layout).iter().map(|t| t.name).chain([DEPTH])
 }
 
 /// The `override` constants selecting `codec` in the G-buffer shaders.
@@ -52,31 +85,19 @@ pub fn codec_constants(codec: NormalCodec) -> [(&'static str, f64); 1] {
     [("NORMAL_CODEC", codec.gpu_id() as f64)]
 }
 
-/// Binding number of each G-buffer target in `shaders/common/gbuffer_read.wgsl`, group 1.
-fn binding_of(name: ResourceName) -> u32 {
-    match name {
-        GBUFFER_POSITION => 0,
-        GBUFFER_NORMAL => 1,
-        GBUFFER_ALBEDO => 2,
-        GBUFFER_PACKED_ALBEDO => 6,
-        GBUFFER_PACKED_POSITION => 7,
-        GBUFFER_EMISSIVE => 8,
-        _ => 3,
-    }
-}
-
 /// Group 1 of `common/gbuffer_read.wgsl` for a layout: its targets, depth and the clear colour.
 pub fn gbuffer_read_layout(device: &wgpu::Device, layout: GBufferLayout) -> wgpu::BindGroupLayout {
     let float = wgpu::TextureSampleType::Float { filterable: false };
     let mut entries: Vec<wgpu::BindGroupLayoutEntry> = targets(layout)
         .iter()
-        .map(|&(name, _)| {
-            let sample = if name == GBUFFER_COMPACT { wgpu::TextureSampleType::Uint } else { float };
-            texture_entry(binding_of(name), sample)
+        .map(|t| {
+            let uint = t.format == wgpu::TextureFormat::Rgba32Uint;
+            texture_entry(t.read_binding, if uint { wgpu::TextureSampleType::Uint } else { float })
         })
         .collect();
-    entries.push(texture_entry(4, wgpu::TextureSampleType::Depth));
-    entries.push(uniform_entry(5, wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE));
+    entries.push(texture_entry(GBUFFER_READ_DEPTH_BINDING, wgpu::TextureSampleType::Depth));
+    let stages = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
+    entries.push(uniform_entry(GBUFFER_READ_CLEAR_COLOR_BINDING, stages));
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("gbuffer_read"),
         entries: &entries,
@@ -94,11 +115,11 @@ pub fn gbuffer_read_bind_group(
     let [r, g, b] = clear_color;
     let clear = ctx.uniform(("gbuffer_clear_color", 0), bytemuck::cast_slice(&[r, g, b, 1.0f32]));
     let mut bindings = Vec::new();
-    for &(name, _) in targets(layout) {
-        bindings.push((binding_of(name), Binding::Texture(ctx.texture(name)?)));
+    for t in targets(layout) {
+        bindings.push((t.read_binding, Binding::Texture(ctx.texture(t.name)?)));
     }
-    bindings.push((4, Binding::Texture(ctx.texture(DEPTH)?)));
-    bindings.push((5, Binding::Buffer(&clear)));
+    bindings.push((GBUFFER_READ_DEPTH_BINDING, Binding::Texture(ctx.texture(DEPTH)?)));
+    bindings.push((GBUFFER_READ_CLEAR_COLOR_BINDING, Binding::Buffer(&clear)));
     Ok(ctx.bind_group_numbered("gbuffer_read", bind_group_layout, &bindings))
 }
 

@@ -228,7 +228,7 @@ impl Pass for LightVolumesPass {
     }
     fn reads(&self) -> Vec<ResourceName> {
         let shadows = self.shadows.then_some(super::SHADOW_ATLAS);
-        targets(self.layout).iter().map(|&(name, _)| name).chain([DEPTH]).chain(shadows).collect()
+        targets(self.layout).iter().map(|t| t.name).chain([DEPTH]).chain(shadows).collect()
     }
     fn writes(&self) -> Vec<ResourceName> {
         vec![HDR]
