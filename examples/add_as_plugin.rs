@@ -2,7 +2,10 @@
 //! system that moves one.
 //!
 //! `cargo run --example add_as_plugin` opens a window (Esc closes it);
-//! `cargo run --example add_as_plugin -- --headless out.png` renders one frame to a PNG.
+//! `cargo run --example add_as_plugin -- --headless out.png` renders 30 frames headless and
+//! writes the last one (`--frames N` for another count).
+
+mod support;
 
 use manylight::prelude::*;
 
@@ -49,11 +52,6 @@ fn orbit(time: Res<Time>, mut lights: Query<&mut Transform, With<Orbiting>>) {
 
 fn main() -> AppExit {
     tracing_subscriber::fmt().with_env_filter("warn,winit=error,manylight_app=info").init();
-    let args: Vec<String> = std::env::args().collect();
-    let plugin = match args.iter().position(|a| a == "--headless") {
-        Some(i) => ManyLightPlugin::headless(UVec2::new(1280, 720))
-            .with_output(args.get(i + 1).map_or("add_as_plugin.png", |s| s.as_str())),
-        None => ManyLightPlugin::default(),
-    };
+    let plugin = support::ExampleArgs::from_env().plugin("add_as_plugin.png");
     App::new().add_plugins(plugin).add_systems(Startup, setup).add_systems(Update, orbit).run()
 }

@@ -69,14 +69,22 @@ fn toggle(
     }
 }
 
+/// The command line: a window by default.
+#[derive(clap::Parser)]
+struct Args {
+    /// Write one PNG per view to this directory (`debug_views` without one) instead of opening
+    /// a window.
+    #[arg(long, num_args = 0..=1)]
+    headless: Option<Option<std::path::PathBuf>>,
+}
+
 fn main() -> AppExit {
     tracing_subscriber::fmt().with_env_filter("warn,winit=error").init();
-    let args: Vec<String> = std::env::args().collect();
-    if let Some(i) = args.iter().position(|a| a == "--headless") {
-        let dir = std::path::PathBuf::from(args.get(i + 1).map_or("debug_views", |s| s.as_str()));
-        return headless(&dir);
+    let args = <Args as clap::Parser>::parse();
+    if let Some(dir) = args.headless {
+        return headless(&dir.unwrap_or_else(|| "debug_views".into()));
     }
-    println!("keys: Right/Space next view, Left previous, 0-8 pick, b bloom, m motion blur, c cap");
+    println!("keys: Right/Space next view, Left previous, 0-9 pick, b bloom, m motion blur, c cap");
     App::new()
         .add_plugins(ManyLightPlugin::default())
         .add_systems(Startup, setup)

@@ -37,9 +37,9 @@ use std::time::Instant;
 
 /// Lights of the default and glTF scenes unless `--lights` says otherwise.
 pub const DEFAULT_LIGHTS: u32 = 4096;
-/// Light count from which the sphere-shell preset shades from refined light lists (at 1 024
-/// lights their pass costs 15–19 ms more than it saves on lavapipe; at 100 000 the window's
-/// frame is 10–13 % faster with them).
+/// Light count from which the sphere-shell preset shades from refined light lists: below it
+/// their pass costs more than it saves, above it the frame is faster with them
+/// (docs/benchmarks.md, "Refined light lists").
 const SHELL_REFINE_FROM: u32 = 16_384;
 /// Lights of the sphere-shell preset unless `--lights` says otherwise.
 pub const DEFAULT_SHELL_LIGHTS: u32 = 100_000;

@@ -142,9 +142,9 @@ impl Plugin for ManyLightPlugin {
             app.add_plugins(TransformPlugin);
             // bevy_transform's serial "static scene" pass marks dirty trees by walking up from
             // every changed entity until it meets an ancestor changed but not newly added: on
-            // the frame a hierarchy is spawned that is entities × depth (a million instances
-            // under a 1 023-deep glTF chain took 54 s), and the serial propagation it feeds
-            // visits every entity with a parent anyway, so it saves nothing here.
+            // the frame a hierarchy is spawned that is entities × depth (quadratic for a deep
+            // glTF chain; docs/reliability.md), and the serial propagation it feeds visits
+            // every entity with a parent anyway, so it saves nothing here.
             app.insert_resource(StaticTransformOptimizations::Disabled);
         }
         if !app.is_plugin_added::<TimePlugin>() {

@@ -822,13 +822,11 @@ fn write_plots(dir: &std::path::Path, name: &str, csv: &str) -> Result<()> {
     Ok(())
 }
 
-/// The settings `report` and `rangeless-lights` start from.
-fn report_base(args: &ReportArgs) -> manylight_render::FrameSettings {
+/// The settings the measuring subcommands (`report`, `rangeless-lights`, `post`, `views`)
+/// start from: the defaults with the command line's cluster settings for `scene`.
+fn measure_base(clusters: &ClusterArgs, scene: &str) -> manylight_render::FrameSettings {
     manylight_render::FrameSettings {
-        render: manylight_render::RenderSettings {
-            clusters: args.clusters.settings(&args.scene),
-            ..Default::default()
-        },
+        render: manylight_render::RenderSettings { clusters: clusters.settings(scene), ..Default::default() },
         ..Default::default()
     }
 }
@@ -838,14 +836,24 @@ fn rangeless_lights_cmd(args: ReportArgs) -> Result<()> {
     check_lights(scene.lights.len().saturating_add(args.lights), "--lights")?;
     let mut renderer = manylight_app::render_world::HeadlessRenderer::new()?;
     let (lights, size, frames) = (args.lights, args.size, args.frames.max(1));
-    print!("{}", report::rangeless_lights(&mut renderer, &scene, lights, size, frames, report_base(&args))?);
+    print!(
+        "{}",
+        report::rangeless_lights(
+            &mut renderer,
+            &scene,
+            lights,
+            size,
+            frames,
+            measure_base(&args.clusters, &args.scene)
+        )?
+    );
     Ok(())
 }
 
 fn report_cmd(args: ReportArgs) -> Result<()> {
     let scene = args.clusters.load(&args.scene)?;
     check_lights(scene.lights.len().saturating_add(args.lights), "--lights")?;
-    let base = report_base(&args);
+    let base = measure_base(&args.clusters, &args.scene);
     let name = scene_name(&args.scene);
     let (frames, size) = (args.frames.max(1), args.size);
     let (report, csv_name) = if args.shadows {
@@ -864,13 +872,7 @@ fn report_cmd(args: ReportArgs) -> Result<()> {
 fn post_cmd(args: ReportArgs) -> Result<()> {
     let scene = args.clusters.load(&args.scene)?;
     check_lights(scene.lights.len().saturating_add(args.lights), "--lights")?;
-    let base = manylight_render::FrameSettings {
-        render: manylight_render::RenderSettings {
-            clusters: args.clusters.settings(&args.scene),
-            ..Default::default()
-        },
-        ..Default::default()
-    };
+    let base = measure_base(&args.clusters, &args.scene);
     let name = scene_name(&args.scene);
     let report = post::run(&scene, &name, args.lights, args.size, args.frames.max(1), base)?;
     print!("{}", report.markdown);
@@ -883,13 +885,7 @@ fn post_cmd(args: ReportArgs) -> Result<()> {
 fn views_cmd(args: ViewsArgs) -> Result<()> {
     let scene = args.clusters.load(&args.scene)?;
     check_lights(scene.lights.len().saturating_add(args.lights), "--lights")?;
-    let base = manylight_render::FrameSettings {
-        render: manylight_render::RenderSettings {
-            clusters: args.clusters.settings(&args.scene),
-            ..Default::default()
-        },
-        ..Default::default()
-    };
+    let base = measure_base(&args.clusters, &args.scene);
     let name = scene_name(&args.scene);
     print!("{}", views::run(&scene, &name, args.lights, args.size, args.frames.max(1), base)?);
     Ok(())

@@ -9,9 +9,9 @@
 @group(0) @binding(1) var<storage, read> lights: array<GpuPointLight>;
 
 // Radiance light `k` adds at `position` seen from `view_dir`, reading its colour and spot
-// fields only when it reaches `position`: on a CPU rasteriser each field read is a gather over the invocations, and most
-// lights of a light list end at the range test (at 100 000 sphere-shell lights this took the
-// shading pass from 95 to 79 ms; docs/benchmarks.md).
+// fields only when it reaches `position`: on a CPU rasteriser each field read is a gather over
+// the invocations, and most lights of a light list end at the range test (what it saves is in
+// docs/benchmarks.md).
 fn shade_light(s: SurfaceParams, position: vec3<f32>, view_dir: vec3<f32>, k: u32) -> vec3<f32> {
     let reach = light_reach(lights[k].position_radius, position);
     if reach.attenuation <= 0.0 {
