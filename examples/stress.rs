@@ -124,6 +124,8 @@ pub struct FrameTimes {
     /// Render-side CPU times (`FrameReport::frame_cpu_ms`) of the frames reported while
     /// measuring.
     pub render_cpu: Vec<f64>,
+    /// The same frames' CPU time by phase and upload bytes (`FrameReport::cpu`).
+    pub phases: Vec<manylight::render::CpuPhases>,
     last_reported: Option<u64>,
     last: Option<Instant>,
     seen: u32,
@@ -240,6 +242,7 @@ pub fn time_frames(
             if let Some(report) = stats.last.as_ref().filter(|r| times.last_reported != Some(r.frame_index)) {
                 times.last_reported = Some(report.frame_index);
                 times.render_cpu.push(report.frame_cpu_ms);
+                times.phases.push(report.cpu);
             }
         }
     }
@@ -255,6 +258,18 @@ pub fn time_frames(
         "median_frame_ms={median:.2} mean_frame_ms={mean:.2} median_render_cpu_ms={render_cpu:.2} frames={} lights={lights} pipeline={}",
         times.samples.len(),
         settings.pipeline.name()
+    );
+    let phase = |f: fn(&manylight::render::CpuPhases) -> f64| {
+        median_mean(&times.phases.iter().map(f).collect::<Vec<_>>()).0
+    };
+    println!(
+        "median_cpu_ms: extract={:.2} upload={:.2} prepare={:.2} record={:.2} submit={:.2} upload_bytes={:.0}",
+        phase(|p| p.extract_ms),
+        phase(|p| p.upload_ms),
+        phase(|p| p.prepare_ms),
+        phase(|p| p.record_ms),
+        phase(|p| p.submit_ms),
+        phase(|p| p.upload_bytes as f64),
     );
     if let Some(report) = &stats.last {
         let passes: Vec<String> = report

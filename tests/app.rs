@@ -54,6 +54,14 @@ fn frame_stats_list_the_passes_with_timings() {
         assert!(gpu_ms >= 0.0 && gpu_ms.is_finite());
     }
     assert!(report.frame_cpu_ms > 0.0);
+    // The CPU time by phase: extraction (main world), then the render side's phases, which
+    // happen inside the frame's CPU time; the uploads include the lights.
+    let cpu = report.cpu;
+    assert!(cpu.extract_ms > 0.0 && cpu.upload_ms > 0.0 && cpu.prepare_ms > 0.0, "{cpu:?}");
+    assert!(cpu.record_ms > 0.0 && cpu.submit_ms > 0.0, "{cpu:?}");
+    let render_side = cpu.upload_ms + cpu.prepare_ms + cpu.record_ms + cpu.submit_ms;
+    assert!(render_side <= report.frame_cpu_ms + 1e-6, "{cpu:?} against {} ms", report.frame_cpu_ms);
+    assert!(report.light_upload_bytes > 0 && cpu.upload_bytes >= report.light_upload_bytes, "{cpu:?}");
 }
 
 #[test]

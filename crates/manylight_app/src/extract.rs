@@ -196,6 +196,7 @@ pub fn build_snapshot(
         directional_lights,
         settings: crate::resources::frame_settings(settings, debug),
         pixel_light_lists: None,
+        extract_cpu_ms: 0.0,
     };
     state.frame_index += 1;
     snapshot
@@ -220,9 +221,11 @@ pub fn extract_and_render(
     if failure.0.is_some() {
         return;
     }
+    let start = std::time::Instant::now();
     let components = components.as_mut().map(|c| &mut c.0);
-    let snapshot =
+    let mut snapshot =
         build_snapshot(&mut state, viewport.0, &settings, &debug, &cameras, &meshes, &lights, components);
+    snapshot.extract_cpu_ms = start.elapsed().as_secs_f64() * 1e3;
     // The stages travel with each frame (an `Arc`, shared until the app changes them).
     let stages = stages.map_or_else(|| state.default_stages.clone(), |s| s.0.clone());
     backend.submit(snapshot, capture.enabled, stages);

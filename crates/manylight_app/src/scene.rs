@@ -243,6 +243,7 @@ pub fn scene_snapshot(
         .collect();
     FrameSnapshot {
         directional_lights,
+        extract_cpu_ms: 0.0,
         frame_index,
         viewport: size,
         views: vec![ExtractedView::main(ExtractedCamera {

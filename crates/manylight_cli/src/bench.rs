@@ -394,7 +394,8 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
          list_entry_bound,tile_entries,tile_entry_bound,list_bound_cpu_ms,shading_ms,shading_vs_oracle,\
          coarse_tiles,coarse_entries,depth_bounded_ratio,cluster_depth_gpu_ms,light_refine_gpu_ms,\
          zbinned_ratio,shadows,shadow_maps_rendered,shadow_maps_cached,shadow_maps_stale,shadow_atlas_bytes,shadow_gpu_ms,\
-         visibility_error,flip_vs_shadow_reference,frame_ms_min,frame_ms_max\n",
+         visibility_error,flip_vs_shadow_reference,frame_ms_min,frame_ms_max,cpu_frame_ms,cpu_upload_ms,\
+         cpu_prepare_ms,cpu_record_ms,cpu_submit_ms,upload_bytes\n",
     );
     for r in rows {
         let c = r.last.clusters.as_ref();
@@ -410,7 +411,7 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
         let vs_oracle = shading.zip(oracle).filter(|&(_, o)| o > 0.0).map(|(s, o)| s / o);
         let _ = writeln!(
             out,
-            "\"{adapter}\",\"{scene}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.3},{:.3}",
+            "\"{adapter}\",\"{scene}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{}",
             match (r.oracle, r.pipeline.is_deferred()) {
                 (true, false) => "oracle-forward",
                 (true, true) => "oracle-deferred",
@@ -464,6 +465,12 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
             r.shadow_accuracy.map_or(String::new(), |a| format!("{:.5}", a.flip_vs_reference)),
             r.frame_ms.iter().copied().fold(f64::INFINITY, f64::min),
             r.frame_ms.iter().copied().fold(0.0, f64::max),
+            r.last.frame_cpu_ms,
+            r.last.cpu.upload_ms,
+            r.last.cpu.prepare_ms,
+            r.last.cpu.record_ms,
+            r.last.cpu.submit_ms,
+            r.last.cpu.upload_bytes,
         );
     }
     out

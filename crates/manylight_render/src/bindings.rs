@@ -121,7 +121,7 @@ impl BindingCache {
             *u = create();
         }
         if u.contents != contents {
-            gpu.queue.write_buffer(&u.buffer, 0, contents);
+            gpu.write_buffer(&u.buffer, 0, contents);
             u.contents.clear();
             u.contents.extend_from_slice(contents);
         }

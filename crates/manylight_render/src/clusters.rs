@@ -654,8 +654,8 @@ impl ClusterResources {
             _pad: [0; 2],
         };
         self.size_bits(gpu)?;
-        gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
-        gpu.queue.write_buffer(self.counters.buffer(), 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
+        gpu.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
+        gpu.write_buffer(self.counters.buffer(), 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
         self.rebind_if_grown(gpu);
         Ok(())
     }
@@ -829,8 +829,8 @@ impl ClusterResources {
             self.indices.reserve(gpu, (counters.total_entries as u64 + self.refined_entries()) * 4)?;
             self.params.index_capacity = self.cluster_index_capacity();
         }
-        gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
-        gpu.queue.write_buffer(self.counters.buffer(), 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
+        gpu.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
+        gpu.write_buffer(self.counters.buffer(), 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
         self.rebind_if_grown(gpu);
         Ok(true)
     }

@@ -173,6 +173,7 @@ struct GpuCounters {
     buffers: AtomicU64,
     bind_groups: AtomicU64,
     blocking_waits: AtomicU64,
+    bytes_uploaded: AtomicU64,
 }
 
 /// A copy of a context's totals ([`GpuContext::counts`]).
@@ -184,6 +185,10 @@ pub struct GpuCounts {
     pub bind_groups: u64,
     /// Times the CPU blocked until the GPU finished submitted work.
     pub blocking_waits: u64,
+    /// Bytes the CPU handed to the GPU: buffer and texture writes and the contents of buffers
+    /// created with data ([`GpuContext::write_buffer`], [`GpuContext::write_texture`],
+    /// [`GpuContext::create_buffer_init`]).
+    pub bytes_uploaded: u64,
 }
 
 impl GpuCounts {
@@ -193,6 +198,7 @@ impl GpuCounts {
             buffers: self.buffers.saturating_sub(earlier.buffers),
             bind_groups: self.bind_groups.saturating_sub(earlier.bind_groups),
             blocking_waits: self.blocking_waits.saturating_sub(earlier.blocking_waits),
+            bytes_uploaded: self.bytes_uploaded.saturating_sub(earlier.bytes_uploaded),
         }
     }
 }
@@ -238,6 +244,7 @@ impl GpuContext {
     pub fn create_buffer_init(&self, desc: &wgpu::util::BufferInitDescriptor<'_>) -> wgpu::Buffer {
         self.counters.buffers.fetch_add(1, Ordering::Relaxed);
         let len = desc.contents.len() as u64;
+        self.counters.bytes_uploaded.fetch_add(len, Ordering::Relaxed);
         let align = wgpu::COPY_BUFFER_ALIGNMENT;
         let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: desc.label,
@@ -256,6 +263,26 @@ impl GpuContext {
         buffer
     }
 
+    /// Writes `data` into `buffer` at `offset` (the queue's write; counted in
+    /// [`GpuCounts::bytes_uploaded`]).
+    pub fn write_buffer(&self, buffer: &wgpu::Buffer, offset: u64, data: &[u8]) {
+        self.counters.bytes_uploaded.fetch_add(data.len() as u64, Ordering::Relaxed);
+        self.queue.write_buffer(buffer, offset, data);
+    }
+
+    /// Writes `data` into a texture (the queue's write; counted in
+    /// [`GpuCounts::bytes_uploaded`]).
+    pub fn write_texture(
+        &self,
+        texture: wgpu::TexelCopyTextureInfo<'_>,
+        data: &[u8],
+        layout: wgpu::TexelCopyBufferLayout,
+        size: wgpu::Extent3d,
+    ) {
+        self.counters.bytes_uploaded.fetch_add(data.len() as u64, Ordering::Relaxed);
+        self.queue.write_texture(texture, data, layout, size);
+    }
+
     /// Creates a bind group (counted in [`GpuCounts::bind_groups`]).
     pub fn create_bind_group(&self, desc: &wgpu::BindGroupDescriptor<'_>) -> wgpu::BindGroup {
         self.counters.bind_groups.fetch_add(1, Ordering::Relaxed);
@@ -268,6 +295,7 @@ impl GpuContext {
             buffers: self.counters.buffers.load(Ordering::Relaxed),
             bind_groups: self.counters.bind_groups.load(Ordering::Relaxed),
             blocking_waits: self.counters.blocking_waits.load(Ordering::Relaxed),
+            bytes_uploaded: self.counters.bytes_uploaded.load(Ordering::Relaxed),
         }
     }
 

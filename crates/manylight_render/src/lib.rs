@@ -47,4 +47,4 @@ pub use snapshot::{
     ExtractedView, FrameSettings, FrameSnapshot, GBufferLayout, MotionBlurSettings, PipelineKind,
     RenderSettings, RenderTextureId, RenderView, ShadowBias, ViewComponents, ViewRect, ViewTarget,
 };
-pub use stats::{FrameReport, PassTiming, ViewReport};
+pub use stats::{CpuPhases, FrameReport, PassTiming, ViewReport};

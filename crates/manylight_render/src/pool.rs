@@ -153,7 +153,7 @@ impl GrowableBuffer {
     pub fn write(&mut self, gpu: &GpuContext, data: &[u8]) -> Result<bool, RenderError> {
         let grew = self.reserve(gpu, data.len() as u64)?;
         if !data.is_empty() {
-            gpu.queue.write_buffer(&self.buffer, 0, data);
+            gpu.write_buffer(&self.buffer, 0, data);
         }
         Ok(grew)
     }

@@ -18,7 +18,7 @@ use crate::pipelines::PipelineCache;
 use crate::pool::{TextureKey, TransientPool};
 use crate::resources::SceneResources;
 use crate::snapshot::{FrameSnapshot, RenderView};
-use crate::stats::{FrameReport, PassTiming};
+use crate::stats::{CpuPhases, FrameReport, PassTiming};
 use std::collections::HashMap;
 use std::time::Instant;
 
@@ -46,6 +46,8 @@ pub struct Renderer {
     last_textures: HashMap<crate::graph::ResourceName, wgpu::TextureView>,
     /// This frame's `FrameSnapshot::pixel_light_lists`.
     pixel_light_lists: Option<std::sync::Arc<manylight_core::cluster::ClusterAssignment>>,
+    /// This frame's CPU time by phase so far.
+    phases: CpuPhases,
 }
 
 impl Renderer {
@@ -71,6 +73,7 @@ impl Renderer {
             cpu_adapter,
             last_textures: HashMap::new(),
             pixel_light_lists: None,
+            phases: CpuPhases::default(),
             gpu,
         }
     }
@@ -85,6 +88,8 @@ impl Renderer {
     /// its read-back slot (waiting for the frame that held it only when every slot is in
     /// flight).
     pub fn prepare(&mut self, snapshot: &FrameSnapshot) -> Result<(), RenderError> {
+        let start = Instant::now();
+        self.phases = CpuPhases { extract_ms: snapshot.extract_cpu_ms, ..CpuPhases::default() };
         let settings = &snapshot.settings;
         settings.check_values().map_err(RenderError::UnsupportedSettings)?;
         if settings.pipeline.is_deferred() && !settings.gbuffer.supports(settings.normal_codec) {
@@ -105,6 +110,7 @@ impl Renderer {
         self.pixel_light_lists = snapshot.pixel_light_lists.clone();
         // Views that went away free their cluster buffers.
         self.clusters.truncate(snapshot.views.len().max(1));
+        self.phases.upload_ms = start.elapsed().as_secs_f64() * 1e3;
         Ok(())
     }
 
@@ -114,6 +120,19 @@ impl Renderer {
     /// `options`: depth bounds and refined lists, from the view's plan
     /// ([`crate::PlanInputs::list_options`]).
     pub fn prepare_view(
+        &mut self,
+        view: &RenderView,
+        has_lights: bool,
+        options: crate::clusters::ListOptions,
+    ) -> Result<(), RenderError> {
+        let start = Instant::now();
+        self.prepare_view_timed(view, has_lights, options)?;
+        self.phases.prepare_ms += start.elapsed().as_secs_f64() * 1e3;
+        Ok(())
+    }
+
+    /// [`Renderer::prepare_view`] without its timing.
+    fn prepare_view_timed(
         &mut self,
         view: &RenderView,
         has_lights: bool,
@@ -268,6 +287,7 @@ impl Renderer {
         report.blocking_waits = counts.blocking_waits;
         report.buffers_created = counts.buffers;
         report.bind_groups_created = counts.bind_groups;
+        report.cpu = CpuPhases { upload_bytes: counts.bytes_uploaded, ..self.phases };
         report.frames_in_flight = self.ring.pending() + 1;
         report.frames_in_flight_limit = self.ring.frames_in_flight();
         self.ring.finish(&self.gpu, report);
@@ -352,6 +372,7 @@ impl Renderer {
             let start = Instant::now();
             pass.record(&mut ctx)?;
             let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
+            self.phases.record_ms += cpu_ms;
             let timed = ctx.stamps.0 && ctx.stamps.1;
             self.ring.pass_recorded(timed);
             timings.push(PassTiming {
@@ -369,7 +390,9 @@ impl Renderer {
             tonemapped.then_some(&self.scene.nonfinite.counter),
             timings.len(),
         );
+        let submit = Instant::now();
         self.gpu.queue.submit([encoder.finish()]);
+        self.phases.submit_ms += submit.elapsed().as_secs_f64() * 1e3;
         self.last_textures = textures;
         let errors = self.gpu.take_errors();
         if !errors.is_empty() {

@@ -572,7 +572,7 @@ impl SceneResources {
                 ..ViewUniform::zeroed_default()
             },
         };
-        gpu.queue.write_buffer(&self.view_buffer, 0, bytemuck::bytes_of(&self.view));
+        gpu.write_buffer(&self.view_buffer, 0, bytemuck::bytes_of(&self.view));
         // Blended draws, farthest first along the view direction (view-space z ascending).
         let view_from_world = self.view.view_from_world;
         let draws = &self.draws;
@@ -952,7 +952,7 @@ fn upload_texture(gpu: &GpuContext, tex: &TextureData) -> wgpu::TextureView {
     let (mut w, mut h) = (tex.width, tex.height);
     let mut level: std::borrow::Cow<[u8]> = std::borrow::Cow::Borrowed(&tex.rgba8);
     for mip in 0..levels {
-        gpu.queue.write_texture(
+        gpu.write_texture(
             wgpu::TexelCopyTextureInfo {
                 texture: &texture,
                 mip_level: mip,

@@ -763,6 +763,9 @@ pub struct FrameSnapshot {
     /// [`FrameSnapshot::lights`]). For a single view. `None` (the default): the cluster build
     /// makes the lists.
     pub pixel_light_lists: Option<Arc<manylight_core::cluster::ClusterAssignment>>,
+    /// CPU time the main world took to extract this snapshot, in milliseconds (0 for a snapshot
+    /// made without an app); reported as `CpuPhases::extract_ms`.
+    pub extract_cpu_ms: f64,
 }
 
 /// A directional light as extracted for rendering: light travelling along `direction`

@@ -15,6 +15,28 @@ pub struct PassTiming {
     pub cpu_ms: f64,
 }
 
+/// Where a frame's CPU time went, by phase (milliseconds), and how many bytes it handed to the
+/// GPU. The render-side phases sum to most of [`FrameReport::frame_cpu_ms`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct CpuPhases {
+    /// The main world's extraction of the frame's snapshot
+    /// ([`crate::FrameSnapshot::extract_cpu_ms`]; 0 for a snapshot made without an app).
+    pub extract_ms: f64,
+    /// Uploading what the views share: lights, instances, meshes, materials, textures and the
+    /// shadow plan (`Renderer::prepare`).
+    pub upload_ms: f64,
+    /// Bytes handed to the GPU while the frame was prepared and recorded, every phase
+    /// (`GpuCounts::bytes_uploaded`).
+    pub upload_bytes: u64,
+    /// Each view's constants, cluster grid, light spheres and list bounds
+    /// (`Renderer::prepare_view`), summed over the views.
+    pub prepare_ms: f64,
+    /// Recording the passes, summed over the views.
+    pub record_ms: f64,
+    /// Handing the command buffers to the queue, summed over the views.
+    pub submit_ms: f64,
+}
+
 /// The report of one frame.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct FrameReport {
@@ -31,6 +53,8 @@ pub struct FrameReport {
     /// CPU time of the frame on the render side: uploads, cluster bounds, recording and
     /// submitting every view (and any wait the frame had: [`FrameReport::blocking_waits`]).
     pub frame_cpu_ms: f64,
+    /// The frame's CPU time by phase, and its upload bytes.
+    pub cpu: CpuPhases,
     /// Sum of the passes' GPU times, when known.
     pub frame_gpu_ms: Option<f64>,
     /// Lights rendered.

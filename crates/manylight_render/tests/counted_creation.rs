@@ -1,13 +1,15 @@
 //! The frame counters (`FrameReport::buffers_created`, `bind_groups_created`,
-//! `blocking_waits`) are complete only if every buffer, bind group and GPU wait of the
-//! renderer goes through `GpuContext`. This test reads the render and app crates' sources and
+//! `blocking_waits`, `cpu.upload_bytes`) are complete only if every buffer, bind group, upload
+//! and GPU wait of the renderer goes through `GpuContext`. This test reads the render and app crates' sources and
 //! fails on any direct call to the device. It needs no GPU.
 
 use std::path::{Path, PathBuf};
 
 /// Calls that bypass the counters, and what to call instead.
-const DIRECT: [(&str, &str); 4] = [
+const DIRECT: [(&str, &str); 6] = [
     ("device.create_buffer(", "GpuContext::create_buffer"),
+    ("queue.write_buffer(", "GpuContext::write_buffer"),
+    ("queue.write_texture(", "GpuContext::write_texture"),
     ("device.create_buffer_init(", "GpuContext::create_buffer_init"),
     ("device.create_bind_group(", "GpuContext::create_bind_group"),
     ("PollType::Wait", "GpuContext::wait_for"),
@@ -28,7 +30,7 @@ fn sources(dir: &Path, out: &mut Vec<PathBuf>) {
 }
 
 #[test]
-fn every_buffer_bind_group_and_wait_is_counted() {
+fn every_buffer_bind_group_upload_and_wait_is_counted() {
     let crates = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let mut files = Vec::new();
     sources(&crates.join("manylight_render/src"), &mut files);

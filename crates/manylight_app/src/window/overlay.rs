@@ -545,6 +545,16 @@ fn timings_ui(ui: &mut egui::Ui, world: &mut World, history: &VecDeque<Sample>, 
         report.light_uploads,
         report.light_upload_bytes as f64 / 1024.0
     ));
+    let cpu = report.cpu;
+    ui.monospace(format!(
+        "CPU ms: extract {:.2}, upload {:.2} ({:.1} KiB), prepare {:.2}, record {:.2}, submit {:.2}",
+        cpu.extract_ms,
+        cpu.upload_ms,
+        cpu.upload_bytes as f64 / 1024.0,
+        cpu.prepare_ms,
+        cpu.record_ms,
+        cpu.submit_ms
+    ));
     ui.small("? = timestamps not trusted on this adapter (compute on lavapipe)");
     plot(ui, history);
 }
