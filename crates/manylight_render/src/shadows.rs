@@ -575,7 +575,7 @@ pub fn box_meets_clip(clip_from_world: &Mat4, bounds: &Aabb) -> bool {
 /// A run of the shadow pass's draw instances that share a mesh.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ShadowMeshDraws {
-    /// Key into `SceneResources::mesh`.
+    /// Key into `SceneAssets::mesh`.
     pub mesh: usize,
     /// First instance (index into the draw buffer).
     pub first: u32,
@@ -1078,7 +1078,7 @@ impl ShadowResources {
         self.work = work;
 
         // Meshes no longer drawn leave the list.
-        self.by_mesh.retain(|(mesh, _)| scene.mesh(*mesh).is_some());
+        self.by_mesh.retain(|(mesh, _)| scene.assets.mesh(*mesh).is_some());
         let mut all = Vec::new();
         for (mesh, list) in &self.by_mesh {
             if list.is_empty() {

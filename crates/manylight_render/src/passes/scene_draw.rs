@@ -116,7 +116,8 @@ pub fn draw_in_order<'d, P: ScenePipeline>(
     let (mut bound_material, mut bound_mesh) = (usize::MAX, usize::MAX);
     let mut bound_variant = None;
     let mut draw = |d: &crate::resources::Draw| {
-        let (Some(mesh), Some(material)) = (scene.mesh(d.mesh), scene.material(d.material)) else {
+        let (Some(mesh), Some(material)) = (scene.assets.mesh(d.mesh), scene.assets.material(d.material))
+        else {
             return;
         };
         if bound_variant != Some(d.variant) {

@@ -167,7 +167,7 @@ impl Pass for ShadowMapsPass {
         }
         pass.set_pipeline(&pipeline.pipeline);
         for run in &shadows.mesh_draws {
-            let Some(mesh) = scene.mesh(run.mesh) else {
+            let Some(mesh) = scene.assets.mesh(run.mesh) else {
                 continue;
             };
             pass.set_vertex_buffer(0, mesh.vertices.slice(..));

@@ -89,7 +89,7 @@ impl Pass for TransparentPass {
         } else {
             None
         };
-        let mut layouts = vec![&scene.view_layout, &scene.material_layout];
+        let mut layouts = vec![&scene.view_layout, &scene.assets.material_layout];
         layouts.extend(clusters.map(|c| &c.shading_layout));
         let clustered = self.clustered;
         let pipelines = blended_variant_pipelines(
