@@ -420,3 +420,51 @@ fn examples_read_their_command_line_with_clap() {
     assert_eq!((named.output("x.png"), named.frames), (Some("o.png".into()), 2));
     assert!(parse("ex --frame 2").is_err() && parse("ex --frames two").is_err());
 }
+
+/// Lights that did not change are not uploaded again: a still frame uploads no light byte after
+/// the first, moving one light uploads that light's bytes, and each image equals the one a
+/// fresh renderer (which uploads everything) makes of the same snapshot. The app's still lights
+/// upload nothing after their first frame either.
+#[test]
+fn only_the_lights_that_changed_are_uploaded() {
+    use manylight::app::render_world::HeadlessRenderer;
+    use manylight::app::scene::{extracted_light, scene_snapshot};
+    let _gpu = gpu();
+    let scene = default_scene();
+    let rig = manylight::scene::light_rig(64, scene.bounds(), 3).expect("64 lights fit");
+    let lights: Vec<_> = rig.iter().map(|l| extracted_light(&l.at(0.0))).collect();
+    let snapshot = |lights: &[manylight::render::ExtractedPointLight], frame: u64| {
+        scene_snapshot(&scene, lights.to_vec(), SIZE, manylight::render::FrameSettings::default(), frame)
+    };
+    let fresh = |lights: &[manylight::render::ExtractedPointLight]| {
+        let mut renderer = HeadlessRenderer::new().expect("adapter");
+        renderer.render(snapshot(lights, 0), true).expect("renders").1.expect("image")
+    };
+    let mut renderer = HeadlessRenderer::new().expect("adapter");
+    let light_bytes =
+        |n: usize| (n * std::mem::size_of::<manylight::render::gpu_types::GpuPointLight>()) as u64;
+    let (first, _) = renderer.render(snapshot(&lights, 0), false).expect("renders");
+    assert_eq!(first.light_upload_bytes, light_bytes(lights.len()));
+    let (still, image) = renderer.render(snapshot(&lights, 1), true).expect("renders");
+    assert_eq!(still.light_upload_bytes, 0, "a still frame uploaded lights");
+    assert_eq!(image.expect("image"), fresh(&lights));
+    let mut moved = lights.clone();
+    moved[17].position += Vec3::new(0.5, 0.0, 0.25);
+    let (one, image) = renderer.render(snapshot(&moved, 2), true).expect("renders");
+    assert_eq!(one.light_upload_bytes, light_bytes(1), "one light moved");
+    assert_eq!(image.expect("image"), fresh(&moved));
+    // A light removed from the middle shifts the ones after it: they are written again.
+    moved.remove(5);
+    let (shifted, image) = renderer.render(snapshot(&moved, 3), true).expect("renders");
+    assert!(shifted.light_upload_bytes > 0 && shifted.light_upload_bytes <= light_bytes(moved.len()));
+    assert_eq!(image.expect("image"), fresh(&moved));
+
+    // The app: the scene's own lights never move.
+    let mut app = scene_app(ManyLightPlugin::headless(SIZE), 0);
+    for _ in 0..3 {
+        app.update();
+    }
+    finish_frames(&mut app);
+    let report = stats(&app).last.expect("a report");
+    assert_eq!(report.light_upload_bytes, 0, "the app's still lights were uploaded again");
+}

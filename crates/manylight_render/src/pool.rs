@@ -118,6 +118,10 @@ fn texel_bytes(format: wgpu::TextureFormat) -> u64 {
         .unwrap_or(4) as u64
 }
 
+/// Changed elements at most this many apart are written together by
+/// [`GrowableBuffer::write_changed`] (a few unchanged bytes cost less than another write).
+pub const MERGE_GAP: usize = 8;
+
 /// A growable GPU buffer (storage or uniform) that is re-created larger when data outgrows it.
 pub struct GrowableBuffer {
     label: &'static str,
@@ -156,6 +160,65 @@ impl GrowableBuffer {
             gpu.write_buffer(&self.buffer, 0, data);
         }
         Ok(grew)
+    }
+
+    /// Uploads `data` where it differs from `previous` (what the buffer holds; `None` when that
+    /// is not known): `data` is compared `element` bytes at a time and each run of changed
+    /// elements is one write (runs fewer than [`MERGE_GAP`] elements apart are merged). Writes
+    /// everything when `previous` is unknown or the buffer had to be re-created. Returns the
+    /// bytes written (0 when nothing changed).
+    pub fn write_changed(
+        &mut self,
+        gpu: &GpuContext,
+        data: &[u8],
+        previous: Option<&[u8]>,
+        element: usize,
+    ) -> Result<u64, RenderError> {
+        let grew = self.reserve(gpu, data.len() as u64)?;
+        let element = element.max(1);
+        // Partial writes need offsets that are multiples of `COPY_BUFFER_ALIGNMENT` (4).
+        let Some(previous) = previous.filter(|_| !grew && element.is_multiple_of(4)) else {
+            if !data.is_empty() {
+                gpu.write_buffer(&self.buffer, 0, data);
+            }
+            return Ok(data.len() as u64);
+        };
+        if previous.get(..data.len()) == Some(data) {
+            return Ok(0);
+        }
+        let bytes =
+            |range: std::ops::Range<usize>| range.start * element..(range.end * element).min(data.len());
+        let same =
+            |range: std::ops::Range<usize>| previous.get(bytes(range.clone())) == data.get(bytes(range));
+        let mut written = 0;
+        let mut write = |run: std::ops::Range<usize>| {
+            let range = bytes(run);
+            written += range.len() as u64;
+            gpu.write_buffer(&self.buffer, range.start as u64, &data[range]);
+        };
+        // Blocks of elements are compared at once (one memcmp each), then the elements of a
+        // block that differs one by one.
+        const BLOCK: usize = 64;
+        let count = data.len().div_ceil(element);
+        let changed = (0..count.div_ceil(BLOCK))
+            .map(|b| b * BLOCK..((b + 1) * BLOCK).min(count))
+            .filter(|block| !same(block.clone()))
+            .flat_map(|block| block.filter(|&i| !same(i..i + 1)));
+        let mut run: Option<std::ops::Range<usize>> = None;
+        for i in changed {
+            run = match run {
+                Some(r) if i - r.end < MERGE_GAP => Some(r.start..i + 1),
+                Some(r) => {
+                    write(r);
+                    Some(i..i + 1)
+                }
+                None => Some(i..i + 1),
+            };
+        }
+        if let Some(r) = run {
+            write(r);
+        }
+        Ok(written)
     }
 
     /// Makes room for `bytes`; returns true when the buffer was re-created.

@@ -2,8 +2,9 @@
 //! live in [`SceneAssets`].
 //!
 //! `prepare` uploads what changed for a frame: meshes and textures once per distinct `Arc`
-//! (and freed a few frames after the last instance using them disappears), light and instance
-//! buffers every frame, grown when the counts outgrow them.
+//! (and freed a few frames after the last instance using them disappears), the lights that
+//! differ from what the light buffer holds, the instance buffer every frame; buffers grow when
+//! the counts outgrow them.
 
 use crate::assets::SceneAssets;
 use crate::context::{GpuContext, RenderError};
@@ -24,9 +25,6 @@ use manylight_core::MaterialData;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// HDR colour format of the lighting target.
 pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-
-/// The light buffer's content when there is no light (every pipeline binds the buffer).
-const PLACEHOLDER_LIGHT: &[u8] = &[0; std::mem::size_of::<GpuPointLight>()];
 
 /// How a draw is rasterised beyond what its pass decides: which winding faces front (the
 /// instance's handedness: a mirrored transform winds its triangles the other way on screen, so
@@ -263,7 +261,8 @@ pub struct SceneResources {
     pub directional_count: u32,
     /// Valid directional lights past [`MAX_DIRECTIONAL_LIGHTS`], not drawn.
     pub dropped_directional_lights: u32,
-    /// Bytes written to the light buffer this frame (once per frame, whatever the views).
+    /// Bytes written to the light buffer this frame (once per frame, whatever the views; only
+    /// the lights that changed).
     pub light_upload_bytes: u64,
     /// Lights dropped for invalid parameters this frame.
     pub invalid_lights: u32,
@@ -275,8 +274,12 @@ pub struct SceneResources {
     /// (centre, radius) of the sphere bounding what each uploaded light can reach (a spot
     /// light's is the smaller sphere around its cone), in light-buffer order.
     pub light_spheres: Vec<(glam::Vec3, f32)>,
-    /// The frame's valid point and spot lights as uploaded (kept for its allocation).
+    /// The frame's valid point and spot lights, packed (one zeroed light when there is none:
+    /// every pipeline binds the buffer).
     gpu_lights: Vec<GpuPointLight>,
+    /// What the light buffer holds (the last frame's `gpu_lights`; swapped with it after each
+    /// upload, so both keep their allocation); `None` until the first upload.
+    uploaded_lights: Option<Vec<GpuPointLight>>,
     /// The tone map's count of non-finite HDR pixels.
     pub nonfinite: NonFiniteCounter,
     /// Meshes, materials, textures and samplers on the GPU, and the material layout.
@@ -349,6 +352,7 @@ impl SceneResources {
             collapsed_instances: 0,
             light_spheres: Vec::new(),
             gpu_lights: Vec::new(),
+            uploaded_lights: None,
             nonfinite: NonFiniteCounter::new(gpu),
             assets: SceneAssets::new(gpu),
             bound: [None, None],
@@ -467,6 +471,22 @@ impl SceneResources {
         });
     }
 
+    /// Writes the packed lights into the light buffer where they differ from what it holds:
+    /// lights that did not change are not uploaded again (a still scene uploads nothing after
+    /// its first frame). Returns the bytes written.
+    fn upload_lights(&mut self, gpu: &GpuContext) -> Result<u64, RenderError> {
+        if self.gpu_lights.is_empty() {
+            self.gpu_lights.push(bytemuck::Zeroable::zeroed());
+        }
+        let previous = self.uploaded_lights.as_deref().map(bytemuck::cast_slice::<GpuPointLight, u8>);
+        let element = std::mem::size_of::<GpuPointLight>();
+        let written =
+            self.lights.write_changed(gpu, bytemuck::cast_slice(&self.gpu_lights), previous, element)?;
+        let uploaded = self.uploaded_lights.get_or_insert_with(Vec::new);
+        std::mem::swap(&mut self.gpu_lights, uploaded);
+        Ok(written)
+    }
+
     /// Uploads the frame's lights, instances and any new meshes/materials/textures, once per
     /// frame whatever the number of views.
     pub fn prepare(&mut self, gpu: &GpuContext, snapshot: &FrameSnapshot) -> Result<(), RenderError> {
@@ -496,13 +516,7 @@ impl SceneResources {
         self.light_spheres.clear();
         self.light_spheres.extend(buffered_lights(&snapshot.lights).map(|(_, l)| bounding_sphere(l)));
         self.light_count = self.gpu_lights.len() as u32;
-        let light_bytes: &[u8] = if self.gpu_lights.is_empty() {
-            PLACEHOLDER_LIGHT
-        } else {
-            bytemuck::cast_slice(&self.gpu_lights)
-        };
-        self.lights.write(gpu, light_bytes)?;
-        self.light_upload_bytes = light_bytes.len() as u64;
+        self.light_upload_bytes = self.upload_lights(gpu)?;
 
         // Meshes, materials, instances.
         let mut instance_data = Vec::with_capacity(snapshot.instances.len());

@@ -100,7 +100,8 @@ pub struct FrameReport {
     /// Times the light buffer was written this frame: 1 when the frame has lights, whatever the
     /// number of views (they share it).
     pub light_uploads: u32,
-    /// Bytes written to the light buffer this frame.
+    /// Bytes written to the light buffer this frame: only the lights that changed since the
+    /// last frame (0 for still lights after their first frame).
     pub light_upload_bytes: u64,
     /// Times the GPU device was found lost and recreated while this frame was rendered (0
     /// normally). A frame in which the loss was found reports no passes: its work went to the
