@@ -14,19 +14,40 @@ use crate::pipelines::PipelineCache;
 use crate::resources::SceneResources;
 use std::collections::HashMap;
 
-/// Name of a graph resource (a texture or buffer slot).
-pub type ResourceName = &'static str;
+/// A graph resource (a texture or buffer slot): passes say what they read and write with these
+/// handles, declared once as constants (`passes::HDR`, `passes::DEPTH`, …), never as bare
+/// strings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct ResourceName(&'static str);
+
+impl ResourceName {
+    /// The resource called `name` (snake_case; also the label of its texture).
+    pub const fn new(name: &'static str) -> ResourceName {
+        ResourceName(name)
+    }
+
+    /// Its name.
+    pub const fn name(self) -> &'static str {
+        self.0
+    }
+}
+
+impl std::fmt::Display for ResourceName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.0)
+    }
+}
 
 /// The external resource every frame ends in: the swapchain image or the headless target.
-pub const OUTPUT: ResourceName = "output";
+pub const OUTPUT: ResourceName = ResourceName::new("output");
 
 /// The HDR scene colour (`passes::HDR`): the shading passes create it, the post passes filter
 /// it, the tone map reads it.
-pub const HDR: ResourceName = "hdr";
+pub const HDR: ResourceName = ResourceName::new("hdr");
 
 /// The second HDR image, which a post-processing pass writes into while it reads [`HDR`]
 /// ([`PassContext::post_process_write`] swaps the two; `passes::HDR_SWAP`).
-pub const HDR_SWAP: ResourceName = "hdr_swap";
+pub const HDR_SWAP: ResourceName = ResourceName::new("hdr_swap");
 
 /// A transient texture a pass creates: sized relative to the viewport.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -137,7 +158,7 @@ impl<'a> PassContext<'a> {
             name => name,
         };
         self.textures
-            .get(name)
+            .get(&name)
             .ok_or_else(|| RenderError::Graph(format!("texture `{name}` was not allocated")))
     }
 
@@ -350,17 +371,17 @@ mod tests {
     #[test]
     fn orders_by_dependencies_and_drops_unread_passes() {
         let mut g = RenderGraph::new();
-        g.add(Fake("tonemap", vec!["hdr"], vec![OUTPUT]));
-        g.add(Fake("unused", vec![], vec!["scratch"]));
-        g.add(Fake("bloom", vec!["hdr"], vec!["hdr"]));
-        g.add(Fake("forward", vec![], vec!["hdr", "depth"]));
+        g.add(Fake("tonemap", vec![HDR], vec![OUTPUT]));
+        g.add(Fake("unused", vec![], vec![ResourceName::new("scratch")]));
+        g.add(Fake("bloom", vec![HDR], vec![HDR]));
+        g.add(Fake("forward", vec![], vec![HDR, ResourceName::new("depth")]));
         assert_eq!(g.pass_names().unwrap(), vec!["forward", "bloom", "tonemap"]);
     }
 
     #[test]
     fn missing_writer_is_an_error() {
         let mut g = RenderGraph::new();
-        g.add(Fake("tonemap", vec!["hdr"], vec![OUTPUT]));
+        g.add(Fake("tonemap", vec![HDR], vec![OUTPUT]));
         assert!(matches!(g.compile(), Err(RenderError::Graph(_))));
     }
 
@@ -369,11 +390,11 @@ mod tests {
         let mut g = RenderGraph::new();
         let fill = |g: &mut RenderGraph, bloom: bool| {
             g.clear();
-            g.add(Fake("forward", vec![], vec!["hdr"]));
+            g.add(Fake("forward", vec![], vec![HDR]));
             if bloom {
-                g.add(Fake("bloom", vec!["hdr"], vec!["hdr"]));
+                g.add(Fake("bloom", vec![HDR], vec![HDR]));
             }
-            g.add(Fake("tonemap", vec!["hdr"], vec![OUTPUT]));
+            g.add(Fake("tonemap", vec![HDR], vec![OUTPUT]));
         };
         fill(&mut g, false);
         assert_eq!(g.pass_names().unwrap(), vec!["forward", "tonemap"]);

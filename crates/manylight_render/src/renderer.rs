@@ -170,7 +170,7 @@ impl Renderer {
 
     /// The last frame's depth buffer (reverse-Z, row-major), if the frame had one.
     pub fn read_depth(&self) -> Result<Option<(u32, u32, Vec<f32>)>, RenderError> {
-        let Some(view) = self.last_textures.get(crate::passes::DEPTH) else {
+        let Some(view) = self.last_textures.get(&crate::passes::DEPTH) else {
             return Ok(None);
         };
         let texture = view.texture();
@@ -333,7 +333,7 @@ impl Renderer {
         for pass in passes {
             for spec in pass.creates() {
                 // Passes may create the same texture (post-processing passes, the HDR swap).
-                if textures.contains_key(spec.name) {
+                if textures.contains_key(&spec.name) {
                     continue;
                 }
                 let scaled = |v: u32| ((v as f32 * spec.scale).round() as u32).max(1);
@@ -343,7 +343,7 @@ impl Renderer {
                     format: spec.format,
                     usage: spec.usage,
                 };
-                textures.insert(spec.name, self.pool.acquire(&self.gpu.device, key, spec.name));
+                textures.insert(spec.name, self.pool.acquire(&self.gpu.device, key, spec.name.name()));
             }
         }
 

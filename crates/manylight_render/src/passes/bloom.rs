@@ -23,12 +23,24 @@ use crate::resources::HDR_FORMAT;
 pub use crate::settings::{BloomChain, BloomSettings, MAX_BLOOM_LEVELS};
 
 /// Graph resources: the blurred levels of the chain.
-pub const BLOOM_LEVELS: [ResourceName; MAX_BLOOM_LEVELS] =
-    ["bloom_0", "bloom_1", "bloom_2", "bloom_3", "bloom_4", "bloom_5"];
+pub const BLOOM_LEVELS: [ResourceName; MAX_BLOOM_LEVELS] = [
+    ResourceName::new("bloom_0"),
+    ResourceName::new("bloom_1"),
+    ResourceName::new("bloom_2"),
+    ResourceName::new("bloom_3"),
+    ResourceName::new("bloom_4"),
+    ResourceName::new("bloom_5"),
+];
 
 /// Graph resources: the horizontally blurred intermediate of each level.
-pub const BLOOM_TEMPS: [ResourceName; MAX_BLOOM_LEVELS] =
-    ["bloom_tmp_0", "bloom_tmp_1", "bloom_tmp_2", "bloom_tmp_3", "bloom_tmp_4", "bloom_tmp_5"];
+pub const BLOOM_TEMPS: [ResourceName; MAX_BLOOM_LEVELS] = [
+    ResourceName::new("bloom_tmp_0"),
+    ResourceName::new("bloom_tmp_1"),
+    ResourceName::new("bloom_tmp_2"),
+    ResourceName::new("bloom_tmp_3"),
+    ResourceName::new("bloom_tmp_4"),
+    ResourceName::new("bloom_tmp_5"),
+];
 
 /// The passes of `bloom`, in order.
 pub fn bloom_passes(bloom: &BloomSettings) -> Vec<Box<dyn Pass>> {
@@ -191,7 +203,7 @@ fn draw(
     let pipeline =
         ctx.pipelines.get_or_create(BloomKey { stage }, |k| BloomPipeline::new(device, k.stage))?;
     // One uniform per draw of the chain: its stage and the level it writes.
-    let params = ctx.uniform((target, stage as u64), bytemuck::bytes_of(&params));
+    let params = ctx.uniform((target.name(), stage as u64), bytemuck::bytes_of(&params));
     let textures = sources.iter().map(|&name| ctx.texture(name)).collect::<Result<Vec<_>, _>>()?;
     let mut bindings = vec![Binding::Buffer(&params), Binding::Sampler(&pipeline.sampler)];
     bindings.extend(textures.into_iter().map(Binding::Texture));
