@@ -20,12 +20,15 @@ pub struct StageId {
 impl StageId {
     /// The stage whose pass is a `P`.
     pub fn of<P: Pass>() -> StageId {
+        // The type's name from its last path segment on, generic arguments whole
+        // (`Probe<1>`, `Blur<my_app::Wide>`).
         let full = std::any::type_name::<P>();
-        let name = full.rsplit("::").next().unwrap_or(full);
+        let path = &full[..full.find('<').unwrap_or(full.len())];
+        let name = &full[path.rfind("::").map_or(0, |i| i + 2)..];
         StageId { type_id: TypeId::of::<P>(), name }
     }
 
-    /// The pass type's name without its module path, for messages.
+    /// The pass type's name without its module path (generic arguments kept), for messages.
     pub fn name(self) -> &'static str {
         self.name
     }
@@ -166,11 +169,11 @@ mod tests {
 
     fn nothing(_: &PlanInputs<'_>, _: &mut Vec<Box<dyn Pass>>) {}
 
-    struct Vignette;
-    struct Grain;
-    impl Pass for Vignette {
+    /// A pass that records nothing; each `N` is a type of its own, so a stage of its own.
+    struct Probe<const N: u8>;
+    impl<const N: u8> Pass for Probe<N> {
         fn name(&self) -> &'static str {
-            "vignette"
+            "probe"
         }
         fn reads(&self) -> Vec<ResourceName> {
             Vec::new()
@@ -182,20 +185,8 @@ mod tests {
             Ok(())
         }
     }
-    impl Pass for Grain {
-        fn name(&self) -> &'static str {
-            "grain"
-        }
-        fn reads(&self) -> Vec<ResourceName> {
-            Vec::new()
-        }
-        fn writes(&self) -> Vec<ResourceName> {
-            Vec::new()
-        }
-        fn record(&self, _: &mut PassContext<'_>) -> Result<(), RenderError> {
-            Ok(())
-        }
-    }
+    type Vignette = Probe<0>;
+    type Grain = Probe<1>;
 
     #[test]
     fn a_stage_goes_next_to_a_known_one_and_never_silently_elsewhere() {
@@ -207,11 +198,11 @@ mod tests {
         assert_eq!(ids[at + 1], StageId::of::<TonemapPass>());
         // Grain is no stage: placing next to it is refused, naming the stages there are.
         let unknown = planner.insert_after::<Grain>(Stage::new::<Grain>(nothing)).unwrap_err();
-        assert!(matches!(&unknown, StageError::UnknownStage { anchor: "Grain", .. }), "{unknown}");
+        assert!(matches!(&unknown, StageError::UnknownStage { anchor: "Probe<1>", .. }), "{unknown}");
         assert!(unknown.to_string().contains("TonemapPass"), "{unknown}");
         assert_eq!(
             planner.insert_after::<ClusteredForwardPass>(Stage::new::<Vignette>(nothing)),
-            Err(StageError::Duplicate("Vignette"))
+            Err(StageError::Duplicate("Probe<0>"))
         );
         assert_eq!(planner.stages().len(), builtin_stages().len() + 1);
         assert!(planner.contains(StageId::of::<Vignette>()) && !planner.contains(StageId::of::<Grain>()));
