@@ -29,8 +29,6 @@ pub struct ExtractState {
     prev_cameras: HashMap<Entity, ExtractedCamera>,
     frame_index: u64,
     default_material: Option<Arc<MaterialData>>,
-    /// The built-in stages, for an app without a [`RenderStages`] resource.
-    default_stages: Arc<manylight_render::FramePlanner>,
 }
 
 /// What extract reads of a camera: which one, placement, projection, target and order, and
@@ -88,7 +86,7 @@ pub fn build_snapshot(
     cameras: &Query<CameraItem, With<Camera3d>>,
     meshes: &Query<MeshItem>,
     lights: &Query<LightItem>,
-    mut camera_components: Option<&mut HashMap<Entity, ViewComponents>>,
+    camera_components: &mut HashMap<Entity, ViewComponents>,
 ) -> FrameSnapshot {
     let mut views: Vec<ExtractedView> = Vec::with_capacity(cameras.iter().len());
     // Last frame's cameras; the map is rebuilt from this frame's, so removed ones go.
@@ -124,7 +122,7 @@ pub fn build_snapshot(
             debug_view: item.debug_view.map(|d| d.0),
             order: camera.order,
             shadows: item.shadows.is_none_or(|s| s.enabled),
-            components: camera_components.as_mut().and_then(|c| c.remove(&entity)).unwrap_or_default(),
+            components: camera_components.remove(&entity).unwrap_or_default(),
         };
         // Last frame's camera at this frame's size: a resize alone moves no pixel, so motion
         // blur does not smear the first frame after one.
@@ -134,9 +132,7 @@ pub fn build_snapshot(
         views.push(view);
     }
     // Components of cameras that rendered nothing this frame are not kept for the next.
-    if let Some(components) = camera_components {
-        components.clear();
-    }
+    camera_components.clear();
     // Lower order first; equal orders keep query order.
     views.sort_by_key(|v| v.order);
     let default_material =
@@ -216,19 +212,25 @@ pub fn extract_and_render(
     mut backend: ResMut<RenderBackend>,
     capture: Res<HeadlessCapture>,
     failure: Res<RenderFailure>,
-    (stages, mut components): (Option<Res<RenderStages>>, Option<ResMut<ExtractedCameraComponents>>),
+    (stages, mut components): (Res<RenderStages>, ResMut<ExtractedCameraComponents>),
 ) {
     if failure.0.is_some() {
         return;
     }
     let start = std::time::Instant::now();
-    let components = components.as_mut().map(|c| &mut c.0);
-    let mut snapshot =
-        build_snapshot(&mut state, viewport.0, &settings, &debug, &cameras, &meshes, &lights, components);
+    let mut snapshot = build_snapshot(
+        &mut state,
+        viewport.0,
+        &settings,
+        &debug,
+        &cameras,
+        &meshes,
+        &lights,
+        &mut components.0,
+    );
     snapshot.extract_cpu_ms = start.elapsed().as_secs_f64() * 1e3;
     // The stages travel with each frame (an `Arc`, shared until the app changes them).
-    let stages = stages.map_or_else(|| state.default_stages.clone(), |s| s.0.clone());
-    backend.submit(snapshot, capture.enabled, stages);
+    backend.submit(snapshot, capture.enabled, stages.0.clone());
 }
 
 /// Stores the frames that finished since the last update ([`crate::backend::record_results`])

@@ -161,6 +161,7 @@ impl Plugin for ManyLightPlugin {
             .init_resource::<crate::resources::RenderedImages>()
             .init_resource::<RenderFailure>()
             .init_resource::<crate::stages::RenderStages>()
+            .init_resource::<crate::stages::ExtractedCameraComponents>()
             .add_message::<crate::backend::RenderFailed>()
             .init_resource::<crate::window::WindowRequests>()
             .init_resource::<crate::window::PressedKeys>()
