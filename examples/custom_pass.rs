@@ -13,7 +13,7 @@ mod support;
 
 use manylight::prelude::*;
 use manylight::render::bindings::Binding;
-use manylight::render::layouts::{texture_entry, uniform_entry};
+use manylight::render::layouts::{BindGroupDecl, BindingDecl, GroupLayout, UNFILTERED};
 use manylight::render::passes::common::{
     FullscreenPipelineDesc, draw_fullscreen, fullscreen_pipeline_with_module,
 };
@@ -52,21 +52,25 @@ impl PipelineKey for VignetteKey {
     type Pipeline = VignettePipeline;
 }
 
-/// The pipeline and its bind group layout: the parameters at 0, the HDR image at 1.
+/// The vignette's bind group, as `custom_pass.wgsl` declares it: its layout and every bind group
+/// made for it come from here.
+static VIGNETTE_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "vignette",
+    entries: &[
+        BindingDecl::uniform(0, "params", wgpu::ShaderStages::FRAGMENT),
+        BindingDecl::texture(1, "source", UNFILTERED, wgpu::ShaderStages::FRAGMENT),
+    ],
+};
+
+/// The pipeline and its bind group layout.
 struct VignettePipeline {
     pipeline: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
+    layout: GroupLayout,
 }
 
 impl VignettePipeline {
     fn new(device: &wgpu::Device) -> Result<Self, RenderError> {
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("vignette"),
-            entries: &[
-                uniform_entry(0, wgpu::ShaderStages::FRAGMENT),
-                texture_entry(1, wgpu::TextureSampleType::Float { filterable: false }),
-            ],
-        });
+        let layout = VIGNETTE_GROUP.create_layout(device, Default::default());
         let module = create_module_from_source(device, "custom_pass.wgsl", VIGNETTE_WGSL)?;
         let desc = FullscreenPipelineDesc {
             label: "vignette",
@@ -103,11 +107,8 @@ impl Pass for VignettePass {
             [self.0.strength, self.0.radius, 0.0, 0.0].iter().flat_map(|v| v.to_ne_bytes()).collect();
         let params = ctx.uniform(("vignette", 0), &params);
         let target = ctx.post_process_write()?;
-        let group = ctx.bind_group(
-            "vignette",
-            &pipeline.layout,
-            &[Binding::Buffer(&params), Binding::Texture(target.source)],
-        );
+        let group =
+            pipeline.layout.bind_group(ctx, &[Binding::Buffer(&params), Binding::Texture(target.source)]);
         let timestamps = ctx.render_timestamps(true, true);
         draw_fullscreen(
             ctx.encoder,

@@ -2,8 +2,11 @@
 //! kept while instances use them and freed [`KEEP_FRAMES`] frames after the last one; the
 //! material bind group layout and the samplers the materials name.
 
+use crate::bindings::Binding;
 use crate::context::{GpuContext, RenderError};
 use crate::gpu_types::{GpuMaterial, GpuTextureUv, SHADING_GLOBAL};
+use crate::layouts::{BindGroupDecl, BindingDecl, BindingKind, GroupLayout};
+use crate::shaders::ShaderDefs;
 use manylight_core::{
     ImageAddressMode, ImageFilterMode, MaterialData, MeshData, TextureData, TextureSampler, Vertex,
 };
@@ -37,6 +40,29 @@ struct CachedTexture {
     last_used: u64,
 }
 
+const FRAGMENT: wgpu::ShaderStages = wgpu::ShaderStages::FRAGMENT;
+const FILTERABLE: wgpu::TextureSampleType = wgpu::TextureSampleType::Float { filterable: true };
+const FILTERING: BindingKind = BindingKind::Sampler(wgpu::SamplerBindingType::Filtering);
+
+/// Group 1 of the mesh passes (`shaders/common/mesh_pass.wgsl`): the material uniform, then
+/// each of its five textures followed by its sampler.
+pub static MATERIAL_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "material",
+    entries: &[
+        BindingDecl::uniform(0, "material", FRAGMENT),
+        BindingDecl::texture(1, "base_color_texture", FILTERABLE, FRAGMENT),
+        BindingDecl::new(2, "base_color_sampler", FILTERING, FRAGMENT),
+        BindingDecl::texture(3, "metallic_roughness_texture", FILTERABLE, FRAGMENT),
+        BindingDecl::new(4, "metallic_roughness_sampler", FILTERING, FRAGMENT),
+        BindingDecl::texture(5, "normal_texture", FILTERABLE, FRAGMENT),
+        BindingDecl::new(6, "normal_sampler", FILTERING, FRAGMENT),
+        BindingDecl::texture(7, "occlusion_texture", FILTERABLE, FRAGMENT),
+        BindingDecl::new(8, "occlusion_sampler", FILTERING, FRAGMENT),
+        BindingDecl::texture(9, "emissive_texture", FILTERABLE, FRAGMENT),
+        BindingDecl::new(10, "emissive_sampler", FILTERING, FRAGMENT),
+    ],
+};
+
 /// A material's bind group (group 1 of mesh pipelines).
 pub struct GpuMaterialBinding {
     _source: Arc<MaterialData>,
@@ -49,8 +75,8 @@ pub struct GpuMaterialBinding {
 
 /// The scene's meshes, materials, textures and samplers on the GPU.
 pub struct SceneAssets {
-    /// Layout of group 1: material uniform, the material's five textures and their samplers.
-    pub material_layout: wgpu::BindGroupLayout,
+    /// Layout of group 1 ([`MATERIAL_GROUP`]).
+    pub material_layout: GroupLayout,
     meshes: HashMap<usize, GpuMesh>,
     materials: HashMap<usize, GpuMaterialBinding>,
     textures: HashMap<usize, CachedTexture>,
@@ -67,52 +93,7 @@ impl SceneAssets {
     /// The material layout and empty caches.
     pub fn new(gpu: &GpuContext) -> SceneAssets {
         let device = &gpu.device;
-        // A filterable 2D texture of the material (base colour, metallic-roughness).
-        let material_texture = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
-        let material_sampler = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-            count: None,
-        };
-        let material_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("material_layout"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-                // base colour
-                material_texture(1),
-                material_sampler(2),
-                // metallic-roughness
-                material_texture(3),
-                // normal map, occlusion, emissive
-                material_texture(4),
-                material_texture(5),
-                material_texture(6),
-                // the samplers of metallic-roughness, normal map, occlusion and emissive
-                material_sampler(7),
-                material_sampler(8),
-                material_sampler(9),
-                material_sampler(10),
-            ],
-        });
+        let material_layout = MATERIAL_GROUP.create_layout(device, ShaderDefs::default());
         let white = upload_texture(
             gpu,
             &TextureData { label: "white".into(), width: 1, height: 1, rgba8: vec![255; 4], srgb: true },
@@ -256,24 +237,13 @@ impl SceneAssets {
             contents: bytemuck::bytes_of(&uniform),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let bind_group = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some(&material.label),
-            layout: &self.material_layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() },
-                // Textures at 1, 3, 4, 5, 6; the base colour's sampler at 2, the others' at 7..10.
-                view_entry(1, &views[0]),
-                sampler_entry(2, &samplers[0]),
-                view_entry(3, &views[1]),
-                view_entry(4, &views[2]),
-                view_entry(5, &views[3]),
-                view_entry(6, &views[4]),
-                sampler_entry(7, &samplers[1]),
-                sampler_entry(8, &samplers[2]),
-                sampler_entry(9, &samplers[3]),
-                sampler_entry(10, &samplers[4]),
-            ],
-        });
+        // The uniform, then each texture (base colour, metallic-roughness, normal map,
+        // occlusion, emissive) followed by its sampler.
+        let mut resources = vec![Binding::Buffer(&buffer)];
+        for (view, sampler) in views.iter().zip(&samplers) {
+            resources.extend([Binding::Texture(view), Binding::Sampler(sampler)]);
+        }
+        let bind_group = self.material_layout.create_bind_group(gpu, &resources);
         self.uploads += 1;
         let order = self.uploads;
         self.materials
@@ -378,14 +348,6 @@ const UNUSED_SLOT_SAMPLER: TextureSampler = TextureSampler {
     mipmap_filter: None,
     anisotropy_clamp: 1,
 };
-
-fn view_entry(binding: u32, view: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
-    wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(view) }
-}
-
-fn sampler_entry(binding: u32, sampler: &wgpu::Sampler) -> wgpu::BindGroupEntry<'_> {
-    wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::Sampler(sampler) }
-}
 
 /// Uploads an RGBA8 texture with a full mip chain (box-filtered on the CPU).
 fn upload_texture(gpu: &GpuContext, tex: &TextureData) -> wgpu::TextureView {

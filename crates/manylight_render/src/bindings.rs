@@ -13,21 +13,38 @@ use std::sync::Mutex;
 /// Frames an unused bind group or uniform buffer is kept.
 pub const KEEP_FRAMES: u64 = 3;
 
-/// One resource of a bind group, by binding index in order.
+/// One resource of a bind group.
 #[derive(Clone, Copy, Debug)]
 pub enum Binding<'a> {
     /// A whole buffer.
     Buffer(&'a wgpu::Buffer),
+    /// The first `size` bytes of a buffer (a shader's `arrayLength` sees only them).
+    BufferPrefix(&'a wgpu::Buffer, wgpu::BufferSize),
     /// A texture view.
     Texture(&'a wgpu::TextureView),
     /// A sampler.
     Sampler(&'a wgpu::Sampler),
 }
 
+impl<'a> Binding<'a> {
+    /// The resource of a bind group entry.
+    pub fn resource(self) -> wgpu::BindingResource<'a> {
+        match self {
+            Binding::Buffer(x) => x.as_entire_binding(),
+            Binding::BufferPrefix(buffer, size) => {
+                wgpu::BindingResource::Buffer(wgpu::BufferBinding { buffer, offset: 0, size: Some(size) })
+            }
+            Binding::Texture(x) => wgpu::BindingResource::TextureView(x),
+            Binding::Sampler(x) => wgpu::BindingResource::Sampler(x),
+        }
+    }
+}
+
 /// What identifies a bind group: its layout and resources (wgpu handles compare by identity).
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 enum Resource {
     Buffer(wgpu::Buffer),
+    BufferPrefix(wgpu::Buffer, wgpu::BufferSize),
     Texture(wgpu::TextureView),
     Sampler(wgpu::Sampler),
 }
@@ -71,6 +88,7 @@ impl BindingCache {
             .map(|&(i, b)| {
                 let resource = match b {
                     Binding::Buffer(x) => Resource::Buffer(x.clone()),
+                    Binding::BufferPrefix(x, size) => Resource::BufferPrefix(x.clone(), size),
                     Binding::Texture(x) => Resource::Texture(x.clone()),
                     Binding::Sampler(x) => Resource::Sampler(x.clone()),
                 };
@@ -81,14 +99,7 @@ impl BindingCache {
         let entry = groups.entry((layout.clone(), key)).or_insert_with(|| {
             let entries: Vec<wgpu::BindGroupEntry<'_>> = bindings
                 .iter()
-                .map(|&(binding, b)| wgpu::BindGroupEntry {
-                    binding,
-                    resource: match b {
-                        Binding::Buffer(x) => x.as_entire_binding(),
-                        Binding::Texture(x) => wgpu::BindingResource::TextureView(x),
-                        Binding::Sampler(x) => wgpu::BindingResource::Sampler(x),
-                    },
-                })
+                .map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.resource() })
                 .collect();
             let group = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some(label),

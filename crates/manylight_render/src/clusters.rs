@@ -5,14 +5,16 @@
 //! The bounds come from `manylight_core::cluster` (the same numbers the CPU reference uses),
 //! so GPU and CPU assignments can be compared light for light.
 
+use crate::bindings::Binding;
 use crate::context::{GpuContext, RenderError};
 use crate::gpu_types::{
     CLUSTER_NO_CAP, COARSE_SCATTER_TILES, CULL_AABB, CULL_BOTH, CULL_PLANES, GpuClusterBounds,
     GpuClusterCounters, GpuClusterParams, REFINE_EDGE, REFINED_LIST_SLOTS, TILE_LIGHT_CHUNK,
 };
-use crate::layouts::{storage_entry, uniform_entry};
+use crate::layouts::{BindGroupDecl, BindingDecl, GroupLayout, SHADING};
 use crate::pool::GrowableBuffer;
 use crate::readback::read_buffer;
+use crate::shaders::ShaderDefs;
 use crate::snapshot::RenderView;
 use glam::Mat4;
 use manylight_core::Projection;
@@ -148,22 +150,73 @@ impl RefinedLists {
     }
 }
 
+const COMPUTE: wgpu::ShaderStages = wgpu::ShaderStages::COMPUTE;
+
+/// Group 0 of the cluster build (`shaders/cluster_build.wgsl`): the parameters, the cluster
+/// bounds and light spheres it reads, the lists it writes, its counters, and the per-tile
+/// bounds and lists.
+pub static CLUSTER_BUILD_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "cluster_build",
+    entries: &[
+        BindingDecl::uniform(0, "params", COMPUTE),
+        BindingDecl::storage(1, "bounds", COMPUTE),
+        BindingDecl::storage(2, "spheres", COMPUTE),
+        BindingDecl::storage_rw(3, "ranges", COMPUTE),
+        BindingDecl::storage_rw(4, "indices", COMPUTE),
+        BindingDecl::storage_rw(5, "build", COMPUTE),
+        BindingDecl::storage(6, "tile_bounds", COMPUTE),
+        BindingDecl::storage_rw(7, "tile_ranges", COMPUTE),
+        BindingDecl::storage_rw(8, "tile_indices", COMPUTE),
+    ],
+};
+
+/// Group 2 of the passes that shade through the cluster lists (`common/cluster_lists.wgsl`,
+/// `tiled_deferred.wgsl`): the parameters, each cluster's range and the light indices.
+pub static CLUSTER_LISTS_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "cluster_lists",
+    entries: &[
+        BindingDecl::uniform(0, "cluster_params", SHADING),
+        BindingDecl::storage(1, "cluster_ranges", SHADING),
+        BindingDecl::storage(2, "cluster_indices", SHADING),
+    ],
+};
+
+/// Group 2 of the `cluster_depth` pass (`shaders/cluster_depth.wgsl`): the parameters, and the
+/// ranges buffer, whose per-cluster depth ranges it writes after the cluster ranges.
+pub static CLUSTER_DEPTH_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "cluster_depth",
+    entries: &[
+        BindingDecl::storage(0, "cluster_params", COMPUTE),
+        BindingDecl::storage_rw(1, "cluster_depths", COMPUTE),
+    ],
+};
+
+/// Group 2 of the `light_refine` pass (`shaders/light_refine.wgsl`): the parameters, the light
+/// spheres, and the ranges and index buffers, whose refined part it writes.
+pub static LIGHT_REFINE_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "light_refine",
+    entries: &[
+        BindingDecl::storage(0, "cluster_params", COMPUTE),
+        BindingDecl::storage(1, "spheres", COMPUTE),
+        BindingDecl::storage_rw(2, "ranges", COMPUTE),
+        BindingDecl::storage_rw(3, "indices", COMPUTE),
+    ],
+};
+
 /// GPU buffers and bind groups of the cluster build and of clustered shading.
 pub struct ClusterResources {
     /// The grid of the current frame.
     pub grid: ClusterGrid,
     /// The parameters uploaded this frame.
     pub params: GpuClusterParams,
-    /// Layout of the build's group 0.
-    pub build_layout: wgpu::BindGroupLayout,
-    /// Layout of the shading passes' cluster group (params, ranges, indices; read-only).
-    pub shading_layout: wgpu::BindGroupLayout,
-    /// Layout of group 2 of the `cluster_depth` pass (`shaders/cluster_depth.wgsl`): params, and
-    /// the ranges buffer, whose per-cluster depth ranges it writes after the cluster ranges.
-    pub depth_layout: wgpu::BindGroupLayout,
-    /// Layout of group 2 of the `light_refine` pass (`shaders/light_refine.wgsl`): params, the
-    /// light spheres, and the ranges and index buffers, whose refined part it writes.
-    pub refine_layout: wgpu::BindGroupLayout,
+    /// Layout of the build's group 0 ([`CLUSTER_BUILD_GROUP`]).
+    pub build_layout: GroupLayout,
+    /// Layout of the shading passes' cluster group ([`CLUSTER_LISTS_GROUP`]).
+    pub shading_layout: GroupLayout,
+    /// Layout of group 2 of the `cluster_depth` pass ([`CLUSTER_DEPTH_GROUP`]).
+    pub depth_layout: GroupLayout,
+    /// Layout of group 2 of the `light_refine` pass ([`LIGHT_REFINE_GROUP`]).
+    pub refine_layout: GroupLayout,
     /// Group 0 of the build.
     pub build_bind_group: wgpu::BindGroup,
     /// The shading group.
@@ -236,40 +289,11 @@ impl ClusterResources {
     /// Creates the buffers (small; they grow with the grid and the lights).
     pub fn new(gpu: &GpuContext) -> ClusterResources {
         let device = &gpu.device;
-        let compute = wgpu::ShaderStages::COMPUTE;
-        let build_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("cluster_build"),
-            entries: &[
-                uniform_entry(0, compute),
-                storage_entry(1, compute, true),
-                storage_entry(2, compute, true),
-                storage_entry(3, compute, false),
-                storage_entry(4, compute, false),
-                storage_entry(5, compute, false),
-                storage_entry(6, compute, true),
-                storage_entry(7, compute, false),
-                storage_entry(8, compute, false),
-            ],
-        });
-        // Read by the shading passes: fragment shaders, and tiled deferred's compute shader.
-        let shade = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
-        let shading_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("cluster_lists"),
-            entries: &[uniform_entry(0, shade), storage_entry(1, shade, true), storage_entry(2, shade, true)],
-        });
-        let depth_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("cluster_depth"),
-            entries: &[storage_entry(0, compute, true), storage_entry(1, compute, false)],
-        });
-        let refine_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("light_refine"),
-            entries: &[
-                storage_entry(0, compute, true),
-                storage_entry(1, compute, true),
-                storage_entry(2, compute, false),
-                storage_entry(3, compute, false),
-            ],
-        });
+        let defs = ShaderDefs::default();
+        let build_layout = CLUSTER_BUILD_GROUP.create_layout(device, defs);
+        let shading_layout = CLUSTER_LISTS_GROUP.create_layout(device, defs);
+        let depth_layout = CLUSTER_DEPTH_GROUP.create_layout(device, defs);
+        let refine_layout = LIGHT_REFINE_GROUP.create_layout(device, defs);
         let params_buffer = gpu.create_buffer(&wgpu::BufferDescriptor {
             label: Some("cluster_params"),
             size: std::mem::size_of::<GpuClusterParams>() as u64,
@@ -339,35 +363,31 @@ impl ClusterResources {
 
     fn bind_groups(
         gpu: &GpuContext,
-        build_layout: &wgpu::BindGroupLayout,
-        shading_layout: &wgpu::BindGroupLayout,
+        build_layout: &GroupLayout,
+        shading_layout: &GroupLayout,
         params: &wgpu::Buffer,
         [bounds, spheres, ranges, indices, tile_bounds, tile_ranges, tile_indices, counters]: [&GrowableBuffer;
             8],
     ) -> (wgpu::BindGroup, wgpu::BindGroup) {
-        fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-            wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() }
-        }
-        let build = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("cluster_build"),
-            layout: build_layout,
-            entries: &[
-                entry(0, params),
-                entry(1, bounds.buffer()),
-                entry(2, spheres.buffer()),
-                entry(3, ranges.buffer()),
-                entry(4, indices.buffer()),
-                entry(5, counters.buffer()),
-                entry(6, tile_bounds.buffer()),
-                entry(7, tile_ranges.buffer()),
-                entry(8, tile_indices.buffer()),
-            ],
-        });
-        let shading = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("cluster_lists"),
-            layout: shading_layout,
-            entries: &[entry(0, params), entry(1, ranges.buffer()), entry(2, indices.buffer())],
-        });
+        let build = build_layout.create_bind_group(
+            gpu,
+            &[
+                params,
+                bounds.buffer(),
+                spheres.buffer(),
+                ranges.buffer(),
+                indices.buffer(),
+                counters.buffer(),
+            ]
+            .into_iter()
+            .chain([tile_bounds.buffer(), tile_ranges.buffer(), tile_indices.buffer()])
+            .map(Binding::Buffer)
+            .collect::<Vec<_>>(),
+        );
+        let shading = shading_layout.create_bind_group(
+            gpu,
+            &[Binding::Buffer(params), Binding::Buffer(ranges.buffer()), Binding::Buffer(indices.buffer())],
+        );
         (build, shading)
     }
 

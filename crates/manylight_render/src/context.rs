@@ -48,6 +48,9 @@ pub enum RenderError {
         /// Device limit.
         limit: u32,
     },
+    /// A bind group or pipeline does not match its declaration ([`crate::layouts`]).
+    #[error(transparent)]
+    Binding(#[from] crate::layouts::BindingError),
     /// The render graph is inconsistent (a pass reads what nobody writes, or a cycle).
     #[error("render graph: {0}")]
     Graph(String),

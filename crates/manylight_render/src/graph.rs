@@ -122,20 +122,10 @@ impl<'a> PassContext<'a> {
         self.clusters.ok_or_else(|| RenderError::Graph(format!("{pass} needs cluster resources")))
     }
 
-    /// The bind group of `layout` with `bindings` (binding `i` is `bindings[i]`), kept across
-    /// frames while its resources live ([`crate::bindings::BindingCache::bind_group`]).
-    pub fn bind_group(
-        &self,
-        label: &'static str,
-        layout: &wgpu::BindGroupLayout,
-        bindings: &[crate::bindings::Binding<'_>],
-    ) -> wgpu::BindGroup {
-        let numbered: Vec<_> = bindings.iter().enumerate().map(|(i, &b)| (i as u32, b)).collect();
-        self.bindings.bind_group(self.gpu, label, layout, &numbered)
-    }
-
-    /// [`PassContext::bind_group`] with explicit binding indices.
-    pub fn bind_group_numbered(
+    /// The bind group of `layout` with `bindings` (binding number, resource), kept by the frame's
+    /// [`crate::bindings::BindingCache`] ([`crate::layouts::GroupLayout::bind_group`] numbers
+    /// them from their declaration).
+    pub(crate) fn bind_group_numbered(
         &self,
         label: &'static str,
         layout: &wgpu::BindGroupLayout,

@@ -7,16 +7,19 @@
 //! the counts outgrow them.
 
 use crate::assets::SceneAssets;
+use crate::bindings::Binding;
 use crate::context::{GpuContext, RenderError};
 use crate::gpu_types::{
     GpuDirectionalLight, GpuInstance, GpuPointLight, MAX_DIRECTIONAL_LIGHTS, SHADING_GLOBAL,
     TEXTURE_SLOT_BASE_COLOR, TEXTURE_SLOT_EMISSIVE, TEXTURE_SLOT_METALLIC_ROUGHNESS, TEXTURE_SLOT_NORMAL,
     TEXTURE_SLOT_OCCLUSION, ViewUniform,
 };
+use crate::layouts::{BindGroupDecl, BindingDecl, BindingKind, GroupLayout, Presence, SHADING};
 use crate::lights::{
     bounding_sphere, buffered_lights, gpu_directional_light, gpu_point_light, viewed_directional_lights,
 };
 use crate::pool::GrowableBuffer;
+use crate::shaders::ShaderDefs;
 use crate::snapshot::{FrameSnapshot, RenderView, aspect};
 use glam::{Mat4, Vec4};
 use manylight_core::MaterialData;
@@ -148,64 +151,37 @@ pub struct Draw {
     pub world_from_local: Mat4,
 }
 
-/// Layout of group 0 of every scene pass: the view uniform (0), the point and spot lights (1),
-/// the instances (2) and, in a frame whose lights cast shadows (`shadows`), the shadow atlas
-/// (3), its comparison sampler (4) and the lights' shadow table (5) of
-/// `shaders/common/shadows.wgsl`.
-fn make_view_layout(device: &wgpu::Device, shadows: bool) -> wgpu::BindGroupLayout {
-    let all = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
-    let shading = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
-    let storage = |binding, visibility| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: true },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    };
-    let mut entries = vec![
-        wgpu::BindGroupLayoutEntry {
-            binding: 0,
-            visibility: all,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<ViewUniform>() as u64),
-            },
-            count: None,
-        },
-        storage(1, all),
-        storage(2, wgpu::ShaderStages::VERTEX),
-    ];
-    if shadows {
-        entries.extend([
-            wgpu::BindGroupLayoutEntry {
-                binding: 3,
-                visibility: shading,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Depth,
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: false,
-                },
-                count: None,
-            },
-            wgpu::BindGroupLayoutEntry {
-                binding: 4,
-                visibility: shading,
-                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
-                count: None,
-            },
-            storage(5, shading),
-            storage(6, shading),
-        ]);
-    }
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some(if shadows { "view_layout_shadowed" } else { "view_layout" }),
-        entries: &entries,
-    })
-}
+/// The shadow bindings of group 0 (`shaders/common/shadows.wgsl`): the shadow atlas, its
+/// comparison sampler, the lights' shadow table and the directional lights' cascades.
+pub const SHADOW_BINDINGS: [BindingDecl; 4] = [
+    BindingDecl::texture(3, "shadow_atlas", wgpu::TextureSampleType::Depth, SHADING),
+    BindingDecl::new(
+        4,
+        "shadow_sampler",
+        BindingKind::Sampler(wgpu::SamplerBindingType::Comparison),
+        SHADING,
+    ),
+    BindingDecl::storage(5, "shadow_lights", SHADING),
+    BindingDecl::storage(6, "directional_shadows", SHADING),
+];
+
+const EVERY_STAGE: wgpu::ShaderStages = wgpu::ShaderStages::VERTEX.union(SHADING);
+
+/// Group 0 of every scene pass: the view uniform (`common/view_binding.wgsl`), the point and
+/// spot lights (`common/point_lights.wgsl`), the instances (`common/mesh_pass.wgsl`) and, in a
+/// frame whose lights cast shadows, [`SHADOW_BINDINGS`].
+pub static SCENE_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "scene",
+    entries: &[
+        BindingDecl::uniform(0, "view", EVERY_STAGE),
+        BindingDecl::storage(1, "lights", EVERY_STAGE),
+        BindingDecl::storage(2, "instances", wgpu::ShaderStages::VERTEX),
+        SHADOW_BINDINGS[0].only(Presence::Shadows),
+        SHADOW_BINDINGS[1].only(Presence::Shadows),
+        SHADOW_BINDINGS[2].only(Presence::Shadows),
+        SHADOW_BINDINGS[3].only(Presence::Shadows),
+    ],
+};
 
 /// What group 0 binds for shadows (`crate::shadows::ShadowResources::bindings`).
 pub struct ShadowBindings<'a> {
@@ -226,13 +202,13 @@ type BoundView = ((u64, u64, u64), wgpu::BindGroup);
 
 /// Scene data on the GPU for the current frame.
 pub struct SceneResources {
-    /// Layout of group 0 this frame: view uniform, lights, instances, and the shadow bindings
-    /// when [`SceneResources::shadows_active`].
-    pub view_layout: wgpu::BindGroupLayout,
+    /// Layout of group 0 this frame ([`SCENE_GROUP`]): view uniform, lights, instances, and the
+    /// shadow bindings when [`SceneResources::shadows_active`].
+    pub view_layout: GroupLayout,
     /// Group 0's layout without shadows.
-    plain_view_layout: wgpu::BindGroupLayout,
+    plain_view_layout: GroupLayout,
     /// Group 0's layout with shadows.
-    shadowed_view_layout: wgpu::BindGroupLayout,
+    shadowed_view_layout: GroupLayout,
     /// This frame's lights cast shadows: group 0 holds the shadow bindings and every shading
     /// pipeline is composed with `SHADOWS`.
     pub shadows_active: bool,
@@ -314,8 +290,9 @@ impl SceneResources {
     /// Creates the layouts and empty buffers.
     pub fn new(gpu: &GpuContext) -> SceneResources {
         let device = &gpu.device;
-        let view_layout = make_view_layout(device, false);
-        let shadowed_view_layout = make_view_layout(device, true);
+        let view_layout = SCENE_GROUP.create_layout(device, ShaderDefs::default());
+        let shadowed_view_layout =
+            SCENE_GROUP.create_layout(device, ShaderDefs { shadows: true, ..Default::default() });
         let view_buffer = gpu.create_buffer(&wgpu::BufferDescriptor {
             label: Some("view_uniform"),
             size: std::mem::size_of::<ViewUniform>() as u64,
@@ -361,36 +338,26 @@ impl SceneResources {
 
     fn make_view_bind_group(
         gpu: &GpuContext,
-        layout: &wgpu::BindGroupLayout,
+        layout: &GroupLayout,
         view: &wgpu::Buffer,
         lights: &GrowableBuffer,
         instances: &GrowableBuffer,
         shadows: Option<&ShadowBindings<'_>>,
     ) -> wgpu::BindGroup {
-        let mut entries = vec![
-            wgpu::BindGroupEntry { binding: 0, resource: view.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: lights.buffer().as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 2, resource: instances.buffer().as_entire_binding() },
+        let mut resources = vec![
+            Binding::Buffer(view),
+            Binding::Buffer(lights.buffer()),
+            Binding::Buffer(instances.buffer()),
         ];
         if let Some(shadows) = shadows {
-            entries.extend([
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::TextureView(shadows.atlas),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: wgpu::BindingResource::Sampler(shadows.sampler),
-                },
-                wgpu::BindGroupEntry { binding: 5, resource: shadows.lights.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 6, resource: shadows.directional.as_entire_binding() },
+            resources.extend([
+                Binding::Texture(shadows.atlas),
+                Binding::Sampler(shadows.sampler),
+                Binding::Buffer(shadows.lights),
+                Binding::Buffer(shadows.directional),
             ]);
         }
-        gpu.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("view_bind_group"),
-            layout,
-            entries: &entries,
-        })
+        layout.create_bind_group(gpu, &resources)
     }
 
     /// Binds group 0 for a view (after [`SceneResources::prepare`] and the shadows'

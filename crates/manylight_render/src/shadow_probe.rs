@@ -4,9 +4,14 @@
 //! calls the very `shadow_visibility` of the shading passes against the last frame's atlas and
 //! light table, so what is measured is what was shaded. Not part of a frame.
 
+use crate::bindings::Binding;
 use crate::context::{GpuContext, RenderError};
 use crate::gpu_types::{GpuPointLight, GpuShadowProbe};
+use crate::layouts::{BindGroupDecl, BindingDecl, check_pipeline};
+use crate::passes::common::pipeline_layout;
 use crate::readback::read_buffer;
+use crate::resources::SHADOW_BINDINGS;
+use crate::shaders::ShaderDefs;
 use crate::shadows::ShadowResources;
 use glam::Vec3;
 
@@ -15,6 +20,22 @@ pub const PROBES_PER_DISPATCH: usize = 1 << 20;
 
 /// Workgroup size of `shadow_probe.wgsl`.
 const WORKGROUP: u32 = 64;
+
+/// Group 0 of the probe: the shadow bindings of the scene's group 0
+/// ([`crate::resources::SHADOW_BINDINGS`]), as `common/shadows.wgsl` declares them.
+pub static SHADOW_PROBE_SCENE_GROUP: BindGroupDecl =
+    BindGroupDecl { label: "shadow_probe_shadows", entries: &SHADOW_BINDINGS };
+
+/// Group 1 of the probe (`shaders/shadow_probe.wgsl`): the frame's lights, the probes and what
+/// it writes for each.
+pub static SHADOW_PROBE_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "shadow_probe",
+    entries: &[
+        BindingDecl::storage(0, "lights", wgpu::ShaderStages::COMPUTE),
+        BindingDecl::storage(1, "probes", wgpu::ShaderStages::COMPUTE),
+        BindingDecl::storage_rw(2, "probed", wgpu::ShaderStages::COMPUTE),
+    ],
+};
 
 /// One light–point pair to probe.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -46,24 +67,32 @@ pub fn probe_shadows(
     }
     let module = crate::shaders::create_module(&gpu.device, "shadow_probe.wgsl")
         .map_err(|e| RenderError::Graph(format!("shadow_probe.wgsl: {e}")))?;
+    let defs = ShaderDefs::default();
+    let shadow_layout = SHADOW_PROBE_SCENE_GROUP.create_layout(&gpu.device, defs);
+    let probe_layout = SHADOW_PROBE_GROUP.create_layout(&gpu.device, defs);
+    check_pipeline("shadow_probe.wgsl", &["main"], &[&shadow_layout, &probe_layout])?;
+    let pipeline_layout = pipeline_layout(&gpu.device, "shadow_probe", &[&shadow_layout, &probe_layout]);
     let pipeline = gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some("shadow_probe"),
-        layout: None,
+        layout: Some(&pipeline_layout),
         module: &module,
         entry_point: Some("main"),
         compilation_options: Default::default(),
         cache: None,
     });
-    let shadow_group = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("shadow_probe_shadows"),
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(bindings.atlas) },
-            wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::Sampler(bindings.sampler) },
-            wgpu::BindGroupEntry { binding: 5, resource: bindings.lights.as_entire_binding() },
+    let shadow_group = shadow_layout.create_bind_group(
+        gpu,
+        &[
+            Binding::Texture(bindings.atlas),
+            Binding::Sampler(bindings.sampler),
+            Binding::Buffer(bindings.lights),
+            Binding::Buffer(bindings.directional),
         ],
-    });
+    );
     let light_bytes = u64::from(light_count) * std::mem::size_of::<GpuPointLight>() as u64;
+    let Some(light_bytes) = wgpu::BufferSize::new(light_bytes) else {
+        return Ok(vec![1.0; probes.len()]);
+    };
     let mut out = Vec::with_capacity(probes.len());
     for part in probes.chunks(PROBES_PER_DISPATCH) {
         let gpu_probes: Vec<GpuShadowProbe> = part
@@ -87,22 +116,10 @@ pub fn probe_shadows(
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let group = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("shadow_probe"),
-            layout: &pipeline.get_bind_group_layout(1),
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: lights,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(light_bytes),
-                    }),
-                },
-                wgpu::BindGroupEntry { binding: 1, resource: input.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: output.as_entire_binding() },
-            ],
-        });
+        let group = probe_layout.create_bind_group(
+            gpu,
+            &[Binding::BufferPrefix(lights, light_bytes), Binding::Buffer(&input), Binding::Buffer(&output)],
+        );
         let mut encoder = gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("shadow_probe") });

@@ -9,6 +9,7 @@ use manylight_render::gpu_types::{
     GpuClusterBounds, GpuClusterCounters, GpuClusterParams, GpuDirectionalLight, GpuInstance, GpuMaterial,
     GpuPointLight, GpuTextureUv, ViewUniform,
 };
+use manylight_render::layouts::{BindingKind, Presence, SHADER_BIND_GROUPS, shader_bind_groups};
 use manylight_render::resources::SurfaceVariant;
 use manylight_render::shaders::{SOURCES, ShaderDefs, compose, compose_with};
 use std::mem::{offset_of, size_of};
@@ -441,38 +442,199 @@ fn every_entry_point_compiles_to_spirv() {
     }
 }
 
-/// Each G-buffer target's read binding, as `passes::gbuffer_layout::targets` declares it (the
-/// layout and bind group the lighting passes make come from that table), is the WGSL's: the
-/// variable of that name sits at that binding of group 1 with the texture type the format
-/// needs, and so do the depth and clear-colour bindings.
-#[test]
-fn gbuffer_read_bindings_match_the_rust_table() {
-    use manylight_render::passes::gbuffer_layout::{
-        GBUFFER_READ_CLEAR_COLOR_BINDING, GBUFFER_READ_DEPTH_BINDING, targets,
-    };
-    for layout in [GBufferLayout::Full, GBufferLayout::Packed, GBufferLayout::Compact] {
-        let module = validate_with("deferred_lighting.wgsl", ShaderDefs::default().with_gbuffer(layout));
-        let at = |binding: u32| {
-            module
-                .global_variables
-                .iter()
-                .map(|(_, v)| v)
-                .find(|v| v.binding == Some(naga::ResourceBinding { group: 1, binding }))
-                .unwrap_or_else(|| panic!("{layout:?}: nothing at @group(1) @binding({binding})"))
-        };
-        for t in targets(layout) {
-            let var = at(t.read_binding);
-            assert_eq!(var.name.as_deref(), Some(t.wgsl_name), "{layout:?} {}", t.name);
-            let uint = t.format == wgpu::TextureFormat::Rgba32Uint;
-            let expected = if uint { naga::ScalarKind::Uint } else { naga::ScalarKind::Float };
-            match module.types[var.ty].inner {
-                naga::TypeInner::Image { class: naga::ImageClass::Sampled { kind, .. }, .. } => {
-                    assert_eq!(kind, expected, "{layout:?} {}", t.name)
+/// Whether naga's view of a bound global variable is what its Rust declaration says.
+fn kind_matches(kind: BindingKind, module: &naga::Module, var: &naga::GlobalVariable) -> bool {
+    use naga::{AddressSpace, ImageClass, ImageDimension, ScalarKind, TypeInner};
+    match (kind, var.space, &module.types[var.ty].inner) {
+        (BindingKind::Uniform, AddressSpace::Uniform, _) => true,
+        (BindingKind::Storage { read_only }, AddressSpace::Storage { access }, _) => {
+            read_only != access.contains(naga::StorageAccess::STORE)
+        }
+        (
+            BindingKind::Texture(sample_type),
+            AddressSpace::Handle,
+            TypeInner::Image { dim, arrayed, class },
+        ) => {
+            *dim == ImageDimension::D2
+                && !arrayed
+                && match (sample_type, class) {
+                    (wgpu::TextureSampleType::Float { .. }, ImageClass::Sampled { kind, multi }) => {
+                        *kind == ScalarKind::Float && !multi
+                    }
+                    (wgpu::TextureSampleType::Uint, ImageClass::Sampled { kind, multi }) => {
+                        *kind == ScalarKind::Uint && !multi
+                    }
+                    (wgpu::TextureSampleType::Sint, ImageClass::Sampled { kind, multi }) => {
+                        *kind == ScalarKind::Sint && !multi
+                    }
+                    (wgpu::TextureSampleType::Depth, ImageClass::Depth { multi }) => !multi,
+                    _ => false,
                 }
-                ref other => panic!("{layout:?} {}: {other:?} is not a sampled texture", t.name),
+        }
+        (
+            BindingKind::StorageTexture(format),
+            AddressSpace::Handle,
+            TypeInner::Image { class: ImageClass::Storage { format: naga_format, access }, .. },
+        ) => {
+            format == wgpu::TextureFormat::Rgba16Float
+                && *naga_format == naga::StorageFormat::Rgba16Float
+                && *access == naga::StorageAccess::STORE
+        }
+        (BindingKind::Sampler(ty), AddressSpace::Handle, TypeInner::Sampler { comparison }) => {
+            *comparison == (ty == wgpu::SamplerBindingType::Comparison)
+        }
+        _ => false,
+    }
+}
+
+/// The stage of an entry point as wgpu names it.
+fn stage_of(stage: naga::ShaderStage) -> wgpu::ShaderStages {
+    match stage {
+        naga::ShaderStage::Vertex => wgpu::ShaderStages::VERTEX,
+        naga::ShaderStage::Fragment => wgpu::ShaderStages::FRAGMENT,
+        naga::ShaderStage::Compute => wgpu::ShaderStages::COMPUTE,
+        other => panic!("no shader of ours has a {other:?} stage"),
+    }
+}
+
+/// What is wrong with the bindings that `module`'s entry points use (composed from `path` with
+/// `defs`), against [`SHADER_BIND_GROUPS`]: a used binding with no row, no group or no
+/// declared entry, another variable name, another kind, or a stage the entry does not list.
+fn binding_mismatches(
+    path: &str,
+    defs: ShaderDefs,
+    module: &naga::Module,
+    info: &naga::valid::ModuleInfo,
+) -> Vec<String> {
+    let mut errors = Vec::new();
+    for (index, entry_point) in module.entry_points.iter().enumerate() {
+        let uses = info.get_entry_point(index);
+        let used: Vec<_> = module
+            .global_variables
+            .iter()
+            .filter(|(handle, var)| var.binding.is_some() && !uses[*handle].is_empty())
+            .collect();
+        if used.is_empty() {
+            continue;
+        }
+        let at = format!("{path} `{}` ({defs:?})", entry_point.name);
+        let Some(row) = shader_bind_groups(path, &[&entry_point.name]) else {
+            errors.push(format!("{at}: binds resources but has no row in SHADER_BIND_GROUPS"));
+            continue;
+        };
+        for (_, var) in used {
+            let (group, binding) = var.binding.as_ref().map(|b| (b.group, b.binding)).unwrap_or_default();
+            let name = var.name.as_deref().unwrap_or("?");
+            let here = format!("{at}: `{name}` @group({group}) @binding({binding})");
+            let Some(decl) = row.groups.get(group as usize) else {
+                errors.push(format!("{here}: the row declares {} groups", row.groups.len()));
+                continue;
+            };
+            let Some(entry) = decl.entries_for(defs).find(|e| e.binding == binding) else {
+                errors.push(format!(
+                    "{here}: `{}` declares no binding {binding} for these defines",
+                    decl.label
+                ));
+                continue;
+            };
+            if entry.name != name {
+                errors.push(format!("{here}: `{}` names it `{}`", decl.label, entry.name));
+            }
+            if !kind_matches(entry.kind, module, var) {
+                errors.push(format!("{here}: `{}` declares {:?}", decl.label, entry.kind));
+            }
+            let stage = stage_of(entry_point.stage);
+            if !entry.visibility.contains(stage) {
+                errors.push(format!(
+                    "{here}: `{}` makes it visible to {:?}, not {stage:?}",
+                    decl.label, entry.visibility
+                ));
             }
         }
-        assert_eq!(at(GBUFFER_READ_DEPTH_BINDING).name.as_deref(), Some("gb_depth"));
-        assert_eq!(at(GBUFFER_READ_CLEAR_COLOR_BINDING).name.as_deref(), Some("clear_color"));
+    }
+    errors
+}
+
+/// Every `@group`/`@binding` an entry point of a library shader uses, in every composition, is
+/// what the Rust declaration of that group says (the layout and the bind groups of its passes
+/// come from that declaration): same binding number, variable name, kind and a visibility
+/// that includes the entry point's stage. Every row of the table names entry points that exist.
+#[test]
+fn every_binding_matches_its_rust_declaration() {
+    let mut errors = Vec::new();
+    let mut entry_points = std::collections::HashSet::new();
+    for (path, _) in SOURCES.iter().filter(|(path, _)| !path.contains('/')) {
+        for defs in all_defs() {
+            let code = compose_with(path, defs).unwrap_or_else(|e| panic!("{path}: {e}"));
+            let module = naga::front::wgsl::parse_str(&code).unwrap_or_else(|e| panic!("{path}: {e}"));
+            let info = naga::valid::Validator::new(
+                naga::valid::ValidationFlags::all(),
+                naga::valid::Capabilities::all(),
+            )
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("{path}: {e}"));
+            errors.extend(binding_mismatches(path, defs, &module, &info));
+            entry_points.extend(module.entry_points.iter().map(|e| (path.to_string(), e.name.clone())));
+        }
+    }
+    for row in SHADER_BIND_GROUPS {
+        assert!(SOURCES.iter().any(|(path, _)| *path == row.shader), "{}: no such shader", row.shader);
+        for name in row.entry_points {
+            if !entry_points.contains(&(row.shader.to_string(), name.to_string())) {
+                errors.push(format!("{} has no entry point `{name}`", row.shader));
+            }
+        }
+    }
+    assert!(errors.is_empty(), "{} binding mismatches:\n{}", errors.len(), errors.join("\n"));
+}
+
+/// Declaration labels are unique (a pipeline's layouts are checked against the table by label),
+/// and no group declares a binding number twice.
+#[test]
+fn bind_group_declarations_are_unique() {
+    let mut labels = std::collections::HashSet::new();
+    for row in SHADER_BIND_GROUPS {
+        for decl in row.groups {
+            let first = labels.insert(decl.label);
+            let same = SHADER_BIND_GROUPS.iter().flat_map(|r| r.groups).find(|d| d.label == decl.label);
+            assert!(
+                first || same.is_some_and(|d| std::ptr::eq(*d, *decl)),
+                "two declarations named {}",
+                decl.label
+            );
+            for (i, a) in decl.entries.iter().enumerate() {
+                for b in &decl.entries[i + 1..] {
+                    // Entries of different G-buffer layouts never meet in one layout.
+                    let exclusive = matches!((a.presence, b.presence), (Presence::GBuffer(x), Presence::GBuffer(y)) if x != y);
+                    assert!(
+                        a.binding != b.binding || exclusive,
+                        "{}: binding {} twice",
+                        decl.label,
+                        a.binding
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// The G-buffer targets of each layout (the G-buffer pass's colour targets, in order) are the
+/// textures of [`GBUFFER_READ_GROUP`] for that layout, in order, with a sample type their format
+/// can be read as; then depth and the clear colour.
+#[test]
+fn gbuffer_targets_are_the_read_group_in_order() {
+    use manylight_render::passes::gbuffer_layout::{GBUFFER_READ_GROUP, targets};
+    for layout in [GBufferLayout::Full, GBufferLayout::Packed, GBufferLayout::Compact] {
+        let entries: Vec<_> =
+            GBUFFER_READ_GROUP.entries_for(ShaderDefs::default().with_gbuffer(layout)).collect();
+        let names: Vec<&str> = entries.iter().map(|e| e.name).collect();
+        let mut expected: Vec<&str> = targets(layout).iter().map(|t| t.read.name).collect();
+        expected.extend(["gb_depth", "clear_color"]);
+        assert_eq!(names, expected, "{layout:?}");
+        for t in targets(layout) {
+            let uint = t.format == wgpu::TextureFormat::Rgba32Uint;
+            let BindingKind::Texture(sample_type) = t.read.kind else { panic!("{}: not a texture", t.name) };
+            assert_eq!(sample_type == wgpu::TextureSampleType::Uint, uint, "{layout:?} {}", t.name);
+        }
     }
 }

@@ -11,20 +11,21 @@
 @group(0) @binding(2) var<storage, read> instances: array<GpuInstance>;
 
 @group(1) @binding(0) var<uniform> material: GpuMaterial;
+// Each texture is followed by its own sampler (glTF wrap and filter modes).
+// base colour (sRGB)
 @group(1) @binding(1) var base_color_texture: texture_2d<f32>;
 @group(1) @binding(2) var base_color_sampler: sampler;
 // glTF metallic-roughness: blue = metalness, green = roughness (linear)
 @group(1) @binding(3) var metallic_roughness_texture: texture_2d<f32>;
+@group(1) @binding(4) var metallic_roughness_sampler: sampler;
 // tangent-space normal map (linear, xyz * 0.5 + 0.5)
-@group(1) @binding(4) var normal_texture: texture_2d<f32>;
+@group(1) @binding(5) var normal_texture: texture_2d<f32>;
+@group(1) @binding(6) var normal_sampler: sampler;
 // ambient occlusion (linear, red)
-@group(1) @binding(5) var occlusion_texture: texture_2d<f32>;
+@group(1) @binding(7) var occlusion_texture: texture_2d<f32>;
+@group(1) @binding(8) var occlusion_sampler: sampler;
 // emitted colour (sRGB)
-@group(1) @binding(6) var emissive_texture: texture_2d<f32>;
-// each texture's own sampler (glTF wrap and filter modes)
-@group(1) @binding(7) var metallic_roughness_sampler: sampler;
-@group(1) @binding(8) var normal_sampler: sampler;
-@group(1) @binding(9) var occlusion_sampler: sampler;
+@group(1) @binding(9) var emissive_texture: texture_2d<f32>;
 @group(1) @binding(10) var emissive_sampler: sampler;
 
 // Everything a shading pass needs of the material at a fragment.

@@ -17,6 +17,7 @@ use super::common::{FullscreenPipelineDesc, fullscreen_pipeline_desc};
 use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::layouts::{BindGroupDecl, BindingDecl, BindingKind, GroupLayout};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 use crate::resources::HDR_FORMAT;
@@ -117,6 +118,24 @@ impl Stage {
     }
 }
 
+const FRAGMENT: wgpu::ShaderStages = wgpu::ShaderStages::FRAGMENT;
+
+/// Bloom's bind group (`shaders/bloom.wgsl`): the stage's parameters, a bilinear sampler and
+/// the level it reads.
+pub static BLOOM_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "bloom",
+    entries: &[
+        BindingDecl::uniform(0, "params", FRAGMENT),
+        BindingDecl::new(
+            1,
+            "linear_sampler",
+            BindingKind::Sampler(wgpu::SamplerBindingType::Filtering),
+            FRAGMENT,
+        ),
+        BindingDecl::texture(2, "source", wgpu::TextureSampleType::Float { filterable: true }, FRAGMENT),
+    ],
+};
+
 /// Bloom's pipelines: one per stage.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 struct BloomKey {
@@ -130,31 +149,19 @@ impl PipelineKey for BloomKey {
 /// The pipeline of one bloom stage.
 struct BloomPipeline {
     pipeline: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
+    layout: GroupLayout,
     sampler: wgpu::Sampler,
 }
 
 impl BloomPipeline {
     fn new(device: &wgpu::Device, stage: Stage) -> Result<Self, RenderError> {
-        let fragment = wgpu::ShaderStages::FRAGMENT;
-        let mut entries = vec![super::common::uniform_entry(0, fragment)];
-        entries.push(wgpu::BindGroupLayoutEntry {
-            binding: 1,
-            visibility: fragment,
-            ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-            count: None,
-        });
-        entries.push(super::common::texture_entry(2, wgpu::TextureSampleType::Float { filterable: true }));
         let (label, entry) = match stage {
             Stage::Bright => ("bloom_bright", "fs_bright"),
             Stage::Blur => ("bloom_blur", "fs_blur"),
             Stage::Upsample => ("bloom_upsample", "fs_upsample"),
             Stage::Composite => ("bloom_composite", "fs_composite"),
         };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some(label),
-            entries: &entries,
-        });
+        let layout = BLOOM_GROUP.create_layout(device, Default::default());
         // The composite adds to the HDR image; the other stages overwrite their level.
         let blend = stage.adds().then_some(wgpu::BlendState {
             color: wgpu::BlendComponent {
@@ -207,7 +214,7 @@ fn draw(
     let textures = sources.iter().map(|&name| ctx.texture(name)).collect::<Result<Vec<_>, _>>()?;
     let mut bindings = vec![Binding::Buffer(&params), Binding::Sampler(&pipeline.sampler)];
     bindings.extend(textures.into_iter().map(Binding::Texture));
-    let bind_group = ctx.bind_group("bloom", &pipeline.layout, &bindings);
+    let bind_group = pipeline.layout.bind_group(ctx, &bindings);
     let view = ctx.texture(target)?;
     let timestamps = ctx.render_timestamps(true, true);
     // The composite loads the HDR image and adds to it; the other stages replace their level.

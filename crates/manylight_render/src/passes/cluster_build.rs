@@ -7,6 +7,7 @@
 use super::{CLUSTER_DEPTHS, CLUSTERS};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName};
+use crate::layouts::GroupLayout;
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 
@@ -42,17 +43,10 @@ pub struct ClusterBuildPipelines {
 }
 
 impl ClusterBuildPipelines {
-    fn new(
-        device: &wgpu::Device,
-        layout: &wgpu::BindGroupLayout,
-        workgroup_size: u32,
-    ) -> Result<Self, RenderError> {
+    fn new(device: &wgpu::Device, layout: &GroupLayout, workgroup_size: u32) -> Result<Self, RenderError> {
         let module = crate::shaders::create_module(device, "cluster_build.wgsl")?;
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("cluster_build"),
-            bind_group_layouts: &[Some(layout)],
-            immediate_size: 0,
-        });
+        crate::layouts::check_pipeline("cluster_build.wgsl", &[], &[layout])?;
+        let pipeline_layout = super::common::pipeline_layout(device, "cluster_build", &[layout]);
         let constants = [("WORKGROUP_SIZE", workgroup_size as f64)];
         let make = |entry: &str| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {

@@ -69,11 +69,9 @@ impl Pass for ClusterDepthPass {
         let ranges = clusters.ranges.buffer();
         let bytes = u64::from(clusters.params.dims[3]) * 8;
         ctx.encoder.clear_buffer(ranges, bytes, Some(bytes));
-        let depths = ctx.bind_group(
-            "cluster_depth",
-            &clusters.depth_layout,
-            &[Binding::Buffer(&clusters.params_buffer), Binding::Buffer(ranges)],
-        );
+        let depths = clusters
+            .depth_layout
+            .bind_group(ctx, &[Binding::Buffer(&clusters.params_buffer), Binding::Buffer(ranges)]);
         let depth = ctx.texture(DEPTH)?.texture();
         let groups = [depth.width().div_ceil(8), depth.height().div_ceil(8)];
         let timestamps = ctx.compute_timestamps(true, true);

@@ -6,6 +6,7 @@ use super::scene_draw::{ScenePipeline, record_scene_pass, variant_pipelines};
 use super::{CLUSTERS, DEPTH, HDR};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::layouts::GroupLayout;
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 use crate::resources::{DEPTH_FORMAT, HDR_FORMAT, SurfaceVariant};
@@ -31,7 +32,7 @@ pub struct ClusteredForwardPipeline {
 impl ClusteredForwardPipeline {
     fn new(
         device: &wgpu::Device,
-        layouts: [&wgpu::BindGroupLayout; 3],
+        layouts: [&GroupLayout; 3],
         key: &ClusteredForwardKey,
     ) -> Result<Self, RenderError> {
         let after_prepass = key.after_prepass;

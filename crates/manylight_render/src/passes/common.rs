@@ -1,18 +1,16 @@
-//! What the passes share: pipeline construction for mesh, full-screen and compute passes, the
-//! attachments they use, and bind-group-layout entries.
+//! What the passes share: pipeline construction for mesh, full-screen and compute passes (each
+//! checks the bind group layouts it is given against [`crate::layouts::SHADER_BIND_GROUPS`]),
+//! and the attachments they use.
 
 use crate::context::RenderError;
 use crate::resources::{DEPTH_FORMAT, SurfaceVariant};
 use manylight_core::Vertex;
 
-pub use crate::layouts::{storage_entry, texture_entry, uniform_entry};
+use crate::layouts::{GroupLayout, check_pipeline};
 
-fn pipeline_layout(
-    device: &wgpu::Device,
-    label: &str,
-    layouts: &[&wgpu::BindGroupLayout],
-) -> wgpu::PipelineLayout {
-    let layouts: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().copied().map(Some).collect();
+/// The pipeline layout of bind groups `layouts`, group 0 first.
+pub fn pipeline_layout(device: &wgpu::Device, label: &str, layouts: &[&GroupLayout]) -> wgpu::PipelineLayout {
+    let layouts: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(|l| Some(l.raw())).collect();
     device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
         bind_group_layouts: &layouts,
@@ -26,7 +24,7 @@ pub fn compute_pipeline(
     device: &wgpu::Device,
     label: &str,
     shader: &str,
-    layouts: &[&wgpu::BindGroupLayout],
+    layouts: &[&GroupLayout],
     entry: &str,
     constants: &[(&str, f64)],
 ) -> Result<wgpu::ComputePipeline, RenderError> {
@@ -38,11 +36,12 @@ pub fn compute_pipeline_with_defs(
     device: &wgpu::Device,
     label: &str,
     shader: &str,
-    layouts: &[&wgpu::BindGroupLayout],
+    layouts: &[&GroupLayout],
     entry: &str,
     constants: &[(&str, f64)],
     defs: crate::shaders::ShaderDefs,
 ) -> Result<wgpu::ComputePipeline, RenderError> {
+    check_pipeline(shader, &[entry], layouts)?;
     let module = crate::shaders::create_module_with(device, shader, defs)?;
     let layout = pipeline_layout(device, label, layouts);
     Ok(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -72,7 +71,7 @@ pub struct MeshPipelineDesc<'a> {
     /// Shader file under `shaders/`.
     pub shader: &'a str,
     /// Bind group layouts, in group order.
-    pub layouts: &'a [&'a wgpu::BindGroupLayout],
+    pub layouts: &'a [&'a GroupLayout],
     /// Fragment entry point; `None` for depth only.
     pub fragment: Option<&'a str>,
     /// Colour target formats.
@@ -113,6 +112,8 @@ pub fn mesh_pipeline_with_defs(
 ) -> Result<wgpu::RenderPipeline, RenderError> {
     let constants: Vec<(&str, f64)> = constants.iter().copied().chain(d.variant.constants()).collect();
     let options = || wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
+    let entry_points: Vec<&str> = ["vs_main"].into_iter().chain(d.fragment).collect();
+    check_pipeline(d.shader, &entry_points, d.layouts)?;
     let module = crate::shaders::create_module_with(device, d.shader, defs)?;
     let layout = pipeline_layout(device, d.label, d.layouts);
     // Blended variants draw over the target by the fragment's alpha (glTF `BLEND`).
@@ -151,7 +152,7 @@ pub fn fullscreen_pipeline(
     device: &wgpu::Device,
     label: &str,
     shader: &str,
-    layouts: &[&wgpu::BindGroupLayout],
+    layouts: &[&GroupLayout],
     fragment: &str,
     output: wgpu::TextureFormat,
 ) -> Result<wgpu::RenderPipeline, RenderError> {
@@ -175,7 +176,7 @@ pub struct FullscreenPipelineDesc<'a> {
     /// Shader file under `shaders/`.
     pub shader: &'a str,
     /// Bind group layouts, in group order.
-    pub layouts: &'a [&'a wgpu::BindGroupLayout],
+    pub layouts: &'a [&'a GroupLayout],
     /// Fragment entry point.
     pub fragment: &'a str,
     /// Format of the one colour target.
@@ -202,12 +203,14 @@ pub fn fullscreen_pipeline_with_defs(
     d: &FullscreenPipelineDesc<'_>,
     defs: crate::shaders::ShaderDefs,
 ) -> Result<wgpu::RenderPipeline, RenderError> {
+    check_pipeline(d.shader, &[d.fragment], d.layouts)?;
     let module = crate::shaders::create_module_with(device, d.shader, defs)?;
     Ok(fullscreen_pipeline_with_module(device, d, &module))
 }
 
 /// [`fullscreen_pipeline_desc`] with a module made already (an app's own shader:
-/// [`crate::shaders::create_module_from_source`]); `d.shader` is not read.
+/// [`crate::shaders::create_module_from_source`]); `d.shader` is not read, and the layouts are
+/// not checked against [`crate::layouts::SHADER_BIND_GROUPS`] (an app's shader has no row).
 pub fn fullscreen_pipeline_with_module(
     device: &wgpu::Device,
     d: &FullscreenPipelineDesc<'_>,

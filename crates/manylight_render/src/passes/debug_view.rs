@@ -9,13 +9,14 @@
 //!   (`shadow-lod`), after a frame planned as without a debug view. A frame without a shadow
 //!   map shows the background.
 
-use super::common::{draw_fullscreen, fullscreen_pipeline, storage_entry, texture_entry, uniform_entry};
+use super::common::{draw_fullscreen, fullscreen_pipeline};
 use super::{
     CLUSTERS, DEPTH, GBUFFER_ALBEDO, GBUFFER_EMISSIVE, GBUFFER_NORMAL, GBUFFER_POSITION, SHADOW_ATLAS,
 };
 use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{OUTPUT, Pass, PassContext, ResourceName};
+use crate::layouts::{BindGroupDecl, BindingDecl, GroupLayout, UNFILTERED};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 use crate::snapshot::DebugViewMode;
@@ -46,6 +47,75 @@ impl Family {
     }
 }
 
+const FRAGMENT: wgpu::ShaderStages = wgpu::ShaderStages::FRAGMENT;
+const VIEW: BindingDecl = BindingDecl::uniform(0, "view", FRAGMENT);
+const DEPTH_TEXTURE: BindingDecl = BindingDecl::texture(1, "depth", wgpu::TextureSampleType::Depth, FRAGMENT);
+const PARAMS: BindingDecl = BindingDecl::uniform(4, "debug", FRAGMENT);
+
+/// The bind group of the cluster views: view, depth, parameters, then the cluster parameters
+/// and ranges.
+pub static CLUSTERS_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "debug_view_clusters",
+    entries: &[
+        VIEW,
+        DEPTH_TEXTURE,
+        PARAMS,
+        BindingDecl::uniform(2, "cluster_params", FRAGMENT),
+        BindingDecl::storage(3, "cluster_ranges", FRAGMENT),
+    ],
+};
+/// The bind group of the depth view: view, depth and parameters.
+pub static DEPTH_GROUP: BindGroupDecl =
+    BindGroupDecl { label: "debug_view_depth", entries: &[VIEW, DEPTH_TEXTURE, PARAMS] };
+/// The bind group of the surface views: view, depth, parameters, then the Full G-buffer.
+pub static SURFACE_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "debug_view_surface",
+    entries: &[
+        VIEW,
+        DEPTH_TEXTURE,
+        PARAMS,
+        BindingDecl::texture(5, "gbuffer_albedo", UNFILTERED, FRAGMENT),
+        BindingDecl::texture(6, "gbuffer_normal", UNFILTERED, FRAGMENT),
+        BindingDecl::texture(7, "gbuffer_emissive", UNFILTERED, FRAGMENT),
+        BindingDecl::texture(8, "gbuffer_position", UNFILTERED, FRAGMENT),
+    ],
+};
+/// The bind group of the shadow-atlas view: view, depth, parameters, then the atlas.
+pub static SHADOW_ATLAS_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "debug_view_shadow_atlas",
+    entries: &[
+        VIEW,
+        DEPTH_TEXTURE,
+        PARAMS,
+        BindingDecl::texture(12, "debug_shadow_atlas", wgpu::TextureSampleType::Depth, FRAGMENT),
+    ],
+};
+/// The bind group of the shadow-LOD view: view, depth, parameters, then the lights and their
+/// shadow table.
+pub static SHADOW_LOD_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "debug_view_shadow_lod",
+    entries: &[
+        VIEW,
+        DEPTH_TEXTURE,
+        PARAMS,
+        BindingDecl::storage(10, "debug_lights", FRAGMENT),
+        BindingDecl::storage(11, "debug_shadow_lights", FRAGMENT),
+    ],
+};
+
+impl Family {
+    /// The family's bind group and fragment entry point.
+    fn group_and_entry(self) -> (&'static BindGroupDecl, &'static str) {
+        match self {
+            Family::Clusters => (&CLUSTERS_GROUP, "fs_clusters"),
+            Family::Depth => (&DEPTH_GROUP, "fs_depth"),
+            Family::Surface => (&SURFACE_GROUP, "fs_surface"),
+            Family::ShadowAtlas => (&SHADOW_ATLAS_GROUP, "fs_shadow_atlas"),
+            Family::ShadowLod => (&SHADOW_LOD_GROUP, "fs_shadow_lod"),
+        }
+    }
+}
+
 /// The debug views' pipelines: per data read and output format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 struct DebugViewKey {
@@ -60,41 +130,13 @@ impl PipelineKey for DebugViewKey {
 /// The pipeline of [`DebugViewPass`] for one family and output format.
 pub struct DebugViewPipeline {
     pipeline: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
+    layout: GroupLayout,
 }
 
 impl DebugViewPipeline {
     fn new(device: &wgpu::Device, family: Family, output: wgpu::TextureFormat) -> Result<Self, RenderError> {
-        let fragment = wgpu::ShaderStages::FRAGMENT;
-        let mut entries = vec![
-            uniform_entry(0, fragment),
-            texture_entry(1, wgpu::TextureSampleType::Depth),
-            uniform_entry(4, fragment),
-        ];
-        let unfiltered = wgpu::TextureSampleType::Float { filterable: false };
-        let entry = match family {
-            Family::Clusters => {
-                entries.extend([uniform_entry(2, fragment), storage_entry(3, fragment, true)]);
-                "fs_clusters"
-            }
-            Family::Depth => "fs_depth",
-            Family::Surface => {
-                entries.extend([5, 6, 7, 8].map(|b| texture_entry(b, unfiltered)));
-                "fs_surface"
-            }
-            Family::ShadowAtlas => {
-                entries.push(texture_entry(12, wgpu::TextureSampleType::Depth));
-                "fs_shadow_atlas"
-            }
-            Family::ShadowLod => {
-                entries.extend([storage_entry(10, fragment, true), storage_entry(11, fragment, true)]);
-                "fs_shadow_lod"
-            }
-        };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("debug_view"),
-            entries: &entries,
-        });
+        let (group, entry) = family.group_and_entry();
+        let layout = group.create_layout(device, Default::default());
         let pipeline =
             fullscreen_pipeline(device, "debug_view", "debug_view.wgsl", &[&layout], entry, output)?;
         Ok(DebugViewPipeline { pipeline, layout })
@@ -183,40 +225,39 @@ impl Pass for DebugViewPass {
             bytemuck::cast_slice(&[self.view.gpu_id(), self.heatmap_max.max(1), depth_far.to_bits(), 0]),
         );
         let mut bindings = vec![
-            (0, Binding::Buffer(&ctx.scene.view_buffer)),
-            (1, Binding::Texture(ctx.texture(DEPTH)?)),
-            (4, Binding::Buffer(&params)),
+            Binding::Buffer(&ctx.scene.view_buffer),
+            Binding::Texture(ctx.texture(DEPTH)?),
+            Binding::Buffer(&params),
         ];
         match family {
             Family::Clusters => {
                 let clusters = ctx.require_clusters("debug_view")?;
                 bindings.extend([
-                    (2, Binding::Buffer(&clusters.params_buffer)),
-                    (3, Binding::Buffer(clusters.ranges.buffer())),
+                    Binding::Buffer(&clusters.params_buffer),
+                    Binding::Buffer(clusters.ranges.buffer()),
                 ]);
             }
             Family::Depth => {}
             Family::Surface => bindings.extend([
-                (5, Binding::Texture(ctx.texture(GBUFFER_ALBEDO)?)),
-                (6, Binding::Texture(ctx.texture(GBUFFER_NORMAL)?)),
-                (7, Binding::Texture(ctx.texture(GBUFFER_EMISSIVE)?)),
-                (8, Binding::Texture(ctx.texture(GBUFFER_POSITION)?)),
+                Binding::Texture(ctx.texture(GBUFFER_ALBEDO)?),
+                Binding::Texture(ctx.texture(GBUFFER_NORMAL)?),
+                Binding::Texture(ctx.texture(GBUFFER_EMISSIVE)?),
+                Binding::Texture(ctx.texture(GBUFFER_POSITION)?),
             ]),
             Family::ShadowAtlas => {
                 let atlas = shadows.and_then(|s| s.atlas_view()).ok_or_else(|| {
                     RenderError::Graph("shadow-atlas: the frame's shadows have no atlas".into())
                 })?;
-                bindings.push((12, Binding::Texture(atlas)));
+                bindings.push(Binding::Texture(atlas));
             }
             Family::ShadowLod => {
                 let table = shadows
                     .map(|s| s.lights.buffer())
                     .ok_or_else(|| RenderError::Graph("shadow-lod: the frame has no shadow table".into()))?;
-                bindings
-                    .extend([(10, Binding::Buffer(ctx.scene.lights.buffer())), (11, Binding::Buffer(table))]);
+                bindings.extend([Binding::Buffer(ctx.scene.lights.buffer()), Binding::Buffer(table)]);
             }
         }
-        let bind_group = ctx.bind_group_numbered("debug_view", &pipeline.layout, &bindings);
+        let bind_group = pipeline.layout.bind_group(ctx, &bindings);
         let output = ctx.texture(OUTPUT)?;
         let timestamps = ctx.render_timestamps(true, true);
         draw_fullscreen(ctx.encoder, "debug_view", output, timestamps, &pipeline.pipeline, &[&bind_group]);

@@ -6,6 +6,7 @@ use super::gbuffer_layout::{codec_constants, gbuffer_read_bind_group, gbuffer_re
 use super::{CLUSTERS, HDR};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::layouts::GroupLayout;
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 use crate::resources::HDR_FORMAT;
@@ -30,14 +31,14 @@ impl PipelineKey for DeferredLightingKey {
 /// The pipeline of [`DeferredLightingPass`] for one layout.
 pub struct DeferredLightingPipeline {
     pipeline: wgpu::RenderPipeline,
-    gbuffer_layout: wgpu::BindGroupLayout,
+    gbuffer_layout: GroupLayout,
 }
 
 impl DeferredLightingPipeline {
     fn new(
         device: &wgpu::Device,
-        view_layout: &wgpu::BindGroupLayout,
-        cluster_layout: &wgpu::BindGroupLayout,
+        view_layout: &GroupLayout,
+        cluster_layout: &GroupLayout,
         layout: GBufferLayout,
         codec: NormalCodec,
         defs: crate::shaders::ShaderDefs,

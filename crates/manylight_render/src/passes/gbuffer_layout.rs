@@ -5,7 +5,7 @@
 //! each pixel's shading distance before shading (`cluster_depth`, `light_refine`) read it:
 //! [`DistanceSource`].
 
-use super::common::{compute_pipeline_with_defs, texture_entry, uniform_entry};
+use super::common::compute_pipeline_with_defs;
 use super::{DEPTH, SHADING_DISTANCE};
 use super::{
     GBUFFER_ALBEDO, GBUFFER_COMPACT, GBUFFER_EMISSIVE, GBUFFER_NORMAL, GBUFFER_PACKED_ALBEDO,
@@ -14,56 +14,91 @@ use super::{
 use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{PassContext, ResourceName};
+use crate::layouts::{BindGroupDecl, BindingDecl, GroupLayout, Presence, SHADING, UNFILTERED};
 use crate::shaders::ShaderDefs;
 use crate::snapshot::GBufferLayout;
 use manylight_core::codec::NormalCodec;
 
-/// One G-buffer target: the graph resource, its format, and where the lighting passes read it
-/// (group 1 of `shaders/common/gbuffer_read.wgsl`: binding and variable name, which
-/// `tests/shaders.rs` checks against the WGSL).
+/// One G-buffer target: the graph resource, its format, and its binding in the group through
+/// which the lighting passes read it ([`GBUFFER_READ_GROUP`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct GBufferTarget {
     /// The graph resource.
     pub name: ResourceName,
     /// Its format (also the G-buffer pass's colour target).
     pub format: wgpu::TextureFormat,
-    /// Its binding in group 1 of `gbuffer_read.wgsl`.
-    pub read_binding: u32,
-    /// Its variable in `gbuffer_read.wgsl`.
-    pub wgsl_name: &'static str,
+    /// Its binding in group 1 of `gbuffer_read.wgsl`, present in the layouts that have it.
+    pub read: BindingDecl,
 }
 
+/// A target of `layout` (`None`: of every layout), read at `binding` as `wgsl_name`.
 const fn target(
     name: ResourceName,
     format: wgpu::TextureFormat,
-    read_binding: u32,
+    layout: Option<GBufferLayout>,
+    binding: u32,
     wgsl_name: &'static str,
 ) -> GBufferTarget {
-    GBufferTarget { name, format, read_binding, wgsl_name }
+    let sample_type = match format {
+        wgpu::TextureFormat::Rgba32Uint => wgpu::TextureSampleType::Uint,
+        _ => UNFILTERED,
+    };
+    let read = BindingDecl::texture(binding, wgsl_name, sample_type, SHADING);
+    let read = match layout {
+        Some(layout) => read.only(Presence::GBuffer(layout)),
+        None => read,
+    };
+    GBufferTarget { name, format, read }
 }
 
-const EMISSIVE: GBufferTarget = target(GBUFFER_EMISSIVE, wgpu::TextureFormat::Rgba16Float, 8, "gb_emissive");
+const EMISSIVE: GBufferTarget =
+    target(GBUFFER_EMISSIVE, wgpu::TextureFormat::Rgba16Float, None, 8, "gb_emissive");
 
-/// Binding of the depth buffer in group 1 of `gbuffer_read.wgsl` (`gb_depth`), every layout.
-pub const GBUFFER_READ_DEPTH_BINDING: u32 = 4;
-/// Binding of the clear colour uniform in group 1 of `gbuffer_read.wgsl` (`clear_color`).
-pub const GBUFFER_READ_CLEAR_COLOR_BINDING: u32 = 5;
+const FULL_LAYOUT: Option<GBufferLayout> = Some(GBufferLayout::Full);
+const PACKED_LAYOUT: Option<GBufferLayout> = Some(GBufferLayout::Packed);
 
 // Albedo is rgba16f, not rgba8: 8 bits (even sRGB-encoded) cost FLIP mean 0.015 against naive
 // forward where 16-bit floats give 0.0035 (docs/accuracy.md).
 const FULL: [GBufferTarget; 4] = [
-    target(GBUFFER_POSITION, wgpu::TextureFormat::Rgba32Float, 0, "gb_position"),
-    target(GBUFFER_NORMAL, wgpu::TextureFormat::Rgba16Float, 1, "gb_normal"),
-    target(GBUFFER_ALBEDO, wgpu::TextureFormat::Rgba16Float, 2, "gb_albedo"),
+    target(GBUFFER_POSITION, wgpu::TextureFormat::Rgba32Float, FULL_LAYOUT, 0, "gb_position"),
+    target(GBUFFER_NORMAL, wgpu::TextureFormat::Rgba16Float, FULL_LAYOUT, 1, "gb_normal"),
+    target(GBUFFER_ALBEDO, wgpu::TextureFormat::Rgba16Float, FULL_LAYOUT, 2, "gb_albedo"),
     EMISSIVE,
 ];
 const PACKED: [GBufferTarget; 3] = [
-    target(GBUFFER_PACKED_ALBEDO, wgpu::TextureFormat::Rgba32Float, 6, "gb_packed_albedo"),
-    target(GBUFFER_PACKED_POSITION, wgpu::TextureFormat::Rgba32Float, 7, "gb_packed_position"),
+    target(GBUFFER_PACKED_ALBEDO, wgpu::TextureFormat::Rgba32Float, PACKED_LAYOUT, 6, "gb_packed_albedo"),
+    target(GBUFFER_PACKED_POSITION, wgpu::TextureFormat::Rgba32Float, PACKED_LAYOUT, 7, "gb_packed_position"),
     EMISSIVE,
 ];
-const COMPACT: [GBufferTarget; 2] =
-    [target(GBUFFER_COMPACT, wgpu::TextureFormat::Rgba32Uint, 3, "gb_compact"), EMISSIVE];
+const COMPACT: [GBufferTarget; 2] = [
+    target(GBUFFER_COMPACT, wgpu::TextureFormat::Rgba32Uint, Some(GBufferLayout::Compact), 3, "gb_compact"),
+    EMISSIVE,
+];
+
+/// Group 1 of the passes that read the G-buffer (`shaders/common/gbuffer_read.wgsl`): the
+/// targets of the layout the shader is composed for (in [`targets`] order), then depth and the
+/// view's clear colour.
+pub static GBUFFER_READ_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "gbuffer_read",
+    entries: &[
+        FULL[0].read,
+        FULL[1].read,
+        FULL[2].read,
+        PACKED[0].read,
+        PACKED[1].read,
+        COMPACT[0].read,
+        EMISSIVE.read,
+        BindingDecl::texture(4, "gb_depth", wgpu::TextureSampleType::Depth, SHADING),
+        BindingDecl::uniform(5, "clear_color", SHADING),
+    ],
+};
+
+/// Group 1 of the passes that read each pixel's shading distance from the depth pre-pass
+/// (`cs_forward` of `cluster_depth.wgsl` and `light_refine.wgsl`).
+pub static SHADING_DISTANCE_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "shading_distance",
+    entries: &[BindingDecl::texture(9, "shading_distance", UNFILTERED, wgpu::ShaderStages::COMPUTE)],
+};
 
 /// The G-buffer targets of a layout, in the G-buffer pass's colour-target order. Every layout
 /// ends with [`GBUFFER_EMISSIVE`] (rgba16f: emitted radiance and ambient occlusion).
@@ -85,42 +120,27 @@ pub fn codec_constants(codec: NormalCodec) -> [(&'static str, f64); 1] {
     [("NORMAL_CODEC", codec.gpu_id() as f64)]
 }
 
-/// Group 1 of `common/gbuffer_read.wgsl` for a layout: its targets, depth and the clear colour.
-pub fn gbuffer_read_layout(device: &wgpu::Device, layout: GBufferLayout) -> wgpu::BindGroupLayout {
-    let float = wgpu::TextureSampleType::Float { filterable: false };
-    let mut entries: Vec<wgpu::BindGroupLayoutEntry> = targets(layout)
-        .iter()
-        .map(|t| {
-            let uint = t.format == wgpu::TextureFormat::Rgba32Uint;
-            texture_entry(t.read_binding, if uint { wgpu::TextureSampleType::Uint } else { float })
-        })
-        .collect();
-    entries.push(texture_entry(GBUFFER_READ_DEPTH_BINDING, wgpu::TextureSampleType::Depth));
-    let stages = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
-    entries.push(uniform_entry(GBUFFER_READ_CLEAR_COLOR_BINDING, stages));
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("gbuffer_read"),
-        entries: &entries,
-    })
+/// The layout of [`GBUFFER_READ_GROUP`] for G-buffer `layout`.
+pub fn gbuffer_read_layout(device: &wgpu::Device, layout: GBufferLayout) -> GroupLayout {
+    GBUFFER_READ_GROUP.create_layout(device, ShaderDefs::default().with_gbuffer(layout))
 }
 
 /// A bind group for [`gbuffer_read_layout`]: the frame's G-buffer targets, depth and
 /// `clear_color` (linear RGB).
 pub fn gbuffer_read_bind_group(
     ctx: &PassContext<'_>,
-    bind_group_layout: &wgpu::BindGroupLayout,
+    bind_group_layout: &GroupLayout,
     layout: GBufferLayout,
     clear_color: [f32; 3],
 ) -> Result<wgpu::BindGroup, RenderError> {
     let [r, g, b] = clear_color;
     let clear = ctx.uniform(("gbuffer_clear_color", 0), bytemuck::cast_slice(&[r, g, b, 1.0f32]));
-    let mut bindings = Vec::new();
+    let mut resources = Vec::new();
     for t in targets(layout) {
-        bindings.push((t.read_binding, Binding::Texture(ctx.texture(t.name)?)));
+        resources.push(Binding::Texture(ctx.texture(t.name)?));
     }
-    bindings.push((GBUFFER_READ_DEPTH_BINDING, Binding::Texture(ctx.texture(DEPTH)?)));
-    bindings.push((GBUFFER_READ_CLEAR_COLOR_BINDING, Binding::Buffer(&clear)));
-    Ok(ctx.bind_group_numbered("gbuffer_read", bind_group_layout, &bindings))
+    resources.extend([Binding::Texture(ctx.texture(DEPTH)?), Binding::Buffer(&clear)]);
+    Ok(bind_group_layout.bind_group(ctx, &resources))
 }
 
 /// Where a pass reads each pixel's shading distance (the `cluster_depth` and `light_refine`
@@ -158,14 +178,10 @@ impl DistanceSource {
     pub fn layout(
         self,
         device: &wgpu::Device,
-    ) -> (wgpu::BindGroupLayout, &'static str, [(&'static str, f64); 1], ShaderDefs) {
+    ) -> (GroupLayout, &'static str, [(&'static str, f64); 1], ShaderDefs) {
         match self {
             DistanceSource::Prepass => {
-                let unfilterable = wgpu::TextureSampleType::Float { filterable: false };
-                let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                    label: Some("shading_distance"),
-                    entries: &[texture_entry(9, unfilterable)],
-                });
+                let layout = SHADING_DISTANCE_GROUP.create_layout(device, ShaderDefs::default());
                 (layout, "cs_forward", codec_constants(NormalCodec::Octa16), ShaderDefs::default())
             }
             DistanceSource::GBuffer(layout, codec) => (
@@ -182,15 +198,13 @@ impl DistanceSource {
     pub fn bind_group(
         self,
         ctx: &PassContext<'_>,
-        layout: &wgpu::BindGroupLayout,
+        layout: &GroupLayout,
         clear_color: [f32; 3],
     ) -> Result<wgpu::BindGroup, RenderError> {
         match self {
-            DistanceSource::Prepass => Ok(ctx.bind_group_numbered(
-                "shading_distance",
-                layout,
-                &[(9, Binding::Texture(ctx.texture(SHADING_DISTANCE)?))],
-            )),
+            DistanceSource::Prepass => {
+                Ok(layout.bind_group(ctx, &[Binding::Texture(ctx.texture(SHADING_DISTANCE)?)]))
+            }
             DistanceSource::GBuffer(g, _) => gbuffer_read_bind_group(ctx, layout, g, clear_color),
         }
     }
@@ -203,7 +217,7 @@ pub struct DistancePipeline {
     /// The pipeline.
     pub pipeline: wgpu::ComputePipeline,
     /// Layout of group 1 (the source).
-    pub source_layout: wgpu::BindGroupLayout,
+    pub source_layout: GroupLayout,
 }
 
 impl DistancePipeline {
@@ -212,7 +226,7 @@ impl DistancePipeline {
         device: &wgpu::Device,
         shader: &str,
         label: &str,
-        [view_layout, pass_layout]: [&wgpu::BindGroupLayout; 2],
+        [view_layout, pass_layout]: [&GroupLayout; 2],
         source: DistanceSource,
     ) -> Result<Self, RenderError> {
         let (source_layout, entry, constants, defs) = source.layout(device);

@@ -67,9 +67,8 @@ impl Pass for LightRefinePass {
             },
         )?;
         let source = self.source.bind_group(ctx, &pipeline.source_layout, self.clear_color)?;
-        let lists = ctx.bind_group(
-            "light_refine",
-            &clusters.refine_layout,
+        let lists = clusters.refine_layout.bind_group(
+            ctx,
             &[
                 Binding::Buffer(&clusters.params_buffer),
                 Binding::Buffer(clusters.spheres.buffer()),

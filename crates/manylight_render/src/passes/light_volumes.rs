@@ -4,7 +4,7 @@
 //! per light, camera inside the sphere and far-plane crossing included).
 
 use super::common::{
-    FullscreenPipelineDesc, fullscreen_pipeline_desc, fullscreen_pipeline_with_defs, texture_entry,
+    FullscreenPipelineDesc, fullscreen_pipeline_desc, fullscreen_pipeline_with_defs, pipeline_layout,
 };
 use super::common::{clear_color, color_attachment, draw_fullscreen};
 use super::gbuffer_layout::{codec_constants, gbuffer_read_bind_group, gbuffer_read_layout, targets};
@@ -12,6 +12,7 @@ use super::{DEPTH, HDR, LIGHT_ACCUM};
 use crate::bindings::Binding;
 use crate::context::{GpuContext, RenderError};
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::layouts::{BindGroupDecl, BindingDecl, GroupLayout, UNFILTERED, check_pipeline};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 use crate::resources::{DEPTH_FORMAT, HDR_FORMAT};
@@ -39,13 +40,20 @@ impl PipelineKey for LightVolumesKey {
     type Pipeline = LightVolumesPipeline;
 }
 
+/// Group 2 of the resolve (`fs_resolve` of `shaders/light_volumes.wgsl`): the f32 sum of the
+/// lights.
+pub static ACCUM_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "light_accum",
+    entries: &[BindingDecl::texture(0, "light_accum", UNFILTERED, wgpu::ShaderStages::FRAGMENT)],
+};
+
 /// The pipelines and proxy mesh of [`LightVolumesPass`] for one layout and codec.
 pub struct LightVolumesPipeline {
     ambient: wgpu::RenderPipeline,
     volume: wgpu::RenderPipeline,
     /// Copies the f32 sum into HDR (only with an f32 accumulation target).
-    resolve: Option<(wgpu::RenderPipeline, wgpu::BindGroupLayout)>,
-    gbuffer_layout: wgpu::BindGroupLayout,
+    resolve: Option<(wgpu::RenderPipeline, GroupLayout)>,
+    gbuffer_layout: GroupLayout,
     vertices: wgpu::Buffer,
     indices: wgpu::Buffer,
     index_count: u32,
@@ -54,7 +62,7 @@ pub struct LightVolumesPipeline {
 impl LightVolumesPipeline {
     fn new(
         gpu: &GpuContext,
-        view_layout: &wgpu::BindGroupLayout,
+        view_layout: &GroupLayout,
         layout: GBufferLayout,
         codec: NormalCodec,
         accumulation: wgpu::TextureFormat,
@@ -64,11 +72,8 @@ impl LightVolumesPipeline {
         let module =
             crate::shaders::create_module_with(device, "light_volumes.wgsl", defs.with_gbuffer(layout))?;
         let gbuffer_layout = gbuffer_read_layout(device, layout);
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("light_volumes"),
-            bind_group_layouts: &[Some(view_layout), Some(&gbuffer_layout)],
-            immediate_size: 0,
-        });
+        check_pipeline("light_volumes.wgsl", &["vs_volume", "fs_volume"], &[view_layout, &gbuffer_layout])?;
+        let pipeline_layout = pipeline_layout(device, "light_volumes", &[view_layout, &gbuffer_layout]);
         let constants = codec_constants(codec);
         let options = || wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
         let depth = |compare| {
@@ -141,10 +146,7 @@ impl LightVolumesPipeline {
             cache: None,
         });
         let resolve = if accumulation != HDR_FORMAT {
-            let accum_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("light_accum"),
-                entries: &[texture_entry(0, wgpu::TextureSampleType::Float { filterable: false })],
-            });
+            let accum_layout = ACCUM_GROUP.create_layout(device, defs);
             let layouts = [view_layout, &gbuffer_layout, &accum_layout];
             let pipeline = fullscreen_pipeline_desc(
                 device,
@@ -255,7 +257,7 @@ impl Pass for LightVolumesPass {
         let target = if self.accumulates_separately() { ctx.texture(LIGHT_ACCUM)? } else { hdr };
         let depth = ctx.texture(DEPTH)?;
         let resolve = pipeline.resolve.as_ref().map(|(resolve, accum_layout)| {
-            let accum = ctx.bind_group("light_accum", accum_layout, &[Binding::Texture(target)]);
+            let accum = accum_layout.bind_group(ctx, &[Binding::Texture(target)]);
             (resolve, accum)
         });
         let timestamps = ctx.render_timestamps(true, resolve.is_none());

@@ -12,13 +12,12 @@
 //! not move (a still camera, or the first frame, which has no previous matrix) the pass records
 //! nothing at all: the image is the unblurred one and costs no GPU time.
 
-use super::common::{
-    FullscreenPipelineDesc, draw_fullscreen, fullscreen_pipeline_desc, texture_entry, uniform_entry,
-};
+use super::common::{FullscreenPipelineDesc, draw_fullscreen, fullscreen_pipeline_desc};
 use super::{DEPTH, HDR, post_process_texture};
 use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::layouts::{BindGroupDecl, BindingDecl, GroupLayout, UNFILTERED};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 use crate::resources::HDR_FORMAT;
@@ -44,25 +43,29 @@ impl PipelineKey for MotionBlurKey {
     type Pipeline = MotionBlurPipeline;
 }
 
+const FRAGMENT: wgpu::ShaderStages = wgpu::ShaderStages::FRAGMENT;
+
+/// Motion blur's bind group (`shaders/motion_blur.wgsl`): the view uniform (this and last
+/// frame's matrices), the blur's parameters, the HDR image and depth.
+pub static MOTION_BLUR_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "motion_blur",
+    entries: &[
+        BindingDecl::uniform(0, "view", FRAGMENT),
+        BindingDecl::uniform(1, "params", FRAGMENT),
+        BindingDecl::texture(2, "hdr", UNFILTERED, FRAGMENT),
+        BindingDecl::texture(3, "depth", wgpu::TextureSampleType::Depth, FRAGMENT),
+    ],
+};
+
 /// The pipeline of [`MotionBlurPass`] for one tap count.
 struct MotionBlurPipeline {
     blur: wgpu::RenderPipeline,
-    blur_layout: wgpu::BindGroupLayout,
+    blur_layout: GroupLayout,
 }
 
 impl MotionBlurPipeline {
     fn new(device: &wgpu::Device, samples: u32) -> Result<Self, RenderError> {
-        let fragment = wgpu::ShaderStages::FRAGMENT;
-        let unfiltered = wgpu::TextureSampleType::Float { filterable: false };
-        let blur_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("motion_blur"),
-            entries: &[
-                uniform_entry(0, fragment),
-                uniform_entry(1, fragment),
-                texture_entry(2, unfiltered),
-                texture_entry(3, wgpu::TextureSampleType::Depth),
-            ],
-        });
+        let blur_layout = MOTION_BLUR_GROUP.create_layout(device, Default::default());
         let blur = fullscreen_pipeline_desc(
             device,
             &FullscreenPipelineDesc {
@@ -130,9 +133,8 @@ impl Pass for MotionBlurPass {
         let params = ctx.uniform(("motion_blur", 0), bytemuck::bytes_of(&params));
         let depth = ctx.texture(DEPTH)?;
         let target = ctx.post_process_write()?;
-        let blur_group = ctx.bind_group(
-            "motion_blur",
-            &pipeline.blur_layout,
+        let blur_group = pipeline.blur_layout.bind_group(
+            ctx,
             &[
                 Binding::Buffer(&ctx.scene.view_buffer),
                 Binding::Buffer(&params),

@@ -3,14 +3,28 @@
 //! atlas keeps other maps, it loads the atlas and first clears the tiles it draws.
 
 use super::SHADOW_ATLAS;
-use super::common::vertex_layout;
+use super::common::{pipeline_layout, vertex_layout};
 use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName};
+use crate::layouts::{BindGroupDecl, BindingDecl, GroupLayout, check_pipeline};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 use crate::shaders::ShaderDefs;
 use crate::shadows::SHADOW_ATLAS_FORMAT;
+
+const VERTEX: wgpu::ShaderStages = wgpu::ShaderStages::VERTEX;
+
+/// The shadow pass's bind group (`shaders/shadow_maps.wgsl`): the faces drawn, the draws (an
+/// instance's faces) and the instances.
+pub static SHADOW_MAPS_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "shadow_maps",
+    entries: &[
+        BindingDecl::storage(0, "shadow_faces", VERTEX),
+        BindingDecl::storage(1, "shadow_draws", VERTEX),
+        BindingDecl::storage(2, "instances", VERTEX),
+    ],
+};
 
 /// The shadow pass's pipeline: with clip distances where the device has them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -32,23 +46,16 @@ pub struct ShadowMapsPipeline {
     pipeline: wgpu::RenderPipeline,
     /// Clears the tiles of the faces drawn (`vs_clear`).
     clear: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
+    layout: GroupLayout,
 }
 
 impl ShadowMapsPipeline {
     fn new(device: &wgpu::Device, key: &ShadowMapsKey) -> Result<Self, RenderError> {
-        let storage = |binding| crate::layouts::storage_entry(binding, wgpu::ShaderStages::VERTEX, true);
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("shadow_maps"),
-            entries: &[storage(0), storage(1), storage(2)],
-        });
+        let layout = SHADOW_MAPS_GROUP.create_layout(device, Default::default());
+        check_pipeline("shadow_maps.wgsl", &["vs_main", "fs_main", "vs_clear"], &[&layout])?;
         let defs = ShaderDefs { clip_distances: key.clip_distances, ..Default::default() };
         let module = crate::shaders::create_module_with(device, "shadow_maps.wgsl", defs)?;
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("shadow_maps"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+        let pipeline_layout = pipeline_layout(device, "shadow_maps", &[&layout]);
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("shadow_maps"),
             layout: Some(&pipeline_layout),
@@ -133,9 +140,8 @@ impl Pass for ShadowMapsPass {
             ShadowMapsKey { clip_distances: shadows.clip_distances, clamps_depth: shadows.clamps_depth };
         let device = &ctx.gpu.device;
         let pipeline = ctx.pipelines.get_or_create(key, |k| ShadowMapsPipeline::new(device, k))?;
-        let bind_group = ctx.bind_group(
-            "shadow_maps",
-            &pipeline.layout,
+        let bind_group = pipeline.layout.bind_group(
+            ctx,
             &[
                 Binding::Buffer(shadows.faces.buffer()),
                 Binding::Buffer(shadows.draws.buffer()),

@@ -8,6 +8,7 @@ use super::{CLUSTERS, HDR};
 use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::layouts::{BindGroupDecl, BindingDecl, BindingKind, GroupLayout};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 use crate::resources::HDR_FORMAT;
@@ -29,36 +30,35 @@ impl PipelineKey for TiledDeferredKey {
     type Pipeline = TiledDeferredPipeline;
 }
 
+/// Group 3 of tiled deferred (`shaders/tiled_deferred.wgsl`): the HDR image it writes.
+pub static OUTPUT_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "tiled_deferred_output",
+    entries: &[BindingDecl::new(
+        0,
+        "hdr_out",
+        BindingKind::StorageTexture(HDR_FORMAT),
+        wgpu::ShaderStages::COMPUTE,
+    )],
+};
+
 /// The compute pipeline of [`TiledDeferredPass`] for one layout.
 pub struct TiledDeferredPipeline {
     pipeline: wgpu::ComputePipeline,
-    gbuffer_layout: wgpu::BindGroupLayout,
-    output_layout: wgpu::BindGroupLayout,
+    gbuffer_layout: GroupLayout,
+    output_layout: GroupLayout,
 }
 
 impl TiledDeferredPipeline {
     fn new(
         device: &wgpu::Device,
-        view_layout: &wgpu::BindGroupLayout,
-        cluster_layout: &wgpu::BindGroupLayout,
+        view_layout: &GroupLayout,
+        cluster_layout: &GroupLayout,
         layout: GBufferLayout,
         codec: NormalCodec,
         defs: crate::shaders::ShaderDefs,
     ) -> Result<Self, RenderError> {
         let gbuffer_layout = gbuffer_read_layout(device, layout);
-        let output_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("tiled_deferred_output"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::StorageTexture {
-                    access: wgpu::StorageTextureAccess::WriteOnly,
-                    format: HDR_FORMAT,
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                },
-                count: None,
-            }],
-        });
+        let output_layout = OUTPUT_GROUP.create_layout(device, defs);
         let layouts = [view_layout, &gbuffer_layout, cluster_layout, &output_layout];
         let constants = codec_constants(codec);
         let pipeline = compute_pipeline_with_defs(
@@ -142,11 +142,7 @@ impl Pass for TiledDeferredPass {
             },
         )?;
         let gbuffer = gbuffer_read_bind_group(ctx, &pipeline.gbuffer_layout, layout, self.clear_color)?;
-        let output = ctx.bind_group(
-            "tiled_deferred_output",
-            &pipeline.output_layout,
-            &[Binding::Texture(ctx.texture(HDR)?)],
-        );
+        let output = pipeline.output_layout.bind_group(ctx, &[Binding::Texture(ctx.texture(HDR)?)]);
         let timestamps = ctx.compute_timestamps(true, true);
         let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("tiled_deferred"),

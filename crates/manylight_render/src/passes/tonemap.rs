@@ -1,15 +1,29 @@
 //! Tone map: HDR colour × exposure through the ACES fit into the output (sRGB) target.
 
 use super::HDR;
-use super::common::{draw_fullscreen, fullscreen_pipeline, storage_entry, texture_entry, uniform_entry};
+use super::common::{draw_fullscreen, fullscreen_pipeline};
 use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{OUTPUT, Pass, PassContext, ResourceName};
+use crate::layouts::{BindGroupDecl, BindingDecl, GroupLayout, UNFILTERED};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 
 /// The tone map's pass name (the renderer reads the non-finite count after it ran).
 pub const TONEMAP: &str = "tonemap";
+
+const FRAGMENT: wgpu::ShaderStages = wgpu::ShaderStages::FRAGMENT;
+
+/// The tone map's bind group (`shaders/tonemap.wgsl`): the view uniform (exposure), the HDR
+/// image and the counter of non-finite pixels.
+pub static TONEMAP_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "tonemap",
+    entries: &[
+        BindingDecl::uniform(0, "view", FRAGMENT),
+        BindingDecl::texture(1, "hdr", UNFILTERED, FRAGMENT),
+        BindingDecl::storage_rw(2, "nonfinite_pixels", FRAGMENT),
+    ],
+};
 
 /// The tone map's pipeline: one per output format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -25,19 +39,12 @@ impl PipelineKey for TonemapKey {
 /// The pipeline of [`TonemapPass`] for one output format.
 pub struct TonemapPipeline {
     pipeline: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
+    layout: GroupLayout,
 }
 
 impl TonemapPipeline {
     fn new(device: &wgpu::Device, output: wgpu::TextureFormat) -> Result<Self, RenderError> {
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("tonemap"),
-            entries: &[
-                uniform_entry(0, wgpu::ShaderStages::FRAGMENT),
-                texture_entry(1, wgpu::TextureSampleType::Float { filterable: false }),
-                storage_entry(2, wgpu::ShaderStages::FRAGMENT, false),
-            ],
-        });
+        let layout = TONEMAP_GROUP.create_layout(device, Default::default());
         let pipeline = fullscreen_pipeline(device, "tonemap", "tonemap.wgsl", &[&layout], "fs_main", output)?;
         Ok(TonemapPipeline { pipeline, layout })
     }
@@ -62,9 +69,8 @@ impl Pass for TonemapPass {
         let device = &ctx.gpu.device;
         let pipeline =
             ctx.pipelines.get_or_create(TonemapKey { format }, |k| TonemapPipeline::new(device, k.format))?;
-        let bind_group = ctx.bind_group(
-            "tonemap",
-            &pipeline.layout,
+        let bind_group = pipeline.layout.bind_group(
+            ctx,
             &[
                 Binding::Buffer(&ctx.scene.view_buffer),
                 Binding::Texture(ctx.texture(HDR)?),

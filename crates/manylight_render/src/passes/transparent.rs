@@ -9,6 +9,7 @@ use super::scene_draw::{ScenePipeline, blended_variant_pipelines, draw_in_order}
 use super::{CLUSTERS, DEPTH, HDR};
 use crate::context::RenderError;
 use crate::graph::{Pass, PassContext, ResourceName};
+use crate::layouts::GroupLayout;
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 use crate::resources::{HDR_FORMAT, SurfaceVariant};
@@ -34,7 +35,7 @@ pub struct TransparentPipeline {
 impl TransparentPipeline {
     fn new(
         device: &wgpu::Device,
-        layouts: &[&wgpu::BindGroupLayout],
+        layouts: &[&GroupLayout],
         key: &TransparentKey,
     ) -> Result<Self, RenderError> {
         let pipeline = mesh_pipeline(
