@@ -131,7 +131,7 @@ impl Pass for ClusterBuildPass {
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
         let clusters = ctx.require_clusters("cluster_build")?;
         let wg = self.workgroup_size.clamp(1, 1024);
-        let layout = &clusters.build_layout;
+        let layout = &clusters.bindings.build_layout;
         let pipelines = ctx.pipelines.get_or_create(ClusterBuildKey { workgroup_size: wg }, |k| {
             ClusterBuildPipelines::new(&ctx.gpu.device, layout, k.workgroup_size)
         })?;
@@ -162,7 +162,7 @@ impl Pass for ClusterBuildPass {
                 label: Some("cluster_build"),
                 timestamp_writes: timestamps,
             });
-            pass.set_bind_group(0, &clusters.build_bind_group, &[]);
+            pass.set_bind_group(0, &clusters.bindings.build_group, &[]);
             // The steps of the build (shaders/cluster_build.wgsl), in order; the scans run as
             // one workgroup.
             // Levels 0 and 1 per (coarse) tile, or from the lights' side where their bits fit.

@@ -59,19 +59,20 @@ impl Pass for ClusterDepthPass {
                     device,
                     "cluster_depth.wgsl",
                     "cluster_depth",
-                    [&scene.view_layout, &clusters.depth_layout],
+                    [&scene.view_layout, &clusters.bindings.depth_layout],
                     k.source,
                 )
             },
         )?;
         let source = self.source.bind_group(ctx, &pipeline.source_layout, self.clear_color)?;
         // Zero the depth ranges (no pixel yet), which follow the cluster ranges.
-        let ranges = clusters.ranges.buffer();
+        let ranges = clusters.buffers.ranges.buffer();
         let bytes = u64::from(clusters.params.dims[3]) * 8;
         ctx.encoder.clear_buffer(ranges, bytes, Some(bytes));
         let depths = clusters
+            .bindings
             .depth_layout
-            .bind_group(ctx, &[Binding::Buffer(&clusters.params_buffer), Binding::Buffer(ranges)]);
+            .bind_group(ctx, &[Binding::Buffer(&clusters.buffers.params), Binding::Buffer(ranges)]);
         let depth = ctx.texture(DEPTH)?.texture();
         let groups = [depth.width().div_ceil(8), depth.height().div_ceil(8)];
         let timestamps = ctx.compute_timestamps(true, true);

@@ -102,7 +102,7 @@ impl Pass for ClusteredForwardPass {
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
         let scene = ctx.scene;
         let clusters = ctx.require_clusters("clustered_forward")?;
-        let layouts = [&scene.view_layout, &scene.assets.material_layout, &clusters.shading_layout];
+        let layouts = [&scene.view_layout, &scene.assets.material_layout, &clusters.bindings.lists_layout];
         let after = self.after_prepass;
         let pipelines = variant_pipelines(
             ctx,
@@ -111,7 +111,7 @@ impl Pass for ClusteredForwardPass {
         )?;
         let color = color_attachment(ctx.texture(HDR)?, clear_color(self.clear_color));
         let depth = ctx.texture(DEPTH)?;
-        let extra = [&clusters.shading_bind_group];
+        let extra = [&clusters.bindings.lists_group];
         record_scene_pass(ctx, "clustered_forward", &[color], depth, !after, &pipelines, &extra);
         Ok(())
     }

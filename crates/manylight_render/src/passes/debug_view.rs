@@ -233,8 +233,8 @@ impl Pass for DebugViewPass {
             Family::Clusters => {
                 let clusters = ctx.require_clusters("debug_view")?;
                 bindings.extend([
-                    Binding::Buffer(&clusters.params_buffer),
-                    Binding::Buffer(clusters.ranges.buffer()),
+                    Binding::Buffer(&clusters.buffers.params),
+                    Binding::Buffer(clusters.buffers.ranges.buffer()),
                 ]);
             }
             Family::Depth => {}

@@ -105,7 +105,7 @@ impl Pass for DeferredLightingPass {
                 DeferredLightingPipeline::new(
                     device,
                     view_layout,
-                    &clusters.shading_layout,
+                    &clusters.bindings.lists_layout,
                     k.layout,
                     k.codec,
                     defs,
@@ -115,7 +115,7 @@ impl Pass for DeferredLightingPass {
         let gbuffer = gbuffer_read_bind_group(ctx, &pipeline.gbuffer_layout, layout, self.clear_color)?;
         let hdr = ctx.texture(HDR)?;
         let timestamps = ctx.render_timestamps(true, true);
-        let groups = [&ctx.scene.view_bind_group, &gbuffer, &clusters.shading_bind_group];
+        let groups = [&ctx.scene.view_bind_group, &gbuffer, &clusters.bindings.lists_group];
         draw_fullscreen(ctx.encoder, "deferred_lighting", hdr, timestamps, &pipeline.pipeline, &groups);
         Ok(())
     }

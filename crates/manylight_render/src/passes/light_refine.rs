@@ -61,19 +61,19 @@ impl Pass for LightRefinePass {
                     device,
                     "light_refine.wgsl",
                     "light_refine",
-                    [&scene.view_layout, &clusters.refine_layout],
+                    [&scene.view_layout, &clusters.bindings.refine_layout],
                     k.source,
                 )
             },
         )?;
         let source = self.source.bind_group(ctx, &pipeline.source_layout, self.clear_color)?;
-        let lists = clusters.refine_layout.bind_group(
+        let lists = clusters.bindings.refine_layout.bind_group(
             ctx,
             &[
-                Binding::Buffer(&clusters.params_buffer),
-                Binding::Buffer(clusters.spheres.buffer()),
-                Binding::Buffer(clusters.ranges.buffer()),
-                Binding::Buffer(clusters.indices.buffer()),
+                Binding::Buffer(&clusters.buffers.params),
+                Binding::Buffer(clusters.buffers.spheres.buffer()),
+                Binding::Buffer(clusters.buffers.ranges.buffer()),
+                Binding::Buffer(clusters.buffers.indices.buffer()),
             ],
         );
         let p = &clusters.params;

@@ -134,7 +134,7 @@ impl Pass for TiledDeferredPass {
                 TiledDeferredPipeline::new(
                     device,
                     view_layout,
-                    &clusters.shading_layout,
+                    &clusters.bindings.lists_layout,
                     k.layout,
                     k.codec,
                     defs,
@@ -149,7 +149,7 @@ impl Pass for TiledDeferredPass {
             timestamp_writes: timestamps,
         });
         pass.set_pipeline(&pipeline.pipeline);
-        for (i, group) in [&ctx.scene.view_bind_group, &gbuffer, &clusters.shading_bind_group, &output]
+        for (i, group) in [&ctx.scene.view_bind_group, &gbuffer, &clusters.bindings.lists_group, &output]
             .into_iter()
             .enumerate()
         {

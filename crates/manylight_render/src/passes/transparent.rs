@@ -91,7 +91,7 @@ impl Pass for TransparentPass {
             None
         };
         let mut layouts = vec![&scene.view_layout, &scene.assets.material_layout];
-        layouts.extend(clusters.map(|c| &c.shading_layout));
+        layouts.extend(clusters.map(|c| &c.bindings.lists_layout));
         let clustered = self.clustered;
         let pipelines = blended_variant_pipelines(
             ctx,
@@ -116,7 +116,7 @@ impl Pass for TransparentPass {
         });
         pass.set_bind_group(0, &scene.view_bind_group, &[]);
         if let Some(c) = clusters {
-            pass.set_bind_group(2, &c.shading_bind_group, &[]);
+            pass.set_bind_group(2, &c.bindings.lists_group, &[]);
         }
         draw_in_order(&mut pass, scene, &pipelines, scene.blended.iter().map(|&i| &scene.draws[i]));
         Ok(())

@@ -5,16 +5,12 @@
 //! The bounds come from `manylight_core::cluster` (the same numbers the CPU reference uses),
 //! so GPU and CPU assignments can be compared light for light.
 
-use crate::bindings::Binding;
 use crate::context::{GpuContext, RenderError};
 use crate::gpu_types::{
     CLUSTER_NO_CAP, COARSE_SCATTER_TILES, CULL_AABB, CULL_BOTH, CULL_PLANES, GpuClusterBounds,
     GpuClusterCounters, GpuClusterParams, REFINE_EDGE, REFINED_LIST_SLOTS, TILE_LIGHT_CHUNK,
 };
-use crate::layouts::{BindGroupDecl, BindingDecl, GroupLayout, SHADING};
-use crate::pool::GrowableBuffer;
 use crate::readback::read_buffer;
-use crate::shaders::ShaderDefs;
 use crate::snapshot::RenderView;
 use glam::Mat4;
 use manylight_core::Projection;
@@ -23,6 +19,15 @@ use manylight_core::cluster::{
     coarse_tiles, to_view_space,
 };
 use serde::Serialize;
+
+mod bindings;
+mod buffers;
+
+pub use bindings::{
+    CLUSTER_BUILD_GROUP, CLUSTER_DEPTH_GROUP, CLUSTER_LISTS_GROUP, ClusterBindings, LIGHT_REFINE_GROUP,
+};
+use buffers::COUNTER_BYTES;
+pub use buffers::{ClusterBuffers, INITIAL_INDEX_CAPACITY, INITIAL_TILE_INDEX_CAPACITY};
 
 /// What the cluster build reported for a frame (in `FrameReport::clusters`).
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
@@ -150,99 +155,20 @@ impl RefinedLists {
     }
 }
 
-const COMPUTE: wgpu::ShaderStages = wgpu::ShaderStages::COMPUTE;
-
-/// Group 0 of the cluster build (`shaders/cluster_build.wgsl`): the parameters, the cluster
-/// bounds and light spheres it reads, the lists it writes, its counters, and the per-tile
-/// bounds and lists.
-pub static CLUSTER_BUILD_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "cluster_build",
-    entries: &[
-        BindingDecl::uniform(0, "params", COMPUTE),
-        BindingDecl::storage(1, "bounds", COMPUTE),
-        BindingDecl::storage(2, "spheres", COMPUTE),
-        BindingDecl::storage_rw(3, "ranges", COMPUTE),
-        BindingDecl::storage_rw(4, "indices", COMPUTE),
-        BindingDecl::storage_rw(5, "build", COMPUTE),
-        BindingDecl::storage(6, "tile_bounds", COMPUTE),
-        BindingDecl::storage_rw(7, "tile_ranges", COMPUTE),
-        BindingDecl::storage_rw(8, "tile_indices", COMPUTE),
-    ],
-};
-
-/// Group 2 of the passes that shade through the cluster lists (`common/cluster_lists.wgsl`,
-/// `tiled_deferred.wgsl`): the parameters, each cluster's range and the light indices.
-pub static CLUSTER_LISTS_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "cluster_lists",
-    entries: &[
-        BindingDecl::uniform(0, "cluster_params", SHADING),
-        BindingDecl::storage(1, "cluster_ranges", SHADING),
-        BindingDecl::storage(2, "cluster_indices", SHADING),
-    ],
-};
-
-/// Group 2 of the `cluster_depth` pass (`shaders/cluster_depth.wgsl`): the parameters, and the
-/// ranges buffer, whose per-cluster depth ranges it writes after the cluster ranges.
-pub static CLUSTER_DEPTH_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "cluster_depth",
-    entries: &[
-        BindingDecl::storage(0, "cluster_params", COMPUTE),
-        BindingDecl::storage_rw(1, "cluster_depths", COMPUTE),
-    ],
-};
-
-/// Group 2 of the `light_refine` pass (`shaders/light_refine.wgsl`): the parameters, the light
-/// spheres, and the ranges and index buffers, whose refined part it writes.
-pub static LIGHT_REFINE_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "light_refine",
-    entries: &[
-        BindingDecl::storage(0, "cluster_params", COMPUTE),
-        BindingDecl::storage(1, "spheres", COMPUTE),
-        BindingDecl::storage_rw(2, "ranges", COMPUTE),
-        BindingDecl::storage_rw(3, "indices", COMPUTE),
-    ],
-};
-
 /// GPU buffers and bind groups of the cluster build and of clustered shading.
 pub struct ClusterResources {
     /// The grid of the current frame.
     pub grid: ClusterGrid,
     /// The parameters uploaded this frame.
     pub params: GpuClusterParams,
-    /// Layout of the build's group 0 ([`CLUSTER_BUILD_GROUP`]).
-    pub build_layout: GroupLayout,
-    /// Layout of the shading passes' cluster group ([`CLUSTER_LISTS_GROUP`]).
-    pub shading_layout: GroupLayout,
-    /// Layout of group 2 of the `cluster_depth` pass ([`CLUSTER_DEPTH_GROUP`]).
-    pub depth_layout: GroupLayout,
-    /// Layout of group 2 of the `light_refine` pass ([`LIGHT_REFINE_GROUP`]).
-    pub refine_layout: GroupLayout,
-    /// Group 0 of the build.
-    pub build_bind_group: wgpu::BindGroup,
-    /// The shading group.
-    pub shading_bind_group: wgpu::BindGroup,
-    /// The params uniform.
-    pub params_buffer: wgpu::Buffer,
-    /// Per-cluster `(offset, count)`, then (with depth bounds) per-cluster depth ranges
-    /// (`shaders/cluster_depth.wgsl`), then (with refined lists) per-block ranges
-    /// (`shaders/light_refine.wgsl`).
-    pub ranges: GrowableBuffer,
-    /// The light-index list: the cluster lists (`GpuClusterParams::index_capacity` entries),
-    /// then (with refined lists) `REFINED_LIST_SLOTS` entries per block.
-    pub indices: GrowableBuffer,
-    bounds: GrowableBuffer,
-    /// The lights' view-space spheres (centre, radius).
-    pub spheres: GrowableBuffer,
-    /// Bounds of the tile columns, then of the coarse tiles.
-    tile_bounds: GrowableBuffer,
-    /// (tile, chunk) ranges, then (coarse tile, chunk) ranges.
-    tile_ranges: GrowableBuffer,
-    /// The per-tile lists (`GpuClusterParams::tile_index_capacity` entries), then the
-    /// per-coarse-tile lists (`tile_list_split`).
-    tile_indices: GrowableBuffer,
-    /// The counters (`GpuClusterCounters`), then the bits of levels 0 and 1 when the build sets
-    /// them from the lights' side this frame (`coarse_bits`).
-    counters: GrowableBuffer,
+    /// The buffers of the build and of the lists.
+    pub buffers: ClusterBuffers,
+    /// The layouts and bind groups over [`Self::buffers`].
+    pub bindings: ClusterBindings,
+    /// The CPU bound that sizes the lists before submission.
+    sizing: ListSizing,
+    /// The view-space spheres uploaded this frame (for the CPU reference in tests and stats).
+    pub view_spheres: Vec<ViewSphere>,
     /// Levels 0 and 1 of the build run from the lights' side this frame (`grid_allows_bits`,
     /// `bits_fit`, `size_bits`).
     from_lights: bool,
@@ -250,9 +176,16 @@ pub struct ClusterResources {
     bounds_of: Option<(ClusterGrid, Option<u32>)>,
     /// Tiles per coarse-tile edge this frame, `None` without a coarse level.
     coarse: Option<u32>,
-    generations: [u64; 8],
-    /// The view-space spheres uploaded this frame (for the CPU reference in tests and stats).
-    pub view_spheres: Vec<ViewSphere>,
+    cull: CullTest,
+    /// The build cuts clusters to their pixels' depth range this frame.
+    depth_bounds: bool,
+    /// Blocks across and down of this frame's refined lists, `None` without them.
+    refine_blocks: Option<glam::UVec2>,
+}
+
+/// The CPU bound of the list sizes, and what it keeps between frames.
+#[derive(Default)]
+struct ListSizing {
     /// The lights some tile can list this frame, ascending (`list_bounds`): level 0 from the
     /// lights' side marks these only. Uploaded after the spheres.
     listed: Vec<u32>,
@@ -263,13 +196,9 @@ pub struct ClusterResources {
     sphere_upload: Vec<[f32; 4]>,
     /// This frame's CPU bounds of the list sizes, which the lists were sized to before it was
     /// submitted.
-    pub bounds_estimate: ListBounds,
-    bound_cpu_ms: f64,
-    cull: CullTest,
-    /// The build cuts clusters to their pixels' depth range this frame.
-    depth_bounds: bool,
-    /// Blocks across and down of this frame's refined lists, `None` without them.
-    refine_blocks: Option<glam::UVec2>,
+    estimate: ListBounds,
+    /// CPU time of this frame's bound.
+    cpu_ms: f64,
 }
 
 /// Chunks of [`TILE_LIGHT_CHUNK`] lights that `lights` lights take, at least 1.
@@ -277,151 +206,24 @@ fn light_chunks_of(lights: usize) -> u32 {
     u32::try_from(lights).unwrap_or(u32::MAX).div_ceil(TILE_LIGHT_CHUNK).max(1)
 }
 
-/// Bytes of the build's counters (`GpuClusterCounters`), before level 0's bits.
-const COUNTER_BYTES: u64 = std::mem::size_of::<GpuClusterCounters>() as u64;
-
-/// Initial entries of the cluster light-index list (it grows as frames need).
-pub const INITIAL_INDEX_CAPACITY: u64 = 1 << 16;
-/// Initial entries of the per-tile lists (they grow as frames need).
-pub const INITIAL_TILE_INDEX_CAPACITY: u64 = 1 << 12;
-
 impl ClusterResources {
     /// Creates the buffers (small; they grow with the grid and the lights).
     pub fn new(gpu: &GpuContext) -> ClusterResources {
-        let device = &gpu.device;
-        let defs = ShaderDefs::default();
-        let build_layout = CLUSTER_BUILD_GROUP.create_layout(device, defs);
-        let shading_layout = CLUSTER_LISTS_GROUP.create_layout(device, defs);
-        let depth_layout = CLUSTER_DEPTH_GROUP.create_layout(device, defs);
-        let refine_layout = LIGHT_REFINE_GROUP.create_layout(device, defs);
-        let params_buffer = gpu.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("cluster_params"),
-            size: std::mem::size_of::<GpuClusterParams>() as u64,
-            // Also bound as storage by the `cluster_depth` and `light_refine` passes.
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let storage = wgpu::BufferUsages::STORAGE;
-        let copy = wgpu::BufferUsages::COPY_SRC;
-        let bounds = GrowableBuffer::new(gpu, "cluster_bounds", storage, 128 * 1024);
-        let spheres = GrowableBuffer::new(gpu, "light_view_spheres", storage, 16 * 1024);
-        // With depth bounds the `cluster_depth` pass clears the depth ranges after the cluster
-        // ranges each frame.
-        let ranges = GrowableBuffer::new(
-            gpu,
-            "cluster_ranges",
-            storage | copy | wgpu::BufferUsages::COPY_DST,
-            8 * 8192,
-        );
-        let indices =
-            GrowableBuffer::new(gpu, "light_index_list", storage | copy, 4 * INITIAL_INDEX_CAPACITY);
-        let tile_bounds = GrowableBuffer::new(gpu, "tile_bounds", storage, 128 * 256);
-        let tile_ranges = GrowableBuffer::new(gpu, "tile_ranges", storage, 8 * 256);
-        let tile_indices =
-            GrowableBuffer::new(gpu, "tile_light_index_list", storage, 4 * INITIAL_TILE_INDEX_CAPACITY);
-        let counters = GrowableBuffer::new(gpu, "cluster_counters", storage | copy, COUNTER_BYTES + 4);
-        let (build_bind_group, shading_bind_group) = Self::bind_groups(
-            gpu,
-            &build_layout,
-            &shading_layout,
-            &params_buffer,
-            [&bounds, &spheres, &ranges, &indices, &tile_bounds, &tile_ranges, &tile_indices, &counters],
-        );
+        let buffers = ClusterBuffers::new(gpu);
+        let bindings = ClusterBindings::new(gpu, &buffers);
         ClusterResources {
             grid: ClusterGrid::new(glam::UVec2::ONE, &Default::default(), &Default::default()),
             params: GpuClusterParams::default(),
-            build_layout,
-            shading_layout,
-            depth_layout,
-            refine_layout,
-            build_bind_group,
-            shading_bind_group,
-            params_buffer,
-            ranges,
-            indices,
-            bounds,
-            spheres,
-            tile_bounds,
-            tile_ranges,
-            tile_indices,
-            counters,
+            buffers,
+            bindings,
+            sizing: ListSizing::default(),
+            view_spheres: Vec::new(),
             from_lights: false,
             bounds_of: None,
             coarse: None,
-            generations: [0; 8],
-            view_spheres: Vec::new(),
-            listed: Vec::new(),
-            bounder: ListBounder::default(),
-            sphere_upload: Vec::new(),
-            bounds_estimate: ListBounds::default(),
-            bound_cpu_ms: 0.0,
             cull: CullTest::default(),
             depth_bounds: false,
             refine_blocks: None,
-        }
-    }
-
-    fn bind_groups(
-        gpu: &GpuContext,
-        build_layout: &GroupLayout,
-        shading_layout: &GroupLayout,
-        params: &wgpu::Buffer,
-        [bounds, spheres, ranges, indices, tile_bounds, tile_ranges, tile_indices, counters]: [&GrowableBuffer;
-            8],
-    ) -> (wgpu::BindGroup, wgpu::BindGroup) {
-        let build = build_layout.create_bind_group(
-            gpu,
-            &[
-                params,
-                bounds.buffer(),
-                spheres.buffer(),
-                ranges.buffer(),
-                indices.buffer(),
-                counters.buffer(),
-            ]
-            .into_iter()
-            .chain([tile_bounds.buffer(), tile_ranges.buffer(), tile_indices.buffer()])
-            .map(Binding::Buffer)
-            .collect::<Vec<_>>(),
-        );
-        let shading = shading_layout.create_bind_group(
-            gpu,
-            &[Binding::Buffer(params), Binding::Buffer(ranges.buffer()), Binding::Buffer(indices.buffer())],
-        );
-        (build, shading)
-    }
-
-    fn rebind_if_grown(&mut self, gpu: &GpuContext) {
-        let generations = [
-            self.bounds.generation(),
-            self.spheres.generation(),
-            self.ranges.generation(),
-            self.indices.generation(),
-            self.tile_bounds.generation(),
-            self.tile_ranges.generation(),
-            self.tile_indices.generation(),
-            self.counters.generation(),
-        ];
-        if generations != self.generations {
-            let (b, s) = Self::bind_groups(
-                gpu,
-                &self.build_layout,
-                &self.shading_layout,
-                &self.params_buffer,
-                [
-                    &self.bounds,
-                    &self.spheres,
-                    &self.ranges,
-                    &self.indices,
-                    &self.tile_bounds,
-                    &self.tile_ranges,
-                    &self.tile_indices,
-                    &self.counters,
-                ],
-            );
-            self.build_bind_group = b;
-            self.shading_bind_group = s;
-            self.generations = generations;
         }
     }
 
@@ -464,7 +266,7 @@ impl ClusterResources {
                     }
                 }
             }
-            self.bounds.write(gpu, bytemuck::cast_slice(&bounds))?;
+            self.buffers.bounds.write(gpu, bytemuck::cast_slice(&bounds))?;
             // Level 1 of the build: the same tiles with one slice from near to far.
             let tile_grid = ClusterGrid::new(
                 view.size,
@@ -493,13 +295,13 @@ impl ClusterResources {
                     planes: c.planes.map(|p| p.to_array()),
                 }));
             }
-            self.tile_bounds.write(gpu, bytemuck::cast_slice(&tiles))?;
+            self.buffers.tile_bounds.write(gpu, bytemuck::cast_slice(&tiles))?;
             self.bounds_of = Some((self.grid, self.coarse));
         }
         // The cluster ranges, then (with depth bounds) the depth ranges of the clusters, then
         // (with refined lists) the blocks' ranges.
         let cluster_ranges = count as u64 * if depth_bounds { 16 } else { 8 };
-        self.ranges.reserve(gpu, cluster_ranges + self.refined_blocks() * 8)?;
+        self.buffers.ranges.reserve(gpu, cluster_ranges + self.refined_blocks() * 8)?;
         // Lists sized before the frame is submitted, from a CPU bound of what the build can
         // write (`ListBounder`, on all cores): the GPU lists cannot overflow, so the frame is
         // never rendered twice. A bound beyond what the device can bind reserves what it can;
@@ -511,23 +313,30 @@ impl ClusterResources {
         let (cull, coarse) = (settings.cull, self.coarse);
         self.from_lights = self.grid_allows_bits();
         let spheres = &self.view_spheres;
-        self.bounds_estimate =
-            self.bounder.bound(&self.grid, spheres, cull, coarse, self.from_lights, &mut self.listed);
-        if self.from_lights && !self.bits_fit(light_chunks_of(self.listed.len())) {
+        self.sizing.estimate = self.sizing.bounder.bound(
+            &self.grid,
+            spheres,
+            cull,
+            coarse,
+            self.from_lights,
+            &mut self.sizing.listed,
+        );
+        if self.from_lights && !self.bits_fit(light_chunks_of(self.sizing.listed.len())) {
             self.from_lights = false;
-            self.bounds_estimate =
-                self.bounder.bound(&self.grid, spheres, cull, coarse, false, &mut self.listed);
+            self.sizing.estimate =
+                self.sizing.bounder.bound(&self.grid, spheres, cull, coarse, false, &mut self.sizing.listed);
         }
-        self.bound_cpu_ms = started.elapsed().as_secs_f64() * 1e3;
+        self.sizing.cpu_ms = started.elapsed().as_secs_f64() * 1e3;
         // Level 0 from the lights' side runs over the listed lights, per tile over all.
-        let light_chunks = if self.from_lights { light_chunks_of(self.listed.len()) } else { all_chunks };
+        let light_chunks =
+            if self.from_lights { light_chunks_of(self.sizing.listed.len()) } else { all_chunks };
         self.upload_spheres(gpu)?;
         // Level 1 loops over each tile's coarse list (every light without a coarse level) in
         // chunks: as many as the longest list the bound allows, so a coarse list never runs
         // past its tile's last chunk.
         let tile_chunks = match self.coarse {
             Some(_) => {
-                self.bounds_estimate.max_coarse_lights.div_ceil(TILE_LIGHT_CHUNK).clamp(1, light_chunks)
+                self.sizing.estimate.max_coarse_lights.div_ceil(TILE_LIGHT_CHUNK).clamp(1, light_chunks)
             }
             None => light_chunks,
         };
@@ -543,17 +352,19 @@ impl ClusterResources {
             }
         };
         // The refined lists' slots follow the cluster lists.
-        let entries = self.bounds_estimate.cluster_pairs + self.refined_entries();
-        self.indices.reserve(gpu, with_headroom(entries, &self.indices))?;
+        let entries = self.sizing.estimate.cluster_pairs + self.refined_entries();
+        self.buffers.indices.reserve(gpu, with_headroom(entries, &self.buffers.indices))?;
         // The tile and coarse-tile lists share a buffer; the spare room is split between them.
         let (tile_need, coarse_need) =
-            (self.bounds_estimate.tile_entries, self.bounds_estimate.coarse_entries);
-        self.tile_indices.reserve(gpu, with_headroom(tile_need + coarse_need, &self.tile_indices))?;
+            (self.sizing.estimate.tile_entries, self.sizing.estimate.coarse_entries);
+        self.buffers
+            .tile_indices
+            .reserve(gpu, with_headroom(tile_need + coarse_need, &self.buffers.tile_indices))?;
         let tiles = self.grid.dims.x as u64 * self.grid.dims.y as u64;
         let coarse_tiles = self.coarse_dims().map_or(0, |d| u64::from(d.x) * u64::from(d.y));
         // Room for level 0's ranges over all lights, should the bits not fit after all (`size_bits`).
         let ranges = tiles * u64::from(tile_chunks) + coarse_tiles * u64::from(all_chunks);
-        self.tile_ranges.reserve(gpu, ranges * 8)?;
+        self.buffers.tile_ranges.reserve(gpu, ranges * 8)?;
         let cap = settings.cap.unwrap_or(CLUSTER_NO_CAP);
         let light_count = self.view_spheres.len() as u32;
         self.write_params(gpu, view, light_count, cap, [light_chunks, tile_chunks])
@@ -562,10 +373,10 @@ impl ClusterResources {
     /// Uploads the view spheres, then the listed lights' indices (their bits, four to a sphere
     /// element: `listed_light` in `shaders/cluster_build.wgsl`).
     fn upload_spheres(&mut self, gpu: &GpuContext) -> Result<(), RenderError> {
-        let upload = &mut self.sphere_upload;
+        let upload = &mut self.sizing.sphere_upload;
         upload.clear();
         upload.extend(self.view_spheres.iter().map(|s| s.center.extend(s.radius).to_array()));
-        upload.extend(self.listed.chunks(4).map(|c| {
+        upload.extend(self.sizing.listed.chunks(4).map(|c| {
             let mut four = [0.0f32; 4];
             for (slot, &light) in four.iter_mut().zip(c) {
                 *slot = f32::from_bits(light);
@@ -575,7 +386,7 @@ impl ClusterResources {
         if upload.is_empty() {
             upload.push([0.0; 4]);
         }
-        self.spheres.write(gpu, bytemuck::cast_slice(upload))?;
+        self.buffers.spheres.write(gpu, bytemuck::cast_slice(upload))?;
         Ok(())
     }
 
@@ -591,7 +402,8 @@ impl ClusterResources {
 
     /// Entries of the index list the cluster lists can take (what the refined lists leave).
     fn cluster_index_capacity(&self) -> u32 {
-        (self.indices.capacity() / 4).saturating_sub(self.refined_entries()).min(u64::from(u32::MAX)) as u32
+        (self.buffers.indices.capacity() / 4).saturating_sub(self.refined_entries()).min(u64::from(u32::MAX))
+            as u32
     }
 
     /// Coarse tiles across and down this frame, `None` without a coarse level.
@@ -605,7 +417,7 @@ impl ClusterResources {
     /// for each of their entries), the tile lists the rest (and the coarse lists what is left
     /// when the buffer could not grow to both).
     fn tile_list_split(&self, tile_need: u64, coarse_need: u64) -> (u32, u32) {
-        let total = (self.tile_indices.capacity() / 4).min(u64::from(u32::MAX));
+        let total = (self.buffers.tile_indices.capacity() / 4).min(u64::from(u32::MAX));
         let coarse = Self::coarse_room(coarse_need).min(total - tile_need.min(total));
         ((total - coarse) as u32, coarse as u32)
     }
@@ -645,7 +457,7 @@ impl ClusterResources {
         let (near, far) = (self.grid.near, self.grid.far);
         let count_ranges = self.grid.cluster_count() * if self.depth_bounds { 2 } else { 1 };
         let (tile_lists, coarse_lists) =
-            self.tile_list_split(self.bounds_estimate.tile_entries, self.bounds_estimate.coarse_entries);
+            self.tile_list_split(self.sizing.estimate.tile_entries, self.sizing.estimate.coarse_entries);
         self.params = GpuClusterParams {
             dims: [self.grid.dims.x, self.grid.dims.y, self.grid.dims.z, self.grid.cluster_count()],
             viewport: [view.size.x.max(1) as f32, view.size.y.max(1) as f32, near, far],
@@ -670,13 +482,17 @@ impl ClusterResources {
             refined_first: count_ranges,
             frustum: manylight_core::cluster::rect_frustum(&self.grid).to_array(),
             light_chunks,
-            listed_lights: if self.from_lights { self.listed.len() as u32 } else { 0 },
+            listed_lights: if self.from_lights { self.sizing.listed.len() as u32 } else { 0 },
             _pad: [0; 2],
         };
         self.size_bits(gpu)?;
-        gpu.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
-        gpu.write_buffer(self.counters.buffer(), 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
-        self.rebind_if_grown(gpu);
+        gpu.write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(&self.params));
+        gpu.write_buffer(
+            self.buffers.counters.buffer(),
+            0,
+            bytemuck::bytes_of(&GpuClusterCounters::default()),
+        );
+        self.bindings.rebind_if_grown(gpu, &self.buffers);
         Ok(())
     }
 
@@ -696,8 +512,9 @@ impl ClusterResources {
     fn bits_fit(&self, light_chunks: u32) -> bool {
         let span = self.coarse.unwrap_or(0);
         let dims = coarse_dims(self.grid.dims.truncate(), span.max(1));
-        let positions = Self::coarse_room(self.bounds_estimate.coarse_entries);
-        COUNTER_BYTES + Self::bit_bytes(dims, span, light_chunks, positions) <= self.counters.max_bytes()
+        let positions = Self::coarse_room(self.sizing.estimate.coarse_entries);
+        COUNTER_BYTES + Self::bit_bytes(dims, span, light_chunks, positions)
+            <= self.buffers.counters.max_bytes()
     }
 
     /// Bytes of the bits of levels 0 and 1: one per (coarse tile, light), then one per (tile of
@@ -714,7 +531,7 @@ impl ClusterResources {
     /// not fit (only when the lists grew past the bound while the frame is checked) send the
     /// levels back to testing each (coarse) tile against its candidates.
     fn size_bits(&mut self, gpu: &GpuContext) -> Result<(), RenderError> {
-        if self.from_lights && COUNTER_BYTES + self.params_bit_bytes() > self.counters.max_bytes() {
+        if self.from_lights && COUNTER_BYTES + self.params_bit_bytes() > self.buffers.counters.max_bytes() {
             // Level 0 per coarse tile loops over all lights.
             self.from_lights = false;
             self.params.light_chunks = light_chunks_of(self.params.light_count as usize);
@@ -722,7 +539,7 @@ impl ClusterResources {
         }
         // The shader's bits array has at least one word.
         let bits = self.coarse_bits().map_or(0, |(_, bytes)| bytes);
-        self.counters.reserve(gpu, COUNTER_BYTES + bits.max(4))?;
+        self.buffers.counters.reserve(gpu, COUNTER_BYTES + bits.max(4))?;
         Ok(())
     }
 
@@ -763,14 +580,14 @@ impl ClusterResources {
         if let Some(l) = lists.indices.iter().find(|&&l| l as usize >= lights.len()) {
             return Err(bad(format!("light {l} of {} lights", lights.len())));
         }
-        self.ranges.write(gpu, bytemuck::cast_slice(&lists.ranges))?;
+        self.buffers.ranges.write(gpu, bytemuck::cast_slice(&lists.ranges))?;
         if lists.indices.is_empty() {
-            self.indices.write(gpu, &[0u8; 4])?;
+            self.buffers.indices.write(gpu, &[0u8; 4])?;
         } else {
-            self.indices.write(gpu, bytemuck::cast_slice(&lists.indices))?;
+            self.buffers.indices.write(gpu, bytemuck::cast_slice(&lists.indices))?;
         }
-        self.bounds_estimate = ListBounds { cluster_pairs: entries, ..ListBounds::default() };
-        self.bound_cpu_ms = 0.0;
+        self.sizing.estimate = ListBounds { cluster_pairs: entries, ..ListBounds::default() };
+        self.sizing.cpu_ms = 0.0;
         self.depth_bounds = false;
         self.refine_blocks = None;
         self.from_lights = false;
@@ -780,7 +597,7 @@ impl ClusterResources {
     /// The buffer the build writes its counters into (the renderer copies it into the frame's
     /// read-back slot after the view's passes).
     pub fn counters_buffer(&self) -> &wgpu::Buffer {
-        self.counters.buffer()
+        self.buffers.counters.buffer()
     }
 
     /// Where the bits of levels 0 and 1 lie this frame, `(offset, bytes)` in
@@ -792,7 +609,7 @@ impl ClusterResources {
 
     /// Reads the counters of the last submitted view (waits for the GPU).
     pub fn read_counters(&self, gpu: &GpuContext) -> Result<GpuClusterCounters, RenderError> {
-        let bytes = read_buffer(gpu, self.counters.buffer(), 0, COUNTER_BYTES)?;
+        let bytes = read_buffer(gpu, self.buffers.counters.buffer(), 0, COUNTER_BYTES)?;
         Ok(bytemuck::pod_read_unaligned(&bytes[..std::mem::size_of::<GpuClusterCounters>()]))
     }
 
@@ -840,18 +657,24 @@ impl ClusterResources {
         if tiles_short {
             let tiles = u64::from(counters.tile_entries.max(self.params.tile_index_capacity));
             let coarse = u64::from(counters.coarse_entries.max(self.params.coarse_index_capacity));
-            self.tile_indices.reserve(gpu, (tiles + coarse) * 4)?;
+            self.buffers.tile_indices.reserve(gpu, (tiles + coarse) * 4)?;
             (self.params.tile_index_capacity, self.params.coarse_index_capacity) =
                 self.tile_list_split(tiles, coarse);
             self.size_bits(gpu)?;
         }
         if clusters_short {
-            self.indices.reserve(gpu, (counters.total_entries as u64 + self.refined_entries()) * 4)?;
+            self.buffers
+                .indices
+                .reserve(gpu, (counters.total_entries as u64 + self.refined_entries()) * 4)?;
             self.params.index_capacity = self.cluster_index_capacity();
         }
-        gpu.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
-        gpu.write_buffer(self.counters.buffer(), 0, bytemuck::bytes_of(&GpuClusterCounters::default()));
-        self.rebind_if_grown(gpu);
+        gpu.write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(&self.params));
+        gpu.write_buffer(
+            self.buffers.counters.buffer(),
+            0,
+            bytemuck::bytes_of(&GpuClusterCounters::default()),
+        );
+        self.bindings.rebind_if_grown(gpu, &self.buffers);
         Ok(true)
     }
 
@@ -862,11 +685,11 @@ impl ClusterResources {
             clusters: self.params.dims[3],
             index_capacity: self.params.index_capacity as u64,
             regrows,
-            pair_bound: self.bounds_estimate.cluster_pairs,
-            tile_entry_bound: self.bounds_estimate.tile_entries,
-            coarse_entry_bound: self.bounds_estimate.coarse_entries,
+            pair_bound: self.sizing.estimate.cluster_pairs,
+            tile_entry_bound: self.sizing.estimate.tile_entries,
+            coarse_entry_bound: self.sizing.estimate.coarse_entries,
             coarse_span: self.coarse.unwrap_or(0),
-            bound_cpu_ms: self.bound_cpu_ms,
+            bound_cpu_ms: self.sizing.cpu_ms,
             buffer_bytes: self.buffer_bytes(),
             cull_test: self.cull.name().to_string(),
             z_slicing: self.grid.slicing.name().to_string(),
@@ -884,25 +707,15 @@ impl ClusterResources {
     /// on a `loop_limited` adapter, the longest tile list could exceed `loop_limit`. Such a
     /// view waits for its counters instead of trusting the bound.
     pub fn bound_can_fail(&self, loop_limited: bool, loop_limit: u32) -> bool {
-        self.bounds_estimate.cluster_pairs > u64::from(self.params.index_capacity)
-            || self.bounds_estimate.tile_entries > u64::from(self.params.tile_index_capacity)
-            || self.bounds_estimate.coarse_entries > u64::from(self.params.coarse_index_capacity)
-            || (loop_limited && self.bounds_estimate.max_tile_lights > loop_limit)
+        self.sizing.estimate.cluster_pairs > u64::from(self.params.index_capacity)
+            || self.sizing.estimate.tile_entries > u64::from(self.params.tile_index_capacity)
+            || self.sizing.estimate.coarse_entries > u64::from(self.params.coarse_index_capacity)
+            || (loop_limited && self.sizing.estimate.max_tile_lights > loop_limit)
     }
 
     /// Bytes of the GPU buffers held (capacities, not what this frame filled).
     pub fn buffer_bytes(&self) -> u64 {
-        let growable = [
-            &self.ranges,
-            &self.indices,
-            &self.bounds,
-            &self.spheres,
-            &self.tile_bounds,
-            &self.tile_ranges,
-            &self.tile_indices,
-            &self.counters,
-        ];
-        growable.iter().map(|b| b.capacity()).sum::<u64>() + self.params_buffer.size()
+        self.buffers.bytes()
     }
 
     /// Reads the refined lists of the last submitted view back (waits for the GPU); `None` when
@@ -914,11 +727,11 @@ impl ClusterResources {
         let n = self.refined_blocks();
         let first = u64::from(self.params.refined_first) * 8;
         let mut ranges: Vec<[u32; 2]> =
-            bytemuck::pod_collect_to_vec(&read_buffer(gpu, self.ranges.buffer(), first, n * 8)?);
+            bytemuck::pod_collect_to_vec(&read_buffer(gpu, self.buffers.ranges.buffer(), first, n * 8)?);
         let base = u64::from(self.params.index_capacity);
         let indices: Vec<u32> = bytemuck::pod_collect_to_vec(&read_buffer(
             gpu,
-            self.indices.buffer(),
+            self.buffers.indices.buffer(),
             base * 4,
             self.refined_entries() * 4,
         )?);
@@ -934,14 +747,14 @@ impl ClusterResources {
     /// `manylight_core::cluster::assign_lights`).
     pub fn read_assignment(&self, gpu: &GpuContext) -> Result<ClusterAssignment, RenderError> {
         let count = self.params.dims[3] as u64;
-        let ranges_bytes = read_buffer(gpu, self.ranges.buffer(), 0, count * 8)?;
+        let ranges_bytes = read_buffer(gpu, self.buffers.ranges.buffer(), 0, count * 8)?;
         let ranges: Vec<[u32; 2]> = bytemuck::pod_collect_to_vec(&ranges_bytes);
         let counters = self.read_counters(gpu)?;
         let total = counters.total_entries as u64;
         let indices: Vec<u32> = if total == 0 {
             Vec::new()
         } else {
-            bytemuck::pod_collect_to_vec(&read_buffer(gpu, self.indices.buffer(), 0, total * 4)?)
+            bytemuck::pod_collect_to_vec(&read_buffer(gpu, self.buffers.indices.buffer(), 0, total * 4)?)
         };
         Ok(ClusterAssignment {
             ranges,
