@@ -251,57 +251,80 @@ impl ClusterResources {
         self.coarse = coarse_span(settings.coarse_tiles, settings.cull);
         let count = self.grid.cluster_count();
         if self.bounds_of != Some((self.grid, self.coarse)) {
-            let dims = self.grid.dims;
-            let mut bounds = Vec::with_capacity(count as usize);
-            for z in 0..dims.z {
-                for y in 0..dims.y {
-                    for x in 0..dims.x {
-                        let (min, max) = self.grid.cluster_aabb(x, y, z);
-                        let planes = self.grid.cluster_planes(x, y, z);
-                        bounds.push(GpuClusterBounds {
-                            aabb_min: min.extend(0.0).to_array(),
-                            aabb_max: max.extend(0.0).to_array(),
-                            planes: planes.map(|p| p.to_array()),
-                        });
-                    }
-                }
-            }
-            self.buffers.bounds.write(gpu, bytemuck::cast_slice(&bounds))?;
-            // Level 1 of the build: the same tiles with one slice from near to far.
-            let tile_grid = ClusterGrid::new(
-                view.size,
-                &projection,
-                &manylight_core::cluster::GridConfig {
-                    dims: Some(glam::UVec3::new(dims.x, dims.y, 1)),
-                    ..grid_config
-                },
-            );
-            let mut tiles = Vec::with_capacity((dims.x * dims.y) as usize);
-            for y in 0..dims.y {
-                for x in 0..dims.x {
-                    let (min, max) = tile_grid.cluster_aabb(x, y, 0);
-                    tiles.push(GpuClusterBounds {
-                        aabb_min: min.extend(0.0).to_array(),
-                        aabb_max: max.extend(0.0).to_array(),
-                        planes: tile_grid.cluster_planes(x, y, 0).map(|p| p.to_array()),
-                    });
-                }
-            }
-            // Level 0: the coarse tiles after the tiles, the column margin in `aabb_min.w`.
-            if let Some(span) = self.coarse {
-                tiles.extend(coarse_tiles(&tile_grid, span).into_iter().map(|c| GpuClusterBounds {
-                    aabb_min: c.min.extend(c.margin).to_array(),
-                    aabb_max: c.max.extend(0.0).to_array(),
-                    planes: c.planes.map(|p| p.to_array()),
-                }));
-            }
-            self.buffers.tile_bounds.write(gpu, bytemuck::cast_slice(&tiles))?;
-            self.bounds_of = Some((self.grid, self.coarse));
+            self.upload_grid_bounds(gpu, view.size, &projection, &grid_config)?;
         }
         // The cluster ranges, then (with depth bounds) the depth ranges of the clusters, then
         // (with refined lists) the blocks' ranges.
         let cluster_ranges = count as u64 * if depth_bounds { 16 } else { 8 };
         self.buffers.ranges.reserve(gpu, cluster_ranges + self.refined_blocks() * 8)?;
+        let chunks = self.size_lists(gpu, settings.cull)?;
+        let cap = settings.cap.unwrap_or(CLUSTER_NO_CAP);
+        let light_count = self.view_spheres.len() as u32;
+        self.write_params(gpu, view, light_count, cap, chunks)
+    }
+
+    /// Uploads the bounds of this frame's grid: its clusters, its tile columns and (with a coarse level)
+    /// of its coarse tiles, for a view of `size` pixels.
+    fn upload_grid_bounds(
+        &mut self,
+        gpu: &GpuContext,
+        size: glam::UVec2,
+        projection: &Projection,
+        grid_config: &manylight_core::cluster::GridConfig,
+    ) -> Result<(), RenderError> {
+        let dims = self.grid.dims;
+        let mut bounds = Vec::with_capacity(self.grid.cluster_count() as usize);
+        for z in 0..dims.z {
+            for y in 0..dims.y {
+                for x in 0..dims.x {
+                    let (min, max) = self.grid.cluster_aabb(x, y, z);
+                    let planes = self.grid.cluster_planes(x, y, z);
+                    bounds.push(GpuClusterBounds {
+                        aabb_min: min.extend(0.0).to_array(),
+                        aabb_max: max.extend(0.0).to_array(),
+                        planes: planes.map(|p| p.to_array()),
+                    });
+                }
+            }
+        }
+        self.buffers.bounds.write(gpu, bytemuck::cast_slice(&bounds))?;
+        // Level 1 of the build: the same tiles with one slice from near to far.
+        let tile_grid = ClusterGrid::new(
+            size,
+            projection,
+            &manylight_core::cluster::GridConfig {
+                dims: Some(glam::UVec3::new(dims.x, dims.y, 1)),
+                ..*grid_config
+            },
+        );
+        let mut tiles = Vec::with_capacity((dims.x * dims.y) as usize);
+        for y in 0..dims.y {
+            for x in 0..dims.x {
+                let (min, max) = tile_grid.cluster_aabb(x, y, 0);
+                tiles.push(GpuClusterBounds {
+                    aabb_min: min.extend(0.0).to_array(),
+                    aabb_max: max.extend(0.0).to_array(),
+                    planes: tile_grid.cluster_planes(x, y, 0).map(|p| p.to_array()),
+                });
+            }
+        }
+        // Level 0: the coarse tiles after the tiles, the column margin in `aabb_min.w`.
+        if let Some(span) = self.coarse {
+            tiles.extend(coarse_tiles(&tile_grid, span).into_iter().map(|c| GpuClusterBounds {
+                aabb_min: c.min.extend(c.margin).to_array(),
+                aabb_max: c.max.extend(0.0).to_array(),
+                planes: c.planes.map(|p| p.to_array()),
+            }));
+        }
+        self.buffers.tile_bounds.write(gpu, bytemuck::cast_slice(&tiles))?;
+        self.bounds_of = Some((self.grid, self.coarse));
+        Ok(())
+    }
+
+    /// Sizes the lists and the tile ranges before the frame is submitted, from the CPU bound of
+    /// what the build can write, and uploads the spheres; returns the light chunks of level 0
+    /// and of level 1.
+    fn size_lists(&mut self, gpu: &GpuContext, cull: CullTest) -> Result<[u32; 2], RenderError> {
         // Lists sized before the frame is submitted, from a CPU bound of what the build can
         // write (`ListBounder`, on all cores): the GPU lists cannot overflow, so the frame is
         // never rendered twice. A bound beyond what the device can bind reserves what it can;
@@ -310,7 +333,7 @@ impl ClusterResources {
         let all_chunks = light_chunks_of(self.view_spheres.len());
         // Levels 0 and 1 from the lights' side where the grid allows and their bits fit (a
         // second bound, of level 0 per coarse tile, when they do not).
-        let (cull, coarse) = (settings.cull, self.coarse);
+        let coarse = self.coarse;
         self.from_lights = self.grid_allows_bits();
         let spheres = &self.view_spheres;
         self.sizing.estimate = self.sizing.bounder.bound(
@@ -365,9 +388,7 @@ impl ClusterResources {
         // Room for level 0's ranges over all lights, should the bits not fit after all (`size_bits`).
         let ranges = tiles * u64::from(tile_chunks) + coarse_tiles * u64::from(all_chunks);
         self.buffers.tile_ranges.reserve(gpu, ranges * 8)?;
-        let cap = settings.cap.unwrap_or(CLUSTER_NO_CAP);
-        let light_count = self.view_spheres.len() as u32;
-        self.write_params(gpu, view, light_count, cap, [light_chunks, tile_chunks])
+        Ok([light_chunks, tile_chunks])
     }
 
     /// Uploads the view spheres, then the listed lights' indices (their bits, four to a sphere

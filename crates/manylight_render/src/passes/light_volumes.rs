@@ -54,9 +54,7 @@ pub struct LightVolumesPipeline {
     /// Copies the f32 sum into HDR (only with an f32 accumulation target).
     resolve: Option<(wgpu::RenderPipeline, GroupLayout)>,
     gbuffer_layout: GroupLayout,
-    vertices: wgpu::Buffer,
-    indices: wgpu::Buffer,
-    index_count: u32,
+    proxy: ProxyMesh,
 }
 
 impl LightVolumesPipeline {
@@ -69,102 +67,139 @@ impl LightVolumesPipeline {
         defs: crate::shaders::ShaderDefs,
     ) -> Result<Self, RenderError> {
         let device = &gpu.device;
-        let module =
-            crate::shaders::create_module_with(device, "light_volumes.wgsl", defs.with_gbuffer(layout))?;
         let gbuffer_layout = gbuffer_read_layout(device, layout);
-        check_pipeline("light_volumes.wgsl", &["vs_volume", "fs_volume"], &[view_layout, &gbuffer_layout])?;
-        let pipeline_layout = pipeline_layout(device, "light_volumes", &[view_layout, &gbuffer_layout]);
         let constants = codec_constants(codec);
-        let options = || wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
-        let depth = |compare| {
-            Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(false),
-                depth_compare: Some(compare),
-                stencil: Default::default(),
-                bias: Default::default(),
-            })
-        };
+        let layouts = [view_layout, &gbuffer_layout];
         // The ambient pass reads no shadows: its shader is composed without them.
         let ambient = fullscreen_pipeline_with_defs(
             device,
             &FullscreenPipelineDesc {
                 label: "light_volumes_ambient",
                 shader: "light_volumes.wgsl",
-                layouts: &[view_layout, &gbuffer_layout],
+                layouts: &layouts,
                 fragment: "fs_ambient",
                 output: accumulation,
                 blend: None,
-                depth: depth(wgpu::CompareFunction::Always),
+                depth: read_only_depth(wgpu::CompareFunction::Always),
                 constants: &constants,
             },
             crate::shaders::ShaderDefs::default().with_gbuffer(layout),
         )?;
-        // Back faces only, kept where they lie at or behind the stored surface (reverse-Z:
-        // LessEqual). Without depth clamping, back faces beyond the far plane would be clipped
-        // and their pixels miss the light, so the depth test is dropped instead.
-        let unclipped_depth = device.features().contains(wgpu::Features::DEPTH_CLIP_CONTROL);
-        let compare =
-            if unclipped_depth { wgpu::CompareFunction::LessEqual } else { wgpu::CompareFunction::Always };
-        let additive = wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::One,
-            dst_factor: wgpu::BlendFactor::One,
-            operation: wgpu::BlendOperation::Add,
-        };
-        let volume = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("light_volumes"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_volume"),
-                compilation_options: options(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: 12,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &wgpu::vertex_attr_array![0 => Float32x3],
-                })],
-            },
-            primitive: wgpu::PrimitiveState {
-                front_face: wgpu::FrontFace::Ccw,
-                cull_mode: Some(wgpu::Face::Front),
-                unclipped_depth,
-                ..Default::default()
-            },
-            depth_stencil: depth(compare),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_volume"),
-                compilation_options: options(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: accumulation,
-                    blend: Some(wgpu::BlendState { color: additive, alpha: additive }),
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let volume = volume_pipeline(device, layouts, &constants, accumulation, defs.with_gbuffer(layout))?;
         let resolve = if accumulation != HDR_FORMAT {
-            let accum_layout = ACCUM_GROUP.create_layout(device, defs);
-            let layouts = [view_layout, &gbuffer_layout, &accum_layout];
-            let pipeline = fullscreen_pipeline_desc(
-                device,
-                &FullscreenPipelineDesc {
-                    label: "light_volumes_resolve",
-                    shader: "light_volumes.wgsl",
-                    layouts: &layouts,
-                    fragment: "fs_resolve",
-                    output: HDR_FORMAT,
-                    blend: None,
-                    depth: None,
-                    constants: &constants,
-                },
-            )?;
-            Some((pipeline, accum_layout))
+            Some(resolve_pipeline(device, layouts, &constants, defs)?)
         } else {
             None
         };
+        Ok(LightVolumesPipeline { ambient, volume, resolve, gbuffer_layout, proxy: ProxyMesh::new(gpu) })
+    }
+}
+
+/// A depth test against the stored surfaces, without writing depth (the shaders read it).
+fn read_only_depth(compare: wgpu::CompareFunction) -> Option<wgpu::DepthStencilState> {
+    Some(wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(false),
+        depth_compare: Some(compare),
+        stencil: Default::default(),
+        bias: Default::default(),
+    })
+}
+
+/// The pipeline that draws each light's proxy (`vs_volume`, `fs_volume`) and adds its light
+/// into the `accumulation` target.
+fn volume_pipeline(
+    device: &wgpu::Device,
+    layouts: [&GroupLayout; 2],
+    constants: &[(&str, f64)],
+    accumulation: wgpu::TextureFormat,
+    defs: crate::shaders::ShaderDefs,
+) -> Result<wgpu::RenderPipeline, RenderError> {
+    check_pipeline("light_volumes.wgsl", &["vs_volume", "fs_volume"], &layouts)?;
+    let module = crate::shaders::create_module_with(device, "light_volumes.wgsl", defs)?;
+    let layout = pipeline_layout(device, "light_volumes", &layouts);
+    let options = || wgpu::PipelineCompilationOptions { constants, ..Default::default() };
+    // Back faces only, kept where they lie at or behind the stored surface (reverse-Z:
+    // LessEqual). Without depth clamping, back faces beyond the far plane would be clipped
+    // and their pixels miss the light, so the depth test is dropped instead.
+    let unclipped_depth = device.features().contains(wgpu::Features::DEPTH_CLIP_CONTROL);
+    let compare =
+        if unclipped_depth { wgpu::CompareFunction::LessEqual } else { wgpu::CompareFunction::Always };
+    let additive = wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::One,
+        dst_factor: wgpu::BlendFactor::One,
+        operation: wgpu::BlendOperation::Add,
+    };
+    Ok(device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("light_volumes"),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_volume"),
+            compilation_options: options(),
+            buffers: &[Some(wgpu::VertexBufferLayout {
+                array_stride: 12,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &wgpu::vertex_attr_array![0 => Float32x3],
+            })],
+        },
+        primitive: wgpu::PrimitiveState {
+            front_face: wgpu::FrontFace::Ccw,
+            cull_mode: Some(wgpu::Face::Front),
+            unclipped_depth,
+            ..Default::default()
+        },
+        depth_stencil: read_only_depth(compare),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs_volume"),
+            compilation_options: options(),
+            targets: &[Some(wgpu::ColorTargetState {
+                format: accumulation,
+                blend: Some(wgpu::BlendState { color: additive, alpha: additive }),
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    }))
+}
+
+/// The pipeline that copies an f32 sum of the lights into HDR (`fs_resolve`), and the layout of
+/// its group 2 ([`ACCUM_GROUP`]).
+fn resolve_pipeline(
+    device: &wgpu::Device,
+    [view_layout, gbuffer_layout]: [&GroupLayout; 2],
+    constants: &[(&str, f64)],
+    defs: crate::shaders::ShaderDefs,
+) -> Result<(wgpu::RenderPipeline, GroupLayout), RenderError> {
+    let accum_layout = ACCUM_GROUP.create_layout(device, defs);
+    let pipeline = fullscreen_pipeline_desc(
+        device,
+        &FullscreenPipelineDesc {
+            label: "light_volumes_resolve",
+            shader: "light_volumes.wgsl",
+            layouts: &[view_layout, gbuffer_layout, &accum_layout],
+            fragment: "fs_resolve",
+            output: HDR_FORMAT,
+            blend: None,
+            depth: None,
+            constants,
+        },
+    )?;
+    Ok((pipeline, accum_layout))
+}
+
+/// The sphere proxy every light draws: an icosphere around the unit sphere.
+struct ProxyMesh {
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    index_count: u32,
+}
+
+impl ProxyMesh {
+    fn new(gpu: &GpuContext) -> ProxyMesh {
         let proxy = Icosphere::circumscribing_unit_sphere(PROXY_SUBDIVISIONS);
         let vertices = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("light_volume_proxy_vertices"),
@@ -181,15 +216,7 @@ impl LightVolumesPipeline {
             contents: bytemuck::cast_slice(&index_data),
             usage: wgpu::BufferUsages::INDEX,
         });
-        Ok(LightVolumesPipeline {
-            ambient,
-            volume,
-            resolve,
-            gbuffer_layout,
-            vertices,
-            indices,
-            index_count: proxy.indices.len() as u32,
-        })
+        ProxyMesh { vertices, indices, index_count: proxy.indices.len() as u32 }
     }
 }
 
@@ -280,9 +307,9 @@ impl Pass for LightVolumesPass {
         pass.draw(0..3, 0..1);
         if scene.light_count > 0 {
             pass.set_pipeline(&pipeline.volume);
-            pass.set_vertex_buffer(0, pipeline.vertices.slice(..));
-            pass.set_index_buffer(pipeline.indices.slice(..), wgpu::IndexFormat::Uint16);
-            pass.draw_indexed(0..pipeline.index_count, 0, 0..scene.light_count);
+            pass.set_vertex_buffer(0, pipeline.proxy.vertices.slice(..));
+            pass.set_index_buffer(pipeline.proxy.indices.slice(..), wgpu::IndexFormat::Uint16);
+            pass.draw_indexed(0..pipeline.proxy.index_count, 0, 0..scene.light_count);
         }
         drop(pass);
         if let Some((resolve, accum)) = resolve {
