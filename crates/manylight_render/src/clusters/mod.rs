@@ -263,8 +263,8 @@ impl ClusterResources {
         self.write_params(gpu, view, light_count, cap, chunks)
     }
 
-    /// Uploads the bounds of this frame's grid: its clusters, its tile columns and (with a coarse level)
-    /// of its coarse tiles, for a view of `size` pixels.
+    /// Uploads the bounds of this frame's grid for a view of `size` pixels: its clusters, its
+    /// tile columns and (with a coarse level) its coarse tiles.
     fn upload_grid_bounds(
         &mut self,
         gpu: &GpuContext,
