@@ -15,6 +15,7 @@ pub use headless::HeadlessRenderer;
 pub(crate) use recovery::DeviceSink;
 pub use recovery::{DEVICE_LOSS_WINDOW, DeviceLoss, MAX_DEVICE_LOSSES, SinkFrame, empty_report};
 
+use bevy_derive::{Deref, DerefMut};
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::ScheduleLabel;
 use manylight_render::passes::LightVolumesPass;
@@ -43,7 +44,7 @@ pub enum RenderSet {
 pub struct RenderSchedule;
 
 /// The snapshot being rendered.
-#[derive(Resource, Default)]
+#[derive(Resource, Default, Deref, DerefMut)]
 pub struct CurrentSnapshot(pub FrameSnapshot);
 
 /// The view being rendered and what the frame holds that its plan depends on.
@@ -92,11 +93,11 @@ impl CurrentView {
 }
 
 /// The graph being built for this frame.
-#[derive(Resource, Default)]
+#[derive(Resource, Default, Deref, DerefMut)]
 pub struct FrameGraph(pub RenderGraph);
 
 /// The renderer (GPU context and everything that lives across frames).
-#[derive(Resource)]
+#[derive(Resource, Deref, DerefMut)]
 pub struct RendererResource(pub Renderer);
 
 /// Where this frame's `OUTPUT` goes.
@@ -174,13 +175,13 @@ impl RenderWorld {
     /// [`RenderWorld::take_reports`].
     pub fn finish_frame(&mut self, report: FrameReport) {
         let report = self.report_empty(report);
-        self.world.resource_mut::<RendererResource>().0.finish_frame(report);
+        self.world.resource_mut::<RendererResource>().finish_frame(report);
     }
 
     /// The reports of finished frames whose GPU figures have arrived, oldest first; with
     /// `wait`, waits for every frame in flight first.
     pub fn take_reports(&mut self, wait: bool) -> Result<Vec<FrameReport>, RenderError> {
-        self.world.resource_mut::<RendererResource>().0.take_reports(wait)
+        self.world.resource_mut::<RendererResource>().take_reports(wait)
     }
 
     /// Plans the next frames with `stages` (the built-in ones and an app's,
@@ -217,7 +218,7 @@ impl RenderWorld {
             self.recovery.lose_in_frame = None;
             self.gpu().device.destroy();
         }
-        self.world.resource_mut::<RendererResource>().0.prepare(&snapshot)?;
+        self.world.resource_mut::<RendererResource>().prepare(&snapshot)?;
         let light_upload_bytes = self.world.resource::<RendererResource>().0.scene.light_upload_bytes;
         self.world.insert_resource(CurrentSnapshot(snapshot));
         let result = self.render_views(output, format);
@@ -309,10 +310,10 @@ impl RenderWorld {
     ) -> Result<FrameReport, RenderError> {
         self.world.insert_resource(view);
         self.world.insert_resource(OutputTarget { view: output.clone(), format });
-        self.world.resource_mut::<FrameGraph>().0.clear();
+        self.world.resource_mut::<FrameGraph>().clear();
         *self.world.resource_mut::<FrameOutcome>() = FrameOutcome::default();
         self.schedule.run(&mut self.world);
-        self.last_passes.extend(self.world.resource::<FrameGraph>().0.pass_names().unwrap_or_default());
+        self.last_passes.extend(self.world.resource::<FrameGraph>().pass_names().unwrap_or_default());
         let outcome = std::mem::take(&mut *self.world.resource_mut::<FrameOutcome>());
         match (outcome.error, outcome.report) {
             (Some(e), _) => Err(e),
@@ -378,7 +379,7 @@ fn add_graph_systems(schedule: &mut Schedule) {
 }
 
 /// The stages views are planned with ([`RenderWorld::set_stages`]).
-#[derive(Resource, Default, Clone, Debug)]
+#[derive(Resource, Default, Clone, Debug, Deref)]
 pub struct Stages(pub Arc<FramePlanner>);
 
 /// The passes the plan runs for `snapshot`, in order, without a GPU (tests and tools use it
@@ -402,7 +403,7 @@ fn prepare(
     mut outcome: ResMut<FrameOutcome>,
 ) {
     let options = view.plan_inputs(manylight_render::resources::HDR_FORMAT).list_options();
-    if let Err(e) = renderer.0.prepare_view(&view.view, view.has_lights, options) {
+    if let Err(e) = renderer.prepare_view(&view.view, view.has_lights, options) {
         outcome.error.get_or_insert(e);
     }
 }
@@ -414,9 +415,9 @@ fn plan_graph(
     stages: Res<Stages>,
     mut graph: ResMut<FrameGraph>,
 ) {
-    let accumulation = LightVolumesPass::accumulation_format(&renderer.0.gpu.device);
+    let accumulation = LightVolumesPass::accumulation_format(&renderer.gpu.device);
     let inputs = view.plan_inputs(accumulation);
-    stages.0.plan_into(&inputs, &mut graph.0);
+    stages.plan_into(&inputs, &mut graph);
 }
 
 fn execute(
@@ -430,7 +431,7 @@ fn execute(
     if outcome.error.is_some() {
         return;
     }
-    match renderer.0.execute(&graph.0, &snapshot.0, &view.view, &target.view, target.format) {
+    match renderer.execute(&graph, &snapshot, &view.view, &target.view, target.format) {
         Ok(report) => outcome.report = Some(report),
         Err(e) => outcome.error = Some(e),
     }
