@@ -12,7 +12,7 @@ use crate::bindings::BindingCache;
 use crate::clusters::ClusterResources;
 use crate::context::{GpuContext, GpuCounts, RenderError};
 use crate::gpu_types::{GpuClusterCounters, LAVAPIPE_LOOP_LIMIT};
-use crate::graph::{OUTPUT, Pass, PassContext, RenderGraph};
+use crate::graph::{OUTPUT, Pass, PassContext, RenderGraph, ResourceName};
 use crate::inflight::{DEFAULT_FRAMES_IN_FLIGHT, FrameRing};
 use crate::pipelines::PipelineCache;
 use crate::pool::{TextureKey, TransientPool};
@@ -327,7 +327,40 @@ impl Renderer {
         let frame_start = Instant::now();
         // Views of one frame run one after the other: they may share transient textures.
         self.pool.release_all();
-        let size = view.size;
+        let textures = self.acquire_textures(passes, view.size, output);
+        let mut encoder =
+            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        let timings = self.record_passes(passes, &mut encoder, view.index, &textures, output_format)?;
+        // The view's counters go to the frame's read-back slot, after the passes wrote them.
+        let clusters = self.clusters.get(view.index).and_then(Option::as_ref);
+        let tonemapped = passes.iter().any(|p| crate::graph::is::<crate::passes::tonemap::TonemapPass>(*p));
+        self.ring.end_view(
+            &mut encoder,
+            clusters.filter(|_| builds_clusters).map(|c| c.counters_buffer()),
+            tonemapped.then_some(&self.scene.nonfinite.counter),
+            timings.len(),
+        );
+        let submit = Instant::now();
+        self.gpu.queue.submit([encoder.finish()]);
+        self.phases.submit_ms += submit.elapsed().as_secs_f64() * 1e3;
+        self.last_textures = textures;
+        let errors = self.gpu.take_errors();
+        if !errors.is_empty() {
+            return Err(RenderError::Device(errors.join("; ")));
+        }
+        let mut report = self.view_report(snapshot, view, timings);
+        report.frame_cpu_ms = frame_start.elapsed().as_secs_f64() * 1e3;
+        Ok(report)
+    }
+
+    /// The transient textures `passes` create, at `size` scaled by each spec, from the pool;
+    /// with [`OUTPUT`] as `output`.
+    fn acquire_textures(
+        &mut self,
+        passes: &[&dyn Pass],
+        size: glam::UVec2,
+        output: &wgpu::TextureView,
+    ) -> HashMap<ResourceName, wgpu::TextureView> {
         let mut textures = HashMap::new();
         textures.insert(OUTPUT, output.clone());
         for pass in passes {
@@ -346,11 +379,21 @@ impl Renderer {
                 textures.insert(spec.name, self.pool.acquire(&self.gpu.device, key, spec.name.name()));
             }
         }
+        textures
+    }
 
-        let mut encoder =
-            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+    /// Records `passes` into `encoder` for view `view_index`, timing each on the CPU and, where
+    /// the device can, on the GPU.
+    fn record_passes(
+        &mut self,
+        passes: &[&dyn Pass],
+        encoder: &mut wgpu::CommandEncoder,
+        view_index: usize,
+        textures: &HashMap<ResourceName, wgpu::TextureView>,
+        output_format: wgpu::TextureFormat,
+    ) -> Result<Vec<PassTiming>, RenderError> {
         let mut timings = Vec::with_capacity(passes.len());
-        let clusters = self.clusters.get(view.index).and_then(Option::as_ref);
+        let clusters = self.clusters.get(view_index).and_then(Option::as_ref);
         let hdr_swapped = std::cell::Cell::new(false);
         for pass in passes {
             let timer = self.ring.timer();
@@ -361,9 +404,9 @@ impl Renderer {
                 clusters,
                 shadows: Some(&self.shadows),
                 bindings: &self.bindings,
-                encoder: &mut encoder,
+                encoder,
                 output_format,
-                textures: &textures,
+                textures,
                 hdr_swapped: &hdr_swapped,
                 timer: timer.map(|(query_set, _)| query_set),
                 pass_index: timer.map_or(0, |(_, index)| index),
@@ -382,30 +425,24 @@ impl Renderer {
                 cpu_ms,
             });
         }
-        // The view's counters go to the frame's read-back slot, after the passes wrote them.
-        let tonemapped = passes.iter().any(|p| crate::graph::is::<crate::passes::tonemap::TonemapPass>(*p));
-        self.ring.end_view(
-            &mut encoder,
-            clusters.filter(|_| builds_clusters).map(|c| c.counters_buffer()),
-            tonemapped.then_some(&self.scene.nonfinite.counter),
-            timings.len(),
-        );
-        let submit = Instant::now();
-        self.gpu.queue.submit([encoder.finish()]);
-        self.phases.submit_ms += submit.elapsed().as_secs_f64() * 1e3;
-        self.last_textures = textures;
-        let errors = self.gpu.take_errors();
-        if !errors.is_empty() {
-            return Err(RenderError::Device(errors.join("; ")));
-        }
-        Ok(FrameReport {
+        Ok(timings)
+    }
+
+    /// The report of a view just submitted, with its passes' `timings` (GPU times, the
+    /// non-finite count and the cluster report arrive with the read-back).
+    fn view_report(
+        &self,
+        snapshot: &FrameSnapshot,
+        view: &RenderView,
+        timings: Vec<PassTiming>,
+    ) -> FrameReport {
+        FrameReport {
             frame_index: snapshot.frame_index,
-            width: size.x,
-            height: size.y,
+            width: view.size.x,
+            height: view.size.y,
             pipeline: view.settings.pipeline.name().to_string(),
             frame_gpu_ms: None,
             passes: timings,
-            frame_cpu_ms: frame_start.elapsed().as_secs_f64() * 1e3,
             light_count: self.scene.light_count,
             invalid_lights: self.scene.invalid_lights,
             directional_lights: self.scene.directional_count,
@@ -426,6 +463,6 @@ impl Renderer {
             device_recoveries: 0,
             shadows: (self.shadows.report.casting_lights > 0).then_some(self.shadows.report),
             ..Default::default()
-        })
+        }
     }
 }
