@@ -108,7 +108,7 @@ impl Pass for VignettePass {
         let params = ctx.uniform(("vignette", 0), &params);
         let target = ctx.post_process_write()?;
         let group =
-            pipeline.layout.bind_group(ctx, &[Binding::Buffer(&params), Binding::Texture(target.source)]);
+            ctx.bind_group(&pipeline.layout, &[Binding::Buffer(&params), Binding::Texture(target.source)]);
         let timestamps = ctx.render_timestamps(true, true);
         draw_fullscreen(
             ctx.encoder,

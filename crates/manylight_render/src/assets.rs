@@ -5,7 +5,7 @@
 use crate::bindings::Binding;
 use crate::context::{GpuContext, RenderError};
 use crate::gpu_types::{GpuMaterial, GpuTextureUv, SHADING_GLOBAL};
-use crate::layouts::{BindGroupDecl, BindingDecl, BindingKind, GroupLayout};
+use crate::layouts::{GroupLayout, MATERIAL_GROUP};
 use crate::shaders::ShaderDefs;
 use manylight_core::{
     ImageAddressMode, ImageFilterMode, MaterialData, MeshData, TextureData, TextureSampler, Vertex,
@@ -39,29 +39,6 @@ struct CachedTexture {
     view: wgpu::TextureView,
     last_used: u64,
 }
-
-const FRAGMENT: wgpu::ShaderStages = wgpu::ShaderStages::FRAGMENT;
-const FILTERABLE: wgpu::TextureSampleType = wgpu::TextureSampleType::Float { filterable: true };
-const FILTERING: BindingKind = BindingKind::Sampler(wgpu::SamplerBindingType::Filtering);
-
-/// Group 1 of the mesh passes (`shaders/common/mesh_pass.wgsl`): the material uniform, then
-/// each of its five textures followed by its sampler.
-pub static MATERIAL_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "material",
-    entries: &[
-        BindingDecl::uniform(0, "material", FRAGMENT),
-        BindingDecl::texture(1, "base_color_texture", FILTERABLE, FRAGMENT),
-        BindingDecl::new(2, "base_color_sampler", FILTERING, FRAGMENT),
-        BindingDecl::texture(3, "metallic_roughness_texture", FILTERABLE, FRAGMENT),
-        BindingDecl::new(4, "metallic_roughness_sampler", FILTERING, FRAGMENT),
-        BindingDecl::texture(5, "normal_texture", FILTERABLE, FRAGMENT),
-        BindingDecl::new(6, "normal_sampler", FILTERING, FRAGMENT),
-        BindingDecl::texture(7, "occlusion_texture", FILTERABLE, FRAGMENT),
-        BindingDecl::new(8, "occlusion_sampler", FILTERING, FRAGMENT),
-        BindingDecl::texture(9, "emissive_texture", FILTERABLE, FRAGMENT),
-        BindingDecl::new(10, "emissive_sampler", FILTERING, FRAGMENT),
-    ],
-};
 
 /// A material's bind group (group 1 of mesh pipelines).
 pub struct GpuMaterialBinding {

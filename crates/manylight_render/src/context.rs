@@ -48,9 +48,9 @@ pub enum RenderError {
         /// Device limit.
         limit: u32,
     },
-    /// A bind group or pipeline does not match its declaration ([`crate::layouts`]).
+    /// A pipeline does not match its bind groups' declaration ([`crate::layouts`]).
     #[error(transparent)]
-    Binding(#[from] crate::layouts::BindingError),
+    Binding(#[from] BindingError),
     /// The render graph is inconsistent (a pass reads what nobody writes, or a cycle).
     #[error("render graph: {0}")]
     Graph(String),
@@ -469,4 +469,33 @@ pub fn new_instance() -> wgpu::Instance {
     let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
     desc.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY);
     wgpu::Instance::new(desc)
+}
+
+/// A pipeline made with other bind group layouts than its shader's declaration.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum BindingError {
+    /// A pipeline was made with other layouts than [`crate::layouts::SHADER_BIND_GROUPS`] gives its entry point.
+    #[error(
+        "`{shader}` `{entry_point}`: group {group} is declared `{declared}`, the pipeline was given `{given}`"
+    )]
+    Pipeline {
+        /// Shader file.
+        shader: String,
+        /// Entry point.
+        entry_point: String,
+        /// Group index.
+        group: usize,
+        /// The declared group's label (`none` past the declared groups).
+        declared: &'static str,
+        /// The given layout's label (`none` past the given layouts).
+        given: &'static str,
+    },
+    /// No row of [`crate::layouts::SHADER_BIND_GROUPS`] covers the entry point.
+    #[error("`{shader}` `{entry_point}` has no row in SHADER_BIND_GROUPS")]
+    Undeclared {
+        /// Shader file.
+        shader: String,
+        /// Entry point.
+        entry_point: String,
+    },
 }

@@ -82,6 +82,14 @@ pub trait Pass: std::any::Any + Send + Sync {
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError>;
 }
 
+/// A pass whose name is known from its type: code that reads a frame's timings (the benchmark
+/// CLI, tests) finds the pass by type ([`crate::FrameReport::pass`]) instead of by a copied
+/// string. Every built-in pass has one; its [`Pass::name`] returns [`NamedPass::NAME`].
+pub trait NamedPass: Pass {
+    /// What [`Pass::name`] returns.
+    const NAME: &'static str;
+}
+
 /// True when `pass` is a `P`: the renderer asks a plan for a pass by its type, not its name.
 pub fn is<P: Pass>(pass: &dyn Pass) -> bool {
     (pass as &dyn std::any::Any).is::<P>()
@@ -122,16 +130,16 @@ impl<'a> PassContext<'a> {
         self.clusters.ok_or_else(|| RenderError::Graph(format!("{pass} needs cluster resources")))
     }
 
-    /// The bind group of `layout` with `bindings` (binding number, resource), kept by the frame's
-    /// [`crate::bindings::BindingCache`] ([`crate::layouts::GroupLayout::bind_group`] numbers
-    /// them from their declaration).
-    pub(crate) fn bind_group_numbered(
+    /// The bind group of `layout` with `resources` (one per binding, in the order its
+    /// [`crate::layouts::BindGroupDecl`] declares them), kept by the frame's
+    /// [`crate::bindings::BindingCache`] while they live.
+    pub fn bind_group(
         &self,
-        label: &'static str,
-        layout: &wgpu::BindGroupLayout,
-        bindings: &[(u32, crate::bindings::Binding<'_>)],
+        layout: &crate::layouts::GroupLayout,
+        resources: &[crate::bindings::Binding<'_>],
     ) -> wgpu::BindGroup {
-        self.bindings.bind_group(self.gpu, label, layout, bindings)
+        let numbered = layout.numbered(resources);
+        self.bindings.bind_group(self.gpu, layout.decl().label, layout.raw(), &numbered)
     }
 
     /// A persistent uniform buffer holding `contents` ([`crate::bindings::BindingCache::uniform`]).

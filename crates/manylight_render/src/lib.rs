@@ -34,7 +34,9 @@ pub mod snapshot;
 pub mod stats;
 
 pub use context::{GpuContext, GpuCounts, NO_ADAPTER_HELP, RenderError};
-pub use graph::{OUTPUT, Pass, PassContext, PostProcessWrite, RenderGraph, ResourceName, TextureSpec};
+pub use graph::{
+    NamedPass, OUTPUT, Pass, PassContext, PostProcessWrite, RenderGraph, ResourceName, TextureSpec,
+};
 pub use inflight::{DEFAULT_FRAMES_IN_FLIGHT, MAX_FRAMES_IN_FLIGHT};
 pub use plan::PlanInputs;
 pub use planner::{FramePlanner, Stage, StageError, StageId, builtin_stages};

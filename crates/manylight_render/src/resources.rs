@@ -14,7 +14,7 @@ use crate::gpu_types::{
     TEXTURE_SLOT_BASE_COLOR, TEXTURE_SLOT_EMISSIVE, TEXTURE_SLOT_METALLIC_ROUGHNESS, TEXTURE_SLOT_NORMAL,
     TEXTURE_SLOT_OCCLUSION, ViewUniform,
 };
-use crate::layouts::{BindGroupDecl, BindingDecl, BindingKind, GroupLayout, Presence, SHADING};
+use crate::layouts::{GroupLayout, SCENE_GROUP};
 use crate::lights::{
     bounding_sphere, buffered_lights, gpu_directional_light, gpu_point_light, viewed_directional_lights,
 };
@@ -150,38 +150,6 @@ pub struct Draw {
     /// The instance's transform (a cached shadow map is drawn again when it changes).
     pub world_from_local: Mat4,
 }
-
-/// The shadow bindings of group 0 (`shaders/common/shadows.wgsl`): the shadow atlas, its
-/// comparison sampler, the lights' shadow table and the directional lights' cascades.
-pub const SHADOW_BINDINGS: [BindingDecl; 4] = [
-    BindingDecl::texture(3, "shadow_atlas", wgpu::TextureSampleType::Depth, SHADING),
-    BindingDecl::new(
-        4,
-        "shadow_sampler",
-        BindingKind::Sampler(wgpu::SamplerBindingType::Comparison),
-        SHADING,
-    ),
-    BindingDecl::storage(5, "shadow_lights", SHADING),
-    BindingDecl::storage(6, "directional_shadows", SHADING),
-];
-
-const EVERY_STAGE: wgpu::ShaderStages = wgpu::ShaderStages::VERTEX.union(SHADING);
-
-/// Group 0 of every scene pass: the view uniform (`common/view_binding.wgsl`), the point and
-/// spot lights (`common/point_lights.wgsl`), the instances (`common/mesh_pass.wgsl`) and, in a
-/// frame whose lights cast shadows, [`SHADOW_BINDINGS`].
-pub static SCENE_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "scene",
-    entries: &[
-        BindingDecl::uniform(0, "view", EVERY_STAGE),
-        BindingDecl::storage(1, "lights", EVERY_STAGE),
-        BindingDecl::storage(2, "instances", wgpu::ShaderStages::VERTEX),
-        SHADOW_BINDINGS[0].only(Presence::Shadows),
-        SHADOW_BINDINGS[1].only(Presence::Shadows),
-        SHADOW_BINDINGS[2].only(Presence::Shadows),
-        SHADOW_BINDINGS[3].only(Presence::Shadows),
-    ],
-};
 
 /// What group 0 binds for shadows (`crate::shadows::ShadowResources::bindings`).
 pub struct ShadowBindings<'a> {

@@ -7,10 +7,8 @@
 use crate::bindings::Binding;
 use crate::context::{GpuContext, RenderError};
 use crate::gpu_types::{GpuPointLight, GpuShadowProbe};
-use crate::layouts::{BindGroupDecl, BindingDecl, check_pipeline};
-use crate::passes::common::pipeline_layout;
+use crate::layouts::{SHADOW_PROBE_GROUP, SHADOW_PROBE_SHADOWS_GROUP, check_pipeline, pipeline_layout};
 use crate::readback::read_buffer;
-use crate::resources::SHADOW_BINDINGS;
 use crate::shaders::ShaderDefs;
 use crate::shadows::ShadowResources;
 use glam::Vec3;
@@ -20,22 +18,6 @@ pub const PROBES_PER_DISPATCH: usize = 1 << 20;
 
 /// Workgroup size of `shadow_probe.wgsl`.
 const WORKGROUP: u32 = 64;
-
-/// Group 0 of the probe: the shadow bindings of the scene's group 0
-/// ([`crate::resources::SHADOW_BINDINGS`]), as `common/shadows.wgsl` declares them.
-pub static SHADOW_PROBE_SCENE_GROUP: BindGroupDecl =
-    BindGroupDecl { label: "shadow_probe_shadows", entries: &SHADOW_BINDINGS };
-
-/// Group 1 of the probe (`shaders/shadow_probe.wgsl`): the frame's lights, the probes and what
-/// it writes for each.
-pub static SHADOW_PROBE_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "shadow_probe",
-    entries: &[
-        BindingDecl::storage(0, "lights", wgpu::ShaderStages::COMPUTE),
-        BindingDecl::storage(1, "probes", wgpu::ShaderStages::COMPUTE),
-        BindingDecl::storage_rw(2, "probed", wgpu::ShaderStages::COMPUTE),
-    ],
-};
 
 /// One light–point pair to probe.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -68,7 +50,7 @@ pub fn probe_shadows(
     let module = crate::shaders::create_module(&gpu.device, "shadow_probe.wgsl")
         .map_err(|e| RenderError::Graph(format!("shadow_probe.wgsl: {e}")))?;
     let defs = ShaderDefs::default();
-    let shadow_layout = SHADOW_PROBE_SCENE_GROUP.create_layout(&gpu.device, defs);
+    let shadow_layout = SHADOW_PROBE_SHADOWS_GROUP.create_layout(&gpu.device, defs);
     let probe_layout = SHADOW_PROBE_GROUP.create_layout(&gpu.device, defs);
     check_pipeline("shadow_probe.wgsl", &["main"], &[&shadow_layout, &probe_layout])?;
     let pipeline_layout = pipeline_layout(&gpu.device, "shadow_probe", &[&shadow_layout, &probe_layout]);

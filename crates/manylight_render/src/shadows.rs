@@ -30,7 +30,7 @@ use crate::gpu_types::{
 use crate::lights::{bounding_sphere, buffered_lights, viewed_directional_lights};
 use crate::pool::GrowableBuffer;
 use crate::resources::SceneResources;
-use crate::snapshot::{ExtractedCamera, ExtractedDirectionalLight, FrameSnapshot};
+use crate::snapshot::{ExtractedCamera, ExtractedDirectionalLight, ExtractedPointLight, FrameSnapshot};
 use glam::{Mat4, UVec2, Vec3, Vec4};
 use manylight_core::{Aabb, ProjectionKind};
 use std::collections::HashMap;
@@ -635,6 +635,38 @@ struct MapWork {
     state: MapState,
 }
 
+/// What gathering a frame's maps reads: its settings, lights, first view and opaque draws.
+struct MapInputs<'a> {
+    settings: ShadowSettings,
+    /// The atlas texture's edge in texels.
+    atlas: u32,
+    /// Point and spot lights, by their index in the light buffer.
+    lights: Vec<&'a ExtractedPointLight>,
+    /// Directional lights, by their index in the view uniform.
+    directional: Vec<&'a ExtractedDirectionalLight>,
+    /// The first view's camera and aspect.
+    view: Option<(&'a ExtractedCamera, f32)>,
+    /// The frustums of the views that show shadows.
+    frustums: Vec<[Vec4; 5]>,
+    opaque: Vec<OpaqueDraw<'a>>,
+    /// What a cascade's depth range must reach back to: every opaque draw.
+    casters: Aabb,
+    /// Each request's importance, by light.
+    importance: HashMap<ShadowCaster, f32>,
+}
+
+/// The bounds of every opaque draw: what a cascade's depth range must reach back to.
+fn caster_bounds(opaque: &[OpaqueDraw]) -> Aabb {
+    let mut casters = Aabb::EMPTY;
+    for o in opaque {
+        if !o.draw.world_bounds.is_empty() {
+            casters.extend(o.draw.world_bounds.min);
+            casters.extend(o.draw.world_bounds.max);
+        }
+    }
+    casters
+}
+
 /// The shadow atlas and the buffers of its pass, kept across frames.
 pub struct ShadowResources {
     /// The atlas (created on the first frame with a casting light, grown when a frame needs a
@@ -792,57 +824,22 @@ impl ShadowResources {
         snapshot: &FrameSnapshot,
     ) -> Result<(), RenderError> {
         let settings = snapshot.settings.shadows;
-        // Maps planned for a frame whose views drew none (no view shaded lights) are not in
-        // the atlas.
-        if self.pending_draw.swap(false, Ordering::Relaxed) {
-            self.cache.clear();
-        }
-        self.report = ShadowReport::default();
-        self.active = false;
-        self.clears_tiles = false;
-        self.faces_drawn = 0;
-        self.mesh_draws.clear();
+        self.start_frame();
         if !snapshot.casts_shadows() {
             self.plan = AtlasPlan::default();
             return Ok(());
         }
         let camera = snapshot.views.first().map(|v| (&v.camera, snapshot.viewport));
-        // Requests, by the light's index in the light buffer (the valid lights in order).
-        self.requests.clear();
         let frustums = view_frustums(snapshot);
-        for (k, light) in buffered_lights(&snapshot.lights) {
-            if light.shadow.is_none() || light.radius <= 0.0 {
-                continue;
-            }
-            let (center, radius) = bounding_sphere(light);
-            // A light no view sees lights no visible pixel: no map.
-            if !sphere_in_view(&frustums, center, radius) {
-                self.report.unseen_lights += 1;
-                continue;
-            }
-            // The same rounding as the edge, without its range: lights larger on screen first.
-            let wanted = projected_radius(camera, center, radius).map(|p| p * settings.resolution_scale);
-            let edge = edge_for(wanted, settings.min_face_size, settings.max_face_size);
-            let importance = edge_for(wanted, 1, 1 << 30) as f32;
-            self.requests.push(ShadowRequest { caster: ShadowCaster::Point(k), edge, importance });
-        }
+        self.request_point_maps(snapshot, camera, &frustums);
         // Directional lights, by their index in the view uniform (the first
-        // MAX_DIRECTIONAL_LIGHTS valid ones), cascades at their set size, kept before any
-        // point light when the atlas is full.
+        // MAX_DIRECTIONAL_LIGHTS valid ones).
         let directional: Vec<&ExtractedDirectionalLight> =
             viewed_directional_lights(&snapshot.directional_lights).map(|(_, l)| l).collect();
         let view = camera.map(|(c, size)| (c, size.x.max(1) as f32 / size.y.max(1) as f32));
         // The largest power of two the device's textures allow.
         let (max_atlas, limited) = atlas_limit(settings.atlas_size, self.max_texture);
-        // A cascade is at most a third of the atlas (a block is 3 tiles wide).
-        let widest = 1u32 << (31 - (max_atlas / SHADOW_TILE_COLUMNS).max(1).leading_zeros());
-        for (i, light) in directional.iter().enumerate() {
-            if light.shadow.is_some() && view.is_some() {
-                let edge = settings.cascade_size.max(settings.min_face_size).min(widest);
-                let caster = ShadowCaster::Directional(i as u32);
-                self.requests.push(ShadowRequest { caster, edge, importance: f32::MAX });
-            }
-        }
+        self.request_cascades(&settings, &directional, view.is_some(), max_atlas);
         // Each light's edge from the whole frame's needs, then its place: where it was while
         // its edge holds.
         let min_edge = settings.min_face_size.min(max_atlas / SHADOW_TILE_COLUMNS).max(1);
@@ -854,14 +851,7 @@ impl ShadowResources {
             self.plan = target;
             return Ok(());
         }
-        self.ensure_atlas(gpu, target.atlas_size);
-        let atlas = self.atlas.as_ref().map_or(target.atlas_size, |t| t.width());
-        if !self.allocator.serves(atlas, min_edge) {
-            self.allocator = BlockAllocator::new(atlas, min_edge);
-        }
-        self.plan = place_stably(&mut self.allocator, &target, &self.requests);
-        self.report.downgraded_lights = self.plan.downgraded;
-        self.report.dropped_lights = self.plan.dropped;
+        let atlas = self.place_maps(gpu, &target, min_edge);
 
         // The light table: every light of the buffer, edge 0 where it has no map.
         self.gpu_lights.clear();
@@ -871,8 +861,103 @@ impl ShadowResources {
         for list in &mut self.by_mesh {
             list.1.clear();
         }
-        // Each opaque draw with the slot of its mesh's pairs and a hash of what it draws (its
-        // mesh and transform), found once a frame.
+        let opaque = self.opaque_draws(scene);
+        let casters = caster_bounds(&opaque);
+        self.gpu_directional.fill(GpuDirectionalShadow::default());
+        let importance = self.requests.iter().map(|r| (r.caster, r.importance)).collect();
+        let inputs =
+            MapInputs { settings, atlas, lights, directional, view, frustums, opaque, casters, importance };
+
+        let mut work = self.gather_work(&inputs);
+        self.choose_redraws(&mut work, &settings);
+        self.commit_maps(&work);
+        self.clears_tiles = work.iter().any(|w| w.state != MapState::Draw);
+        self.work = work;
+        self.upload(gpu, scene, atlas)
+    }
+
+    /// Clears the last frame's counters and draws; forgets the maps of a frame whose views
+    /// drew none.
+    fn start_frame(&mut self) {
+        // Maps planned for a frame whose views drew none (no view shaded lights) are not in
+        // the atlas.
+        if self.pending_draw.swap(false, Ordering::Relaxed) {
+            self.cache.clear();
+        }
+        self.report = ShadowReport::default();
+        self.active = false;
+        self.clears_tiles = false;
+        self.faces_drawn = 0;
+        self.mesh_draws.clear();
+    }
+
+    /// Asks for a map for every valid point and spot light with a shadow that one of
+    /// `frustums` sees, by the light's index in the light buffer (the valid lights in order),
+    /// its edge from its size through `camera`; counts the lights no view sees.
+    fn request_point_maps(
+        &mut self,
+        snapshot: &FrameSnapshot,
+        camera: Option<(&ExtractedCamera, UVec2)>,
+        frustums: &[[Vec4; 5]],
+    ) {
+        let settings = snapshot.settings.shadows;
+        self.requests.clear();
+        for (k, light) in buffered_lights(&snapshot.lights) {
+            if light.shadow.is_none() || light.radius <= 0.0 {
+                continue;
+            }
+            let (center, radius) = bounding_sphere(light);
+            // A light no view sees lights no visible pixel: no map.
+            if !sphere_in_view(frustums, center, radius) {
+                self.report.unseen_lights += 1;
+                continue;
+            }
+            // The same rounding as the edge, without its range: lights larger on screen first.
+            let wanted = projected_radius(camera, center, radius).map(|p| p * settings.resolution_scale);
+            let edge = edge_for(wanted, settings.min_face_size, settings.max_face_size);
+            let importance = edge_for(wanted, 1, 1 << 30) as f32;
+            self.requests.push(ShadowRequest { caster: ShadowCaster::Point(k), edge, importance });
+        }
+    }
+
+    /// Asks for the cascades of every casting light of `directional` when the frame has a
+    /// view (`has_view`), at their set size (at most a third of `max_atlas`: a block is 3 tiles
+    /// wide), kept before any point light when the atlas is full.
+    fn request_cascades(
+        &mut self,
+        settings: &ShadowSettings,
+        directional: &[&ExtractedDirectionalLight],
+        has_view: bool,
+        max_atlas: u32,
+    ) {
+        let widest = 1u32 << (31 - (max_atlas / SHADOW_TILE_COLUMNS).max(1).leading_zeros());
+        for (i, light) in directional.iter().enumerate() {
+            if light.shadow.is_some() && has_view {
+                let edge = settings.cascade_size.max(settings.min_face_size).min(widest);
+                let caster = ShadowCaster::Directional(i as u32);
+                self.requests.push(ShadowRequest { caster, edge, importance: f32::MAX });
+            }
+        }
+    }
+
+    /// Places `target`'s maps in the atlas (created or grown to its size first), each where it
+    /// was while its edge holds ([`place_stably`]), as the frame's plan; returns the atlas
+    /// texture's edge.
+    fn place_maps(&mut self, gpu: &GpuContext, target: &AtlasPlan, min_edge: u32) -> u32 {
+        self.ensure_atlas(gpu, target.atlas_size);
+        let atlas = self.atlas.as_ref().map_or(target.atlas_size, |t| t.width());
+        if !self.allocator.serves(atlas, min_edge) {
+            self.allocator = BlockAllocator::new(atlas, min_edge);
+        }
+        self.plan = place_stably(&mut self.allocator, target, &self.requests);
+        self.report.downgraded_lights = self.plan.downgraded;
+        self.report.dropped_lights = self.plan.dropped;
+        atlas
+    }
+
+    /// Each opaque draw of `scene` with the slot of its mesh's pairs (a new slot for a new
+    /// mesh) and a hash of what it draws (its mesh and transform), found once a frame.
+    fn opaque_draws<'a>(&mut self, scene: &'a SceneResources) -> Vec<OpaqueDraw<'a>> {
         let mut opaque = Vec::new();
         for d in scene.draws.iter().filter(|d| !d.variant.blend) {
             let slot = match self.by_mesh.iter().position(|(m, _)| *m == d.mesh) {
@@ -887,119 +972,142 @@ impl ShadowResources {
             d.world_from_local.to_cols_array().map(f32::to_bits).hash(&mut hash);
             opaque.push(OpaqueDraw { draw: d, slot, content: hash.finish() });
         }
-        // What a cascade's depth range must reach back to: every opaque draw.
-        let mut casters = Aabb::EMPTY;
-        for o in &opaque {
-            if !o.draw.world_bounds.is_empty() {
-                casters.extend(o.draw.world_bounds.min);
-                casters.extend(o.draw.world_bounds.max);
-            }
-        }
-        self.gpu_directional.fill(GpuDirectionalShadow::default());
-        let importance: HashMap<ShadowCaster, f32> =
-            self.requests.iter().map(|r| (r.caster, r.importance)).collect();
+        opaque
+    }
 
-        // Each placed map's faces, casters and content, before deciding whether to draw it.
+    /// Each placed map's faces, casters and content, before deciding whether to draw it: the
+    /// faces and pairs go to `work_faces` and `work_draws`, each map's ranges of them to the
+    /// list returned.
+    fn gather_work(&mut self, inputs: &MapInputs) -> Vec<MapWork> {
         let mut work = std::mem::take(&mut self.work);
         work.clear();
         self.work_faces.clear();
         self.work_draws.clear();
-        for p in &self.plan.placements {
+        for i in 0..self.plan.placements.len() {
+            let p = self.plan.placements[i];
             let (faces, draws) = (self.work_faces.len(), self.work_draws.len());
             let mut content = DefaultHasher::new();
             let mut light_entry = GpuShadowLight::default();
             let mut directional_entry = None;
             match p.caster {
-                ShadowCaster::Point(k) => {
-                    let light = lights[k as usize];
-                    let bias = light.shadow.unwrap_or_default();
-                    let far = light.radius;
-                    let near = far * SHADOW_NEAR_FRACTION;
-                    light_entry = GpuShadowLight {
-                        tile: [p.x, p.y, p.edge, settings.filter.gpu_id()],
-                        params: [near, far, bias.depth, bias.normal],
-                        origin: light.position.extend(0.0).to_array(),
-                    };
-                    for face in 0..SHADOW_FACES {
-                        let (tx, ty) = tile_of(p, face);
-                        self.work_faces.push(GpuShadowFace {
-                            clip_from_world: face_clip_from_world(light.position, face, near, far),
-                            atlas: tile_transform(tx, ty, p.edge, atlas),
-                        });
-                    }
-                    let (center, radius) = bounding_sphere(light);
-                    let seen: Vec<bool> = (0..SHADOW_FACES)
-                        .map(|face| face_in_view(&frustums, light.position, face, light.radius))
-                        .collect();
-                    self.report.unseen_faces += seen.iter().filter(|s| !**s).count() as u32;
-                    (light.position.to_array().map(f32::to_bits), far.to_bits(), &seen).hash(&mut content);
-                    for o in &opaque {
-                        if !sphere_meets_box(center, radius, &o.draw.world_bounds) {
-                            continue;
-                        }
-                        for face in 0..SHADOW_FACES {
-                            if seen[face as usize]
-                                && box_meets_face(light.position, face, &o.draw.world_bounds)
-                            {
-                                let draw = GpuShadowDraw { instance: o.draw.instance, face };
-                                self.work_draws.push((o.slot, draw));
-                                (o.content, face).hash(&mut content);
-                            }
-                        }
-                    }
-                }
+                ShadowCaster::Point(k) => light_entry = self.gather_point_map(inputs, &p, k, &mut content),
                 ShadowCaster::Directional(i) => {
-                    let (Some(light), Some((camera, aspect))) = (directional.get(i as usize), view) else {
-                        continue;
-                    };
-                    let Some(shadow) = light.shadow else { continue };
-                    let config = shadow.cascades;
-                    let bounds = config.far_bounds();
-                    let mut gpu = GpuDirectionalShadow {
-                        count: [bounds.len() as u32, 0, 0, 0],
-                        bias: [shadow.bias.depth, shadow.bias.normal, 0.0, 0.0],
-                        ..Default::default()
-                    };
-                    for (c, &far) in bounds.iter().enumerate() {
-                        let slice = ViewSlice { near: config.near_bound(c), far };
-                        let reach = (!self.clamps_depth).then_some(&casters);
-                        let fit = fit_cascade(camera, aspect, slice, light.direction, reach, p.edge);
-                        let (tx, ty) = tile_of(p, c as u32);
-                        gpu.cascades[c] = GpuCascade {
-                            clip_from_world: fit.clip_from_world,
-                            tile: [tx, ty, p.edge, settings.filter.gpu_id()],
-                            params: [far, fit.texel, fit.depth_range, 0.0],
-                        };
-                        self.work_faces.push(GpuShadowFace {
-                            clip_from_world: fit.clip_from_world,
-                            atlas: tile_transform(tx, ty, p.edge, atlas),
-                        });
-                        fit.clip_from_world.to_cols_array().map(f32::to_bits).hash(&mut content);
-                        for o in &opaque {
-                            if box_meets_clip(&fit.clip_from_world, &o.draw.world_bounds) {
-                                let draw = GpuShadowDraw { instance: o.draw.instance, face: c as u32 };
-                                self.work_draws.push((o.slot, draw));
-                                (o.content, c).hash(&mut content);
-                            }
-                        }
-                    }
+                    let Some(gpu) = self.gather_cascades(inputs, &p, i, &mut content) else { continue };
                     directional_entry = Some((i, gpu));
                 }
             }
             work.push(MapWork {
-                placement: *p,
+                placement: p,
                 content: content.finish(),
                 light: light_entry,
                 directional: directional_entry,
                 faces: faces..self.work_faces.len(),
                 draws: draws..self.work_draws.len(),
-                importance: importance.get(&p.caster).copied().unwrap_or(0.0),
+                importance: inputs.importance.get(&p.caster).copied().unwrap_or(0.0),
                 state: MapState::Draw,
             });
         }
+        work
+    }
 
-        // Which maps to draw: a map whose block and content are unchanged is kept; past the
-        // redraw budget, the changed point and spot light maps least important keep theirs.
+    /// The six faces of light `k`'s map at `p` and the pairs of each opaque draw in its range
+    /// with each face a view sees (the faces no view sees are counted); hashes the light and
+    /// its casters into `content` and returns the light table's entry.
+    fn gather_point_map(
+        &mut self,
+        inputs: &MapInputs,
+        p: &ShadowPlacement,
+        k: u32,
+        content: &mut DefaultHasher,
+    ) -> GpuShadowLight {
+        let light = inputs.lights[k as usize];
+        let bias = light.shadow.unwrap_or_default();
+        let far = light.radius;
+        let near = far * SHADOW_NEAR_FRACTION;
+        let entry = GpuShadowLight {
+            tile: [p.x, p.y, p.edge, inputs.settings.filter.gpu_id()],
+            params: [near, far, bias.depth, bias.normal],
+            origin: light.position.extend(0.0).to_array(),
+        };
+        for face in 0..SHADOW_FACES {
+            let (tx, ty) = tile_of(p, face);
+            self.work_faces.push(GpuShadowFace {
+                clip_from_world: face_clip_from_world(light.position, face, near, far),
+                atlas: tile_transform(tx, ty, p.edge, inputs.atlas),
+            });
+        }
+        let (center, radius) = bounding_sphere(light);
+        let seen: Vec<bool> = (0..SHADOW_FACES)
+            .map(|face| face_in_view(&inputs.frustums, light.position, face, light.radius))
+            .collect();
+        self.report.unseen_faces += seen.iter().filter(|s| !**s).count() as u32;
+        (light.position.to_array().map(f32::to_bits), far.to_bits(), &seen).hash(content);
+        for o in &inputs.opaque {
+            if !sphere_meets_box(center, radius, &o.draw.world_bounds) {
+                continue;
+            }
+            for face in 0..SHADOW_FACES {
+                if seen[face as usize] && box_meets_face(light.position, face, &o.draw.world_bounds) {
+                    let draw = GpuShadowDraw { instance: o.draw.instance, face };
+                    self.work_draws.push((o.slot, draw));
+                    (o.content, face).hash(content);
+                }
+            }
+        }
+        entry
+    }
+
+    /// The cascades of directional light `i`'s map at `p`, each fitted to its slice of the
+    /// first view, and the pairs of each opaque draw with each cascade it meets; hashes the
+    /// cascades and their casters into `content` and returns the directional table's entry.
+    /// `None` (nothing gathered) when the light casts none or the frame has no view.
+    fn gather_cascades(
+        &mut self,
+        inputs: &MapInputs,
+        p: &ShadowPlacement,
+        i: u32,
+        content: &mut DefaultHasher,
+    ) -> Option<GpuDirectionalShadow> {
+        let (Some(light), Some((camera, aspect))) = (inputs.directional.get(i as usize), inputs.view) else {
+            return None;
+        };
+        let shadow = light.shadow?;
+        let config = shadow.cascades;
+        let bounds = config.far_bounds();
+        let mut gpu = GpuDirectionalShadow {
+            count: [bounds.len() as u32, 0, 0, 0],
+            bias: [shadow.bias.depth, shadow.bias.normal, 0.0, 0.0],
+            ..Default::default()
+        };
+        for (c, &far) in bounds.iter().enumerate() {
+            let slice = ViewSlice { near: config.near_bound(c), far };
+            let reach = (!self.clamps_depth).then_some(&inputs.casters);
+            let fit = fit_cascade(camera, aspect, slice, light.direction, reach, p.edge);
+            let (tx, ty) = tile_of(p, c as u32);
+            gpu.cascades[c] = GpuCascade {
+                clip_from_world: fit.clip_from_world,
+                tile: [tx, ty, p.edge, inputs.settings.filter.gpu_id()],
+                params: [far, fit.texel, fit.depth_range, 0.0],
+            };
+            self.work_faces.push(GpuShadowFace {
+                clip_from_world: fit.clip_from_world,
+                atlas: tile_transform(tx, ty, p.edge, inputs.atlas),
+            });
+            fit.clip_from_world.to_cols_array().map(f32::to_bits).hash(content);
+            for o in &inputs.opaque {
+                if box_meets_clip(&fit.clip_from_world, &o.draw.world_bounds) {
+                    let draw = GpuShadowDraw { instance: o.draw.instance, face: c as u32 };
+                    self.work_draws.push((o.slot, draw));
+                    (o.content, c).hash(content);
+                }
+            }
+        }
+        Some(gpu)
+    }
+
+    /// Which maps to draw: a map whose block and content are unchanged is kept; past the
+    /// redraw budget, the changed point and spot light maps least important keep theirs.
+    fn choose_redraws(&self, work: &mut [MapWork], settings: &ShadowSettings) {
         let budget = settings.max_redrawn_maps.map_or(usize::MAX, |n| n as usize);
         let mut changed = Vec::new();
         for (i, w) in work.iter_mut().enumerate() {
@@ -1022,9 +1130,14 @@ impl ShadowResources {
                 work[i].state = MapState::Stale;
             }
         }
+    }
 
+    /// Applies each map's state: a drawn map's faces and pairs join the frame's, a kept or
+    /// stale one keeps its tiles; the light tables get each map's entry and the cache the maps
+    /// the atlas will hold.
+    fn commit_maps(&mut self, work: &[MapWork]) {
         self.next_cache.clear();
-        for w in &work {
+        for w in work {
             let p = w.placement;
             let mut entry = w.light;
             match w.state {
@@ -1074,10 +1187,12 @@ impl ShadowResources {
             }
         }
         std::mem::swap(&mut self.cache, &mut self.next_cache);
-        self.clears_tiles = work.iter().any(|w| w.state != MapState::Draw);
-        self.work = work;
+    }
 
-        // Meshes no longer drawn leave the list.
+    /// Groups the frame's pairs by mesh (meshes no longer drawn leave the list), uploads the
+    /// shadow tables, faces and pairs, and marks the frame's maps for drawing in an `atlas`
+    /// texels wide atlas.
+    fn upload(&mut self, gpu: &GpuContext, scene: &SceneResources, atlas: u32) -> Result<(), RenderError> {
         self.by_mesh.retain(|(mesh, _)| scene.assets.mesh(*mesh).is_some());
         let mut all = Vec::new();
         for (mesh, list) in &self.by_mesh {

@@ -151,4 +151,14 @@ impl FrameReport {
     pub fn pass_names(&self) -> Vec<&str> {
         self.passes.iter().map(|p| p.name.as_str()).collect()
     }
+
+    /// The timing of the first pass of type `P` this frame ran, if it ran one.
+    pub fn pass<P: crate::graph::NamedPass>(&self) -> Option<&PassTiming> {
+        self.passes.iter().find(|p| p.name == P::NAME)
+    }
+
+    /// GPU milliseconds of the first pass of type `P`, if it ran and was timed.
+    pub fn pass_gpu_ms<P: crate::graph::NamedPass>(&self) -> Option<f64> {
+        self.pass::<P>().and_then(|p| p.gpu_ms)
+    }
 }

@@ -623,7 +623,8 @@ fn bind_group_declarations_are_unique() {
 /// can be read as; then depth and the clear colour.
 #[test]
 fn gbuffer_targets_are_the_read_group_in_order() {
-    use manylight_render::passes::gbuffer_layout::{GBUFFER_READ_GROUP, targets};
+    use manylight_render::layouts::GBUFFER_READ_GROUP;
+    use manylight_render::passes::gbuffer_layout::targets;
     for layout in [GBufferLayout::Full, GBufferLayout::Packed, GBufferLayout::Compact] {
         let entries: Vec<_> =
             GBUFFER_READ_GROUP.entries_for(ShaderDefs::default().with_gbuffer(layout)).collect();

@@ -4,61 +4,10 @@
 use super::buffers::ClusterBuffers;
 use crate::bindings::Binding;
 use crate::context::GpuContext;
-use crate::layouts::{BindGroupDecl, BindingDecl, GroupLayout, SHADING};
+use crate::layouts::{
+    CLUSTER_BUILD_GROUP, CLUSTER_DEPTH_GROUP, CLUSTER_LISTS_GROUP, GroupLayout, LIGHT_REFINE_GROUP,
+};
 use crate::shaders::ShaderDefs;
-
-const COMPUTE: wgpu::ShaderStages = wgpu::ShaderStages::COMPUTE;
-
-/// Group 0 of the cluster build (`shaders/cluster_build.wgsl`): the parameters, the cluster
-/// bounds and light spheres it reads, the lists it writes, its counters, and the per-tile
-/// bounds and lists.
-pub static CLUSTER_BUILD_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "cluster_build",
-    entries: &[
-        BindingDecl::uniform(0, "params", COMPUTE),
-        BindingDecl::storage(1, "bounds", COMPUTE),
-        BindingDecl::storage(2, "spheres", COMPUTE),
-        BindingDecl::storage_rw(3, "ranges", COMPUTE),
-        BindingDecl::storage_rw(4, "indices", COMPUTE),
-        BindingDecl::storage_rw(5, "build", COMPUTE),
-        BindingDecl::storage(6, "tile_bounds", COMPUTE),
-        BindingDecl::storage_rw(7, "tile_ranges", COMPUTE),
-        BindingDecl::storage_rw(8, "tile_indices", COMPUTE),
-    ],
-};
-
-/// Group 2 of the passes that shade through the cluster lists (`common/cluster_lists.wgsl`,
-/// `tiled_deferred.wgsl`): the parameters, each cluster's range and the light indices.
-pub static CLUSTER_LISTS_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "cluster_lists",
-    entries: &[
-        BindingDecl::uniform(0, "cluster_params", SHADING),
-        BindingDecl::storage(1, "cluster_ranges", SHADING),
-        BindingDecl::storage(2, "cluster_indices", SHADING),
-    ],
-};
-
-/// Group 2 of the `cluster_depth` pass (`shaders/cluster_depth.wgsl`): the parameters, and the
-/// ranges buffer, whose per-cluster depth ranges it writes after the cluster ranges.
-pub static CLUSTER_DEPTH_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "cluster_depth",
-    entries: &[
-        BindingDecl::storage(0, "cluster_params", COMPUTE),
-        BindingDecl::storage_rw(1, "cluster_depths", COMPUTE),
-    ],
-};
-
-/// Group 2 of the `light_refine` pass (`shaders/light_refine.wgsl`): the parameters, the light
-/// spheres, and the ranges and index buffers, whose refined part it writes.
-pub static LIGHT_REFINE_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "light_refine",
-    entries: &[
-        BindingDecl::storage(0, "cluster_params", COMPUTE),
-        BindingDecl::storage(1, "spheres", COMPUTE),
-        BindingDecl::storage_rw(2, "ranges", COMPUTE),
-        BindingDecl::storage_rw(3, "indices", COMPUTE),
-    ],
-};
 
 /// The cluster groups' layouts, and the two groups made over one view's buffers.
 pub struct ClusterBindings {

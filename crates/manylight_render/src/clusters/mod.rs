@@ -23,9 +23,7 @@ use serde::Serialize;
 mod bindings;
 mod buffers;
 
-pub use bindings::{
-    CLUSTER_BUILD_GROUP, CLUSTER_DEPTH_GROUP, CLUSTER_LISTS_GROUP, ClusterBindings, LIGHT_REFINE_GROUP,
-};
+pub use bindings::ClusterBindings;
 use buffers::COUNTER_BYTES;
 pub use buffers::{ClusterBuffers, INITIAL_INDEX_CAPACITY, INITIAL_TILE_INDEX_CAPACITY};
 

@@ -16,8 +16,8 @@ use super::HDR;
 use super::common::{FullscreenPipelineDesc, fullscreen_pipeline_desc};
 use crate::bindings::Binding;
 use crate::context::RenderError;
-use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
-use crate::layouts::{BindGroupDecl, BindingDecl, BindingKind, GroupLayout};
+use crate::graph::{NamedPass, Pass, PassContext, ResourceName, TextureSpec};
+use crate::layouts::{BLOOM_GROUP, GroupLayout};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 use crate::resources::HDR_FORMAT;
@@ -118,24 +118,6 @@ impl Stage {
     }
 }
 
-const FRAGMENT: wgpu::ShaderStages = wgpu::ShaderStages::FRAGMENT;
-
-/// Bloom's bind group (`shaders/bloom.wgsl`): the stage's parameters, a bilinear sampler and
-/// the level it reads.
-pub static BLOOM_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "bloom",
-    entries: &[
-        BindingDecl::uniform(0, "params", FRAGMENT),
-        BindingDecl::new(
-            1,
-            "linear_sampler",
-            BindingKind::Sampler(wgpu::SamplerBindingType::Filtering),
-            FRAGMENT,
-        ),
-        BindingDecl::texture(2, "source", wgpu::TextureSampleType::Float { filterable: true }, FRAGMENT),
-    ],
-};
-
 /// Bloom's pipelines: one per stage.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 struct BloomKey {
@@ -214,7 +196,7 @@ fn draw(
     let textures = sources.iter().map(|&name| ctx.texture(name)).collect::<Result<Vec<_>, _>>()?;
     let mut bindings = vec![Binding::Buffer(&params), Binding::Sampler(&pipeline.sampler)];
     bindings.extend(textures.into_iter().map(Binding::Texture));
-    let bind_group = pipeline.layout.bind_group(ctx, &bindings);
+    let bind_group = ctx.bind_group(&pipeline.layout, &bindings);
     let view = ctx.texture(target)?;
     let timestamps = ctx.render_timestamps(true, true);
     // The composite loads the HDR image and adds to it; the other stages replace their level.
@@ -246,9 +228,13 @@ pub struct BloomBrightPass {
     pub scale: f32,
 }
 
+impl NamedPass for BloomBrightPass {
+    const NAME: &'static str = "bloom_bright";
+}
+
 impl Pass for BloomBrightPass {
     fn name(&self) -> &'static str {
-        "bloom_bright"
+        Self::NAME
     }
     fn reads(&self) -> Vec<ResourceName> {
         vec![HDR]
@@ -314,9 +300,13 @@ pub struct BloomUpsamplePass {
     pub target: ResourceName,
 }
 
+impl NamedPass for BloomUpsamplePass {
+    const NAME: &'static str = "bloom_upsample";
+}
+
 impl Pass for BloomUpsamplePass {
     fn name(&self) -> &'static str {
-        "bloom_upsample"
+        Self::NAME
     }
     fn reads(&self) -> Vec<ResourceName> {
         vec![self.source, self.target]
@@ -337,9 +327,13 @@ pub struct BloomCompositePass {
     pub intensity: f32,
 }
 
+impl NamedPass for BloomCompositePass {
+    const NAME: &'static str = "bloom_composite";
+}
+
 impl Pass for BloomCompositePass {
     fn name(&self) -> &'static str {
-        "bloom_composite"
+        Self::NAME
     }
     fn reads(&self) -> Vec<ResourceName> {
         // HDR: ordered after the lighting that writes it (it is blended into, not sampled).

@@ -6,7 +6,7 @@
 
 use super::{CLUSTER_DEPTHS, CLUSTERS};
 use crate::context::RenderError;
-use crate::graph::{Pass, PassContext, ResourceName};
+use crate::graph::{NamedPass, Pass, PassContext, ResourceName};
 use crate::layouts::GroupLayout;
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
@@ -115,9 +115,13 @@ pub fn dispatch_size(
     Ok([max, rows])
 }
 
+impl NamedPass for ClusterBuildPass {
+    const NAME: &'static str = "cluster_build";
+}
+
 impl Pass for ClusterBuildPass {
     fn name(&self) -> &'static str {
-        "cluster_build"
+        Self::NAME
     }
     fn reads(&self) -> Vec<ResourceName> {
         if self.depth_bounds { vec![CLUSTER_DEPTHS] } else { Vec::new() }
@@ -209,9 +213,13 @@ pub struct PixelListsPass;
 /// Name of [`PixelListsPass`] in pass lists and reports.
 pub const PIXEL_LIGHT_LISTS: &str = "pixel_light_lists";
 
+impl NamedPass for PixelListsPass {
+    const NAME: &'static str = PIXEL_LIGHT_LISTS;
+}
+
 impl Pass for PixelListsPass {
     fn name(&self) -> &'static str {
-        PIXEL_LIGHT_LISTS
+        Self::NAME
     }
     fn reads(&self) -> Vec<ResourceName> {
         Vec::new()

@@ -8,7 +8,7 @@ use super::gbuffer_layout::{DistancePipeline, DistanceSource};
 use super::{CLUSTER_DEPTHS, DEPTH};
 use crate::bindings::Binding;
 use crate::context::RenderError;
-use crate::graph::{Pass, PassContext, ResourceName};
+use crate::graph::{NamedPass, Pass, PassContext, ResourceName};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 
@@ -35,9 +35,13 @@ pub struct ClusterDepthPass {
     pub clear_color: [f32; 3],
 }
 
+impl NamedPass for ClusterDepthPass {
+    const NAME: &'static str = "cluster_depth";
+}
+
 impl Pass for ClusterDepthPass {
     fn name(&self) -> &'static str {
-        "cluster_depth"
+        Self::NAME
     }
     fn reads(&self) -> Vec<ResourceName> {
         self.source.reads()
@@ -69,10 +73,8 @@ impl Pass for ClusterDepthPass {
         let ranges = clusters.buffers.ranges.buffer();
         let bytes = u64::from(clusters.params.dims[3]) * 8;
         ctx.encoder.clear_buffer(ranges, bytes, Some(bytes));
-        let depths = clusters
-            .bindings
-            .depth_layout
-            .bind_group(ctx, &[Binding::Buffer(&clusters.buffers.params), Binding::Buffer(ranges)]);
+        let resources = [Binding::Buffer(&clusters.buffers.params), Binding::Buffer(ranges)];
+        let depths = ctx.bind_group(&clusters.bindings.depth_layout, &resources);
         let depth = ctx.texture(DEPTH)?.texture();
         let groups = [depth.width().div_ceil(8), depth.height().div_ceil(8)];
         let timestamps = ctx.compute_timestamps(true, true);

@@ -5,7 +5,7 @@ use super::common::{MeshPipelineDesc, clear_color, color_attachment, mesh_pipeli
 use super::scene_draw::{ScenePipeline, record_scene_pass, variant_pipelines};
 use super::{CLUSTERS, DEPTH, HDR};
 use crate::context::RenderError;
-use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::graph::{NamedPass, Pass, PassContext, ResourceName, TextureSpec};
 use crate::layouts::GroupLayout;
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
@@ -74,9 +74,13 @@ pub struct ClusteredForwardPass {
     pub shadows: bool,
 }
 
+impl NamedPass for ClusteredForwardPass {
+    const NAME: &'static str = "clustered_forward";
+}
+
 impl Pass for ClusteredForwardPass {
     fn name(&self) -> &'static str {
-        "clustered_forward"
+        Self::NAME
     }
     fn reads(&self) -> Vec<ResourceName> {
         let mut reads = if self.after_prepass { vec![CLUSTERS, DEPTH] } else { vec![CLUSTERS] };

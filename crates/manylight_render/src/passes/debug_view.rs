@@ -15,8 +15,11 @@ use super::{
 };
 use crate::bindings::Binding;
 use crate::context::RenderError;
-use crate::graph::{OUTPUT, Pass, PassContext, ResourceName};
-use crate::layouts::{BindGroupDecl, BindingDecl, GroupLayout, UNFILTERED};
+use crate::graph::{NamedPass, OUTPUT, Pass, PassContext, ResourceName};
+use crate::layouts::{
+    BindGroupDecl, DEBUG_CLUSTERS_GROUP, DEBUG_DEPTH_GROUP, DEBUG_SHADOW_ATLAS_GROUP, DEBUG_SHADOW_LOD_GROUP,
+    DEBUG_SURFACE_GROUP, GroupLayout,
+};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 use crate::snapshot::DebugViewMode;
@@ -47,71 +50,15 @@ impl Family {
     }
 }
 
-const FRAGMENT: wgpu::ShaderStages = wgpu::ShaderStages::FRAGMENT;
-const VIEW: BindingDecl = BindingDecl::uniform(0, "view", FRAGMENT);
-const DEPTH_TEXTURE: BindingDecl = BindingDecl::texture(1, "depth", wgpu::TextureSampleType::Depth, FRAGMENT);
-const PARAMS: BindingDecl = BindingDecl::uniform(4, "debug", FRAGMENT);
-
-/// The bind group of the cluster views: view, depth, parameters, then the cluster parameters
-/// and ranges.
-pub static CLUSTERS_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "debug_view_clusters",
-    entries: &[
-        VIEW,
-        DEPTH_TEXTURE,
-        PARAMS,
-        BindingDecl::uniform(2, "cluster_params", FRAGMENT),
-        BindingDecl::storage(3, "cluster_ranges", FRAGMENT),
-    ],
-};
-/// The bind group of the depth view: view, depth and parameters.
-pub static DEPTH_GROUP: BindGroupDecl =
-    BindGroupDecl { label: "debug_view_depth", entries: &[VIEW, DEPTH_TEXTURE, PARAMS] };
-/// The bind group of the surface views: view, depth, parameters, then the Full G-buffer.
-pub static SURFACE_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "debug_view_surface",
-    entries: &[
-        VIEW,
-        DEPTH_TEXTURE,
-        PARAMS,
-        BindingDecl::texture(5, "gbuffer_albedo", UNFILTERED, FRAGMENT),
-        BindingDecl::texture(6, "gbuffer_normal", UNFILTERED, FRAGMENT),
-        BindingDecl::texture(7, "gbuffer_emissive", UNFILTERED, FRAGMENT),
-        BindingDecl::texture(8, "gbuffer_position", UNFILTERED, FRAGMENT),
-    ],
-};
-/// The bind group of the shadow-atlas view: view, depth, parameters, then the atlas.
-pub static SHADOW_ATLAS_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "debug_view_shadow_atlas",
-    entries: &[
-        VIEW,
-        DEPTH_TEXTURE,
-        PARAMS,
-        BindingDecl::texture(12, "debug_shadow_atlas", wgpu::TextureSampleType::Depth, FRAGMENT),
-    ],
-};
-/// The bind group of the shadow-LOD view: view, depth, parameters, then the lights and their
-/// shadow table.
-pub static SHADOW_LOD_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "debug_view_shadow_lod",
-    entries: &[
-        VIEW,
-        DEPTH_TEXTURE,
-        PARAMS,
-        BindingDecl::storage(10, "debug_lights", FRAGMENT),
-        BindingDecl::storage(11, "debug_shadow_lights", FRAGMENT),
-    ],
-};
-
 impl Family {
     /// The family's bind group and fragment entry point.
     fn group_and_entry(self) -> (&'static BindGroupDecl, &'static str) {
         match self {
-            Family::Clusters => (&CLUSTERS_GROUP, "fs_clusters"),
-            Family::Depth => (&DEPTH_GROUP, "fs_depth"),
-            Family::Surface => (&SURFACE_GROUP, "fs_surface"),
-            Family::ShadowAtlas => (&SHADOW_ATLAS_GROUP, "fs_shadow_atlas"),
-            Family::ShadowLod => (&SHADOW_LOD_GROUP, "fs_shadow_lod"),
+            Family::Clusters => (&DEBUG_CLUSTERS_GROUP, "fs_clusters"),
+            Family::Depth => (&DEBUG_DEPTH_GROUP, "fs_depth"),
+            Family::Surface => (&DEBUG_SURFACE_GROUP, "fs_surface"),
+            Family::ShadowAtlas => (&DEBUG_SHADOW_ATLAS_GROUP, "fs_shadow_atlas"),
+            Family::ShadowLod => (&DEBUG_SHADOW_LOD_GROUP, "fs_shadow_lod"),
         }
     }
 }
@@ -171,9 +118,13 @@ pub struct DebugViewPass {
     pub shadows: bool,
 }
 
+impl NamedPass for DebugViewPass {
+    const NAME: &'static str = "debug_view";
+}
+
 impl Pass for DebugViewPass {
     fn name(&self) -> &'static str {
-        "debug_view"
+        Self::NAME
     }
     fn reads(&self) -> Vec<ResourceName> {
         match Family::of(self.view) {
@@ -257,7 +208,7 @@ impl Pass for DebugViewPass {
                 bindings.extend([Binding::Buffer(ctx.scene.lights.buffer()), Binding::Buffer(table)]);
             }
         }
-        let bind_group = pipeline.layout.bind_group(ctx, &bindings);
+        let bind_group = ctx.bind_group(&pipeline.layout, &bindings);
         let output = ctx.texture(OUTPUT)?;
         let timestamps = ctx.render_timestamps(true, true);
         draw_fullscreen(ctx.encoder, "debug_view", output, timestamps, &pipeline.pipeline, &[&bind_group]);

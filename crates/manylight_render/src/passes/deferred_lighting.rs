@@ -5,7 +5,7 @@ use super::common::{FullscreenPipelineDesc, draw_fullscreen, fullscreen_pipeline
 use super::gbuffer_layout::{codec_constants, gbuffer_read_bind_group, gbuffer_read_layout, gbuffer_reads};
 use super::{CLUSTERS, HDR};
 use crate::context::RenderError;
-use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::graph::{NamedPass, Pass, PassContext, ResourceName, TextureSpec};
 use crate::layouts::GroupLayout;
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
@@ -76,9 +76,13 @@ pub struct DeferredLightingPass {
     pub shadows: bool,
 }
 
+impl NamedPass for DeferredLightingPass {
+    const NAME: &'static str = "deferred_lighting";
+}
+
 impl Pass for DeferredLightingPass {
     fn name(&self) -> &'static str {
-        "deferred_lighting"
+        Self::NAME
     }
     fn reads(&self) -> Vec<ResourceName> {
         gbuffer_reads(self.layout)

@@ -4,7 +4,7 @@ use super::common::{MeshPipelineDesc, color_attachment, mesh_pipeline};
 use super::scene_draw::{ScenePipeline, record_scene_pass, variant_pipelines};
 use super::{DEPTH, SHADING_DISTANCE};
 use crate::context::RenderError;
-use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::graph::{NamedPass, Pass, PassContext, ResourceName, TextureSpec};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 use crate::resources::{DEPTH_FORMAT, SceneResources, SurfaceVariant};
@@ -72,9 +72,13 @@ pub struct DepthPrepass {
     pub distance: bool,
 }
 
+impl NamedPass for DepthPrepass {
+    const NAME: &'static str = "depth_prepass";
+}
+
 impl Pass for DepthPrepass {
     fn name(&self) -> &'static str {
-        "depth_prepass"
+        Self::NAME
     }
     fn reads(&self) -> Vec<ResourceName> {
         Vec::new()

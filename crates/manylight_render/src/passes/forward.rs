@@ -5,7 +5,7 @@ use super::common::{MeshPipelineDesc, clear_color, color_attachment, mesh_pipeli
 use super::scene_draw::{ScenePipeline, record_scene_pass, variant_pipelines};
 use super::{DEPTH, HDR};
 use crate::context::RenderError;
-use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::graph::{NamedPass, Pass, PassContext, ResourceName, TextureSpec};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 use crate::resources::{DEPTH_FORMAT, HDR_FORMAT, SceneResources, SurfaceVariant};
@@ -60,9 +60,13 @@ pub struct ForwardPass {
     pub shadows: bool,
 }
 
+impl NamedPass for ForwardPass {
+    const NAME: &'static str = "forward";
+}
+
 impl Pass for ForwardPass {
     fn name(&self) -> &'static str {
-        "forward"
+        Self::NAME
     }
     fn reads(&self) -> Vec<ResourceName> {
         if self.shadows { vec![super::SHADOW_ATLAS] } else { Vec::new() }

@@ -6,7 +6,7 @@ use super::gbuffer_layout::{codec_constants, targets};
 use super::scene_draw::{ScenePipeline, record_scene_pass, variant_pipelines};
 use super::{DEPTH, DEPTH_USAGE};
 use crate::context::RenderError;
-use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
+use crate::graph::{NamedPass, Pass, PassContext, ResourceName, TextureSpec};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 use crate::resources::{DEPTH_FORMAT, SceneResources, SurfaceVariant};
@@ -70,9 +70,13 @@ pub struct GBufferPass {
     pub codec: NormalCodec,
 }
 
+impl NamedPass for GBufferPass {
+    const NAME: &'static str = "gbuffer";
+}
+
 impl Pass for GBufferPass {
     fn name(&self) -> &'static str {
-        "gbuffer"
+        Self::NAME
     }
     fn reads(&self) -> Vec<ResourceName> {
         Vec::new()

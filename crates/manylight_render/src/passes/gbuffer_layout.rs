@@ -14,13 +14,16 @@ use super::{
 use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{PassContext, ResourceName};
-use crate::layouts::{BindGroupDecl, BindingDecl, GroupLayout, Presence, SHADING, UNFILTERED};
+use crate::layouts::{
+    BindingDecl, GB_ALBEDO, GB_COMPACT, GB_EMISSIVE, GB_NORMAL, GB_PACKED_ALBEDO, GB_PACKED_POSITION,
+    GB_POSITION, GBUFFER_READ_GROUP, GroupLayout, SHADING_DISTANCE_GROUP,
+};
 use crate::shaders::ShaderDefs;
 use crate::snapshot::GBufferLayout;
 use manylight_core::codec::NormalCodec;
 
 /// One G-buffer target: the graph resource, its format, and its binding in the group through
-/// which the lighting passes read it ([`GBUFFER_READ_GROUP`]).
+/// which the lighting passes read it ([`crate::layouts::GBUFFER_READ_GROUP`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct GBufferTarget {
     /// The graph resource.
@@ -31,74 +34,27 @@ pub struct GBufferTarget {
     pub read: BindingDecl,
 }
 
-/// A target of `layout` (`None`: of every layout), read at `binding` as `wgsl_name`.
-const fn target(
-    name: ResourceName,
-    format: wgpu::TextureFormat,
-    layout: Option<GBufferLayout>,
-    binding: u32,
-    wgsl_name: &'static str,
-) -> GBufferTarget {
-    let sample_type = match format {
-        wgpu::TextureFormat::Rgba32Uint => wgpu::TextureSampleType::Uint,
-        _ => UNFILTERED,
-    };
-    let read = BindingDecl::texture(binding, wgsl_name, sample_type, SHADING);
-    let read = match layout {
-        Some(layout) => read.only(Presence::GBuffer(layout)),
-        None => read,
-    };
+const fn target(name: ResourceName, format: wgpu::TextureFormat, read: BindingDecl) -> GBufferTarget {
     GBufferTarget { name, format, read }
 }
 
-const EMISSIVE: GBufferTarget =
-    target(GBUFFER_EMISSIVE, wgpu::TextureFormat::Rgba16Float, None, 8, "gb_emissive");
-
-const FULL_LAYOUT: Option<GBufferLayout> = Some(GBufferLayout::Full);
-const PACKED_LAYOUT: Option<GBufferLayout> = Some(GBufferLayout::Packed);
+const EMISSIVE: GBufferTarget = target(GBUFFER_EMISSIVE, wgpu::TextureFormat::Rgba16Float, GB_EMISSIVE);
 
 // Albedo is rgba16f, not rgba8: 8 bits (even sRGB-encoded) cost FLIP mean 0.015 against naive
 // forward where 16-bit floats give 0.0035 (docs/accuracy.md).
 const FULL: [GBufferTarget; 4] = [
-    target(GBUFFER_POSITION, wgpu::TextureFormat::Rgba32Float, FULL_LAYOUT, 0, "gb_position"),
-    target(GBUFFER_NORMAL, wgpu::TextureFormat::Rgba16Float, FULL_LAYOUT, 1, "gb_normal"),
-    target(GBUFFER_ALBEDO, wgpu::TextureFormat::Rgba16Float, FULL_LAYOUT, 2, "gb_albedo"),
+    target(GBUFFER_POSITION, wgpu::TextureFormat::Rgba32Float, GB_POSITION),
+    target(GBUFFER_NORMAL, wgpu::TextureFormat::Rgba16Float, GB_NORMAL),
+    target(GBUFFER_ALBEDO, wgpu::TextureFormat::Rgba16Float, GB_ALBEDO),
     EMISSIVE,
 ];
 const PACKED: [GBufferTarget; 3] = [
-    target(GBUFFER_PACKED_ALBEDO, wgpu::TextureFormat::Rgba32Float, PACKED_LAYOUT, 6, "gb_packed_albedo"),
-    target(GBUFFER_PACKED_POSITION, wgpu::TextureFormat::Rgba32Float, PACKED_LAYOUT, 7, "gb_packed_position"),
+    target(GBUFFER_PACKED_ALBEDO, wgpu::TextureFormat::Rgba32Float, GB_PACKED_ALBEDO),
+    target(GBUFFER_PACKED_POSITION, wgpu::TextureFormat::Rgba32Float, GB_PACKED_POSITION),
     EMISSIVE,
 ];
-const COMPACT: [GBufferTarget; 2] = [
-    target(GBUFFER_COMPACT, wgpu::TextureFormat::Rgba32Uint, Some(GBufferLayout::Compact), 3, "gb_compact"),
-    EMISSIVE,
-];
-
-/// Group 1 of the passes that read the G-buffer (`shaders/common/gbuffer_read.wgsl`): the
-/// targets of the layout the shader is composed for (in [`targets`] order), then depth and the
-/// view's clear colour.
-pub static GBUFFER_READ_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "gbuffer_read",
-    entries: &[
-        FULL[0].read,
-        FULL[1].read,
-        FULL[2].read,
-        PACKED[0].read,
-        PACKED[1].read,
-        COMPACT[0].read,
-        EMISSIVE.read,
-        BindingDecl::texture(4, "gb_depth", wgpu::TextureSampleType::Depth, SHADING),
-        BindingDecl::uniform(5, "clear_color", SHADING),
-    ],
-};
-
-/// Group 1 of the passes that read each pixel's shading distance from the depth pre-pass
-/// (`cs_forward` of `cluster_depth.wgsl` and `light_refine.wgsl`).
-pub static SHADING_DISTANCE_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "shading_distance",
-    entries: &[BindingDecl::texture(9, "shading_distance", UNFILTERED, wgpu::ShaderStages::COMPUTE)],
-};
+const COMPACT: [GBufferTarget; 2] =
+    [target(GBUFFER_COMPACT, wgpu::TextureFormat::Rgba32Uint, GB_COMPACT), EMISSIVE];
 
 /// The G-buffer targets of a layout, in the G-buffer pass's colour-target order. Every layout
 /// ends with [`GBUFFER_EMISSIVE`] (rgba16f: emitted radiance and ambient occlusion).
@@ -140,7 +96,7 @@ pub fn gbuffer_read_bind_group(
         resources.push(Binding::Texture(ctx.texture(t.name)?));
     }
     resources.extend([Binding::Texture(ctx.texture(DEPTH)?), Binding::Buffer(&clear)]);
-    Ok(bind_group_layout.bind_group(ctx, &resources))
+    Ok(ctx.bind_group(bind_group_layout, &resources))
 }
 
 /// Where a pass reads each pixel's shading distance (the `cluster_depth` and `light_refine`
@@ -203,7 +159,7 @@ impl DistanceSource {
     ) -> Result<wgpu::BindGroup, RenderError> {
         match self {
             DistanceSource::Prepass => {
-                Ok(layout.bind_group(ctx, &[Binding::Texture(ctx.texture(SHADING_DISTANCE)?)]))
+                Ok(ctx.bind_group(layout, &[Binding::Texture(ctx.texture(SHADING_DISTANCE)?)]))
             }
             DistanceSource::GBuffer(g, _) => gbuffer_read_bind_group(ctx, layout, g, clear_color),
         }

@@ -9,7 +9,7 @@ use super::gbuffer_layout::{DistancePipeline, DistanceSource};
 use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::gpu_types::REFINE_GROUP_EDGE;
-use crate::graph::{Pass, PassContext, ResourceName};
+use crate::graph::{NamedPass, Pass, PassContext, ResourceName};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 
@@ -35,9 +35,13 @@ pub struct LightRefinePass {
     pub clear_color: [f32; 3],
 }
 
+impl NamedPass for LightRefinePass {
+    const NAME: &'static str = "light_refine";
+}
+
 impl Pass for LightRefinePass {
     fn name(&self) -> &'static str {
-        "light_refine"
+        Self::NAME
     }
     fn reads(&self) -> Vec<ResourceName> {
         let mut reads = self.source.reads();
@@ -67,8 +71,8 @@ impl Pass for LightRefinePass {
             },
         )?;
         let source = self.source.bind_group(ctx, &pipeline.source_layout, self.clear_color)?;
-        let lists = clusters.bindings.refine_layout.bind_group(
-            ctx,
+        let lists = ctx.bind_group(
+            &clusters.bindings.refine_layout,
             &[
                 Binding::Buffer(&clusters.buffers.params),
                 Binding::Buffer(clusters.buffers.spheres.buffer()),

@@ -3,16 +3,14 @@
 //! covers (see `shaders/light_volumes.wgsl` for the depth-test rule that lights each pixel once
 //! per light, camera inside the sphere and far-plane crossing included).
 
-use super::common::{
-    FullscreenPipelineDesc, fullscreen_pipeline_desc, fullscreen_pipeline_with_defs, pipeline_layout,
-};
+use super::common::{FullscreenPipelineDesc, fullscreen_pipeline_desc, fullscreen_pipeline_with_defs};
 use super::common::{clear_color, color_attachment, draw_fullscreen};
 use super::gbuffer_layout::{codec_constants, gbuffer_read_bind_group, gbuffer_read_layout, targets};
 use super::{DEPTH, HDR, LIGHT_ACCUM};
 use crate::bindings::Binding;
 use crate::context::{GpuContext, RenderError};
-use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
-use crate::layouts::{BindGroupDecl, BindingDecl, GroupLayout, UNFILTERED, check_pipeline};
+use crate::graph::{NamedPass, Pass, PassContext, ResourceName, TextureSpec};
+use crate::layouts::{GroupLayout, LIGHT_ACCUM_GROUP, check_pipeline, pipeline_layout};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 use crate::resources::{DEPTH_FORMAT, HDR_FORMAT};
@@ -39,13 +37,6 @@ pub struct LightVolumesKey {
 impl PipelineKey for LightVolumesKey {
     type Pipeline = LightVolumesPipeline;
 }
-
-/// Group 2 of the resolve (`fs_resolve` of `shaders/light_volumes.wgsl`): the f32 sum of the
-/// lights.
-pub static ACCUM_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "light_accum",
-    entries: &[BindingDecl::texture(0, "light_accum", UNFILTERED, wgpu::ShaderStages::FRAGMENT)],
-};
 
 /// The pipelines and proxy mesh of [`LightVolumesPass`] for one layout and codec.
 pub struct LightVolumesPipeline {
@@ -167,14 +158,14 @@ fn volume_pipeline(
 }
 
 /// The pipeline that copies an f32 sum of the lights into HDR (`fs_resolve`), and the layout of
-/// its group 2 ([`ACCUM_GROUP`]).
+/// its group 2 ([`LIGHT_ACCUM_GROUP`]).
 fn resolve_pipeline(
     device: &wgpu::Device,
     [view_layout, gbuffer_layout]: [&GroupLayout; 2],
     constants: &[(&str, f64)],
     defs: crate::shaders::ShaderDefs,
 ) -> Result<(wgpu::RenderPipeline, GroupLayout), RenderError> {
-    let accum_layout = ACCUM_GROUP.create_layout(device, defs);
+    let accum_layout = LIGHT_ACCUM_GROUP.create_layout(device, defs);
     let pipeline = fullscreen_pipeline_desc(
         device,
         &FullscreenPipelineDesc {
@@ -251,9 +242,13 @@ impl LightVolumesPass {
     }
 }
 
+impl NamedPass for LightVolumesPass {
+    const NAME: &'static str = "light_volumes";
+}
+
 impl Pass for LightVolumesPass {
     fn name(&self) -> &'static str {
-        "light_volumes"
+        Self::NAME
     }
     fn reads(&self) -> Vec<ResourceName> {
         let shadows = self.shadows.then_some(super::SHADOW_ATLAS);
@@ -284,7 +279,7 @@ impl Pass for LightVolumesPass {
         let target = if self.accumulates_separately() { ctx.texture(LIGHT_ACCUM)? } else { hdr };
         let depth = ctx.texture(DEPTH)?;
         let resolve = pipeline.resolve.as_ref().map(|(resolve, accum_layout)| {
-            let accum = accum_layout.bind_group(ctx, &[Binding::Texture(target)]);
+            let accum = ctx.bind_group(accum_layout, &[Binding::Texture(target)]);
             (resolve, accum)
         });
         let timestamps = ctx.render_timestamps(true, resolve.is_none());

@@ -16,8 +16,8 @@ use super::common::{FullscreenPipelineDesc, draw_fullscreen, fullscreen_pipeline
 use super::{DEPTH, HDR, post_process_texture};
 use crate::bindings::Binding;
 use crate::context::RenderError;
-use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
-use crate::layouts::{BindGroupDecl, BindingDecl, GroupLayout, UNFILTERED};
+use crate::graph::{NamedPass, Pass, PassContext, ResourceName, TextureSpec};
+use crate::layouts::{GroupLayout, MOTION_BLUR_GROUP};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 use crate::resources::HDR_FORMAT;
@@ -42,20 +42,6 @@ struct MotionBlurKey {
 impl PipelineKey for MotionBlurKey {
     type Pipeline = MotionBlurPipeline;
 }
-
-const FRAGMENT: wgpu::ShaderStages = wgpu::ShaderStages::FRAGMENT;
-
-/// Motion blur's bind group (`shaders/motion_blur.wgsl`): the view uniform (this and last
-/// frame's matrices), the blur's parameters, the HDR image and depth.
-pub static MOTION_BLUR_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "motion_blur",
-    entries: &[
-        BindingDecl::uniform(0, "view", FRAGMENT),
-        BindingDecl::uniform(1, "params", FRAGMENT),
-        BindingDecl::texture(2, "hdr", UNFILTERED, FRAGMENT),
-        BindingDecl::texture(3, "depth", wgpu::TextureSampleType::Depth, FRAGMENT),
-    ],
-};
 
 /// The pipeline of [`MotionBlurPass`] for one tap count.
 struct MotionBlurPipeline {
@@ -102,9 +88,13 @@ impl MotionBlurPass {
     }
 }
 
+impl NamedPass for MotionBlurPass {
+    const NAME: &'static str = "motion_blur";
+}
+
 impl Pass for MotionBlurPass {
     fn name(&self) -> &'static str {
-        "motion_blur"
+        Self::NAME
     }
     fn reads(&self) -> Vec<ResourceName> {
         vec![HDR, DEPTH]
@@ -133,8 +123,8 @@ impl Pass for MotionBlurPass {
         let params = ctx.uniform(("motion_blur", 0), bytemuck::bytes_of(&params));
         let depth = ctx.texture(DEPTH)?;
         let target = ctx.post_process_write()?;
-        let blur_group = pipeline.blur_layout.bind_group(
-            ctx,
+        let blur_group = ctx.bind_group(
+            &pipeline.blur_layout,
             &[
                 Binding::Buffer(&ctx.scene.view_buffer),
                 Binding::Buffer(&params),

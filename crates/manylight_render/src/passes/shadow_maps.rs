@@ -3,28 +3,15 @@
 //! atlas keeps other maps, it loads the atlas and first clears the tiles it draws.
 
 use super::SHADOW_ATLAS;
-use super::common::{pipeline_layout, vertex_layout};
+use super::common::vertex_layout;
 use crate::bindings::Binding;
 use crate::context::RenderError;
-use crate::graph::{Pass, PassContext, ResourceName};
-use crate::layouts::{BindGroupDecl, BindingDecl, GroupLayout, check_pipeline};
+use crate::graph::{NamedPass, Pass, PassContext, ResourceName};
+use crate::layouts::{GroupLayout, SHADOW_MAPS_GROUP, check_pipeline, pipeline_layout};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 use crate::shaders::ShaderDefs;
 use crate::shadows::SHADOW_ATLAS_FORMAT;
-
-const VERTEX: wgpu::ShaderStages = wgpu::ShaderStages::VERTEX;
-
-/// The shadow pass's bind group (`shaders/shadow_maps.wgsl`): the faces drawn, the draws (an
-/// instance's faces) and the instances.
-pub static SHADOW_MAPS_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "shadow_maps",
-    entries: &[
-        BindingDecl::storage(0, "shadow_faces", VERTEX),
-        BindingDecl::storage(1, "shadow_draws", VERTEX),
-        BindingDecl::storage(2, "instances", VERTEX),
-    ],
-};
 
 /// The shadow pass's pipeline: with clip distances where the device has them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -118,9 +105,13 @@ impl ShadowMapsPipeline {
 /// Draws the frame's shadow maps into [`SHADOW_ATLAS`].
 pub struct ShadowMapsPass;
 
+impl NamedPass for ShadowMapsPass {
+    const NAME: &'static str = "shadow_maps";
+}
+
 impl Pass for ShadowMapsPass {
     fn name(&self) -> &'static str {
-        "shadow_maps"
+        Self::NAME
     }
     fn reads(&self) -> Vec<ResourceName> {
         Vec::new()
@@ -140,8 +131,8 @@ impl Pass for ShadowMapsPass {
             ShadowMapsKey { clip_distances: shadows.clip_distances, clamps_depth: shadows.clamps_depth };
         let device = &ctx.gpu.device;
         let pipeline = ctx.pipelines.get_or_create(key, |k| ShadowMapsPipeline::new(device, k))?;
-        let bind_group = pipeline.layout.bind_group(
-            ctx,
+        let bind_group = ctx.bind_group(
+            &pipeline.layout,
             &[
                 Binding::Buffer(shadows.faces.buffer()),
                 Binding::Buffer(shadows.draws.buffer()),

@@ -7,8 +7,8 @@ use super::gbuffer_layout::{codec_constants, gbuffer_read_bind_group, gbuffer_re
 use super::{CLUSTERS, HDR};
 use crate::bindings::Binding;
 use crate::context::RenderError;
-use crate::graph::{Pass, PassContext, ResourceName, TextureSpec};
-use crate::layouts::{BindGroupDecl, BindingDecl, BindingKind, GroupLayout};
+use crate::graph::{NamedPass, Pass, PassContext, ResourceName, TextureSpec};
+use crate::layouts::{GroupLayout, TILED_DEFERRED_OUTPUT_GROUP};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 use crate::resources::HDR_FORMAT;
@@ -30,17 +30,6 @@ impl PipelineKey for TiledDeferredKey {
     type Pipeline = TiledDeferredPipeline;
 }
 
-/// Group 3 of tiled deferred (`shaders/tiled_deferred.wgsl`): the HDR image it writes.
-pub static OUTPUT_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "tiled_deferred_output",
-    entries: &[BindingDecl::new(
-        0,
-        "hdr_out",
-        BindingKind::StorageTexture(HDR_FORMAT),
-        wgpu::ShaderStages::COMPUTE,
-    )],
-};
-
 /// The compute pipeline of [`TiledDeferredPass`] for one layout.
 pub struct TiledDeferredPipeline {
     pipeline: wgpu::ComputePipeline,
@@ -58,7 +47,7 @@ impl TiledDeferredPipeline {
         defs: crate::shaders::ShaderDefs,
     ) -> Result<Self, RenderError> {
         let gbuffer_layout = gbuffer_read_layout(device, layout);
-        let output_layout = OUTPUT_GROUP.create_layout(device, defs);
+        let output_layout = TILED_DEFERRED_OUTPUT_GROUP.create_layout(device, defs);
         let layouts = [view_layout, &gbuffer_layout, cluster_layout, &output_layout];
         let constants = codec_constants(codec);
         let pipeline = compute_pipeline_with_defs(
@@ -86,9 +75,13 @@ pub struct TiledDeferredPass {
     pub shadows: bool,
 }
 
+impl NamedPass for TiledDeferredPass {
+    const NAME: &'static str = "tiled_deferred";
+}
+
 impl Pass for TiledDeferredPass {
     fn name(&self) -> &'static str {
-        "tiled_deferred"
+        Self::NAME
     }
     fn reads(&self) -> Vec<ResourceName> {
         gbuffer_reads(self.layout)
@@ -142,7 +135,7 @@ impl Pass for TiledDeferredPass {
             },
         )?;
         let gbuffer = gbuffer_read_bind_group(ctx, &pipeline.gbuffer_layout, layout, self.clear_color)?;
-        let output = pipeline.output_layout.bind_group(ctx, &[Binding::Texture(ctx.texture(HDR)?)]);
+        let output = ctx.bind_group(&pipeline.output_layout, &[Binding::Texture(ctx.texture(HDR)?)]);
         let timestamps = ctx.compute_timestamps(true, true);
         let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("tiled_deferred"),

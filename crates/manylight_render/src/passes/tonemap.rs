@@ -4,26 +4,10 @@ use super::HDR;
 use super::common::{draw_fullscreen, fullscreen_pipeline};
 use crate::bindings::Binding;
 use crate::context::RenderError;
-use crate::graph::{OUTPUT, Pass, PassContext, ResourceName};
-use crate::layouts::{BindGroupDecl, BindingDecl, GroupLayout, UNFILTERED};
+use crate::graph::{NamedPass, OUTPUT, Pass, PassContext, ResourceName};
+use crate::layouts::{GroupLayout, TONEMAP_GROUP};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
-
-/// The tone map's pass name (the renderer reads the non-finite count after it ran).
-pub const TONEMAP: &str = "tonemap";
-
-const FRAGMENT: wgpu::ShaderStages = wgpu::ShaderStages::FRAGMENT;
-
-/// The tone map's bind group (`shaders/tonemap.wgsl`): the view uniform (exposure), the HDR
-/// image and the counter of non-finite pixels.
-pub static TONEMAP_GROUP: BindGroupDecl = BindGroupDecl {
-    label: "tonemap",
-    entries: &[
-        BindingDecl::uniform(0, "view", FRAGMENT),
-        BindingDecl::texture(1, "hdr", UNFILTERED, FRAGMENT),
-        BindingDecl::storage_rw(2, "nonfinite_pixels", FRAGMENT),
-    ],
-};
 
 /// The tone map's pipeline: one per output format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -54,9 +38,13 @@ impl TonemapPipeline {
 /// finite (shown black) into [`SceneResources::nonfinite`](crate::resources::SceneResources).
 pub struct TonemapPass;
 
+impl NamedPass for TonemapPass {
+    const NAME: &'static str = "tonemap";
+}
+
 impl Pass for TonemapPass {
     fn name(&self) -> &'static str {
-        TONEMAP
+        Self::NAME
     }
     fn reads(&self) -> Vec<ResourceName> {
         vec![HDR]
@@ -69,8 +57,8 @@ impl Pass for TonemapPass {
         let device = &ctx.gpu.device;
         let pipeline =
             ctx.pipelines.get_or_create(TonemapKey { format }, |k| TonemapPipeline::new(device, k.format))?;
-        let bind_group = pipeline.layout.bind_group(
-            ctx,
+        let bind_group = ctx.bind_group(
+            &pipeline.layout,
             &[
                 Binding::Buffer(&ctx.scene.view_buffer),
                 Binding::Texture(ctx.texture(HDR)?),

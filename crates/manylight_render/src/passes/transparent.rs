@@ -8,7 +8,7 @@ use super::common::{MeshPipelineDesc, depth_attachment, mesh_pipeline};
 use super::scene_draw::{ScenePipeline, blended_variant_pipelines, draw_in_order};
 use super::{CLUSTERS, DEPTH, HDR};
 use crate::context::RenderError;
-use crate::graph::{Pass, PassContext, ResourceName};
+use crate::graph::{NamedPass, Pass, PassContext, ResourceName};
 use crate::layouts::GroupLayout;
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
@@ -70,9 +70,13 @@ pub struct TransparentPass {
     pub shadows: bool,
 }
 
+impl NamedPass for TransparentPass {
+    const NAME: &'static str = "transparent";
+}
+
 impl Pass for TransparentPass {
     fn name(&self) -> &'static str {
-        "transparent"
+        Self::NAME
     }
     fn reads(&self) -> Vec<ResourceName> {
         let mut reads = if self.clustered { vec![HDR, DEPTH, CLUSTERS] } else { vec![HDR, DEPTH] };

@@ -11,10 +11,13 @@
 //! [`crate::passes::common::fullscreen_pipeline_with_module`].
 
 use crate::bindings::Binding;
-use crate::context::GpuContext;
-use crate::graph::PassContext;
+use crate::context::{BindingError, GpuContext};
 use crate::shaders::ShaderDefs;
 use crate::snapshot::GBufferLayout;
+
+mod groups;
+
+pub use groups::*;
 
 /// What a binding holds, as its WGSL declaration says.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -214,12 +217,6 @@ impl GroupLayout {
         numbers.zip(resources.iter().copied()).collect()
     }
 
-    /// The bind group of `resources` (one per binding, in declaration order), kept by the
-    /// frame's [`crate::bindings::BindingCache`] while they live.
-    pub fn bind_group(&self, ctx: &PassContext<'_>, resources: &[Binding<'_>]) -> wgpu::BindGroup {
-        ctx.bind_group_numbered(self.decl.label, &self.raw, &self.numbered(resources))
-    }
-
     /// A new bind group of `resources` (one per binding, in declaration order), for groups that
     /// live longer than the frame's cache keeps them.
     pub fn create_bind_group(&self, gpu: &GpuContext, resources: &[Binding<'_>]) -> wgpu::BindGroup {
@@ -234,35 +231,6 @@ impl GroupLayout {
             entries: &entries,
         })
     }
-}
-
-/// A pipeline made with other bind group layouts than its shader's declaration.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-pub enum BindingError {
-    /// A pipeline was made with other layouts than [`SHADER_BIND_GROUPS`] gives its entry point.
-    #[error(
-        "`{shader}` `{entry_point}`: group {group} is declared `{declared}`, the pipeline was given `{given}`"
-    )]
-    Pipeline {
-        /// Shader file.
-        shader: String,
-        /// Entry point.
-        entry_point: String,
-        /// Group index.
-        group: usize,
-        /// The declared group's label (`none` past the declared groups).
-        declared: &'static str,
-        /// The given layout's label (`none` past the given layouts).
-        given: &'static str,
-    },
-    /// No row of [`SHADER_BIND_GROUPS`] covers the entry point.
-    #[error("`{shader}` `{entry_point}` has no row in SHADER_BIND_GROUPS")]
-    Undeclared {
-        /// Shader file.
-        shader: String,
-        /// Entry point.
-        entry_point: String,
-    },
 }
 
 /// The bind groups that entry points of a library shader read, group 0 first.
@@ -317,52 +285,12 @@ pub fn check_pipeline(
     Ok(())
 }
 
-/// Shorthand for a row of [`SHADER_BIND_GROUPS`].
-const fn row(
-    shader: &'static str,
-    entry_points: &'static [&'static str],
-    groups: &'static [&'static BindGroupDecl],
-) -> ShaderBindGroups {
-    ShaderBindGroups { shader, entry_points, groups }
+/// The pipeline layout of bind groups `layouts`, group 0 first.
+pub fn pipeline_layout(device: &wgpu::Device, label: &str, layouts: &[&GroupLayout]) -> wgpu::PipelineLayout {
+    let layouts: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(|l| Some(l.raw())).collect();
+    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &layouts,
+        immediate_size: 0,
+    })
 }
-
-use crate::assets::MATERIAL_GROUP as MATERIAL;
-use crate::clusters::{
-    CLUSTER_BUILD_GROUP, CLUSTER_DEPTH_GROUP, CLUSTER_LISTS_GROUP as LISTS, LIGHT_REFINE_GROUP,
-};
-use crate::passes::gbuffer_layout::{GBUFFER_READ_GROUP as GBUFFER, SHADING_DISTANCE_GROUP};
-use crate::passes::{bloom, debug_view, light_volumes, motion_blur, shadow_maps, tiled_deferred, tonemap};
-use crate::resources::SCENE_GROUP as SCENE;
-use crate::shadow_probe::{SHADOW_PROBE_GROUP, SHADOW_PROBE_SCENE_GROUP};
-
-/// Which declaration each pipeline of each library shader reads at each group: a row covers the
-/// entry points it lists (all of the shader's when it lists none), and a pipeline's entry
-/// points are all covered by one row. Every entry point of every shader under `shaders/` that
-/// binds anything has a row (`tests/shaders.rs`).
-pub static SHADER_BIND_GROUPS: &[ShaderBindGroups] = &[
-    row("forward.wgsl", &[], &[&SCENE, &MATERIAL]),
-    row("transparent.wgsl", &["vs_main", "fs_every_light"], &[&SCENE, &MATERIAL]),
-    row("transparent.wgsl", &["vs_main", "fs_clusters"], &[&SCENE, &MATERIAL, &LISTS]),
-    row("depth_prepass.wgsl", &[], &[&SCENE, &MATERIAL]),
-    row("clustered_forward.wgsl", &[], &[&SCENE, &MATERIAL, &LISTS]),
-    row("gbuffer.wgsl", &[], &[&SCENE, &MATERIAL]),
-    row("deferred_lighting.wgsl", &[], &[&SCENE, &GBUFFER, &LISTS]),
-    row("tiled_deferred.wgsl", &[], &[&SCENE, &GBUFFER, &LISTS, &tiled_deferred::OUTPUT_GROUP]),
-    row("light_volumes.wgsl", &["vs_volume", "fs_ambient", "fs_volume"], &[&SCENE, &GBUFFER]),
-    row("light_volumes.wgsl", &["fs_resolve"], &[&SCENE, &GBUFFER, &light_volumes::ACCUM_GROUP]),
-    row("cluster_build.wgsl", &[], &[&CLUSTER_BUILD_GROUP]),
-    row("cluster_depth.wgsl", &["cs_forward"], &[&SCENE, &SHADING_DISTANCE_GROUP, &CLUSTER_DEPTH_GROUP]),
-    row("cluster_depth.wgsl", &["cs_gbuffer"], &[&SCENE, &GBUFFER, &CLUSTER_DEPTH_GROUP]),
-    row("light_refine.wgsl", &["cs_forward"], &[&SCENE, &SHADING_DISTANCE_GROUP, &LIGHT_REFINE_GROUP]),
-    row("light_refine.wgsl", &["cs_gbuffer"], &[&SCENE, &GBUFFER, &LIGHT_REFINE_GROUP]),
-    row("shadow_maps.wgsl", &[], &[&shadow_maps::SHADOW_MAPS_GROUP]),
-    row("shadow_probe.wgsl", &[], &[&SHADOW_PROBE_SCENE_GROUP, &SHADOW_PROBE_GROUP]),
-    row("bloom.wgsl", &[], &[&bloom::BLOOM_GROUP]),
-    row("motion_blur.wgsl", &[], &[&motion_blur::MOTION_BLUR_GROUP]),
-    row("tonemap.wgsl", &[], &[&tonemap::TONEMAP_GROUP]),
-    row("debug_view.wgsl", &["fs_clusters"], &[&debug_view::CLUSTERS_GROUP]),
-    row("debug_view.wgsl", &["fs_depth"], &[&debug_view::DEPTH_GROUP]),
-    row("debug_view.wgsl", &["fs_surface"], &[&debug_view::SURFACE_GROUP]),
-    row("debug_view.wgsl", &["fs_shadow_atlas"], &[&debug_view::SHADOW_ATLAS_GROUP]),
-    row("debug_view.wgsl", &["fs_shadow_lod"], &[&debug_view::SHADOW_LOD_GROUP]),
-];
