@@ -109,8 +109,8 @@ impl Projection {
     ///
     /// Orthographic: a height that is NaN or not positive becomes 1, and one outside
     /// [`MIN_ORTHOGRAPHIC_HEIGHT`, `MAX_ORTHOGRAPHIC_HEIGHT`] (`+∞` included) is clamped into
-    /// it (an infinite height used to become 1, shrinking the view by 38 orders of magnitude
-    /// without a word), and a far plane
+    /// it (an infinite height is clamped, not replaced by 1, which would shrink the view by 38
+    /// orders of magnitude without a word), and a far plane
     /// that is missing, infinite, not beyond the near plane or too close to it for the linear
     /// depth scale to be finite becomes `near + ORTHOGRAPHIC_FALLBACK_DEPTH` (or the near
     /// plane is moved back from a far plane at `f32::MAX`).
@@ -259,7 +259,7 @@ mod tests {
     use glam::Vec4;
 
     /// Extreme and invalid parameters never give a non-finite matrix: a huge near plane with
-    /// no far plane used to make `far` infinite and the depth terms `inf × 0 = NaN`.
+    /// no far plane must not make `far` infinite and the depth terms `inf × 0 = NaN`.
     #[test]
     fn extreme_parameters_give_a_finite_matrix() {
         let values = [

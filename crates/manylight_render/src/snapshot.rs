@@ -366,7 +366,7 @@ pub struct RenderSettings {
 
 impl RenderSettings {
     /// Refuses values no frame can be rendered with, naming the field: an `exposure` that is
-    /// not finite and positive (NaN used to give an all-black image with no non-finite pixel
+    /// not finite and positive (NaN would give an all-black image with no non-finite pixel
     /// counted), an `ambient` or a `clear_color` channel that is not finite and non-negative.
     pub fn check_values(&self) -> Result<(), String> {
         if !(self.exposure.is_finite() && self.exposure > 0.0) {
@@ -907,7 +907,7 @@ impl FrameSnapshot {
 mod tests {
     use super::*;
 
-    /// An exposure of NaN used to render an all-black frame with no non-finite pixel counted:
+    /// An exposure of NaN would render an all-black frame with no non-finite pixel counted:
     /// values no frame can render with are refused, naming the field.
     #[test]
     fn settings_no_frame_can_render_with_are_refused_by_name() {
