@@ -88,6 +88,33 @@ pub fn build_snapshot(
     lights: &Query<LightItem>,
     camera_components: &mut HashMap<Entity, ViewComponents>,
 ) -> FrameSnapshot {
+    let views = extract_views(state, viewport, cameras, camera_components);
+    let instances = extract_instances(state, meshes);
+    let lights = extract_lights(lights);
+    let snapshot = FrameSnapshot {
+        frame_index: state.frame_index,
+        viewport,
+        views,
+        instances,
+        lights: lights.point,
+        directional_lights: lights.directional,
+        settings: crate::resources::frame_settings(settings, debug),
+        pixel_light_lists: None,
+        extract_cpu_ms: 0.0,
+    };
+    state.frame_index += 1;
+    snapshot
+}
+
+/// One view per active camera, lowest order first, each with its last frame's matrix (kept in
+/// `state` for the next frame) and the components extracted for it; the components of
+/// cameras that rendered nothing this frame are dropped.
+fn extract_views(
+    state: &mut ExtractState,
+    viewport: glam::UVec2,
+    cameras: &Query<CameraItem, With<Camera3d>>,
+    camera_components: &mut HashMap<Entity, ViewComponents>,
+) -> Vec<ExtractedView> {
     let mut views: Vec<ExtractedView> = Vec::with_capacity(cameras.iter().len());
     // Last frame's cameras; the map is rebuilt from this frame's, so removed ones go.
     let prev_cameras = std::mem::take(&mut state.prev_cameras);
@@ -135,9 +162,15 @@ pub fn build_snapshot(
     camera_components.clear();
     // Lower order first; equal orders keep query order.
     views.sort_by_key(|v| v.order);
+    views
+}
+
+/// Every shown mesh entity as an instance (without a material: the default one, made once
+/// and kept in `state`).
+fn extract_instances(state: &mut ExtractState, meshes: &Query<MeshItem>) -> Vec<ExtractedInstance> {
     let default_material =
         state.default_material.get_or_insert_with(|| Arc::new(MaterialData::default())).clone();
-    let instances = meshes
+    meshes
         .iter()
         .filter(|(.., visibility)| shown(*visibility))
         .map(|(t, mesh, material, _)| ExtractedInstance {
@@ -145,7 +178,18 @@ pub fn build_snapshot(
             material: material.map_or_else(|| default_material.clone(), |m| m.0.clone()),
             world_from_local: t.to_matrix(),
         })
-        .collect();
+        .collect()
+}
+
+/// The frame's shown lights, by kind.
+struct ExtractedLights {
+    /// Point and spot lights.
+    point: Vec<ExtractedPointLight>,
+    directional: Vec<ExtractedDirectionalLight>,
+}
+
+/// Every shown light entity, in query order.
+fn extract_lights(lights: &Query<LightItem>) -> ExtractedLights {
     let mut point_lights = Vec::new();
     let mut directional_lights = Vec::new();
     for (t, (point, spot, directional), visibility, cascades) in lights {
@@ -183,19 +227,7 @@ pub fn build_snapshot(
             shadow,
         });
     }
-    let snapshot = FrameSnapshot {
-        frame_index: state.frame_index,
-        viewport,
-        views,
-        instances,
-        lights: point_lights,
-        directional_lights,
-        settings: crate::resources::frame_settings(settings, debug),
-        pixel_light_lists: None,
-        extract_cpu_ms: 0.0,
-    };
-    state.frame_index += 1;
-    snapshot
+    ExtractedLights { point: point_lights, directional: directional_lights }
 }
 
 /// The extract system (runs in `Last`, in [`crate::ManyLightSystems::Extract`]): takes the

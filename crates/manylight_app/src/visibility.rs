@@ -83,111 +83,147 @@ pub fn propagate_visibility(
     stats: Option<ResMut<VisibilityUpdateStats>>,
 ) {
     // Fresh per run: allocation follows this run's changes, not the largest run's.
-    let mut nodes: EntityHashMap<Node> = EntityHashMap::default();
-    let mut path = Vec::new();
-    let mut stack: Vec<(Entity, bool)> = Vec::new();
-    let mut done = VisibilityUpdateStats::default();
-    // A well-formed hierarchy has no cycles; a walk longer than there are entities is one.
-    let limit = entities.len() as usize;
-
-    // Entities that lost their parent or their `Visibility`. The messages may repeat an entity
-    // and name despawned ones, which have nothing to update.
-    let mut removed = Vec::new();
-    for entity in orphaned.read().chain(unset.read()) {
-        if tree.contains(entity) && nodes.insert(entity, Node::Pending).is_none() {
-            removed.push(entity);
-        }
+    let mut run = Run {
+        tree: &tree,
+        nodes: EntityHashMap::default(),
+        path: Vec::new(),
+        stack: Vec::new(),
+        done: VisibilityUpdateStats::default(),
+        // A well-formed hierarchy has no cycles; a walk longer than there are entities is one.
+        limit: entities.len() as usize,
+    };
+    let removed = run.settle_removed(orphaned.read().chain(unset.read()), &mut queries.p1());
+    run.settle_changed(&mut queries.p0(), removed);
+    run.pass_down(&mut queries.p1(), removed);
+    if let Some(mut stats) = stats {
+        stats.set_if_neq(run.done);
     }
-    {
-        let mut stored = queries.p1();
+}
+
+/// One run of [`propagate_visibility`]: what it has resolved, the values it still has to pass
+/// down, and what it did.
+struct Run<'t, 'w, 's> {
+    tree: &'t Tree<'w, 's>,
+    nodes: EntityHashMap<Node>,
+    /// Scratch space of [`resolve`].
+    path: Vec<Entity>,
+    /// Children still to look at, with their parent's value.
+    stack: Vec<(Entity, bool)>,
+    done: VisibilityUpdateStats,
+    /// Longest walk up or down before the hierarchy counts as a cycle.
+    limit: usize,
+}
+
+impl Run<'_, '_, '_> {
+    /// Resolves `entity`'s value ([`resolve`]).
+    fn resolve(&mut self, entity: Entity) -> bool {
+        resolve(entity, self.tree, &mut self.nodes, &mut self.path, self.limit)
+    }
+
+    /// Settles the entities that lost their parent or their `Visibility` (`lost`: the
+    /// messages, which may repeat an entity and name despawned ones, which have nothing to
+    /// update). Returns whether there was one.
+    fn settle_removed(&mut self, lost: impl Iterator<Item = Entity>, stored: &mut Stored) -> bool {
+        let tree = self.tree;
+        let mut removed = Vec::new();
+        for entity in lost {
+            if tree.contains(entity) && self.nodes.insert(entity, Node::Pending).is_none() {
+                removed.push(entity);
+            }
+        }
         for &entity in &removed {
-            let value = resolve(entity, &tree, &mut nodes, &mut path, limit);
+            let value = self.resolve(entity);
             let (visibility, inherited) = stored.get_mut(entity).ok().unzip();
-            if settle_dirty(visibility.flatten(), inherited, value, &mut done.written)
+            if settle_dirty(visibility.flatten(), inherited, value, &mut self.done.written)
                 && let Ok((_, _, Some(children))) = tree.get(entity)
             {
-                stack.extend(children.iter().map(|child| (child, value)));
+                self.stack.extend(children.iter().map(|child| (child, value)));
             }
         }
+        self.done.dirty = removed.len();
+        !removed.is_empty()
     }
-    done.dirty = removed.len();
 
-    // The last parent resolved for a leaf: siblings usually come one after another.
-    let mut last_parent: Option<(Entity, bool)> = None;
-    let mut leaves = 0;
-    for (entity, visibility, child_of, children, inherited) in &mut queries.p0() {
-        if !removed.is_empty() && matches!(nodes.get(&entity), Some(Node::Removed(_))) {
-            continue; // settled above
-        }
-        done.dirty += 1;
-        let children = children.filter(|c| !c.is_empty());
-        let value = if children.is_some() {
-            // Recorded, as dirty entities below it may walk through it.
-            resolve(entity, &tree, &mut nodes, &mut path, limit)
-        } else {
-            // A leaf is no one's ancestor: not recorded, so the many leaves of a large change
-            // cost no map entries.
-            leaves += 1;
-            match (own_value(visibility.as_deref().copied()), child_of) {
-                (Some(value), _) => value,
-                (None, None) => true,
-                (None, Some(child_of)) => match last_parent {
-                    Some((parent, value)) if parent == child_of.parent() => value,
-                    _ => {
-                        let value = resolve(child_of.parent(), &tree, &mut nodes, &mut path, limit);
-                        last_parent = Some((child_of.parent(), value));
-                        value
-                    }
-                },
+    /// Settles the entities whose own inputs changed, but those [`Run::settle_removed`]
+    /// settled (when `removed`: it settled some).
+    fn settle_changed(&mut self, changed: &mut ChangedInputs, removed: bool) {
+        // The last parent resolved for a leaf: siblings usually come one after another.
+        let mut last_parent: Option<(Entity, bool)> = None;
+        let mut leaves = 0;
+        for (entity, visibility, child_of, children, inherited) in changed.iter_mut() {
+            if removed && matches!(self.nodes.get(&entity), Some(Node::Removed(_))) {
+                continue; // settled already
             }
-        };
-        if settle_dirty(visibility, inherited, value, &mut done.written)
-            && let Some(children) = children
-        {
-            stack.extend(children.iter().map(|child| (child, value)));
-        }
-    }
-    done.resolved = nodes.len() + leaves;
-
-    let mut stored = queries.p1();
-    while let Some((entity, parent)) = stack.pop() {
-        done.propagated += 1;
-        if done.propagated > limit {
-            tracing::warn!("the ChildOf hierarchy has a cycle; visibility left partly updated");
-            break;
-        }
-        let Ok((own, child_of, children)) = tree.get(entity) else { continue };
-        // A dirty entity was settled above from its exact value and passes that down itself.
-        let dirty = own.as_ref().is_some_and(|v| v.is_changed())
-            || child_of.as_ref().is_some_and(|c| c.is_changed())
-            || (!removed.is_empty() && matches!(nodes.get(&entity), Some(Node::Pending | Node::Removed(_))));
-        if dirty {
-            continue;
-        }
-        let value = own_value(own.as_deref().copied()).unwrap_or(parent);
-        let descend = match stored.get_mut(entity) {
-            // Written by someone else since the last run: dirty, settled above.
-            Ok((_, inherited)) if inherited.is_changed() => false,
-            Ok((Some(_), mut inherited)) => {
-                // A clean entity's stored value is current unless an ancestor's changed; when
-                // it already is `value`, so is everything below it.
-                let changed = inherited.0 != value;
-                if changed {
-                    inherited.0 = value;
-                    done.written += 1;
+            self.done.dirty += 1;
+            let children = children.filter(|c| !c.is_empty());
+            let value = if children.is_some() {
+                // Recorded, as dirty entities below it may walk through it.
+                self.resolve(entity)
+            } else {
+                // A leaf is no one's ancestor: not recorded, so the many leaves of a large change
+                // cost no map entries.
+                leaves += 1;
+                match (own_value(visibility.as_deref().copied()), child_of) {
+                    (Some(value), _) => value,
+                    (None, None) => true,
+                    (None, Some(child_of)) => match last_parent {
+                        Some((parent, value)) if parent == child_of.parent() => value,
+                        _ => {
+                            let value = self.resolve(child_of.parent());
+                            last_parent = Some((child_of.parent(), value));
+                            value
+                        }
+                    },
                 }
-                changed
+            };
+            if settle_dirty(visibility, inherited, value, &mut self.done.written)
+                && let Some(children) = children
+            {
+                self.stack.extend(children.iter().map(|child| (child, value)));
             }
-            // No `Visibility`: the value passes through to the children.
-            Ok((None, _)) | Err(_) => true,
-        };
-        if descend && let Some(children) = children {
-            stack.extend(children.iter().map(|child| (child, value)));
         }
+        self.done.resolved = self.nodes.len() + leaves;
     }
 
-    if let Some(mut stats) = stats {
-        stats.set_if_neq(done);
+    /// Passes the settled values down to the clean entities below them, down to where a
+    /// stored value does not change (`removed`: [`Run::settle_removed`] settled some).
+    fn pass_down(&mut self, stored: &mut Stored, removed: bool) {
+        let tree = self.tree;
+        while let Some((entity, parent)) = self.stack.pop() {
+            self.done.propagated += 1;
+            if self.done.propagated > self.limit {
+                tracing::warn!("the ChildOf hierarchy has a cycle; visibility left partly updated");
+                break;
+            }
+            let Ok((own, child_of, children)) = tree.get(entity) else { continue };
+            // A dirty entity was settled above from its exact value and passes that down itself.
+            let dirty = own.as_ref().is_some_and(|v| v.is_changed())
+                || child_of.as_ref().is_some_and(|c| c.is_changed())
+                || (removed && matches!(self.nodes.get(&entity), Some(Node::Pending | Node::Removed(_))));
+            if dirty {
+                continue;
+            }
+            let value = own_value(own.as_deref().copied()).unwrap_or(parent);
+            let descend = match stored.get_mut(entity) {
+                // Written by someone else since the last run: dirty, settled above.
+                Ok((_, inherited)) if inherited.is_changed() => false,
+                Ok((Some(_), mut inherited)) => {
+                    // A clean entity's stored value is current unless an ancestor's changed; when
+                    // it already is `value`, so is everything below it.
+                    let changed = inherited.0 != value;
+                    if changed {
+                        inherited.0 = value;
+                        self.done.written += 1;
+                    }
+                    changed
+                }
+                // No `Visibility`: the value passes through to the children.
+                Ok((None, _)) | Err(_) => true,
+            };
+            if descend && let Some(children) = children {
+                self.stack.extend(children.iter().map(|child| (child, value)));
+            }
+        }
     }
 }
 

@@ -7,6 +7,7 @@ use crate::shadow_error::{measure_shadows, occluders};
 use anyhow::{Context, Result};
 use glam::UVec2;
 use manylight_app::render_world::HeadlessRenderer;
+use manylight_core::shadow_oracle::OccluderSet;
 use manylight_render::{FrameReport, FrameSettings, GBufferLayout, PipelineKind, RenderSettings};
 use manylight_scene::{
     AnimatedLight, SHELL_LIGHT_RANGE, SHELL_RADIUS, Scene, light_rig, sphere_shell_lights,
@@ -153,113 +154,165 @@ pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
     let adapter = renderer.render_world.gpu().info.name.clone();
     let shadow_settings: Vec<bool> =
         if sweep.shadows.is_empty() { vec![false] } else { sweep.shadows.clone() };
-    let configs: Vec<(PipelineKind, Option<GBufferLayout>, usize, bool)> = sweep
-        .lights
-        .iter()
-        .flat_map(|&n| {
-            let shadow_settings = shadow_settings.clone();
-            sweep.pipelines.iter().flat_map(move |&p| {
-                let layouts: Vec<Option<GBufferLayout>> = if p.is_deferred() {
-                    sweep.gbuffers.iter().copied().map(Some).collect()
-                } else {
-                    vec![None]
-                };
-                let shadow_settings = shadow_settings.clone();
-                layouts
-                    .into_iter()
-                    .flat_map(move |g| shadow_settings.clone().into_iter().map(move |s| (p, g, n, s)))
-            })
-        })
-        .filter(|&(p, _, n, _)| p != PipelineKind::NaiveForward || n <= sweep.naive_max_lights)
-        .collect();
-    // One forward oracle per light count, and a deferred one per G-buffer layout when the
-    // sweep has deferred pipelines.
-    let deferred = sweep.pipelines.iter().any(|p| p.is_deferred());
-    let oracles: Vec<(PipelineKind, Option<GBufferLayout>, usize, bool)> = if sweep.oracle {
-        let kinds: Vec<(PipelineKind, Option<GBufferLayout>)> =
-            std::iter::once((PipelineKind::ClusteredForward, None))
-                .chain(
-                    sweep
-                        .gbuffers
-                        .iter()
-                        .filter(|_| deferred)
-                        .map(|&g| (PipelineKind::ClusteredDeferred, Some(g))),
-                )
-                .collect();
-        sweep
-            .lights
-            .iter()
-            .filter(|&&n| n > 0)
-            .flat_map(|&n| kinds.iter().map(move |&(p, g)| (p, g, n)))
-            .flat_map(|(p, g, n)| shadow_settings.iter().map(move |&s| (p, g, n, s)))
-            .collect()
-    } else {
-        Vec::new()
-    };
+    let configs = configurations(sweep, &shadow_settings);
+    let oracles = oracle_configurations(sweep, &shadow_settings);
     let occluders = sweep.shadow_oracle.then(|| occluders(scene));
     let mut progress = Progress::new((configs.len() + oracles.len()) as u64, "configurations");
     let mut rows = Vec::new();
-    let runs = configs.into_iter().map(|c| (c, false)).chain(oracles.into_iter().map(|c| (c, true)));
-    for ((pipeline, gbuffer, lights, shadows), oracle) in runs {
-        let label = match (oracle, gbuffer) {
-            (true, Some(g)) => format!("deferred oracle ({} G-buffer), {lights} lights", g.name()),
-            (true, None) => format!("forward oracle, {lights} lights"),
-            (false, Some(g)) => format!("{} ({} G-buffer), {lights} lights", pipeline.name(), g.name()),
-            (false, None) => format!("{}, {lights} lights", pipeline.name()),
-        };
-        let label = if shadows { format!("{label}, shadows") } else { label };
+    for config in configs.into_iter().chain(oracles) {
+        let label = config.label();
         progress.set_message(label.clone());
-        let (lit, rig) = lights_of(scene, sweep.shell_lattice, lights)?;
-        let settings = FrameSettings {
-            render: RenderSettings {
-                pipeline,
-                gbuffer: gbuffer.unwrap_or(sweep.settings.gbuffer),
-                ..sweep.settings.render
-            },
-            ..sweep.settings
-        };
-        let (frame_ms, last, oracle_culling) =
-            timed_frames(&mut renderer, &lit, &rig, sweep, settings, oracle, shadows)?;
-        let (culling, depth_bounded, zbinned) = if oracle {
-            (oracle_culling, None, None)
-        } else if sweep.culling_efficiency && pipeline.uses_clusters() && lights > 0 {
-            let snap = snapshot(&lit, &rig, 0.0, sweep.size, settings, 0);
-            let c = measure_culling(&mut renderer, snap)?.1;
-            (Some(c.lists.ratio()), Some(c.depth_bounded.ratio()), c.zbinned.map(|z| z.ratio()))
-        } else {
-            (None, None, None)
-        };
-        let shadow_accuracy = match &occluders {
-            Some(occluders) if !oracle => {
-                let t = (sweep.warmup + sweep.frames).saturating_sub(1);
-                let mut snap = snapshot(&lit, &rig, t as f32 / 60.0, sweep.size, settings, u64::from(t));
-                if shadows {
-                    crate::direct::cast_every_shadow(&mut snap);
-                }
-                let a = measure_shadows(&mut renderer, snap, occluders)?;
-                Some(ShadowFigures { visibility_error: a.visibility_error, flip_vs_reference: a.flip.mean })
-            }
-            _ => None,
-        };
-        let median_ms = median(&frame_ms);
+        let row = measure_config(&mut renderer, scene, sweep, config, occluders.as_ref())?;
+        let median_ms = median(&row.frame_ms);
         progress.step(|| format!("{label}: {median_ms:.1} ms"));
-        rows.push(Row {
-            pipeline,
-            gbuffer,
-            lights,
-            frame_ms,
-            last,
-            culling,
-            depth_bounded,
-            zbinned,
-            oracle,
-            shadows,
-            shadow_accuracy,
-        });
+        rows.push(row);
     }
     progress.finish();
     warn_unlike_oracle_frames(&rows);
     Ok(csv(&rows, scene_name, sweep.size, &adapter))
+}
+
+/// One configuration of the sweep: a row of the CSV.
+#[derive(Clone, Copy, Debug)]
+struct Config {
+    pipeline: PipelineKind,
+    /// The G-buffer layout of a deferred pipeline.
+    gbuffer: Option<GBufferLayout>,
+    lights: usize,
+    /// Every light casts a shadow.
+    shadows: bool,
+    /// An oracle's run (see [`Row::oracle`]).
+    oracle: bool,
+}
+
+impl Config {
+    /// What the progress line calls the configuration.
+    fn label(&self) -> String {
+        let lights = self.lights;
+        let label = match (self.oracle, self.gbuffer) {
+            (true, Some(g)) => format!("deferred oracle ({} G-buffer), {lights} lights", g.name()),
+            (true, None) => format!("forward oracle, {lights} lights"),
+            (false, Some(g)) => format!("{} ({} G-buffer), {lights} lights", self.pipeline.name(), g.name()),
+            (false, None) => format!("{}, {lights} lights", self.pipeline.name()),
+        };
+        if self.shadows { format!("{label}, shadows") } else { label }
+    }
+}
+
+/// The sweep's pipeline configurations, by light count, pipeline, G-buffer layout (deferred
+/// pipelines) and shadow setting (of `shadows`); naive forward only up to
+/// `sweep.naive_max_lights` lights.
+fn configurations(sweep: &Sweep, shadows: &[bool]) -> Vec<Config> {
+    sweep
+        .lights
+        .iter()
+        .flat_map(|&lights| {
+            sweep.pipelines.iter().flat_map(move |&pipeline| {
+                let layouts: Vec<Option<GBufferLayout>> = if pipeline.is_deferred() {
+                    sweep.gbuffers.iter().copied().map(Some).collect()
+                } else {
+                    vec![None]
+                };
+                layouts.into_iter().flat_map(move |gbuffer| {
+                    shadows.iter().map(move |&shadows| Config {
+                        pipeline,
+                        gbuffer,
+                        lights,
+                        shadows,
+                        oracle: false,
+                    })
+                })
+            })
+        })
+        .filter(|c| c.pipeline != PipelineKind::NaiveForward || c.lights <= sweep.naive_max_lights)
+        .collect()
+}
+
+/// The oracles of `--oracle` (none without it): one forward oracle per light count, and a
+/// deferred one per G-buffer layout when the sweep has deferred pipelines, each with every
+/// shadow setting of `shadows`.
+fn oracle_configurations(sweep: &Sweep, shadows: &[bool]) -> Vec<Config> {
+    if !sweep.oracle {
+        return Vec::new();
+    }
+    let deferred = sweep.pipelines.iter().any(|p| p.is_deferred());
+    let kinds: Vec<(PipelineKind, Option<GBufferLayout>)> =
+        std::iter::once((PipelineKind::ClusteredForward, None))
+            .chain(
+                sweep
+                    .gbuffers
+                    .iter()
+                    .filter(|_| deferred)
+                    .map(|&g| (PipelineKind::ClusteredDeferred, Some(g))),
+            )
+            .collect();
+    sweep
+        .lights
+        .iter()
+        .filter(|&&n| n > 0)
+        .flat_map(|&n| kinds.iter().map(move |&(p, g)| (p, g, n)))
+        .flat_map(|(pipeline, gbuffer, lights)| {
+            shadows.iter().map(move |&shadows| Config { pipeline, gbuffer, lights, shadows, oracle: true })
+        })
+        .collect()
+}
+
+/// Renders and measures one configuration: its timed frames, its culling ratios (an oracle's
+/// lists', or with `--culling-efficiency` a pipeline's) and, with `occluders`, its last frame's
+/// shadows against exact visibility.
+fn measure_config(
+    renderer: &mut HeadlessRenderer,
+    scene: &Scene,
+    sweep: &Sweep,
+    config: Config,
+    occluders: Option<&OccluderSet>,
+) -> Result<Row> {
+    let Config { pipeline, gbuffer, lights, shadows, oracle } = config;
+    let (lit, rig) = lights_of(scene, sweep.shell_lattice, lights)?;
+    let settings = FrameSettings {
+        render: RenderSettings {
+            pipeline,
+            gbuffer: gbuffer.unwrap_or(sweep.settings.gbuffer),
+            ..sweep.settings.render
+        },
+        ..sweep.settings
+    };
+    let (frame_ms, last, oracle_culling) =
+        timed_frames(renderer, &lit, &rig, sweep, settings, oracle, shadows)?;
+    let (culling, depth_bounded, zbinned) = if oracle {
+        (oracle_culling, None, None)
+    } else if sweep.culling_efficiency && pipeline.uses_clusters() && lights > 0 {
+        let snap = snapshot(&lit, &rig, 0.0, sweep.size, settings, 0);
+        let c = measure_culling(renderer, snap)?.1;
+        (Some(c.lists.ratio()), Some(c.depth_bounded.ratio()), c.zbinned.map(|z| z.ratio()))
+    } else {
+        (None, None, None)
+    };
+    let shadow_accuracy = match occluders {
+        Some(occluders) if !oracle => {
+            let t = (sweep.warmup + sweep.frames).saturating_sub(1);
+            let mut snap = snapshot(&lit, &rig, t as f32 / 60.0, sweep.size, settings, u64::from(t));
+            if shadows {
+                crate::direct::cast_every_shadow(&mut snap);
+            }
+            let a = measure_shadows(renderer, snap, occluders)?;
+            Some(ShadowFigures { visibility_error: a.visibility_error, flip_vs_reference: a.flip.mean })
+        }
+        _ => None,
+    };
+    Ok(Row {
+        pipeline,
+        gbuffer,
+        lights,
+        frame_ms,
+        last,
+        culling,
+        depth_bounded,
+        zbinned,
+        oracle,
+        shadows,
+        shadow_accuracy,
+    })
 }
 
 /// How far a pass of the same work may take longer or shorter in one frame than in another
@@ -398,82 +451,142 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
          cpu_prepare_ms,cpu_record_ms,cpu_submit_ms,upload_bytes\n",
     );
     for r in rows {
-        let c = r.last.clusters.as_ref();
+        let fields = [
+            r.configuration_fields(size),
+            r.pass_fields(),
+            r.cluster_fields(),
+            r.shading_fields(rows),
+            r.refinement_fields(),
+            r.shadow_fields(),
+            r.cpu_fields(),
+        ]
+        .concat();
+        let _ = writeln!(out, "\"{adapter}\",\"{scene}\",{}", fields.join(","));
+    }
+    out
+}
+
+/// `x` with three decimals; empty when `None`.
+fn opt3(x: Option<f64>) -> String {
+    x.map_or(String::new(), |x| format!("{x:.3}"))
+}
+
+/// The row's fields of [`csv`], in groups of neighbouring columns.
+impl Row {
+    /// `pipeline` to `frames`: what was rendered.
+    fn configuration_fields(&self, size: UVec2) -> Vec<String> {
+        let pipeline = match (self.oracle, self.pipeline.is_deferred()) {
+            (true, false) => "oracle-forward",
+            (true, true) => "oracle-deferred",
+            _ => self.pipeline.name(),
+        };
+        vec![
+            pipeline.to_string(),
+            self.gbuffer.map_or("", |g| g.name()).to_string(),
+            self.gbuffer.map_or(String::new(), |g| g.bytes_per_pixel().to_string()),
+            self.lights.to_string(),
+            size.x.to_string(),
+            size.y.to_string(),
+            self.frame_ms.len().to_string(),
+        ]
+    }
+
+    /// `frame_ms_median` to `tonemap_gpu_ms`: the frame times and the main passes' GPU times.
+    fn pass_fields(&self) -> Vec<String> {
+        let r = &self.last;
         let trusted = r
-            .last
             .passes
             .iter()
             .find(|p| p.name == "cluster_build")
             .map_or(String::new(), |p| p.gpu_trusted.to_string());
-        let mean = r.frame_ms.iter().sum::<f64>() / r.frame_ms.len().max(1) as f64;
-        let shading = shading_ms(&r.last);
-        let oracle = r.oracle_of(rows).and_then(|o| shading_ms(&o.last));
-        let vs_oracle = shading.zip(oracle).filter(|&(_, o)| o > 0.0).map(|(s, o)| s / o);
-        let _ = writeln!(
-            out,
-            "\"{adapter}\",\"{scene}\",{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{}",
-            match (r.oracle, r.pipeline.is_deferred()) {
-                (true, false) => "oracle-forward",
-                (true, true) => "oracle-deferred",
-                _ => r.pipeline.name(),
-            },
-            r.gbuffer.map_or("", |g| g.name()),
-            r.gbuffer.map_or(String::new(), |g| g.bytes_per_pixel().to_string()),
-            r.lights,
-            size.x,
-            size.y,
-            r.frame_ms.len(),
-            median(&r.frame_ms),
-            mean,
-            pass_ms(&r.last, "depth_prepass"),
-            pass_ms(&r.last, "cluster_build"),
+        let mean = self.frame_ms.iter().sum::<f64>() / self.frame_ms.len().max(1) as f64;
+        vec![
+            format!("{:.3}", median(&self.frame_ms)),
+            format!("{mean:.3}"),
+            pass_ms(r, "depth_prepass"),
+            pass_ms(r, "cluster_build"),
             trusted,
-            pass_ms(&r.last, "forward"),
-            pass_ms(&r.last, "clustered_forward"),
-            pass_ms(&r.last, "gbuffer"),
-            pass_ms(&r.last, "deferred_lighting"),
-            pass_ms(&r.last, "light_volumes"),
-            pass_ms(&r.last, "tonemap"),
+            pass_ms(r, "forward"),
+            pass_ms(r, "clustered_forward"),
+            pass_ms(r, "gbuffer"),
+            pass_ms(r, "deferred_lighting"),
+            pass_ms(r, "light_volumes"),
+            pass_ms(r, "tonemap"),
+        ]
+    }
+
+    /// `clusters` to `list_bound_cpu_ms`: the cluster lists, the culling ratio and the memory.
+    fn cluster_fields(&self) -> Vec<String> {
+        let c = self.last.clusters.as_ref();
+        vec![
             c.map_or(String::new(), |c| c.clusters.to_string()),
             c.map_or(String::new(), |c| c.non_empty.to_string()),
             c.map_or(String::new(), |c| c.total_entries.to_string()),
             c.map_or(String::new(), |c| c.max_per_cluster.to_string()),
             c.map_or(String::new(), |c| format!("{:.2}", c.mean_per_non_empty)),
             c.map_or(String::new(), |c| c.dropped_pairs.to_string()),
-            r.culling.map_or(String::new(), |x| format!("{x:.3}")),
-            mib(r.last.transient_bytes),
+            opt3(self.culling),
+            format!("{:.2}", mib(self.last.transient_bytes)),
             c.map_or(String::new(), |c| format!("{:.2}", mib(c.buffer_bytes))),
             c.map_or(String::new(), |c| c.pair_bound.to_string()),
             c.map_or(String::new(), |c| c.tile_entries.to_string()),
             c.map_or(String::new(), |c| c.tile_entry_bound.to_string()),
             c.map_or(String::new(), |c| format!("{:.3}", c.bound_cpu_ms)),
-            shading.map_or(String::new(), |x| format!("{x:.3}")),
-            vs_oracle.map_or(String::new(), |x| format!("{x:.3}")),
+        ]
+    }
+
+    /// `shading_ms` and `shading_vs_oracle` (against the row's oracle among `rows`).
+    fn shading_fields(&self, rows: &[Row]) -> Vec<String> {
+        let shading = shading_ms(&self.last);
+        let oracle = self.oracle_of(rows).and_then(|o| shading_ms(&o.last));
+        let vs_oracle = shading.zip(oracle).filter(|&(_, o)| o > 0.0).map(|(s, o)| s / o);
+        vec![opt3(shading), opt3(vs_oracle)]
+    }
+
+    /// `coarse_tiles` to `zbinned_ratio`: the coarse level, depth bounds, refined lists and
+    /// z-binning.
+    fn refinement_fields(&self) -> Vec<String> {
+        let c = self.last.clusters.as_ref();
+        vec![
             c.map_or(String::new(), |c| c.coarse_span.to_string()),
             c.map_or(String::new(), |c| c.coarse_entries.to_string()),
-            r.depth_bounded.map_or(String::new(), |x| format!("{x:.3}")),
-            pass_ms(&r.last, "cluster_depth"),
-            pass_ms(&r.last, "light_refine"),
-            r.zbinned.map_or(String::new(), |x| format!("{x:.3}")),
-            if r.shadows { "on" } else { "off" },
-            r.last.shadows.map_or(0, |s| s.maps_rendered),
-            r.last.shadows.map_or(0, |s| s.maps_cached),
-            r.last.shadows.map_or(0, |s| s.maps_stale),
-            r.last.shadows.map_or(0, |s| s.atlas_bytes),
-            pass_ms(&r.last, "shadow_maps"),
-            r.shadow_accuracy.map_or(String::new(), |a| format!("{:.5}", a.visibility_error)),
-            r.shadow_accuracy.map_or(String::new(), |a| format!("{:.5}", a.flip_vs_reference)),
-            r.frame_ms.iter().copied().fold(f64::INFINITY, f64::min),
-            r.frame_ms.iter().copied().fold(0.0, f64::max),
-            r.last.frame_cpu_ms,
-            r.last.cpu.upload_ms,
-            r.last.cpu.prepare_ms,
-            r.last.cpu.record_ms,
-            r.last.cpu.submit_ms,
-            r.last.cpu.upload_bytes,
-        );
+            opt3(self.depth_bounded),
+            pass_ms(&self.last, "cluster_depth"),
+            pass_ms(&self.last, "light_refine"),
+            opt3(self.zbinned),
+        ]
     }
-    out
+
+    /// `shadows` to `flip_vs_shadow_reference`: the shadow maps and their accuracy.
+    fn shadow_fields(&self) -> Vec<String> {
+        let s = self.last.shadows;
+        let a = self.shadow_accuracy;
+        vec![
+            if self.shadows { "on" } else { "off" }.to_string(),
+            s.map_or(0, |s| s.maps_rendered).to_string(),
+            s.map_or(0, |s| s.maps_cached).to_string(),
+            s.map_or(0, |s| s.maps_stale).to_string(),
+            s.map_or(0, |s| s.atlas_bytes).to_string(),
+            pass_ms(&self.last, "shadow_maps"),
+            a.map_or(String::new(), |a| format!("{:.5}", a.visibility_error)),
+            a.map_or(String::new(), |a| format!("{:.5}", a.flip_vs_reference)),
+        ]
+    }
+
+    /// `frame_ms_min` to `upload_bytes`: the frame time's range and the CPU phases.
+    fn cpu_fields(&self) -> Vec<String> {
+        let cpu = &self.last.cpu;
+        vec![
+            format!("{:.3}", self.frame_ms.iter().copied().fold(f64::INFINITY, f64::min)),
+            format!("{:.3}", self.frame_ms.iter().copied().fold(0.0, f64::max)),
+            format!("{:.3}", self.last.frame_cpu_ms),
+            format!("{:.3}", cpu.upload_ms),
+            format!("{:.3}", cpu.prepare_ms),
+            format!("{:.3}", cpu.record_ms),
+            format!("{:.3}", cpu.submit_ms),
+            cpu.upload_bytes.to_string(),
+        ]
+    }
 }
 
 #[cfg(test)]

@@ -605,6 +605,57 @@ fn measure_shadow_accuracy(
 fn render(args: RenderArgs) -> Result<()> {
     let mut scene = args.clusters.load(&args.scene)?;
     select_camera(&mut scene, &args.camera)?;
+    let lit = add_render_lights(&mut scene, &args)?;
+    let ambient = args.ambient.unwrap_or(if lit.unlit { 0.2 } else { RenderSettings::default().ambient });
+    let shadow_settings = args.shadow.settings()?;
+    let measured = measured_snapshot(&args, &scene, lit.rig, shadow_settings)?;
+    let culling = match &measured {
+        Some(snap) if args.culling_efficiency => Some(measure_culling_efficiency(snap.clone())?),
+        _ => None,
+    };
+    let shadow_accuracy = match &measured {
+        Some(snap) if args.shadow_oracle => {
+            let a = measure_shadow_accuracy(&scene, snap.clone())?;
+            if let Some(path) = &args.shadow_reference {
+                save_png(&a.reference, path).map_err(anyhow::Error::msg)?;
+                println!("wrote the shadow reference to {}", path.display());
+            }
+            Some(a)
+        }
+        _ => None,
+    };
+    let oracle = match measured {
+        Some(snap) if args.oracle => Some(measure_oracle(snap, args.pipeline)?),
+        _ => None,
+    };
+    let settings = app_settings(&args, ambient, shadow_settings);
+    let frames = if args.post.motion_blur { args.frames.max(2) } else { args.frames };
+    let (image, stats) =
+        render_scene(scene, args.size, frames, lit.rig, args.seed, settings, render_extras(&args))?;
+    save_png(&image, &args.out).map_err(anyhow::Error::msg)?;
+    if let Some(path) = &args.stats_json {
+        let json = render_stats_json(&stats, oracle, shadow_accuracy.as_ref(), culling);
+        let text = serde_json::to_string_pretty(&json)?;
+        std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    if let Some(r) = &stats.last {
+        print_written(&args.out, r);
+    }
+    Ok(())
+}
+
+/// What `render` lights its scene with beyond the scene's own lights.
+struct RenderLights {
+    /// Animated rig lights the app spawns (`--lights`; none for the sphere-shell preset).
+    rig: usize,
+    /// The scene is unlit by itself: it brings no lights of its own (for the sphere-shell
+    /// preset: its lattice is empty), so ambient light and studio lights default higher.
+    unlit: bool,
+}
+
+/// Adds the sphere-shell preset's lattice and the studio lights to `scene`, after checking
+/// every light the command creates against the adapter's light limit and the memory.
+fn add_render_lights(scene: &mut Scene, args: &RenderArgs) -> Result<RenderLights> {
     // The sphere-shell preset is lit by its own lattice (`--lights`, default 100 000 of range
     // 0.3 just inside the radius-50 sphere), not by the animated rig.
     let shell = args.scene == "sphere-shell";
@@ -624,84 +675,87 @@ fn render(args: RenderArgs) -> Result<()> {
     }
     let studio = manylight_scene::studio_lights(studio, scene.bounds())?;
     scene.lights.extend(studio);
-    let ambient = args.ambient.unwrap_or(if unlit { 0.2 } else { RenderSettings::default().ambient });
-    let shadow_settings = args.shadow.settings()?;
-    // The measured frame of `--culling-efficiency` and `--oracle`: the last frame's animation
-    // time, rendered straight from the scene (no app).
-    let measured = (args.culling_efficiency || args.oracle || args.shadow_oracle).then(|| -> Result<_> {
-        let rig = manylight_scene::light_rig(lights, scene.bounds(), args.seed)?;
-        let t = args.frames.max(1).saturating_sub(1) as f32 / 60.0;
-        let settings = manylight_render::FrameSettings {
-            render: manylight_render::RenderSettings {
-                pipeline: args.pipeline,
-                shading: args.shading,
-                clusters: args.clusters.settings(&args.scene),
-                gbuffer: args.clusters.gbuffer,
-                normal_codec: args.clusters.normal_codec,
-                shadows: shadow_settings,
-                ..Default::default()
-            },
+    Ok(RenderLights { rig: lights, unlit })
+}
+
+/// The measured frame of `--culling-efficiency`, `--oracle` and `--shadow-oracle` (`None`
+/// without them): the last frame's animation time with `rig_lights` rig lights, rendered
+/// straight from the scene (no app).
+fn measured_snapshot(
+    args: &RenderArgs,
+    scene: &Scene,
+    rig_lights: usize,
+    shadows: manylight_render::ShadowSettings,
+) -> Result<Option<manylight_render::FrameSnapshot>> {
+    if !(args.culling_efficiency || args.oracle || args.shadow_oracle) {
+        return Ok(None);
+    }
+    let rig = manylight_scene::light_rig(rig_lights, scene.bounds(), args.seed)?;
+    let t = args.frames.max(1).saturating_sub(1) as f32 / 60.0;
+    let settings = manylight_render::FrameSettings {
+        render: manylight_render::RenderSettings {
+            pipeline: args.pipeline,
+            shading: args.shading,
+            clusters: args.clusters.settings(&args.scene),
+            gbuffer: args.clusters.gbuffer,
+            normal_codec: args.clusters.normal_codec,
+            shadows,
             ..Default::default()
-        };
-        let mut snapshot = direct::snapshot(&scene, &rig, t, args.size, settings, 0);
-        if args.shadows {
-            direct::cast_every_shadow(&mut snapshot);
-        }
-        Ok(snapshot)
-    });
-    let measured = measured.transpose()?;
-    let culling = match &measured {
-        Some(snap) if args.culling_efficiency => {
-            let mut renderer = manylight_app::render_world::HeadlessRenderer::new()?;
-            let (_, culling) = direct::measure_culling(&mut renderer, snap.clone())?;
-            let eff = culling.lists;
-            println!(
-                "culling efficiency: {} light-pixel pairs evaluated, {} contributing: {:.3}x \
-                 ({} sampled pixels, {} contributing pairs missing from the lists)",
-                eff.evaluated_pairs,
-                eff.contributing_pairs,
-                eff.ratio(),
-                eff.sampled_pixels,
-                eff.missed_pairs
-            );
-            let bounded = culling.depth_bounded;
-            println!(
-                "with per-cluster depth bounds (measured on these lists, not built): {} pairs \
-                 evaluated: {:.3}x ({} contributing pairs missing)",
-                bounded.evaluated_pairs,
-                bounded.ratio(),
-                bounded.missed_pairs
-            );
-            if let Some(z) = culling.zbinned {
-                println!(
-                    "with z-binning of the tile lists ({} bins; measured, not built): {} pairs \
-                     evaluated: {:.3}x ({} contributing pairs missing)",
-                    direct::ZBINS,
-                    z.evaluated_pairs,
-                    z.ratio(),
-                    z.missed_pairs
-                );
-            }
-            Some(eff)
-        }
-        _ => None,
+        },
+        ..Default::default()
     };
-    let shadow_accuracy = match &measured {
-        Some(snap) if args.shadow_oracle => {
-            let a = measure_shadow_accuracy(&scene, snap.clone())?;
-            if let Some(path) = &args.shadow_reference {
-                save_png(&a.reference, path).map_err(anyhow::Error::msg)?;
-                println!("wrote the shadow reference to {}", path.display());
-            }
-            Some(a)
-        }
-        _ => None,
-    };
-    let oracle = match measured {
-        Some(snap) if args.oracle => Some(measure_oracle(snap, args.pipeline)?),
-        _ => None,
-    };
-    let settings = RenderSettings {
+    let mut snapshot = direct::snapshot(scene, &rig, t, args.size, settings, 0);
+    if args.shadows {
+        direct::cast_every_shadow(&mut snapshot);
+    }
+    Ok(Some(snapshot))
+}
+
+/// Measures the culling efficiency of `snapshot`'s lists, and of the lists depth bounds and
+/// z-binning would make (measured, not built), prints them and returns the lists'.
+fn measure_culling_efficiency(
+    snapshot: manylight_render::FrameSnapshot,
+) -> Result<manylight_core::efficiency::CullingEfficiency> {
+    let mut renderer = manylight_app::render_world::HeadlessRenderer::new()?;
+    let (_, culling) = direct::measure_culling(&mut renderer, snapshot)?;
+    let eff = culling.lists;
+    println!(
+        "culling efficiency: {} light-pixel pairs evaluated, {} contributing: {:.3}x \
+         ({} sampled pixels, {} contributing pairs missing from the lists)",
+        eff.evaluated_pairs,
+        eff.contributing_pairs,
+        eff.ratio(),
+        eff.sampled_pixels,
+        eff.missed_pairs
+    );
+    let bounded = culling.depth_bounded;
+    println!(
+        "with per-cluster depth bounds (measured on these lists, not built): {} pairs \
+         evaluated: {:.3}x ({} contributing pairs missing)",
+        bounded.evaluated_pairs,
+        bounded.ratio(),
+        bounded.missed_pairs
+    );
+    if let Some(z) = culling.zbinned {
+        println!(
+            "with z-binning of the tile lists ({} bins; measured, not built): {} pairs \
+             evaluated: {:.3}x ({} contributing pairs missing)",
+            direct::ZBINS,
+            z.evaluated_pairs,
+            z.ratio(),
+            z.missed_pairs
+        );
+    }
+    Ok(eff)
+}
+
+/// The app's settings for `render`, from the command line.
+fn app_settings(
+    args: &RenderArgs,
+    ambient: f32,
+    shadows: manylight_render::ShadowSettings,
+) -> RenderSettings {
+    RenderSettings {
         pipeline: args.pipeline,
         shading: args.shading,
         exposure: args.ev100.map_or(args.exposure, |ev100| manylight_app::Exposure { ev100 }.multiplier()),
@@ -709,10 +763,14 @@ fn render(args: RenderArgs) -> Result<()> {
         clusters: args.clusters.settings(&args.scene),
         gbuffer: args.clusters.gbuffer,
         normal_codec: args.clusters.normal_codec,
-        shadows: shadow_settings,
+        shadows,
         ..RenderSettings::default()
-    };
-    let extras = Extras {
+    }
+}
+
+/// The post stages, debug view and shadows `render` adds to the scene.
+fn render_extras(args: &RenderArgs) -> Extras {
+    Extras {
         bloom: args.post.bloom.then(|| manylight_app::Bloom {
             chain: args.post.bloom_chain,
             ..manylight_app::Bloom::default()
@@ -720,66 +778,71 @@ fn render(args: RenderArgs) -> Result<()> {
         motion_blur: args.post.motion_blur.then(manylight_app::MotionBlur::default),
         debug: manylight_app::DebugView::new(args.clusters.debug_view),
         shadows: args.shadows,
-    };
-    let frames = if args.post.motion_blur { args.frames.max(2) } else { args.frames };
-    let (image, stats) = render_scene(scene, args.size, frames, lights, args.seed, settings, extras)?;
-    save_png(&image, &args.out).map_err(anyhow::Error::msg)?;
-    if let Some(path) = &args.stats_json {
-        let mut json = stats_json(&stats);
-        if let Some((ours, floor)) = oracle {
-            json["oracle"] = serde_json::json!({
-                "shading_ms": ours,
-                "oracle_shading_ms": floor,
-                "shading_vs_oracle": ours / floor,
-            });
-        }
-        if let Some(a) = &shadow_accuracy {
-            json["shadow_oracle"] = serde_json::json!({
-                "contributing_pairs": a.contributing_pairs,
-                "blocked_pairs": a.blocked_pairs,
-                "wrong_pairs": a.wrong_pairs,
-                "visibility_error": a.visibility_error,
-                "false_shadow": a.false_shadow,
-                "light_leak": a.light_leak,
-                "flip_vs_shadow_reference": a.flip.mean,
-                "flip_vs_shadow_reference_p99": a.flip.p99,
-                "rays": a.rays,
-                "ray_cast_ms": a.ray_cast_ms,
-            });
-        }
-        if let Some(e) = culling {
-            json["culling_efficiency"] = serde_json::json!({
-                "pixels": e.pixels,
-                "evaluated_pairs": e.evaluated_pairs,
-                "contributing_pairs": e.contributing_pairs,
-                "ratio": e.ratio(),
-                "sampled_pixels": e.sampled_pixels,
-                "missed_pairs": e.missed_pairs,
-            });
-        }
-        let text = serde_json::to_string_pretty(&json)?;
-        std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))?;
     }
-    if let Some(r) = &stats.last {
-        let passes: Vec<String> = r
-            .passes
-            .iter()
-            .map(|p| match p.gpu_ms {
-                Some(g) => format!("{} {:.2} ms", p.name, g),
-                None => format!("{} (cpu {:.2} ms)", p.name, p.cpu_ms),
-            })
-            .collect();
-        println!(
-            "wrote {} ({}x{}, {} lights, {} instances): {}",
-            args.out.display(),
-            r.width,
-            r.height,
-            r.light_count,
-            r.instance_count,
-            passes.join(", ")
-        );
+}
+
+/// `--stats-json`'s document: the last frame's statistics ([`stats_json`]) and the
+/// measurements `render` made of it.
+fn render_stats_json(
+    stats: &FrameStats,
+    oracle: Option<(f64, f64)>,
+    shadow_accuracy: Option<&shadow_error::ShadowAccuracy>,
+    culling: Option<manylight_core::efficiency::CullingEfficiency>,
+) -> serde_json::Value {
+    let mut json = stats_json(stats);
+    if let Some((ours, floor)) = oracle {
+        json["oracle"] = serde_json::json!({
+            "shading_ms": ours,
+            "oracle_shading_ms": floor,
+            "shading_vs_oracle": ours / floor,
+        });
     }
-    Ok(())
+    if let Some(a) = shadow_accuracy {
+        json["shadow_oracle"] = serde_json::json!({
+            "contributing_pairs": a.contributing_pairs,
+            "blocked_pairs": a.blocked_pairs,
+            "wrong_pairs": a.wrong_pairs,
+            "visibility_error": a.visibility_error,
+            "false_shadow": a.false_shadow,
+            "light_leak": a.light_leak,
+            "flip_vs_shadow_reference": a.flip.mean,
+            "flip_vs_shadow_reference_p99": a.flip.p99,
+            "rays": a.rays,
+            "ray_cast_ms": a.ray_cast_ms,
+        });
+    }
+    if let Some(e) = culling {
+        json["culling_efficiency"] = serde_json::json!({
+            "pixels": e.pixels,
+            "evaluated_pairs": e.evaluated_pairs,
+            "contributing_pairs": e.contributing_pairs,
+            "ratio": e.ratio(),
+            "sampled_pixels": e.sampled_pixels,
+            "missed_pairs": e.missed_pairs,
+        });
+    }
+    json
+}
+
+/// Prints what `render` wrote to `out`: the last frame's size, lights, instances and passes.
+fn print_written(out: &std::path::Path, r: &manylight_render::FrameReport) {
+    let passes: Vec<String> = r
+        .passes
+        .iter()
+        .map(|p| match p.gpu_ms {
+            Some(g) => format!("{} {:.2} ms", p.name, g),
+            None => format!("{} (cpu {:.2} ms)", p.name, p.cpu_ms),
+        })
+        .collect();
+    println!(
+        "wrote {} ({}x{}, {} lights, {} instances): {}",
+        out.display(),
+        r.width,
+        r.height,
+        r.light_count,
+        r.instance_count,
+        passes.join(", ")
+    );
 }
 
 fn check(path: PathBuf) -> Result<()> {

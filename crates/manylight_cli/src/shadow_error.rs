@@ -17,7 +17,7 @@
 
 use crate::direct::oracle_snapshot;
 use anyhow::{Context, Result};
-use glam::{UVec2, Vec2};
+use glam::{Mat4, UVec2, Vec2};
 use manylight_app::render_world::HeadlessRenderer;
 use manylight_core::AlphaMode;
 use manylight_core::cluster::ClusterAssignment;
@@ -92,7 +92,54 @@ pub fn measure_shadows(
 
     let world_from_clip =
         camera.world_from_view * camera.projection.matrix(size.x as f32 / size.y as f32).inverse();
-    let surfaces: Vec<Option<SurfaceHit>> = (0..size.x * size.y)
+    let surfaces = pixel_surfaces(&world_from_clip, size, &lists, occluders);
+    let pairs = light_pairs(&surfaces, &lists, &lights);
+    let cast = std::time::Instant::now();
+    let visible = occluders.visibility(&pairs.queries);
+    let ray_cast_ms = cast.elapsed().as_secs_f64() * 1e3;
+    let probe_inputs: Vec<ShadowProbe> = (pairs.entries.iter())
+        .zip(&pairs.queries)
+        .filter(|((_, reaches), _)| *reaches)
+        .map(|((entry, _), q)| ShadowProbe {
+            position: q.point,
+            normal: q.normal,
+            light: lists.indices[*entry as usize],
+        })
+        .collect();
+    let tested = renderer.render_world.renderer().probe_shadows(&probe_inputs)?;
+    let exact: Vec<bool> =
+        pairs.entries.iter().zip(&visible).filter(|((_, reaches), _)| *reaches).map(|(_, &v)| v).collect();
+    let errors = test_errors(&tested, &exact);
+    let contributing_pairs = exact.len() as u64;
+    let blocked_pairs = exact.iter().filter(|&&v| !v).count() as u64;
+
+    let reference = shadow_reference(renderer, oracle, &lists, &pairs.entries, &visible)?;
+    let (flip, _) =
+        flip_compare(reference.dimensions(), reference.as_raw(), image.dimensions(), image.as_raw())?;
+    let per_pair = |sum: f64| if contributing_pairs == 0 { 0.0 } else { sum / contributing_pairs as f64 };
+    Ok(ShadowAccuracy {
+        contributing_pairs,
+        blocked_pairs,
+        visibility_error: per_pair(errors.false_shadow + errors.light_leak),
+        wrong_pairs: errors.wrong,
+        rays: pairs.queries.len() as u64,
+        ray_cast_ms,
+        false_shadow: per_pair(errors.false_shadow),
+        light_leak: per_pair(errors.light_leak),
+        flip,
+        reference,
+    })
+}
+
+/// The surface under each pixel of a `size` frame whose list in `lists` is not empty: the
+/// first hit of its camera ray (through `world_from_clip`) in `occluders`.
+fn pixel_surfaces(
+    world_from_clip: &Mat4,
+    size: UVec2,
+    lists: &ClusterAssignment,
+    occluders: &OccluderSet,
+) -> Vec<Option<SurfaceHit>> {
+    (0..size.x * size.y)
         .into_par_iter()
         .map(|i| {
             let [_, count] = lists.ranges.get(i as usize).copied().unwrap_or_default();
@@ -109,9 +156,25 @@ pub fn measure_shadows(
             let further = world_from_clip.project_point3(ndc.extend(0.5));
             occluders.first_hit(near, further - near)
         })
-        .collect();
+        .collect()
+}
 
-    // Every (pixel, light) entry of the lists with a surface, and whether the light reaches it.
+/// The (pixel, light) entries of the oracle's lists whose pixel has a surface.
+struct LightPairs {
+    /// Each entry's index into the lists' `indices`, and whether its light reaches the surface
+    /// ([`reaches`]).
+    entries: Vec<(u32, bool)>,
+    /// The segment from each entry's surface to its light.
+    queries: Vec<ShadowQuery>,
+}
+
+/// Every (pixel, light) entry of `lists` with a surface in `surfaces` (`lights` by their
+/// index in the light buffer), and whether the light reaches it.
+fn light_pairs(
+    surfaces: &[Option<SurfaceHit>],
+    lists: &ClusterAssignment,
+    lights: &[&ExtractedPointLight],
+) -> LightPairs {
     let mut entries = Vec::new();
     let mut queries = Vec::new();
     for (pixel, surface) in surfaces.iter().enumerate() {
@@ -128,24 +191,23 @@ pub fn measure_shadows(
             });
         }
     }
-    let cast = std::time::Instant::now();
-    let visible = occluders.visibility(&queries);
-    let ray_cast_ms = cast.elapsed().as_secs_f64() * 1e3;
-    let probe_inputs: Vec<ShadowProbe> = entries
-        .iter()
-        .zip(&queries)
-        .filter(|((_, reaches), _)| *reaches)
-        .map(|((entry, _), q)| ShadowProbe {
-            position: q.point,
-            normal: q.normal,
-            light: lists.indices[*entry as usize],
-        })
-        .collect();
-    let tested = renderer.render_world.renderer().probe_shadows(&probe_inputs)?;
-    let exact: Vec<bool> =
-        entries.iter().zip(&visible).filter(|((_, reaches), _)| *reaches).map(|(_, &v)| v).collect();
+    LightPairs { entries, queries }
+}
+
+/// How far the shadow tests are from exact visibility, summed over the contributing pairs.
+struct TestErrors {
+    /// `1 - test` over the pairs the light reaches.
+    false_shadow: f64,
+    /// `test` over the blocked pairs.
+    light_leak: f64,
+    /// Pairs whose test is on the wrong side of one half.
+    wrong: u64,
+}
+
+/// The errors of the shadow tests `tested` (1: lit) against `exact` visibility, pair by pair.
+fn test_errors(tested: &[f32], exact: &[bool]) -> TestErrors {
     let (mut false_shadow, mut light_leak, mut wrong) = (0.0f64, 0.0f64, 0u64);
-    for (&test, &lit) in tested.iter().zip(&exact) {
+    for (&test, &lit) in tested.iter().zip(exact) {
         let e = if lit { 1.0 - f64::from(test) } else { f64::from(test) };
         if lit {
             false_shadow += e;
@@ -154,32 +216,25 @@ pub fn measure_shadows(
         }
         wrong += u64::from(e > 0.5);
     }
-    let contributing_pairs = exact.len() as u64;
-    let blocked_pairs = exact.iter().filter(|&&v| !v).count() as u64;
+    TestErrors { false_shadow, light_leak, wrong }
+}
 
-    // The reference: the oracle's lists without the blocked pairs, no shadow maps.
+/// Renders the shadow reference: the `oracle` snapshot's `lists` without the blocked pairs
+/// (`entries` whose segment is not `visible`), no shadow maps.
+fn shadow_reference(
+    renderer: &mut HeadlessRenderer,
+    oracle: FrameSnapshot,
+    lists: &ClusterAssignment,
+    entries: &[(u32, bool)],
+    visible: &[bool],
+) -> Result<image::RgbaImage> {
     let blocked: Vec<u32> =
-        entries.iter().zip(&visible).filter(|(_, v)| !**v).map(|((entry, _), _)| *entry).collect();
+        entries.iter().zip(visible).filter(|(_, v)| !**v).map(|((entry, _), _)| *entry).collect();
     let mut reference_snapshot = oracle;
     reference_snapshot.settings.shadows.enabled = false;
-    reference_snapshot.pixel_light_lists = Some(Arc::new(without_entries(&lists, &blocked)));
+    reference_snapshot.pixel_light_lists = Some(Arc::new(without_entries(lists, &blocked)));
     let (_, reference) = renderer.render(reference_snapshot, true)?;
-    let reference = reference.context("the reference was not read back")?;
-    let (flip, _) =
-        flip_compare(reference.dimensions(), reference.as_raw(), image.dimensions(), image.as_raw())?;
-    let per_pair = |sum: f64| if contributing_pairs == 0 { 0.0 } else { sum / contributing_pairs as f64 };
-    Ok(ShadowAccuracy {
-        contributing_pairs,
-        blocked_pairs,
-        visibility_error: per_pair(false_shadow + light_leak),
-        wrong_pairs: wrong,
-        rays: queries.len() as u64,
-        ray_cast_ms,
-        false_shadow: per_pair(false_shadow),
-        light_leak: per_pair(light_leak),
-        flip,
-        reference,
-    })
+    reference.context("the reference was not read back")
 }
 
 /// True when `light` sends light to the surface at `s`: in front of it and, for a spot light,

@@ -245,26 +245,7 @@ fn measure(
 
 /// Runs the soak and prints its summary; a failed criterion is an error (exit status 1).
 pub fn run(args: SoakArgs) -> Result<()> {
-    let plan = Plan {
-        sizes: args.sizes.clone(),
-        light_counts: args.lights.clone(),
-        resize_every: args.resize_every,
-        post_every: args.post_every,
-        debug_every: args.debug_every,
-        lights_every: args.lights_every,
-    };
-    plan.validate().map_err(anyhow::Error::msg)?;
-    if args.sample_every == 0 {
-        bail!("--sample-every: must be at least 1");
-    }
-    if args.frames < args.warmup + args.sample_every {
-        bail!(
-            "--frames {} leaves no sample after the {} warm-up frames (sampled every {})",
-            args.frames,
-            args.warmup,
-            args.sample_every
-        );
-    }
+    let plan = checked_plan(&args)?;
     measure::resident_kib().map_err(anyhow::Error::msg)?;
     if !display::has_display() {
         let status = display::rerun_under_xvfb()?;
@@ -275,32 +256,12 @@ pub fn run(args: SoakArgs) -> Result<()> {
     }
     // A path that cannot be written fails now, not after the run.
     let csv = match &args.csv {
-        Some(path) => {
-            if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-                std::fs::create_dir_all(parent)
-                    .with_context(|| format!("cannot create {}", parent.display()))?;
-            }
-            Some((
-                path,
-                std::fs::File::create(path).with_context(|| format!("cannot write {}", path.display()))?,
-            ))
-        }
+        Some(path) => Some((path, create_csv(path)?)),
         None => None,
     };
     let scene = load_scene(&args.scene, &LoadOptions::default())?;
     let first = plan.at(0).size;
-    let log = Arc::new(Mutex::new(Log {
-        outcome: Outcome {
-            frames: args.frames,
-            warmup: args.warmup,
-            max_growth_percent: args.max_growth,
-            ..Outcome::default()
-        },
-        progress: Some(Progress::new(args.frames.div_ceil(args.sample_every), "samples")),
-        started: Instant::now(),
-        last_sample: (0, Instant::now()),
-        last_report: None,
-    }));
+    let log = Arc::new(Mutex::new(new_log(&args)));
     let soak = Soak {
         bounds: scene.bounds(),
         plan,
@@ -329,7 +290,17 @@ pub fn run(args: SoakArgs) -> Result<()> {
         .add_systems(Update, (drive, measure).chain())
         .run();
     let seconds = started.elapsed().as_secs_f64();
+    conclude(&log, seconds, &exit, csv)
+}
 
+/// Completes the run's outcome with its `seconds` and how the app exited, writes the samples
+/// to the `csv` file, prints the summary and applies the pass criterion.
+fn conclude(
+    log: &Mutex<Log>,
+    seconds: f64,
+    exit: &AppExit,
+    csv: Option<(&PathBuf, std::fs::File)>,
+) -> Result<()> {
     let mut log = log.lock().map_err(|_| anyhow::anyhow!("the soak's log was poisoned by a panic"))?;
     let Log { outcome, progress, .. } = &mut *log;
     if let Some(p) = progress.take() {
@@ -351,4 +322,54 @@ pub fn run(args: SoakArgs) -> Result<()> {
         bail!("soak failed: {}", verdict.failures.join("; "));
     }
     Ok(())
+}
+
+/// The plan of `args`, refused with the flag's problem when it or the sampling cannot run.
+fn checked_plan(args: &SoakArgs) -> Result<Plan> {
+    let plan = Plan {
+        sizes: args.sizes.clone(),
+        light_counts: args.lights.clone(),
+        resize_every: args.resize_every,
+        post_every: args.post_every,
+        debug_every: args.debug_every,
+        lights_every: args.lights_every,
+    };
+    plan.validate().map_err(anyhow::Error::msg)?;
+    if args.sample_every == 0 {
+        bail!("--sample-every: must be at least 1");
+    }
+    if args.frames < args.warmup + args.sample_every {
+        bail!(
+            "--frames {} leaves no sample after the {} warm-up frames (sampled every {})",
+            args.frames,
+            args.warmup,
+            args.sample_every
+        );
+    }
+    Ok(plan)
+}
+
+/// Creates `--csv`'s file (and its folder), so that a path that cannot be written fails
+/// before the run.
+fn create_csv(path: &std::path::Path) -> Result<std::fs::File> {
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent).with_context(|| format!("cannot create {}", parent.display()))?;
+    }
+    std::fs::File::create(path).with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// The log of a run of `args`, before its first frame.
+fn new_log(args: &SoakArgs) -> Log {
+    Log {
+        outcome: Outcome {
+            frames: args.frames,
+            warmup: args.warmup,
+            max_growth_percent: args.max_growth,
+            ..Outcome::default()
+        },
+        progress: Some(Progress::new(args.frames.div_ceil(args.sample_every), "samples")),
+        started: Instant::now(),
+        last_sample: (0, Instant::now()),
+        last_report: None,
+    }
 }

@@ -78,39 +78,69 @@ fn column_x(i: usize) -> f32 {
 /// static warm lights, with one camera looking down the hall. Deterministic.
 pub fn default_scene() -> Scene {
     let mut a = Assembler { scene: Scene { name: "default".into(), ..Scene::default() } };
-    let t = Mat4::from_translation;
+    let m = add_materials(&mut a);
+    add_shell(&mut a, &m);
+    add_arcades(&mut a, &m);
+    add_props(&mut a, &m);
+    add_lights(&mut a);
+    add_camera(&mut a);
+    a.scene
+}
 
-    // Textures and materials.
+/// The hall's materials, by the part they dress (indices into the scene's materials).
+struct Materials {
+    floor: usize,
+    wall: usize,
+    stone: usize,
+    arch: usize,
+    /// Banner colours, cycled through.
+    cloth: [usize; 3],
+    gold: usize,
+    plaster: usize,
+    teal: usize,
+    crate_box: usize,
+}
+
+/// Adds the textures and materials every part of the hall uses.
+fn add_materials(a: &mut Assembler) -> Materials {
     let [tiles, brick, stone_tex, cloth_tex] =
         [floor_tiles(256), bricks(256), stone(128), cloth(128)].map(Arc::new);
-    let m_floor = a.material("floor", Vec3::ONE, Some(&tiles), (0.0, 0.35), (64.0, 0.3));
-    let m_wall = a.material("wall", Vec3::ONE, Some(&brick), (0.0, 0.85), (8.0, 0.05));
-    let m_stone = a.material("stone", Vec3::ONE, Some(&stone_tex), (0.0, 0.7), (16.0, 0.1));
-    let m_arch = a.material("arch", Vec3::new(1.0, 0.9, 0.8), Some(&stone_tex), (0.0, 0.7), (16.0, 0.1));
-    let m_cloth = [
+    let floor = a.material("floor", Vec3::ONE, Some(&tiles), (0.0, 0.35), (64.0, 0.3));
+    let wall = a.material("wall", Vec3::ONE, Some(&brick), (0.0, 0.85), (8.0, 0.05));
+    let stone = a.material("stone", Vec3::ONE, Some(&stone_tex), (0.0, 0.7), (16.0, 0.1));
+    let arch = a.material("arch", Vec3::new(1.0, 0.9, 0.8), Some(&stone_tex), (0.0, 0.7), (16.0, 0.1));
+    let cloth = [
         a.material("cloth_red", Vec3::new(0.75, 0.08, 0.06), Some(&cloth_tex), (0.0, 0.95), (4.0, 0.02)),
         a.material("cloth_green", Vec3::new(0.08, 0.55, 0.15), Some(&cloth_tex), (0.0, 0.95), (4.0, 0.02)),
         a.material("cloth_blue", Vec3::new(0.08, 0.15, 0.7), Some(&cloth_tex), (0.0, 0.95), (4.0, 0.02)),
     ];
-    let m_gold = a.material("gold", Vec3::new(1.0, 0.76, 0.33), None, (1.0, 0.3), (128.0, 0.9));
-    let m_plaster = a.material("plaster", Vec3::splat(0.9), None, (0.0, 0.6), (32.0, 0.2));
-    let m_teal = a.material("teal", Vec3::new(0.1, 0.6, 0.6), None, (0.0, 0.2), (256.0, 0.5));
+    let gold = a.material("gold", Vec3::new(1.0, 0.76, 0.33), None, (1.0, 0.3), (128.0, 0.9));
+    let plaster = a.material("plaster", Vec3::splat(0.9), None, (0.0, 0.6), (32.0, 0.2));
+    let teal = a.material("teal", Vec3::new(0.1, 0.6, 0.6), None, (0.0, 0.2), (256.0, 0.5));
     // Matte boxes use the Lambert model so one surface type ignores the global setting.
-    let m_crate = a.material("crate", Vec3::new(0.6, 0.45, 0.3), None, (0.0, 1.0), (1.0, 0.0));
-    if let Some(m) = Arc::get_mut(&mut a.scene.materials[m_crate]) {
+    let crate_box = a.material("crate", Vec3::new(0.6, 0.45, 0.3), None, (0.0, 1.0), (1.0, 0.0));
+    if let Some(m) = Arc::get_mut(&mut a.scene.materials[crate_box]) {
         m.shading = Some(ShadingModel::Lambert);
     }
+    Materials { floor, wall, stone, arch, cloth, gold, plaster, teal, crate_box }
+}
 
-    // Shell: floor, side walls, end walls.
+/// Adds the shell: floor, side walls, end walls.
+fn add_shell(a: &mut Assembler, m: &Materials) {
+    let t = Mat4::from_translation;
     let floor = a.mesh(cuboid("floor", Vec3::new(2.0 * HALF_LENGTH, 0.2, 2.0 * HALF_WIDTH), 0.25));
-    a.place(floor, m_floor, t(Vec3::new(0.0, -0.1, 0.0)));
+    a.place(floor, m.floor, t(Vec3::new(0.0, -0.1, 0.0)));
     let side = a.mesh(cuboid("side_wall", Vec3::new(2.0 * HALF_LENGTH, WALL_HEIGHT, 0.5), 0.25));
     let end = a.mesh(cuboid("end_wall", Vec3::new(0.5, WALL_HEIGHT, 2.0 * HALF_WIDTH + 0.5), 0.25));
     for s in [-1.0, 1.0] {
-        a.place(side, m_wall, t(Vec3::new(0.0, WALL_HEIGHT * 0.5, s * (HALF_WIDTH + 0.25))));
-        a.place(end, m_wall, t(Vec3::new(s * (HALF_LENGTH + 0.25), WALL_HEIGHT * 0.5, 0.0)));
+        a.place(side, m.wall, t(Vec3::new(0.0, WALL_HEIGHT * 0.5, s * (HALF_WIDTH + 0.25))));
+        a.place(end, m.wall, t(Vec3::new(s * (HALF_LENGTH + 0.25), WALL_HEIGHT * 0.5, 0.0)));
     }
+}
 
+/// Adds both arcades and the galleries above them.
+fn add_arcades(a: &mut Assembler, m: &Materials) {
+    let t = Mat4::from_translation;
     // Lower arcades: base, shaft, capital; arches between columns; a beam on top.
     let base = a.mesh(cuboid("column_base", Vec3::new(1.2, 0.4, 1.2), 0.5));
     let shaft = a.mesh(cylinder("column_shaft", 0.4, 5.3, 16, 0.5));
@@ -129,32 +159,34 @@ pub fn default_scene() -> Scene {
         let z = s * ARCADE_Z;
         for i in 0..COLUMNS {
             let x = column_x(i);
-            a.place(base, m_stone, t(Vec3::new(x, 0.2, z)));
-            a.place(shaft, m_stone, t(Vec3::new(x, 0.4 + 2.65, z)));
-            a.place(capital, m_stone, t(Vec3::new(x, SPRING_Y - 0.15, z)));
-            a.place(small_shaft, m_stone, t(Vec3::new(x, GALLERY_Y + 1.3, z)));
+            a.place(base, m.stone, t(Vec3::new(x, 0.2, z)));
+            a.place(shaft, m.stone, t(Vec3::new(x, 0.4 + 2.65, z)));
+            a.place(capital, m.stone, t(Vec3::new(x, SPRING_Y - 0.15, z)));
+            a.place(small_shaft, m.stone, t(Vec3::new(x, GALLERY_Y + 1.3, z)));
             if i + 1 < COLUMNS {
                 let mid = x + COLUMN_SPACING * 0.5;
-                a.place(arch_mesh, m_arch, t(Vec3::new(mid, SPRING_Y, z)));
+                a.place(arch_mesh, m.arch, t(Vec3::new(mid, SPRING_Y, z)));
                 // Banners hang in every other upper bay, cycling through the cloth colours.
                 if i % 2 == 0 {
-                    let m = m_cloth[(i / 2 + if s > 0.0 { 1 } else { 0 }) % m_cloth.len()];
-                    a.place(banner, m, t(Vec3::new(mid, GALLERY_Y + 1.4, z - s * 0.3)));
+                    let cloth = m.cloth[(i / 2 + if s > 0.0 { 1 } else { 0 }) % m.cloth.len()];
+                    a.place(banner, cloth, t(Vec3::new(mid, GALLERY_Y + 1.4, z - s * 0.3)));
                 }
             }
         }
-        a.place(beam, m_stone, t(Vec3::new(0.0, SPRING_Y + 2.5 + 0.25, z)));
+        a.place(beam, m.stone, t(Vec3::new(0.0, SPRING_Y + 2.5 + 0.25, z)));
         let gz = s * (ARCADE_Z + (HALF_WIDTH - ARCADE_Z + 0.45) * 0.5 - 0.45);
-        a.place(gallery, m_stone, t(Vec3::new(0.0, GALLERY_Y - 0.15, gz)));
-        a.place(beam, m_stone, t(Vec3::new(0.0, GALLERY_Y + 2.6 + 0.25, z)));
+        a.place(gallery, m.stone, t(Vec3::new(0.0, GALLERY_Y - 0.15, gz)));
+        a.place(beam, m.stone, t(Vec3::new(0.0, GALLERY_Y + 2.6 + 0.25, z)));
     }
+}
 
-    // Props in the nave.
+/// Adds the props in the nave: three spheres and four crates.
+fn add_props(a: &mut Assembler, m: &Materials) {
     let sphere = a.mesh(uv_sphere("sphere", 1.0, 16, 32, false));
-    for (x, r, m) in [(-10.0, 1.0, m_gold), (0.0, 0.7, m_plaster), (10.0, 1.2, m_teal)] {
+    for (x, r, material) in [(-10.0, 1.0, m.gold), (0.0, 0.7, m.plaster), (10.0, 1.2, m.teal)] {
         a.place(
             sphere,
-            m,
+            material,
             Mat4::from_scale_rotation_translation(
                 Vec3::splat(r),
                 glam::Quat::IDENTITY,
@@ -169,13 +201,15 @@ pub fn default_scene() -> Scene {
         let rot = glam::Quat::from_rotation_y(0.3 * i as f32);
         a.place(
             unit_box,
-            m_crate,
+            m.crate_box,
             Mat4::from_scale_rotation_translation(Vec3::splat(size), rot, Vec3::new(x, size * 0.5, z)),
         );
     }
+}
 
-    // Six warm lights down the nave, enough to see the hall with no extra lights (80 cd: the
-    // PBR model's diffuse lobe is albedo / pi, so this lights the hall as 25 did under Lambert).
+/// Adds six warm lights down the nave, enough to see the hall with no extra lights (80 cd: the
+/// PBR model's diffuse lobe is albedo / pi, so this lights the hall as 25 did under Lambert).
+fn add_lights(a: &mut Assembler) {
     for i in 0..6 {
         a.scene.lights.push(SceneLight {
             position: Vec3::new(-15.0 + 6.0 * i as f32, 4.0, 0.0),
@@ -185,14 +219,15 @@ pub fn default_scene() -> Scene {
             spot: None,
         });
     }
+}
 
-    // Camera at the west end at head height, looking east down the nave.
+/// Adds the camera at the west end at head height, looking east down the nave.
+fn add_camera(a: &mut Assembler) {
     let eye = Vec3::new(-HALF_LENGTH + 2.0, 1.7, 0.0);
     a.scene.cameras.push(SceneCamera {
         transform: camera_looking_at(eye, eye + Vec3::X),
         projection: Projection::perspective(60f32.to_radians(), 0.1, 200.0),
     });
-    a.scene
 }
 
 #[cfg(test)]

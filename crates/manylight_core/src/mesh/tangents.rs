@@ -369,61 +369,22 @@ fn split_candidates(mesh: &MeshData, tris: &[u32], normal: [f32; 3], scratch: &m
 
 /// Checks that MikkTSpace runs on `mesh` within [`work_limit`] and finds the stack it needs.
 pub(super) fn plan(mesh: &MeshData) -> Result<Plan, TangentFallback> {
-    let vertices = &mesh.vertices;
     let faces = mesh.indices.len() / 3;
     let tris = &mesh.indices[..faces * 3];
-    // Ids and offsets below are u32, as indices are.
-    let too_many = vertices.len() > u32::MAX as usize || tris.len() > u32::MAX as usize;
-    if too_many || tris.iter().any(|&i| i as usize >= vertices.len()) {
-        return Err(TangentFallback::UnusableData);
-    }
-    let usable = |v: &super::Vertex| {
-        v.position.iter().all(|x| x.is_finite() && x.abs() <= MAX_COORDINATE)
-            && v.normal.iter().chain(&v.uv).all(|x| x.is_finite())
-    };
-    if !vertices.iter().all(usable) {
-        return Err(TangentFallback::UnusableData);
-    }
+    check_usable(&mesh.vertices, tris)?;
     let corners = tris.len() as u64;
     let mut work = Work { used: 0, limit: work_limit(corners) };
 
     // Welded vertices: MikkTSpace welds corners with equal position, normal and uv.
-    let (pos_id, positions) = dense_ids(vertices.iter().map(|v| v.position.map(canonical)));
-    let (class_id, classes) = dense_ids(vertices.iter().zip(&pos_id).map(|(v, &p)| {
+    let (pos_id, positions) = dense_ids(mesh.vertices.iter().map(|v| v.position.map(canonical)));
+    let (class_id, classes) = dense_ids(mesh.vertices.iter().zip(&pos_id).map(|(v, &p)| {
         let [nx, ny, nz] = v.normal.map(canonical);
         let [u, w] = v.uv.map(canonical);
         [p, nx, ny, nz, u, w]
     }));
-    let class_of = |corner: usize| class_id[tris[corner] as usize] as usize;
+    let welded = Welded { tris, class_id, classes };
 
-    // Welding.
-    let mut pos_corners = vec![0u64; positions];
-    let mut class_corners = vec![0u64; classes];
-    for &i in tris {
-        pos_corners[pos_id[i as usize] as usize] += 1;
-        class_corners[class_id[i as usize] as usize] += 1;
-    }
-    let mut pos_vertex = vec![0u32; positions];
-    let mut class_pos = vec![0u32; classes];
-    let mut class_vertex = vec![0u32; classes];
-    for i in 0..vertices.len() {
-        pos_vertex[pos_id[i] as usize] = i as u32;
-        class_pos[class_id[i] as usize] = pos_id[i];
-        class_vertex[class_id[i] as usize] = i as u32;
-    }
-    let mut pos_classes = vec![0u64; positions];
-    for c in (0..classes).filter(|&c| class_corners[c] > 0) {
-        pos_classes[class_pos[c] as usize] += 1;
-    }
-    let mut points: Vec<Point> = (0..positions)
-        .filter(|&p| pos_corners[p] > 0)
-        .map(|p| Point {
-            p: vertices[pos_vertex[p] as usize].position,
-            corners: pos_corners[p],
-            classes: pos_classes[p],
-        })
-        .collect();
-    drop((pos_corners, pos_classes, pos_vertex, class_pos));
+    let mut points = weld_points(&mesh.vertices, &welded, &pos_id, positions);
     let weld_depth = weld_work(&mut points, &mut work)?;
     drop(points);
 
@@ -436,10 +397,87 @@ pub(super) fn plan(mesh: &MeshData) -> Result<Plan, TangentFallback> {
         .collect();
     drop(pos_id);
 
-    // Neighbour pairing: each corner of an edge shared by k good triangles scans the others.
+    pairing_work(&welded, &good, &mut work)?;
+    let valence_max = group_work(mesh, &welded, &good, &mut work)?;
+    if good.len() < faces {
+        degenerate_work(&welded, &good, faces, &mut work)?;
+    }
+
+    let sort_levels = 4 * (corners.max(2).ilog2() as usize);
+    Ok(Plan { work: work.used, levels: weld_depth + valence_max + sort_levels })
+}
+
+/// Refuses a mesh `plan` cannot estimate or MikkTSpace cannot run on: more vertices or
+/// corners than `u32` ids hold, an index out of range, or a non-finite or too large attribute.
+fn check_usable(vertices: &[super::Vertex], tris: &[u32]) -> Result<(), TangentFallback> {
+    // Ids and offsets below are u32, as indices are.
+    let too_many = vertices.len() > u32::MAX as usize || tris.len() > u32::MAX as usize;
+    if too_many || tris.iter().any(|&i| i as usize >= vertices.len()) {
+        return Err(TangentFallback::UnusableData);
+    }
+    let usable = |v: &super::Vertex| {
+        v.position.iter().all(|x| x.is_finite() && x.abs() <= MAX_COORDINATE)
+            && v.normal.iter().chain(&v.uv).all(|x| x.is_finite())
+    };
+    if !vertices.iter().all(usable) {
+        return Err(TangentFallback::UnusableData);
+    }
+    Ok(())
+}
+
+/// The welded vertex of each corner: its (position, normal, uv) class.
+struct Welded<'a> {
+    /// The mesh's whole triangles' indices.
+    tris: &'a [u32],
+    /// Class of each vertex (dense ids).
+    class_id: Vec<u32>,
+    /// Number of classes.
+    classes: usize,
+}
+
+impl Welded<'_> {
+    /// The class of corner `corner` (an index into `tris`).
+    fn of(&self, corner: usize) -> usize {
+        self.class_id[self.tris[corner] as usize] as usize
+    }
+}
+
+/// The distinct positions the triangles use (`pos_id`: each vertex's position id, of
+/// `positions` ids), each with its corners and its welded classes, for [`weld_work`].
+fn weld_points(vertices: &[super::Vertex], welded: &Welded, pos_id: &[u32], positions: usize) -> Vec<Point> {
+    let (tris, class_id, classes) = (welded.tris, &welded.class_id, welded.classes);
+    let mut pos_corners = vec![0u64; positions];
+    let mut class_corners = vec![0u64; classes];
+    for &i in tris {
+        pos_corners[pos_id[i as usize] as usize] += 1;
+        class_corners[class_id[i as usize] as usize] += 1;
+    }
+    let mut pos_vertex = vec![0u32; positions];
+    let mut class_pos = vec![0u32; classes];
+    for i in 0..vertices.len() {
+        pos_vertex[pos_id[i] as usize] = i as u32;
+        class_pos[class_id[i] as usize] = pos_id[i];
+    }
+    let mut pos_classes = vec![0u64; positions];
+    for c in (0..classes).filter(|&c| class_corners[c] > 0) {
+        pos_classes[class_pos[c] as usize] += 1;
+    }
+    (0..positions)
+        .filter(|&p| pos_corners[p] > 0)
+        .map(|p| Point {
+            p: vertices[pos_vertex[p] as usize].position,
+            corners: pos_corners[p],
+            classes: pos_classes[p],
+        })
+        .collect()
+}
+
+/// Neighbour pairing: each corner of an edge shared by k of the `good` triangles scans the
+/// others.
+fn pairing_work(welded: &Welded, good: &[u32], work: &mut Work) -> Result<(), TangentFallback> {
     let mut edges: Vec<u64> = Vec::with_capacity(good.len() * 3);
-    for &f in &good {
-        let c = [0, 1, 2].map(|k| class_of(f as usize * 3 + k) as u64);
+    for &f in good {
+        let c = [0, 1, 2].map(|k| welded.of(f as usize * 3 + k) as u64);
         for (a, b) in [(c[0], c[1]), (c[1], c[2]), (c[2], c[0])] {
             edges.push(a.min(b) << 32 | a.max(b));
         }
@@ -449,13 +487,26 @@ pub(super) fn plan(mesh: &MeshData) -> Result<Plan, TangentFallback> {
         let k = run.len() as u64;
         work.add((k.saturating_mul(k - 1) / 2).saturating_mul(EDGE_SCAN_UNITS))?;
     }
-    drop(edges);
+    Ok(())
+}
 
-    // Groups: the good triangles around each welded vertex.
+/// Groups: the `good` triangles around each welded vertex, each pair tested, and the
+/// sub-group splits among them. Returns the most triangles around one vertex.
+fn group_work(
+    mesh: &MeshData,
+    welded: &Welded,
+    good: &[u32],
+    work: &mut Work,
+) -> Result<usize, TangentFallback> {
+    let classes = welded.classes;
+    let mut class_vertex = vec![0u32; classes];
+    for (i, &c) in welded.class_id.iter().enumerate() {
+        class_vertex[c as usize] = i as u32;
+    }
     let mut offsets = vec![0u32; classes + 1];
-    for &f in &good {
+    for &f in good {
         for k in 0..3 {
-            offsets[class_of(f as usize * 3 + k) + 1] += 1;
+            offsets[welded.of(f as usize * 3 + k) + 1] += 1;
         }
     }
     for c in 0..classes {
@@ -463,9 +514,9 @@ pub(super) fn plan(mesh: &MeshData) -> Result<Plan, TangentFallback> {
     }
     let mut around = vec![0u32; good.len() * 3];
     let mut fill = offsets.clone();
-    for &f in &good {
+    for &f in good {
         for k in 0..3 {
-            let c = class_of(f as usize * 3 + k);
+            let c = welded.of(f as usize * 3 + k);
             around[fill[c] as usize] = f;
             fill[c] += 1;
         }
@@ -483,38 +534,41 @@ pub(super) fn plan(mesh: &MeshData) -> Result<Plan, TangentFallback> {
         // Before the (O(g log g)) split test: the quadratic part alone may be over the limit.
         let pairs = g.saturating_mul(g);
         work.add(pairs.saturating_mul(GROUP_PAIR_UNITS + u64::from(g.ilog2())))?;
-        let normal = vertices[class_vertex[c] as usize].normal;
+        let normal = mesh.vertices[class_vertex[c] as usize].normal;
         let split = split_candidates(mesh, tris_around, normal, &mut scratch);
         work.add(pairs.saturating_mul(split))?;
     }
-    drop((around, offsets));
+    Ok(valence_max)
+}
 
-    // Degenerate triangles: each corner scans the good triangles' corners, in face order,
-    // up to the first of its welded vertex (or all of them).
-    if good.len() < faces {
-        let mut first = vec![u64::MAX; classes];
-        for (rank, &f) in good.iter().enumerate() {
-            for k in 0..3 {
-                let c = class_of(f as usize * 3 + k);
-                first[c] = first[c].min(rank as u64 * 3 + k as u64);
-            }
-        }
-        let good_corners = good.len() as u64 * 3;
-        let mut is_good = vec![false; faces];
-        for &f in &good {
-            is_good[f as usize] = true;
-        }
-        for f in (0..faces).filter(|&f| !is_good[f]) {
-            for k in 0..3 {
-                let c = class_of(f * 3 + k);
-                let scanned = if first[c] == u64::MAX { good_corners } else { first[c] + 1 };
-                work.add(scanned.saturating_mul(DEGENERATE_SCAN_UNITS))?;
-            }
+/// Degenerate triangles (those of the `faces` not in `good`): each corner scans the good
+/// triangles' corners, in face order, up to the first of its welded vertex (or all of them).
+fn degenerate_work(
+    welded: &Welded,
+    good: &[u32],
+    faces: usize,
+    work: &mut Work,
+) -> Result<(), TangentFallback> {
+    let mut first = vec![u64::MAX; welded.classes];
+    for (rank, &f) in good.iter().enumerate() {
+        for k in 0..3 {
+            let c = welded.of(f as usize * 3 + k);
+            first[c] = first[c].min(rank as u64 * 3 + k as u64);
         }
     }
-
-    let sort_levels = 4 * (corners.max(2).ilog2() as usize);
-    Ok(Plan { work: work.used, levels: weld_depth + valence_max + sort_levels })
+    let good_corners = good.len() as u64 * 3;
+    let mut is_good = vec![false; faces];
+    for &f in good {
+        is_good[f as usize] = true;
+    }
+    for f in (0..faces).filter(|&f| !is_good[f]) {
+        for k in 0..3 {
+            let c = welded.of(f * 3 + k);
+            let scanned = if first[c] == u64::MAX { good_corners } else { first[c] + 1 };
+            work.add(scanned.saturating_mul(DEGENERATE_SCAN_UNITS))?;
+        }
+    }
+    Ok(())
 }
 
 /// `bevy_mikktspace`'s view of a mesh: one face per index triple.

@@ -1,5 +1,6 @@
 //! The node tree of a glTF scene: transforms, mesh instances, point lights and cameras.
 
+use super::data::Layout;
 use super::{Ctx, over_budget};
 use crate::{SceneCamera, SceneDirectionalLight, SceneError, SceneInstance, SceneLight, SceneNode};
 use glam::{Mat4, Quat, Vec3};
@@ -12,6 +13,44 @@ use manylight_core::mesh::TangentMethod;
 use manylight_core::{MeshData, Projection, SpotCone, radius_for_intensity};
 use std::f32::consts::FRAC_PI_2;
 use std::sync::Arc;
+
+/// The accessors a triangle primitive is converted from: primitives with the same ones share
+/// one scene mesh.
+struct PrimitiveKey {
+    position: usize,
+    normal: Option<usize>,
+    uv: Option<usize>,
+    tangent: Option<usize>,
+    indices: Option<usize>,
+    uv1: Option<usize>,
+}
+
+impl PrimitiveKey {
+    /// The key of `Ctx::meshes`.
+    fn cache_key(&self) -> [Option<usize>; 6] {
+        [Some(self.position), self.normal, self.uv, self.tangent, self.indices, self.uv1]
+    }
+}
+
+/// The checked layouts of a primitive's accessors (`None` where it has no such accessor).
+struct PrimitiveLayouts {
+    position: Layout,
+    normal: Option<Layout>,
+    uv: Option<Layout>,
+    uv1: Option<Layout>,
+    tangent: Option<Layout>,
+    indices: Option<Layout>,
+}
+
+/// A primitive's attributes and indices as read from its accessors.
+struct PrimitiveAttributes {
+    positions: Vec<Vec3>,
+    normals: Option<Vec<Vec3>>,
+    uvs: Option<Vec<glam::Vec2>>,
+    uv1: Option<Vec<glam::Vec2>>,
+    tangents: Option<Vec<glam::Vec4>>,
+    indices: Option<Vec<u32>>,
+}
 
 impl Ctx<'_> {
     /// Walks the default scene (or scene 0, or every root node when there is no scene) and
@@ -217,62 +256,109 @@ impl Ctx<'_> {
             tracing::warn!(file = %self.path.display(), mesh, primitive = p, "primitive has no POSITION, skipped");
             return Ok(None);
         };
-        let key = [
-            Some(pos),
-            attr(Semantic::Normals),
-            attr(Semantic::TexCoords(0)),
-            attr(Semantic::Tangents),
-            prim.indices.map(|i| i.value()),
-            attr(Semantic::TexCoords(1)),
-        ];
-        let generate_tangents = normal_mapped && key[2].is_some() && key[3].is_none();
-        if let Some(&index) = self.meshes.get(&key) {
-            if let Some(i) = index
-                && generate_tangents
-                && !self.generated_tangents.contains(&i)
-            {
-                self.count_tangent_triangles(self.scene.meshes[i].triangle_count() as u64, mesh, p)?;
-                self.generated_tangents.insert(i);
-                let method = Arc::make_mut(&mut self.scene.meshes[i]).generate_tangents();
-                self.report_tangents(method, mesh, p, i);
-            }
+        let key = PrimitiveKey {
+            position: pos,
+            normal: attr(Semantic::Normals),
+            uv: attr(Semantic::TexCoords(0)),
+            tangent: attr(Semantic::Tangents),
+            indices: prim.indices.map(|i| i.value()),
+            uv1: attr(Semantic::TexCoords(1)),
+        };
+        let generate_tangents = normal_mapped && key.uv.is_some() && key.tangent.is_none();
+        if let Some(&index) = self.meshes.get(&key.cache_key()) {
+            self.reuse_primitive_mesh(index, generate_tangents, mesh, p)?;
             return Ok(index);
         }
+        // Types and counts first, then the budgets, and only then read anything.
+        let layouts = self.primitive_layouts(&key, mesh, p, &what)?;
+        self.count_primitive(&layouts, generate_tangents, mesh, p, &what)?;
+        let mut attributes = self.read_primitive(&key, &layouts)?;
+        self.replace_non_finite(&mut attributes, mesh, p);
+        let count = attributes.indices.as_ref().map_or(attributes.positions.len(), Vec::len);
+        if count == 0 {
+            tracing::warn!(file = %self.path.display(), mesh, primitive = p, "primitive has no triangles, skipped");
+            // Remembered, so that other nodes sharing it do not read its accessors again.
+            self.meshes.insert(key.cache_key(), None);
+            return Ok(None);
+        }
+        self.add_primitive_mesh(key, attributes, generate_tangents, mesh, p).map(Some)
+    }
+
+    /// For primitive `p` of mesh `mesh` whose accessors were converted before (to scene mesh
+    /// `index`, `None` when it had no triangles): generates that mesh's tangents when this
+    /// primitive needs them and no primitive before it did.
+    fn reuse_primitive_mesh(
+        &mut self,
+        index: Option<usize>,
+        generate_tangents: bool,
+        mesh: usize,
+        p: usize,
+    ) -> Result<(), SceneError> {
+        if let Some(i) = index
+            && generate_tangents
+            && !self.generated_tangents.contains(&i)
+        {
+            self.count_tangent_triangles(self.scene.meshes[i].triangle_count() as u64, mesh, p)?;
+            self.generated_tangents.insert(i);
+            let method = Arc::make_mut(&mut self.scene.meshes[i]).generate_tangents();
+            self.report_tangents(method, mesh, p, i);
+        }
+        Ok(())
+    }
+
+    /// The checked layouts of `key`'s accessors (primitive `p` of mesh `mesh`, called `what`);
+    /// an error when one has the wrong type or an attribute's count is not the positions'.
+    fn primitive_layouts(
+        &self,
+        key: &PrimitiveKey,
+        mesh: usize,
+        p: usize,
+        what: &str,
+    ) -> Result<PrimitiveLayouts, SceneError> {
         let bad = |problem: String| SceneError::BadPrimitive {
             path: self.path.to_owned(),
             mesh,
             primitive: p,
             problem,
         };
-        // Types and counts first, then the budgets, and only then read anything.
-        let pos_layout = self.vec3_layout(pos, &what, "POSITION")?;
-        let normal_layout = key[1].map(|a| self.vec3_layout(a, &what, "NORMAL")).transpose()?;
-        let uv_layout = key[2].map(|a| self.uv_layout(a, &what, "TEXCOORD_0")).transpose()?;
-        let uv1_layout = key[5].map(|a| self.uv_layout(a, &what, "TEXCOORD_1")).transpose()?;
-        let tangent_layout = key[3].map(|a| self.tangent_layout(a, &what)).transpose()?;
-        let index_layout = key[4].map(|a| self.index_layout(a, &what)).transpose()?;
-        let vertices = pos_layout.count;
-        if let Some(n) = normal_layout
-            && n.count != vertices
-        {
-            return Err(bad(format!("{} normals for {vertices} positions", n.count)));
+        let layouts = PrimitiveLayouts {
+            position: self.vec3_layout(key.position, what, "POSITION")?,
+            normal: key.normal.map(|a| self.vec3_layout(a, what, "NORMAL")).transpose()?,
+            uv: key.uv.map(|a| self.uv_layout(a, what, "TEXCOORD_0")).transpose()?,
+            uv1: key.uv1.map(|a| self.uv_layout(a, what, "TEXCOORD_1")).transpose()?,
+            tangent: key.tangent.map(|a| self.tangent_layout(a, what)).transpose()?,
+            indices: key.indices.map(|a| self.index_layout(a, what)).transpose()?,
+        };
+        let vertices = layouts.position.count;
+        let attributes = [
+            (layouts.normal, "normals"),
+            (layouts.uv, "TEXCOORD_0 values"),
+            (layouts.uv1, "TEXCOORD_1 values"),
+            (layouts.tangent, "tangents"),
+        ];
+        for (layout, name) in attributes {
+            if let Some(l) = layout
+                && l.count != vertices
+            {
+                return Err(bad(format!("{} {name} for {vertices} positions", l.count)));
+            }
         }
-        if let Some(u) = uv_layout
-            && u.count != vertices
-        {
-            return Err(bad(format!("{} TEXCOORD_0 values for {vertices} positions", u.count)));
-        }
-        if let Some(u) = uv1_layout
-            && u.count != vertices
-        {
-            return Err(bad(format!("{} TEXCOORD_1 values for {vertices} positions", u.count)));
-        }
-        if let Some(t) = tangent_layout
-            && t.count != vertices
-        {
-            return Err(bad(format!("{} tangents for {vertices} positions", t.count)));
-        }
-        let indices = index_layout.map_or(vertices, |l| l.count);
+        Ok(layouts)
+    }
+
+    /// Counts the primitive's vertices and indices (and, when its tangents are to be
+    /// generated, its triangles) against the load's budgets; nothing is counted when one is
+    /// over.
+    fn count_primitive(
+        &mut self,
+        layouts: &PrimitiveLayouts,
+        generate_tangents: bool,
+        mesh: usize,
+        p: usize,
+        what: &str,
+    ) -> Result<(), SceneError> {
+        let vertices = layouts.position.count;
+        let indices = layouts.indices.map_or(vertices, |l| l.count);
         let options = self.options;
         let (used_vertices, used_indices) = (
             self.used.vertices.saturating_add(vertices as u64),
@@ -292,51 +378,58 @@ impl Ctx<'_> {
         }
         self.used.vertices = used_vertices;
         self.used.indices = used_indices;
-        let positions = self.read_vec3(pos, pos_layout)?;
-        let mut normals = match (key[1], normal_layout) {
-            (Some(a), Some(l)) => Some(self.read_vec3(a, l)?),
-            _ => None,
-        };
-        let mut uvs = match (key[2], uv_layout) {
-            (Some(a), Some(l)) => Some(self.read_uv(a, l)?),
-            _ => None,
-        };
-        let mut uv1 = match (key[5], uv1_layout) {
-            (Some(a), Some(l)) => Some(self.read_uv(a, l)?),
-            _ => None,
-        };
-        let tangents = match (key[3], tangent_layout) {
-            (Some(a), Some(l)) => Some(self.read_vec4(a, l)?),
-            _ => None,
-        };
-        let indices = match (key[4], index_layout) {
-            (Some(a), Some(l)) => Some(self.read_indices(a, l)?),
-            _ => None,
-        };
-        if let Some(n) = normals.as_mut().filter(|n| n.iter().any(|v| !v.is_finite())) {
+        Ok(())
+    }
+
+    /// Reads the primitive's attributes and indices through their checked layouts.
+    fn read_primitive(
+        &self,
+        key: &PrimitiveKey,
+        layouts: &PrimitiveLayouts,
+    ) -> Result<PrimitiveAttributes, SceneError> {
+        Ok(PrimitiveAttributes {
+            positions: self.read_vec3(key.position, layouts.position)?,
+            normals: key.normal.zip(layouts.normal).map(|(a, l)| self.read_vec3(a, l)).transpose()?,
+            uvs: key.uv.zip(layouts.uv).map(|(a, l)| self.read_uv(a, l)).transpose()?,
+            uv1: key.uv1.zip(layouts.uv1).map(|(a, l)| self.read_uv(a, l)).transpose()?,
+            tangents: key.tangent.zip(layouts.tangent).map(|(a, l)| self.read_vec4(a, l)).transpose()?,
+            indices: key.indices.zip(layouts.indices).map(|(a, l)| self.read_indices(a, l)).transpose()?,
+        })
+    }
+
+    /// Replaces non-finite normals and texture coordinates with zero, with a warning each;
+    /// non-finite tangents are only warned of (`MeshData::set_tangents` drops them).
+    fn replace_non_finite(&self, attributes: &mut PrimitiveAttributes, mesh: usize, p: usize) {
+        if let Some(n) = attributes.normals.as_mut().filter(|n| n.iter().any(|v| !v.is_finite())) {
             tracing::warn!(file = %self.path.display(), mesh, primitive = p, "non-finite normals replaced");
             n.iter_mut().filter(|v| !v.is_finite()).for_each(|v| *v = Vec3::ZERO);
         }
-        if let Some(u) = uvs.as_mut().filter(|u| u.iter().any(|v| !v.is_finite())) {
+        if let Some(u) = attributes.uvs.as_mut().filter(|u| u.iter().any(|v| !v.is_finite())) {
             tracing::warn!(file = %self.path.display(), mesh, primitive = p, "non-finite TEXCOORD_0 replaced");
             u.iter_mut().filter(|v| !v.is_finite()).for_each(|v| *v = glam::Vec2::ZERO);
         }
-        if let Some(u) = uv1.as_mut().filter(|u| u.iter().any(|v| !v.is_finite())) {
+        if let Some(u) = attributes.uv1.as_mut().filter(|u| u.iter().any(|v| !v.is_finite())) {
             tracing::warn!(file = %self.path.display(), mesh, primitive = p, "non-finite TEXCOORD_1 replaced");
             u.iter_mut().filter(|v| !v.is_finite()).for_each(|v| *v = glam::Vec2::ZERO);
         }
-        if tangents.as_ref().is_some_and(|t| t.iter().any(|v| !v.is_finite())) {
+        if attributes.tangents.as_ref().is_some_and(|t| t.iter().any(|v| !v.is_finite())) {
             // `MeshData::set_tangents` turns them into "no tangent frame".
             tracing::warn!(file = %self.path.display(), mesh, primitive = p, "non-finite tangents replaced");
         }
-        let count = indices.as_ref().map_or(positions.len(), Vec::len);
-        if count == 0 {
-            tracing::warn!(file = %self.path.display(), mesh, primitive = p, "primitive has no triangles, skipped");
-            // Remembered, so that other nodes sharing it do not read its accessors again.
-            self.meshes.insert(key, None);
-            return Ok(None);
-        }
-        let label = match &root.meshes[mesh].name {
+    }
+
+    /// Adds the scene mesh made of primitive `p` of mesh `mesh` (its tangents generated when
+    /// `generate_tangents`) and remembers it under `key`; returns its index.
+    fn add_primitive_mesh(
+        &mut self,
+        key: PrimitiveKey,
+        attributes: PrimitiveAttributes,
+        generate_tangents: bool,
+        mesh: usize,
+        p: usize,
+    ) -> Result<usize, SceneError> {
+        let PrimitiveAttributes { positions, normals, uvs, uv1, tangents, indices } = attributes;
+        let label = match &self.root.meshes[mesh].name {
             Some(name) => format!("{name}/{p}"),
             None => format!("{} mesh {mesh}/{p}", self.file_name()),
         };
@@ -355,12 +448,12 @@ impl Ctx<'_> {
             method = Some(data.generate_tangents());
         }
         self.scene.meshes.push(Arc::new(data));
-        self.meshes.insert(key, Some(index));
+        self.meshes.insert(key.cache_key(), Some(index));
         if let Some(method) = method {
             self.generated_tangents.insert(index);
             self.report_tangents(method, mesh, p, index);
         }
-        Ok(Some(index))
+        Ok(index)
     }
 
     /// Counts `triangles` more triangles with generated tangents (primitive `p` of mesh
