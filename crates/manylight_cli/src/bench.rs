@@ -8,7 +8,12 @@ use anyhow::{Context, Result};
 use glam::UVec2;
 use manylight_app::render_world::HeadlessRenderer;
 use manylight_core::shadow_oracle::OccluderSet;
-use manylight_render::{FrameReport, FrameSettings, GBufferLayout, PipelineKind, RenderSettings};
+use manylight_render::passes::{
+    ClusterBuildPass, ClusterDepthPass, ClusteredForwardPass, DeferredLightingPass, DepthPrepass,
+    ForwardPass, GBufferPass, LightRefinePass, LightVolumesPass, ShadowMapsPass, TiledDeferredPass,
+    TonemapPass,
+};
+use manylight_render::{FrameReport, FrameSettings, GBufferLayout, NamedPass, PipelineKind, RenderSettings};
 use manylight_scene::{
     AnimatedLight, SHELL_LIGHT_RANGE, SHELL_RADIUS, Scene, light_rig, sphere_shell_lights,
 };
@@ -57,10 +62,15 @@ impl Row {
     }
 }
 
-/// Passes that shade lights (a pipeline's lighting cost): `forward`, `clustered_forward`,
-/// `deferred_lighting`, `tiled_deferred`, `light_volumes`.
-pub const SHADING_PASSES: [&str; 5] =
-    ["forward", "clustered_forward", "deferred_lighting", "tiled_deferred", "light_volumes"];
+/// Passes that shade lights (a pipeline's lighting cost): forward, clustered forward, deferred
+/// lighting, tiled deferred and light volumes.
+pub const SHADING_PASSES: [&str; 5] = [
+    ForwardPass::NAME,
+    ClusteredForwardPass::NAME,
+    DeferredLightingPass::NAME,
+    TiledDeferredPass::NAME,
+    LightVolumesPass::NAME,
+];
 
 /// GPU milliseconds of `report`'s shading passes ([`SHADING_PASSES`]); `None` without timings.
 pub fn shading_ms(report: &FrameReport) -> Option<f64> {
@@ -107,12 +117,9 @@ pub(crate) fn median(v: &[f64]) -> f64 {
     if s.is_empty() { f64::NAN } else { s[s.len() / 2] }
 }
 
-fn pass_ms(r: &FrameReport, name: &str) -> String {
-    r.passes
-        .iter()
-        .find(|p| p.name == name)
-        .and_then(|p| p.gpu_ms)
-        .map_or(String::new(), |ms| format!("{ms:.3}"))
+/// GPU milliseconds of `r`'s pass of type `P`, or an empty field.
+fn pass_ms<P: NamedPass>(r: &FrameReport) -> String {
+    r.pass_gpu_ms::<P>().map_or(String::new(), |ms| format!("{ms:.3}"))
 }
 
 /// What to sweep.
@@ -325,7 +332,7 @@ const LIKE_FRAMES_TOLERANCE: f64 = 1.25;
 /// to 5.7 times slower), and its `shading_vs_oracle` says nothing. Warns of each such oracle;
 /// `render --oracle` interleaves the two frame by frame instead.
 fn warn_unlike_oracle_frames(rows: &[Row]) {
-    let tonemap = |r: &Row| r.last.passes.iter().find(|p| p.name == "tonemap").and_then(|p| p.gpu_ms);
+    let tonemap = |r: &Row| r.last.pass_gpu_ms::<TonemapPass>();
     for o in rows.iter().filter(|r| r.oracle) {
         let theirs: Vec<f64> =
             rows.iter().filter(|r| !r.oracle && r.lights == o.lights).filter_map(tonemap).collect();
@@ -497,21 +504,21 @@ impl Row {
         let trusted = r
             .passes
             .iter()
-            .find(|p| p.name == "cluster_build")
+            .find(|p| p.name == ClusterBuildPass::NAME)
             .map_or(String::new(), |p| p.gpu_trusted.to_string());
         let mean = self.frame_ms.iter().sum::<f64>() / self.frame_ms.len().max(1) as f64;
         vec![
             format!("{:.3}", median(&self.frame_ms)),
             format!("{mean:.3}"),
-            pass_ms(r, "depth_prepass"),
-            pass_ms(r, "cluster_build"),
+            pass_ms::<DepthPrepass>(r),
+            pass_ms::<ClusterBuildPass>(r),
             trusted,
-            pass_ms(r, "forward"),
-            pass_ms(r, "clustered_forward"),
-            pass_ms(r, "gbuffer"),
-            pass_ms(r, "deferred_lighting"),
-            pass_ms(r, "light_volumes"),
-            pass_ms(r, "tonemap"),
+            pass_ms::<ForwardPass>(r),
+            pass_ms::<ClusteredForwardPass>(r),
+            pass_ms::<GBufferPass>(r),
+            pass_ms::<DeferredLightingPass>(r),
+            pass_ms::<LightVolumesPass>(r),
+            pass_ms::<TonemapPass>(r),
         ]
     }
 
@@ -551,8 +558,8 @@ impl Row {
             c.map_or(String::new(), |c| c.coarse_span.to_string()),
             c.map_or(String::new(), |c| c.coarse_entries.to_string()),
             opt3(self.depth_bounded),
-            pass_ms(&self.last, "cluster_depth"),
-            pass_ms(&self.last, "light_refine"),
+            pass_ms::<ClusterDepthPass>(&self.last),
+            pass_ms::<LightRefinePass>(&self.last),
             opt3(self.zbinned),
         ]
     }
@@ -567,7 +574,7 @@ impl Row {
             s.map_or(0, |s| s.maps_cached).to_string(),
             s.map_or(0, |s| s.maps_stale).to_string(),
             s.map_or(0, |s| s.atlas_bytes).to_string(),
-            pass_ms(&self.last, "shadow_maps"),
+            pass_ms::<ShadowMapsPass>(&self.last),
             a.map_or(String::new(), |a| format!("{:.5}", a.visibility_error)),
             a.map_or(String::new(), |a| format!("{:.5}", a.flip_vs_reference)),
         ]

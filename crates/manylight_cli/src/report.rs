@@ -538,7 +538,7 @@ fn shadow_markdown(rows: &[ShadowRow], context: &str) -> String {
             off_ms = r.frame_ms;
         }
         let s = r.report.shadows.unwrap_or_default();
-        let pass = r.report.passes.iter().find(|p| p.name == "shadow_maps").and_then(|p| p.gpu_ms);
+        let pass = r.report.pass_gpu_ms::<manylight_render::passes::ShadowMapsPass>();
         let a = &r.accuracy;
         let _ = writeln!(
             out,

@@ -7,7 +7,8 @@ use crate::bench::median;
 use crate::direct::{interleaved, snapshot};
 use anyhow::Result;
 use glam::{Mat4, UVec2};
-use manylight_render::{ExtractedView, FrameReport, FrameSettings, FrameSnapshot, ViewRect};
+use manylight_render::passes::ClusterBuildPass;
+use manylight_render::{ExtractedView, FrameReport, FrameSettings, FrameSnapshot, NamedPass, ViewRect};
 use manylight_scene::{Scene, light_rig};
 use std::fmt::Write as _;
 
@@ -95,7 +96,7 @@ fn markdown(rows: &[Row], context: &str) -> Result<String> {
     let one = rows.first().map_or(f64::NAN, |r| r.frame_ms);
     for r in rows {
         let l = &r.last;
-        let builds = l.passes.iter().filter(|p| p.name == "cluster_build").count();
+        let builds = l.passes.iter().filter(|p| p.name == ClusterBuildPass::NAME).count();
         let entries: u64 = l.views.iter().filter_map(|v| v.clusters.as_ref()).map(|c| c.total_entries).sum();
         writeln!(
             out,
