@@ -46,7 +46,7 @@ impl ClusterBuildPipelines {
     fn new(device: &wgpu::Device, layout: &GroupLayout, workgroup_size: u32) -> Result<Self, RenderError> {
         let module = crate::shaders::create_module(device, "cluster_build.wgsl")?;
         crate::layouts::check_pipeline("cluster_build.wgsl", &[], &[layout])?;
-        let pipeline_layout = super::common::pipeline_layout(device, "cluster_build", &[layout]);
+        let pipeline_layout = crate::layouts::pipeline_layout(device, "cluster_build", &[layout]);
         let constants = [("WORKGROUP_SIZE", workgroup_size as f64)];
         let make = |entry: &str| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {

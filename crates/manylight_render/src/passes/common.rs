@@ -3,20 +3,9 @@
 //! and the attachments they use.
 
 use crate::context::RenderError;
+use crate::layouts::{GroupLayout, check_pipeline, pipeline_layout};
 use crate::resources::{DEPTH_FORMAT, SurfaceVariant};
 use manylight_core::Vertex;
-
-use crate::layouts::{GroupLayout, check_pipeline};
-
-/// The pipeline layout of bind groups `layouts`, group 0 first.
-pub fn pipeline_layout(device: &wgpu::Device, label: &str, layouts: &[&GroupLayout]) -> wgpu::PipelineLayout {
-    let layouts: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(|l| Some(l.raw())).collect();
-    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(label),
-        bind_group_layouts: &layouts,
-        immediate_size: 0,
-    })
-}
 
 /// The compute pipeline of `shader`'s `entry` over the bind groups `layouts` (group 0 first),
 /// with its `override` constants (`label` names the layout and the pipeline).
