@@ -12,6 +12,7 @@ use crate::stages::{ExtractedCameraComponents, RenderStages};
 use bevy_app::AppExit;
 use bevy_ecs::prelude::*;
 use bevy_ecs::query::QueryData;
+use bevy_ecs::system::SystemParam;
 use bevy_time::Time;
 use glam::Mat4;
 use manylight_core::{MaterialData, SpotCone, candela_from_lumens};
@@ -76,21 +77,28 @@ fn shown(visibility: Option<&InheritedVisibility>) -> bool {
     visibility.is_none_or(|v| v.0)
 }
 
-/// Builds the frame's snapshot from the world.
-#[allow(clippy::too_many_arguments)]
+/// What extraction reads of the main world.
+#[derive(SystemParam)]
+pub struct ExtractInputs<'w, 's> {
+    viewport: Res<'w, ViewportSize>,
+    settings: Res<'w, RenderSettings>,
+    debug: Res<'w, DebugView>,
+    cameras: Query<'w, 's, CameraItem, With<Camera3d>>,
+    meshes: Query<'w, 's, MeshItem>,
+    lights: Query<'w, 's, LightItem>,
+}
+
+/// Builds the frame's snapshot from the world; the components an app extracts per camera are
+/// in `camera_components`.
 pub fn build_snapshot(
     state: &mut ExtractState,
-    viewport: glam::UVec2,
-    settings: &RenderSettings,
-    debug: &DebugView,
-    cameras: &Query<CameraItem, With<Camera3d>>,
-    meshes: &Query<MeshItem>,
-    lights: &Query<LightItem>,
+    world: &ExtractInputs,
     camera_components: &mut HashMap<Entity, ViewComponents>,
 ) -> FrameSnapshot {
-    let views = extract_views(state, viewport, cameras, camera_components);
-    let instances = extract_instances(state, meshes);
-    let lights = extract_lights(lights);
+    let viewport = world.viewport.0;
+    let views = extract_views(state, viewport, &world.cameras, camera_components);
+    let instances = extract_instances(state, &world.meshes);
+    let lights = extract_lights(&world.lights);
     let snapshot = FrameSnapshot {
         frame_index: state.frame_index,
         viewport,
@@ -98,7 +106,7 @@ pub fn build_snapshot(
         instances,
         lights: lights.point,
         directional_lights: lights.directional,
-        settings: crate::resources::frame_settings(settings, debug),
+        settings: crate::resources::frame_settings(&world.settings, &world.debug),
         pixel_light_lists: None,
         extract_cpu_ms: 0.0,
     };
@@ -232,15 +240,9 @@ fn extract_lights(lights: &Query<LightItem>) -> ExtractedLights {
 
 /// The extract system (runs in `Last`, in [`crate::ManyLightSystems::Extract`]): takes the
 /// snapshot and hands it to the renderer; [`collect_results`] runs right after it.
-#[allow(clippy::too_many_arguments)]
 pub fn extract_and_render(
     mut state: Local<ExtractState>,
-    viewport: Res<ViewportSize>,
-    settings: Res<RenderSettings>,
-    debug: Res<DebugView>,
-    cameras: Query<CameraItem, With<Camera3d>>,
-    meshes: Query<MeshItem>,
-    lights: Query<LightItem>,
+    inputs: ExtractInputs,
     mut backend: ResMut<RenderBackend>,
     capture: Res<HeadlessCapture>,
     failure: Res<RenderFailure>,
@@ -250,16 +252,7 @@ pub fn extract_and_render(
         return;
     }
     let start = std::time::Instant::now();
-    let mut snapshot = build_snapshot(
-        &mut state,
-        viewport.0,
-        &settings,
-        &debug,
-        &cameras,
-        &meshes,
-        &lights,
-        &mut components.0,
-    );
+    let mut snapshot = build_snapshot(&mut state, &inputs, &mut components.0);
     snapshot.extract_cpu_ms = start.elapsed().as_secs_f64() * 1e3;
     // The stages travel with each frame (an `Arc`, shared until the app changes them).
     backend.submit(snapshot, capture.enabled, stages.0.clone());
