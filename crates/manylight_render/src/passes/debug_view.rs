@@ -48,9 +48,7 @@ impl Family {
             Family::Depth
         }
     }
-}
 
-impl Family {
     /// The family's bind group and fragment entry point.
     fn group_and_entry(self) -> (&'static BindGroupDecl, &'static str) {
         match self {
