@@ -86,7 +86,7 @@ impl ClusterBuffers {
         ]
     }
 
-    /// Bytes of every buffer.
+    /// Bytes of every buffer (capacities, not what this frame filled).
     pub fn bytes(&self) -> u64 {
         let growable = [
             &self.ranges,

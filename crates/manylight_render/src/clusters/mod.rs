@@ -709,7 +709,7 @@ impl ClusterResources {
             coarse_entry_bound: self.sizing.estimate.coarse_entries,
             coarse_span: self.coarse.unwrap_or(0),
             bound_cpu_ms: self.sizing.cpu_ms,
-            buffer_bytes: self.buffer_bytes(),
+            buffer_bytes: self.buffers.bytes(),
             cull_test: self.cull.name().to_string(),
             z_slicing: self.grid.slicing.name().to_string(),
             from_lights: self.from_lights,
@@ -730,11 +730,6 @@ impl ClusterResources {
             || self.sizing.estimate.tile_entries > u64::from(self.params.tile_index_capacity)
             || self.sizing.estimate.coarse_entries > u64::from(self.params.coarse_index_capacity)
             || (loop_limited && self.sizing.estimate.max_tile_lights > loop_limit)
-    }
-
-    /// Bytes of the GPU buffers held (capacities, not what this frame filled).
-    pub fn buffer_bytes(&self) -> u64 {
-        self.buffers.bytes()
     }
 
     /// Reads the refined lists of the last submitted view back (waits for the GPU); `None` when
