@@ -186,7 +186,8 @@ fn count_views_show_the_cpu_reference_of_each_pixels_cluster() {
         let r = renderer.render_world.renderer();
         let clusters = r.view_clusters(0).expect("the frame built clusters");
         // Uncapped counts: the overflow view shows a capped cluster red when its list hit the cap.
-        let reference = assign_lights(&clusters.grid, &clusters.view_spheres, settings.clusters.cull, None);
+        let spheres = clusters.read_view_spheres(&r.gpu).expect("spheres");
+        let reference = assign_lights(&clusters.grid, &spheres, settings.clusters.cull, None);
         let (w, h, depth) = r.read_depth().expect("depth readback").expect("a depth buffer");
         let p = projection.sanitized();
         let legend_top = h as f32 * 0.96;

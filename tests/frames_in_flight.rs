@@ -79,7 +79,9 @@ fn check(seen: &Seen, max_lag: u64, what: &str) {
         // The figures read back without waiting are there: the cluster counters.
         let clusters = r.clusters.as_ref().unwrap_or_else(|| panic!("{at}: no cluster statistics"));
         assert!(
-            clusters.total_entries > 0 && clusters.total_entries <= clusters.pair_bound,
+            clusters.total_entries > 0
+                && clusters.total_entries <= clusters.index_capacity
+                && clusters.fallback_clusters == 0,
             "{at}: {clusters:?}"
         );
         assert_eq!(r.nonfinite_pixels, Some(0), "{at}");

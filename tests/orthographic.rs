@@ -122,7 +122,8 @@ fn orthographic_gpu_lists_equal_the_cpu_reference() {
             let clusters = renderer.view_clusters(0).expect("clusters");
             assert!(clusters.grid.ortho_half.is_some() && clusters.grid.slicing == ZSlicing::Linear);
             let gpu = clusters.read_assignment(&renderer.gpu).expect("readback");
-            let cpu = assign_lights(&clusters.grid, &clusters.view_spheres, cull, None);
+            let spheres = clusters.read_view_spheres(&renderer.gpu).expect("spheres");
+            let cpu = assign_lights(&clusters.grid, &spheres, cull, None);
             let what = format!("{cull:?}/{}", pipeline.name());
             assert!(cpu.ranges.iter().any(|r| r[1] > 0), "{what}: lights were assigned");
             for c in 0..cpu.ranges.len() as u32 {

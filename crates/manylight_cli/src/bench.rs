@@ -451,7 +451,7 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
          frame_ms_mean,depth_prepass_gpu_ms,cluster_build_gpu_ms,cluster_build_gpu_trusted,\
          forward_gpu_ms,clustered_forward_gpu_ms,gbuffer_gpu_ms,deferred_lighting_gpu_ms,light_volumes_gpu_ms,tonemap_gpu_ms,clusters,non_empty_clusters,list_entries,\
          max_per_cluster,mean_per_non_empty,dropped_pairs,culling_ratio,transient_mib,cluster_buffer_mib,\
-         list_entry_bound,tile_entries,tile_entry_bound,list_bound_cpu_ms,shading_ms,shading_vs_oracle,\
+         list_capacity,tile_entries,tile_capacity,fallback_clusters,shading_ms,shading_vs_oracle,\
          coarse_tiles,coarse_entries,depth_bounded_ratio,cluster_depth_gpu_ms,light_refine_gpu_ms,\
          zbinned_ratio,shadows,shadow_maps_rendered,shadow_maps_cached,shadow_maps_stale,shadow_atlas_bytes,shadow_gpu_ms,\
          visibility_error,flip_vs_shadow_reference,frame_ms_min,frame_ms_max,cpu_frame_ms,cpu_upload_ms,\
@@ -522,7 +522,7 @@ impl Row {
         ]
     }
 
-    /// `clusters` to `list_bound_cpu_ms`: the cluster lists, the culling ratio and the memory.
+    /// `clusters` to `fallback_clusters`: the cluster lists, the culling ratio and the memory.
     fn cluster_fields(&self) -> Vec<String> {
         let c = self.last.clusters.as_ref();
         vec![
@@ -535,10 +535,10 @@ impl Row {
             opt3(self.culling),
             format!("{:.2}", mib(self.last.transient_bytes)),
             c.map_or(String::new(), |c| format!("{:.2}", mib(c.buffer_bytes))),
-            c.map_or(String::new(), |c| c.pair_bound.to_string()),
+            c.map_or(String::new(), |c| c.index_capacity.to_string()),
             c.map_or(String::new(), |c| c.tile_entries.to_string()),
-            c.map_or(String::new(), |c| c.tile_entry_bound.to_string()),
-            c.map_or(String::new(), |c| format!("{:.3}", c.bound_cpu_ms)),
+            c.map_or(String::new(), |c| c.tile_index_capacity.to_string()),
+            c.map_or(String::new(), |c| c.fallback_clusters.to_string()),
         ]
     }
 

@@ -62,7 +62,7 @@ fn render_and_read_lists(renderer: &mut HeadlessRenderer, snapshot: FrameSnapsho
     let assignment = clusters.read_assignment(&r.gpu)?;
     let refined = clusters.read_refined(&r.gpu)?;
     let (_, _, depth) = r.read_depth()?.context("the frame has no depth buffer")?;
-    let (grid, spheres) = (clusters.grid, clusters.view_spheres.clone());
+    let (grid, spheres) = (clusters.grid, clusters.read_view_spheres(&r.gpu)?);
     Ok(FrameLists { report, projection, grid, assignment, spheres, depth, refined })
 }
 

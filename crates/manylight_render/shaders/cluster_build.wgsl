@@ -21,7 +21,7 @@
 //    dispatched and level 1 takes every light as a candidate;
 // 1. `tile_count`: one invocation per (tile, chunk of TILE_LIGHT_CHUNK candidates of its coarse
 //    tile's list; `tile_chunk`: `tile_chunks` chunks per tile, enough for the longest coarse
-//    list the CPU bound allows, so far fewer than level 0's chunks of all lights) counts the
+//    list there can be; chunks past a tile's list return at once) counts the
 //    chunk's lights whose sphere passes the chosen test against the tile's whole column,
 //    radius inflated a little more: the column's box contains each cluster's box and its
 //    planes are each cluster's side planes moved outwards, so this is a superset of what any
@@ -48,8 +48,13 @@
 // Sums and offsets saturate at 2^32 - 1 instead of wrapping (`add_saturating`), so a frame
 // with more pairs than a u32 counts is seen as too large (PAIR_COUNT_SATURATED) rather than as
 // a small total whose lists would silently miss lights.
-// A fill whose list is too small is skipped; the renderer reads the totals back, grows the
-// lists and renders the frame again, so nothing is lost. The result is the same compacted
+// The lists are sized from the counters of earlier frames, read back without waiting: no
+// bound is computed on the CPU. A fill whose list does not fit is skipped, and a cluster
+// whose list is missing or incomplete for that (its coarse tile's list, its tile's list or its
+// own did not fit, or its tile list is longer than the loop limit) gets the range
+// (0, LIST_EVERY_LIGHT): its pixels shade from every light that frame, exact and slower,
+// `fallback_clusters` counts it, and the renderer grows the lists for the next frames. No
+// frame is rendered twice and no light is lost. The result is otherwise the same compacted
 // structure as manylight_core::cluster::assign_lights.
 //!include common/clusters.wgsl
 
@@ -62,20 +67,20 @@ struct ClusterCounters {
     tile_entries: atomic<u32>,
     max_tile_lights: atomic<u32>,
     coarse_entries: atomic<u32>,
+    fallback_clusters: atomic<u32>,
 };
 
 @group(0) @binding(0) var<uniform> params: ClusterParams;
 @group(0) @binding(1) var<storage, read> bounds: array<GpuClusterBounds>;
-// The lights' view-space spheres (centre, radius), then the indices of the lights level 0 from
-// the lights' side marks, four to an element (`listed_light`).
+// The lights' view-space spheres (centre, radius; light_spheres.wgsl writes them first).
 @group(0) @binding(2) var<storage, read> spheres: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> ranges: array<vec2<u32>>;
 @group(0) @binding(4) var<storage, read_write> indices: array<u32>;
 // The counters, then, where levels 0 and 1 run from the lights' side, their bits (the build's
 // 8 storage bindings are taken, and atomics need an atomic binding): level 0's first
 // (`light_marks`: bit `e % 32` of word `c * coarse_words + e / 32` of `coarse_bits` is set when
-// coarse tile `c` keeps the `e`-th listed light, `coarse_words` being `light_chunks *
-// CHUNK_WORDS`, a chunk of TILE_LIGHT_CHUNK listed lights being CHUNK_WORDS words), then level
+// coarse tile `c` keeps light `e`, `coarse_words` being `light_chunks * CHUNK_WORDS`, a chunk
+// of TILE_LIGHT_CHUNK lights being CHUNK_WORDS words), then level
 // 1's (`tile_marks`, `tile_bits_first`). The renderer clears the bits before the build.
 struct ClusterBuildState {
     counters: ClusterCounters,
@@ -89,7 +94,7 @@ struct ClusterBuildState {
 
 // TILE_PREFILTER_INFLATION (from Rust, manylight_core::cluster::TILE_PREFILTER_INFLATION): extra
 // inflation of the tile prefilter, so float rounding can never make it reject a light a cluster
-// of the column would accept; the CPU bound of the tile list (cluster::list_bounds) uses it too.
+// of the column would accept.
 
 override WORKGROUP_SIZE: u32 = 64u;
 
@@ -180,12 +185,17 @@ fn tile_chunk(e: u32) -> vec3<u32> {
 }
 
 // The list (offset, count) made of the `chunks` consecutive entries from `first` of
-// `tile_ranges`, or empty when it does not fit in `capacity` entries this frame (the frame is
-// rendered again).
-fn chunked_list(first: u32, chunks: u32, capacity: u32) -> vec2<u32> {
+// `tile_ranges`.
+fn chunked_range(first: u32, chunks: u32) -> vec2<u32> {
     let a = tile_ranges[first];
     let z = tile_ranges[first + chunks - 1u];
-    let range = vec2<u32>(a.x, add_saturating(z.x, z.y) - a.x);
+    return vec2<u32>(a.x, add_saturating(z.x, z.y) - a.x);
+}
+
+// `chunked_range`, or empty when it does not fit in `capacity` entries this frame: its fill
+// skipped it, and the clusters below it shade from every light (`fill`).
+fn chunked_list(first: u32, chunks: u32, capacity: u32) -> vec2<u32> {
+    let range = chunked_range(first, chunks);
     return select(vec2<u32>(0u), range, fits(range, capacity));
 }
 
@@ -384,25 +394,18 @@ fn count_bits(row: u32, first: u32, end: u32) -> u32 {
     return n;
 }
 
-// The `e`-th of the lights level 0 from the lights' side marks (`params.listed_lights` of them,
-// ascending): those whose rectangle the CPU's bound leaves non-empty, which holds the GPU's
-// (`manylight_core::cluster::list_bounds`); no other light is in any list. Most lights of a
-// scene that surrounds the camera are not, and marking them cost an invocation each.
-fn listed_light(e: u32) -> u32 {
-    return bitcast<u32>(spheres[params.light_count + e / 4u][e % 4u]);
-}
-
 // Level 0 from the lights' side (where the coarse bits fit, `ClusterResources`): one invocation
-// per listed light makes its rectangle (`light_rect`) and sets its bit in each coarse tile of
-// the rectangle that `touches_coarse`. The loops run over the rectangle, at most
-// COARSE_SCATTER_TILES coarse tiles, not over the lights.
+// per light makes its rectangle (`light_rect`) and sets its bit in each coarse tile of the
+// rectangle that `touches_coarse`. The loops run over the rectangle, at most
+// COARSE_SCATTER_TILES coarse tiles, not over the lights; a light that no tile can list (an
+// empty rectangle: behind the camera, outside the frustum) returns at once.
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn light_marks(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let e = linear_index(id, groups);
-    if e >= params.listed_lights {
+    if e >= params.light_count {
         return;
     }
-    let l = listed_light(e);
+    let l = e;
     let rect = light_rect(spheres[l]);
     let span = params.coarse_span;
     let lo = rect_first(rect) / span;
@@ -427,12 +430,12 @@ fn coarse_count_bits(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_
         return;
     }
     let c = coarse_chunk(e);
-    let lights = chunk_range(c.y, params.listed_lights);
+    let lights = chunk_range(c.y, params.light_count);
     tile_ranges[tile_entry_total() + c.z] = vec2<u32>(0u, count_bits(coarse_word(c.x, 0u), lights.x, lights.y));
 }
 
-// `coarse_fill` from the bits: the set bits in ascending order, and the listed lights are
-// ascending, so the coarse lists are in ascending light order as before.
+// `coarse_fill` from the bits: the set bits in ascending order, so the coarse lists are in
+// ascending light order as before.
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn coarse_fill_bits(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let e = linear_index(id, groups);
@@ -449,14 +452,21 @@ fn coarse_fill_bits(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_w
     var k = 0u;
     for (var i = 0u; i < CHUNK_WORDS; i++) {
         var bits = atomicLoad(&build.coarse_bits[first + i]);
-        let listed0 = (c.y * CHUNK_WORDS + i) * 32u;
+        let first_light = (c.y * CHUNK_WORDS + i) * 32u;
         // One iteration per set bit; at most TILE_LIGHT_CHUNK in all.
         while bits != 0u && k < range.y {
-            tile_indices[base + k] = listed_light(listed0 + firstTrailingBit(bits));
+            tile_indices[base + k] = first_light + firstTrailingBit(bits);
             k += 1u;
             bits &= bits - 1u;
         }
     }
+}
+
+// The first entry of `tile_ranges` of the coarse tile that holds tile `t`.
+fn coarse_entry_of_tile(t: u32) -> u32 {
+    let x = (t % params.dims.x) / params.coarse_span;
+    let y = (t / params.dims.x) / params.coarse_span;
+    return tile_entry_total() + (x + y * params.coarse_dims.x) * params.light_chunks;
 }
 
 // Level 1's candidates for tile `t`: its coarse tile's list (offset, count into the coarse
@@ -465,11 +475,17 @@ fn tile_candidates(t: u32) -> vec2<u32> {
     if params.coarse_span == 0u {
         return vec2<u32>(0u, params.light_count);
     }
-    let x = (t % params.dims.x) / params.coarse_span;
-    let y = (t / params.dims.x) / params.coarse_span;
-    let c = x + y * params.coarse_dims.x;
-    let chunks = params.light_chunks;
-    return chunked_list(tile_entry_total() + c * chunks, chunks, params.coarse_index_capacity);
+    return chunked_list(coarse_entry_of_tile(t), params.light_chunks, params.coarse_index_capacity);
+}
+
+// True when tile `t`'s candidates are all its coarse tile's lights: there is no coarse level,
+// or its coarse tile's list fit this frame's coarse lists and level 1's `tile_chunks` chunks.
+fn candidates_complete(t: u32) -> bool {
+    if params.coarse_span == 0u {
+        return true;
+    }
+    let list = chunked_range(coarse_entry_of_tile(t), params.light_chunks);
+    return fits(list, params.coarse_index_capacity) && list.y <= params.tile_chunks * TILE_LIGHT_CHUNK;
 }
 
 // Candidate `i` of a list from `tile_candidates`.
@@ -633,11 +649,22 @@ fn tile_fill_bits(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_wor
     }
 }
 
-// The lights of the cluster's tile: (offset, count) into `tile_indices`, from its first and
-// last chunk's ranges.
-fn tile_lights(cluster: u32) -> vec2<u32> {
+// The lights of a cluster's tile (`range`: offset, count into `tile_indices`, from its first and
+// last chunk's ranges), and whether they are every light of the tile's column the build can
+// loop over: its coarse tile's list and its own fit this frame's lists, and it is no longer
+// than `loop_limit`. When not (`exact` false), the range is empty and the cluster shades from
+// every light (`fill`).
+struct TileLights {
+    range: vec2<u32>,
+    exact: bool,
+};
+
+fn tile_lights(cluster: u32) -> TileLights {
+    let t = cluster % tile_count_total();
     let chunks = params.tile_chunks;
-    return chunked_list((cluster % tile_count_total()) * chunks, chunks, params.tile_index_capacity);
+    let range = chunked_range(t * chunks, chunks);
+    let exact = candidates_complete(t) && fits(range, params.tile_index_capacity) && range.y <= params.loop_limit;
+    return TileLights(select(vec2<u32>(0u), range, exact), exact);
 }
 
 // The coordinate (x for planes 0 and 1, y for 2 and 3: `along` is the plane's normal along
@@ -704,12 +731,13 @@ fn count(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) 
         return;
     }
     let b = level2_bounds(cluster);
-    var tile = tile_lights(cluster);
+    let lights = tile_lights(cluster);
+    var tile = lights.range;
     if cluster_without_pixels(cluster) {
         tile.y = 0u;
     }
-    // The longest tile list: the loops below run that often (lavapipe ends an invocation
-    // after LAVAPIPE_LOOP_LIMIT iterations, so the renderer refuses longer lists there).
+    // The longest tile list the loops below run over (lavapipe ends an invocation after
+    // LAVAPIPE_LOOP_LIMIT iterations: a longer list is not looped over, `loop_limit`).
     atomicMax(&build.counters.max_tile_lights, tile.y);
     var n = 0u;
     for (var i = 0u; i < tile.y; i++) {
@@ -802,12 +830,20 @@ fn fill(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
     if cluster >= params.dims.w {
         return;
     }
+    if cluster_without_pixels(cluster) {
+        return; // no pixel shades from it: its list stays empty
+    }
     let range = ranges[cluster];
-    if !fits(range, params.index_capacity) {
-        return; // the list is too small this frame; the renderer grows it and renders again
+    let lights = tile_lights(cluster);
+    if !lights.exact || !fits(range, params.index_capacity) {
+        // This frame's lists cannot hold the cluster's list: its pixels shade from every light
+        // (exact, slower), and the lists grow for the following frames from the counters.
+        ranges[cluster] = vec2<u32>(0u, LIST_EVERY_LIGHT);
+        atomicAdd(&build.counters.fallback_clusters, 1u);
+        return;
     }
     let b = level2_bounds(cluster);
-    let tile = tile_lights(cluster);
+    let tile = lights.range;
     var k = 0u;
     for (var i = 0u; i < tile.y && k < range.y; i++) {
         let l = tile_indices[tile.x + i];

@@ -55,6 +55,11 @@ fn index_color(i: u32) -> vec3<f32> {
     return clamp(abs(fract(vec3<f32>(h) + k) * 6.0 - 3.0) - 1.0, vec3<f32>(0.0), vec3<f32>(1.0)) * select(0.55, 0.95, i % 2u == 0u);
 }
 
+// Lights cluster `cluster` shades from: its list's, or every light where its list did not fit.
+fn list_length(cluster: u32) -> u32 {
+    let n = cluster_ranges[cluster].y;
+    return select(n, cluster_params.light_count, n == LIST_EVERY_LIGHT);
+}
 
 @fragment
 fn fs_clusters(in: FullscreenOut) -> @location(0) vec4<f32> {
@@ -79,12 +84,12 @@ fn fs_clusters(in: FullscreenOut) -> @location(0) vec4<f32> {
     let dims = cluster_params.dims;
     var color = vec3<f32>(0.0);
     if debug.mode == DEBUG_LIGHT_COUNT {
-        let n = cluster_ranges[cluster].y;
+        let n = list_length(cluster);
         color = select(heat(f32(n) / f32(max(debug.scale_max, 1u))), vec3<f32>(0.0), n == 0u);
     } else if debug.mode == DEBUG_OVERFLOW {
         // The stored count is capped, so a cluster at the cap is one that overflowed (or was
         // exactly full); without a cap nothing overflows and the green shows the fill.
-        let n = cluster_ranges[cluster].y;
+        let n = list_length(cluster);
         let capped = cluster_params.cap != CLUSTER_NO_CAP;
         let full = select(max(debug.scale_max, 1u), max(cluster_params.cap, 1u), capped);
         if capped && n >= cluster_params.cap {

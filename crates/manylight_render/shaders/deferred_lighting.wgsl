@@ -19,6 +19,10 @@ fn shade(g: GSurface, frag: vec2<f32>) -> vec4<f32> {
     let view_dir = direction_to_eye(view, g.world_position);
     let range = light_list_range(frag, gbuffer_view_distance(g.world_position));
     var color = gbuffer_base_radiance(g) + shade_directional_lights(g.params, g.world_position, view_dir);
+    if range.y == LIST_EVERY_LIGHT {
+        let n = cluster_params.light_count;
+        return vec4<f32>(add_every_light_to(color, g.params, g.world_position, view_dir, n), 1.0);
+    }
     for (var i = 0u; i < range.y; i++) {
         color += shade_light(g.params, g.world_position, view_dir, cluster_indices[range.x + i]);
     }

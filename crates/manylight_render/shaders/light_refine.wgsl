@@ -17,7 +17,8 @@
 //    REFINED_FALLBACK when its pixels are to shade from their cluster lists: more than
 //    REFINED_LIST_SLOTS lights kept, more than REFINE_MAX_CLUSTERS clusters or
 //    REFINE_CANDIDATE_LIMIT list entries to test (which keeps the invocation far inside
-//    lavapipe's loop limit), or a distance that is not finite.
+//    lavapipe's loop limit; a cluster that shades from every light, LIST_EVERY_LIGHT, has more),
+//    or a distance that is not finite.
 // When every block of the group that has surface points falls in one and the same cluster
 // (most groups at 16-px tiles), step 2 reads that cluster's list once for all of them and tests
 // each light against each block's box, which gives each block the list it would get alone; the

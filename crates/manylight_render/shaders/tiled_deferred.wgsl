@@ -132,9 +132,12 @@ fn cull_tile(tile: vec2<u32>, li: u32) {
     let r = tile_depths();
     let mask = atomicLoad(&depth_mask);
     let bounded = atomicLoad(&depth_unbounded) == 0u;
+    // A column whose list did not fit the frame's lists (LIST_EVERY_LIGHT) culls every light.
+    let every = range.y == LIST_EVERY_LIGHT;
+    let n = select(range.y, cluster_params.light_count, every);
     if r.x <= r.y {
-        for (var i = li; i < range.y; i += TILED_EDGE * TILED_EDGE) {
-            let index = cluster_indices[range.x + i];
+        for (var i = li; i < n; i += TILED_EDGE * TILED_EDGE) {
+            let index = select(cluster_indices[range.x + i], i, every);
             if !bounded || light_reaches_tile(lights[index], r, mask) {
                 let slot = atomicAdd(&list_count, 1u);
                 if slot < TILED_LIST_CAPACITY {
@@ -155,8 +158,12 @@ fn shade(g: GSurface, tile: vec2<u32>) -> vec4<f32> {
             color += shade_light(g.params, g.world_position, view_dir, tile_list[i]);
         }
     } else {
-        // More lights than workgroup memory holds: the column's whole list.
+        // More lights than workgroup memory holds: the column's whole list, or every light.
         let range = cluster_ranges[tile.x + tile.y * cluster_params.dims.x];
+        if range.y == LIST_EVERY_LIGHT {
+            let n = cluster_params.light_count;
+            return vec4<f32>(add_every_light_to(color, g.params, g.world_position, view_dir, n), 1.0);
+        }
         for (var i = 0u; i < range.y; i++) {
             color += shade_light(g.params, g.world_position, view_dir, cluster_indices[range.x + i]);
         }

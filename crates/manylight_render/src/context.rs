@@ -70,19 +70,6 @@ pub enum RenderError {
         /// Which limit: `max_storage_buffer_binding_size` or `max_buffer_size`.
         limit_name: &'static str,
     },
-    /// The cluster build still found its light-index lists too small after growing them (a
-    /// frame is never shown with lights missing).
-    #[error(
-        "the cluster light lists were still too small after {regrows} regrowths ({needed} entries needed, {capacity} available)"
-    )]
-    ListsTooSmall {
-        /// Regrowths tried.
-        regrows: u32,
-        /// Entries the frame needed.
-        needed: u64,
-        /// Entries available.
-        capacity: u64,
-    },
     /// The frame has 2³² − 1 or more light–cluster (or light–tile) pairs: more than the cluster
     /// build's u32 counters and offsets hold. Refused rather than built from a wrapped total.
     #[error(

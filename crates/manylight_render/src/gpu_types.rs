@@ -84,6 +84,13 @@ pub const REFINE_SLACK: f32 = 1e-5;
 /// The count of a block's refined range that sends its pixels to their cluster lists.
 pub const REFINED_FALLBACK: u32 = u32::MAX;
 
+/// The count of a cluster's range when its list did not fit the frame's lists (or its tile
+/// list was longer than the loop limit): its pixels shade from every light, which is exact
+/// and needs no list memory, only slower (`shaders/cluster_build.wgsl`, `fill`). The build's
+/// counters count such clusters (`GpuClusterCounters::fallback_clusters`) and the lists grow
+/// for the following frames from them.
+pub const LIST_EVERY_LIGHT: u32 = u32::MAX;
+
 /// Workgroup size of the prefix-sum step of the cluster build (one workgroup scans all).
 pub const SCAN_WORKGROUP_SIZE: u32 = 256;
 /// `GpuClusterParams::cull_test` values.
@@ -131,6 +138,7 @@ pub fn shared_u32_constants() -> Vec<(&'static str, u32)> {
         ("REFINE_CANDIDATE_LIMIT", REFINE_CANDIDATE_LIMIT),
         ("REFINE_MAX_CLUSTERS", REFINE_MAX_CLUSTERS),
         ("REFINED_FALLBACK", REFINED_FALLBACK),
+        ("LIST_EVERY_LIGHT", LIST_EVERY_LIGHT),
         ("CULL_AABB", CULL_AABB),
         ("CULL_PLANES", CULL_PLANES),
         ("CULL_BOTH", CULL_BOTH),
@@ -510,16 +518,21 @@ pub struct GpuClusterParams {
     /// `shaders/cluster_build.wgsl`; `manylight_core::cluster::rect_frustum`): `(tan_x, tan_y,
     /// 0, margin)` in perspective, `(half_x, half_y, 1, margin)` orthographic.
     pub frustum: [f32; 4],
-    /// Light chunks of level 0 (its invocations per coarse tile), at least 1: of the listed
-    /// lights, `ceil(listed_lights / TILE_LIGHT_CHUNK)`, from the lights' side, else of all,
+    /// Light chunks of level 0 (its invocations per coarse tile), at least 1:
     /// `ceil(light_count / TILE_LIGHT_CHUNK)`.
     pub light_chunks: u32,
-    /// Level 0 from the lights' side: how many lights it marks, those whose CPU rectangle bound
-    /// is not empty (`manylight_core::cluster::list_bounds`), listed after the spheres (0 per
-    /// coarse tile).
-    pub listed_lights: u32,
+    /// 1 when level 0 runs from the lights' side (`light_marks` in
+    /// `shaders/cluster_build.wgsl`: one invocation per light), 0 per coarse tile.
+    pub from_lights: u32,
+    /// The longest tile list the build loops over in one invocation: [`LAVAPIPE_LOOP_LIMIT`]
+    /// on an adapter that stops invocations there, else `u32::MAX`. A cluster whose tile list
+    /// is longer shades from every light ([`LIST_EVERY_LIGHT`]).
+    pub loop_limit: u32,
     /// Padding to 16 bytes.
-    pub _pad: [u32; 2],
+    pub _pad: u32,
+    /// The view's world-to-view transform (columns): `shaders/light_spheres.wgsl` moves the
+    /// lights' spheres into view space with it.
+    pub view_from_world: [[f32; 4]; 4],
 }
 
 /// Bounds of one cluster in view space (`GpuClusterBounds` in `shaders/common/clusters.wgsl`).
@@ -554,6 +567,10 @@ pub struct GpuClusterCounters {
     pub max_tile_lights: u32,
     /// Entries the coarse-tile lists needed (level 0; 0 without a coarse level).
     pub coarse_entries: u32,
+    /// Clusters whose list did not fit this frame's lists (or whose tile list was longer than
+    /// `GpuClusterParams::loop_limit`): their range is `(0, LIST_EVERY_LIGHT)` and they shade
+    /// from every light.
+    pub fallback_clusters: u32,
 }
 
 #[cfg(test)]

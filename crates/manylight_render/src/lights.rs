@@ -64,6 +64,44 @@ pub fn gpu_directional_light(light: &ExtractedDirectionalLight) -> GpuDirectiona
     }
 }
 
+/// The box around everything the light buffer's lights can reach (each light's range around
+/// its position, which holds a spot light's smaller sphere too), kept as the lights are
+/// packed: what slicing a projection without a far plane needs ([`LightReach::farthest`]),
+/// without visiting the lights again for each view.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LightReach {
+    /// The box's (minimum, maximum) corners, `None` while no light was added.
+    bounds: Option<(Vec3, Vec3)>,
+}
+
+impl LightReach {
+    /// Adds what `light` can reach.
+    pub fn add(&mut self, light: &ExtractedPointLight) {
+        let r = Vec3::splat(light.radius);
+        let (lo, hi) = (light.position - r, light.position + r);
+        self.bounds = Some(match self.bounds {
+            Some((min, max)) => (min.min(lo), max.max(hi)),
+            None => (lo, hi),
+        });
+    }
+
+    /// The farthest view distance (along −Z of `view_from_world`) any light can reach, at
+    /// least that of every light's own sphere (`manylight_core::cluster::farthest_reach`); 0
+    /// when there is no light. The farthest corner of the box: a sphere's farthest point along
+    /// any direction lies in its own box.
+    pub fn farthest(&self, view_from_world: &glam::Mat4) -> f32 {
+        let Some((min, max)) = self.bounds else { return 0.0 };
+        (0..8)
+            .map(|corner| {
+                let pick = |bit: u32, lo: f32, hi: f32| if corner & bit == 0 { lo } else { hi };
+                let p = Vec3::new(pick(1, min.x, max.x), pick(2, min.y, max.y), pick(4, min.z, max.z));
+                -view_from_world.transform_point3(p).z
+            })
+            .filter(|d| d.is_finite())
+            .fold(0.0, f32::max)
+    }
+}
+
 /// The lights the light buffer holds, with their index in it: the valid ones, in order.
 pub fn buffered_lights(lights: &[ExtractedPointLight]) -> impl Iterator<Item = (u32, &ExtractedPointLight)> {
     lights.iter().filter(|l| l.is_valid()).enumerate().map(|(i, l)| (i as u32, l))
@@ -113,6 +151,24 @@ mod tests {
         let (_, r) = bounding_sphere(&spot);
         assert!(r < 4.0, "a narrow cone's sphere is smaller than the range: {r}");
         assert_eq!(gpu_point_light(&spot).spot[1], -1.0);
+    }
+
+    #[test]
+    fn the_reach_box_covers_every_lights_farthest_point() {
+        let view =
+            glam::Mat4::from_rotation_y(0.4) * glam::Mat4::from_translation(Vec3::new(-3.0, -1.0, -9.0));
+        let mut lights = vec![light(None); 3];
+        lights[1].position = Vec3::new(-5.0, 2.0, -20.0);
+        lights[2].radius = 0.5;
+        let mut reach = LightReach::default();
+        assert_eq!(reach.farthest(&view), 0.0);
+        lights.iter().for_each(|l| reach.add(l));
+        let exact = manylight_core::cluster::farthest_reach(manylight_core::cluster::to_view_space(
+            view,
+            lights.iter().map(|l| (l.position, l.radius)),
+        ));
+        let bound = reach.farthest(&view);
+        assert!(bound >= exact && bound <= exact + 2.0 * 4.0 * 3f32.sqrt(), "{bound} vs {exact}");
     }
 
     #[test]

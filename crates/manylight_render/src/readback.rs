@@ -113,6 +113,16 @@ pub fn read_buffer(
 ) -> Result<Vec<u8>, RenderError> {
     let size = size.max(4).div_ceil(4) * 4;
     let staging_needed = !buffer.usage().contains(wgpu::BufferUsages::MAP_READ);
+    // Refused here rather than left to a copy the device rejects, which reads back zeros.
+    if offset.checked_add(size).is_none_or(|end| end > buffer.size()) {
+        return Err(RenderError::Readback(format!(
+            "{size} bytes at {offset} of a {}-byte buffer",
+            buffer.size()
+        )));
+    }
+    if staging_needed && !buffer.usage().contains(wgpu::BufferUsages::COPY_SRC) {
+        return Err(RenderError::Readback("the buffer cannot be copied from (no COPY_SRC)".into()));
+    }
     let staging;
     let (source, start) = if staging_needed {
         staging = gpu.create_buffer(&wgpu::BufferDescriptor {

@@ -101,6 +101,7 @@ impl Renderer {
         }
         self.counts_at_begin = self.gpu.counts();
         let arrived = self.ring.begin(&self.gpu, snapshot.views.len().max(1))?;
+        self.observe_lists(&arrived);
         self.arrived.extend(arrived);
         self.pool.begin_frame();
         self.bindings.begin_frame();
@@ -149,15 +150,10 @@ impl Renderer {
             let gpu = &self.gpu;
             let clusters = self.clusters[view.index].get_or_insert_with(|| ClusterResources::new(gpu));
             let view_from_world = view.camera.map(|c| c.view_from_world()).unwrap_or_default();
+            let lights = (self.scene.light_count, &self.scene.light_reach);
             match &self.pixel_light_lists {
-                Some(lists) => clusters.prepare_pixel_lists(
-                    gpu,
-                    view,
-                    &view_from_world,
-                    &self.scene.light_spheres,
-                    lists,
-                )?,
-                None => clusters.prepare(gpu, view, &view_from_world, &self.scene.light_spheres, options)?,
+                Some(lists) => clusters.prepare_pixel_lists(gpu, view, &view_from_world, lights, lists)?,
+                None => clusters.prepare(gpu, view, &view_from_world, lights, options)?,
             }
         }
         Ok(())
@@ -199,12 +195,12 @@ impl Renderer {
     /// waiting for the GPU: the returned report has the CPU-side figures, and its GPU times
     /// and cluster counts arrive with the frame's read-back ([`Renderer::take_reports`]).
     ///
-    /// The light lists were sized by their CPU bounds in [`Renderer::prepare_view`], so the
-    /// build cannot overflow them. Only when a bound could fail (it exceeds what the device can
-    /// bind, or on a loop-limited adapter the longest tile list could pass the loop limit),
-    /// which the frame knows before it is submitted, does the view wait for its counters: a
-    /// list found short grows and the view is rendered again (`ClusterReport::regrows`), so no
-    /// light is ever lost to a buffer size.
+    /// The light lists were sized in [`Renderer::prepare_view`] from the counters of the latest
+    /// frame read back; a cluster whose list still does not fit shades from every light that
+    /// frame (exact, slower), so no light is lost and no frame is rendered twice. Only when the
+    /// lists have no counts to go by (the view's first frame, or the light count more than
+    /// doubled) does the view run its build once before the frame, only to count, and wait for
+    /// those counters (`ClusterReport::counted_first`).
     pub fn execute(
         &mut self,
         graph: &RenderGraph,
@@ -229,53 +225,64 @@ impl Renderer {
                 limit: LAVAPIPE_LOOP_LIMIT,
             });
         }
-        let verify = builds_clusters
-            && self
-                .view_clusters(view.index)
-                .is_some_and(|c| c.bound_can_fail(loop_limited, LAVAPIPE_LOOP_LIMIT));
-        let mut regrows = 0;
-        loop {
-            let first_pass = self.ring.passes_recorded();
-            let mut report =
-                self.execute_once(&passes, builds_clusters, snapshot, view, output, output_format)?;
-            let Some(clusters) =
-                self.clusters.get_mut(view.index).and_then(Option::as_mut).filter(|_| builds_clusters)
-            else {
-                return Ok(report);
+        if builds_clusters && self.view_clusters(view.index).is_some_and(ClusterResources::needs_counting) {
+            self.count_lists(snapshot, view, output, output_format)?;
+        }
+        let mut report =
+            self.execute_once(&passes, builds_clusters, snapshot, view, output, output_format)?;
+        if let Some(clusters) = self.view_clusters(view.index).filter(|_| builds_clusters) {
+            report.clusters = Some(clusters.report(&GpuClusterCounters::default()));
+        }
+        Ok(report)
+    }
+
+    /// Runs the cluster build of `view` alone, only to count, and sizes its lists from the
+    /// counters (waiting for them), again while a list proved short (a level below a short one
+    /// counts short too); then puts the frame's parameters back.
+    fn count_lists(
+        &mut self,
+        snapshot: &FrameSnapshot,
+        view: &RenderView,
+        output: &wgpu::TextureView,
+        output_format: wgpu::TextureFormat,
+    ) -> Result<(), RenderError> {
+        let build = crate::passes::cluster_build::ClusterBuildPass {
+            workgroup_size: view.settings.clusters.workgroup_size,
+            depth_bounds: false,
+        };
+        // Each level can be short once: coarse, tile and cluster lists.
+        for _ in 0..3 {
+            let Some(clusters) = self.clusters.get_mut(view.index).and_then(Option::as_mut) else {
+                return Ok(());
             };
-            if !verify {
-                report.clusters = Some(clusters.report(&GpuClusterCounters::default(), regrows));
-                return Ok(report);
-            }
+            clusters.count_first(&self.gpu, true);
+            let first_pass = self.ring.passes_recorded();
+            self.execute_once(&[&build], true, snapshot, view, output, output_format)?;
+            self.ring.rewind_view(first_pass);
+            let Some(clusters) = self.clusters.get_mut(view.index).and_then(Option::as_mut) else {
+                return Ok(());
+            };
             let counters = clusters.read_counters(&self.gpu)?;
             ClusterResources::check_saturation(&counters)?;
-            if regrows < 4 && clusters.grow_if_needed(&self.gpu, &counters)? {
-                regrows += 1;
-                tracing::debug!("light-index list grew to {} entries", clusters.params.index_capacity);
-                self.ring.rewind_view(first_pass);
+            if !clusters.grow_to_counts(&self.gpu, &counters)? {
+                break;
+            }
+            tracing::debug!("light lists grew to {} entries", clusters.params.index_capacity);
+        }
+        if let Some(clusters) = self.clusters.get_mut(view.index).and_then(Option::as_mut) {
+            clusters.count_first(&self.gpu, false);
+        }
+        Ok(())
+    }
+
+    /// Hands what the frames in `reports` read back of each view's lists to that view's
+    /// cluster buffers: the following frames' lists are sized to it.
+    fn observe_lists(&mut self, reports: &[FrameReport]) {
+        for view in reports.iter().flat_map(|r| &r.views) {
+            let (Some(c), Some(Some(clusters))) = (&view.clusters, self.clusters.get_mut(view.index)) else {
                 continue;
-            }
-            if clusters.lists_short(&counters) {
-                // Never show a frame with lights missing from the lists.
-                return Err(RenderError::ListsTooSmall {
-                    regrows,
-                    needed: u64::from(counters.total_entries.max(counters.tile_entries)),
-                    capacity: u64::from(
-                        clusters.params.index_capacity.min(clusters.params.tile_index_capacity),
-                    ),
-                });
-            }
-            if loop_limited && counters.max_tile_lights > LAVAPIPE_LOOP_LIMIT {
-                // The build's loops over that tile list (and shading over its clusters' lists)
-                // ended early: lights would be missing.
-                return Err(RenderError::LoopLimit {
-                    what: "a tile's light list".into(),
-                    iterations: u64::from(counters.max_tile_lights),
-                    limit: LAVAPIPE_LOOP_LIMIT,
-                });
-            }
-            report.clusters = Some(clusters.report(&counters, regrows));
-            return Ok(report);
+            };
+            clusters.observe(c);
         }
     }
 
@@ -297,6 +304,7 @@ impl Renderer {
     /// waits for every frame in flight first (a blocking wait).
     pub fn take_reports(&mut self, wait: bool) -> Result<Vec<FrameReport>, RenderError> {
         let collected = self.ring.collect(&self.gpu, wait)?;
+        self.observe_lists(&collected);
         self.arrived.extend(collected);
         Ok(std::mem::take(&mut self.arrived))
     }

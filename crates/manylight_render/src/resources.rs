@@ -16,7 +16,7 @@ use crate::gpu_types::{
 };
 use crate::layouts::{GroupLayout, SCENE_GROUP};
 use crate::lights::{
-    bounding_sphere, buffered_lights, gpu_directional_light, gpu_point_light, viewed_directional_lights,
+    LightReach, buffered_lights, gpu_directional_light, gpu_point_light, viewed_directional_lights,
 };
 use crate::pool::GrowableBuffer;
 use crate::shaders::ShaderDefs;
@@ -215,9 +215,9 @@ pub struct SceneResources {
     /// Instances not drawn this frame because their transform collapses the mesh to a line or
     /// a point (a zero scale on two or three axes, on the mesh or a parent): they cover no pixel.
     pub collapsed_instances: u32,
-    /// (centre, radius) of the sphere bounding what each uploaded light can reach (a spot
-    /// light's is the smaller sphere around its cone), in light-buffer order.
-    pub light_spheres: Vec<(glam::Vec3, f32)>,
+    /// The box around what the uploaded lights can reach (the cluster grids slice a projection
+    /// without a far plane to it).
+    pub light_reach: LightReach,
     /// The frame's valid point and spot lights, packed (one zeroed light when there is none:
     /// every pipeline binds the buffer).
     gpu_lights: Vec<GpuPointLight>,
@@ -295,7 +295,7 @@ impl SceneResources {
             invalid_lights: 0,
             invalid_instances: 0,
             collapsed_instances: 0,
-            light_spheres: Vec::new(),
+            light_reach: LightReach::default(),
             gpu_lights: Vec::new(),
             uploaded_lights: None,
             nonfinite: NonFiniteCounter::new(gpu),
@@ -430,7 +430,11 @@ impl SceneResources {
         // Lights: invalid ones (NaN, inf, negative) are dropped and counted, never uploaded.
         // Both light Vecs keep their allocation from frame to frame.
         self.gpu_lights.clear();
-        self.gpu_lights.extend(buffered_lights(&snapshot.lights).map(|(_, l)| gpu_point_light(l)));
+        self.light_reach = LightReach::default();
+        for (_, light) in buffered_lights(&snapshot.lights) {
+            self.gpu_lights.push(gpu_point_light(light));
+            self.light_reach.add(light);
+        }
         self.invalid_lights = (snapshot.lights.len() - self.gpu_lights.len()) as u32;
         // Directional lights: the first MAX_DIRECTIONAL_LIGHTS valid ones, in the view uniform.
         let valid_count = snapshot.directional_lights.iter().filter(|l| l.is_valid()).count() as u32;
@@ -448,8 +452,7 @@ impl SceneResources {
                 self.dropped_directional_lights
             );
         }
-        self.light_spheres.clear();
-        self.light_spheres.extend(buffered_lights(&snapshot.lights).map(|(_, l)| bounding_sphere(l)));
+
         self.light_count = self.gpu_lights.len() as u32;
         self.light_upload_bytes = self.upload_lights(gpu)?;
 

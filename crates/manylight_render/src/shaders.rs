@@ -37,6 +37,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("forward.wgsl", include_str!("../shaders/forward.wgsl")),
     ("depth_prepass.wgsl", include_str!("../shaders/depth_prepass.wgsl")),
     ("cluster_build.wgsl", include_str!("../shaders/cluster_build.wgsl")),
+    ("light_spheres.wgsl", include_str!("../shaders/light_spheres.wgsl")),
     ("cluster_depth.wgsl", include_str!("../shaders/cluster_depth.wgsl")),
     ("light_refine.wgsl", include_str!("../shaders/light_refine.wgsl")),
     ("clustered_forward.wgsl", include_str!("../shaders/clustered_forward.wgsl")),

@@ -311,6 +311,7 @@ fn shared_structs_match_rust() {
             ("tile_entries", offset_of!(GpuClusterCounters, tile_entries)),
             ("max_tile_lights", offset_of!(GpuClusterCounters, max_tile_lights)),
             ("coarse_entries", offset_of!(GpuClusterCounters, coarse_entries)),
+            ("fallback_clusters", offset_of!(GpuClusterCounters, fallback_clusters)),
         ],
     );
     offsets(
@@ -347,7 +348,9 @@ fn shared_structs_match_rust() {
             ("refined_first", offset_of!(GpuClusterParams, refined_first)),
             ("frustum", offset_of!(GpuClusterParams, frustum)),
             ("light_chunks", offset_of!(GpuClusterParams, light_chunks)),
-            ("listed_lights", offset_of!(GpuClusterParams, listed_lights)),
+            ("from_lights", offset_of!(GpuClusterParams, from_lights)),
+            ("loop_limit", offset_of!(GpuClusterParams, loop_limit)),
+            ("view_from_world", offset_of!(GpuClusterParams, view_from_world)),
         ],
     );
 }

@@ -9,7 +9,8 @@
 
 // The (offset, count) in `cluster_indices` of the list a fragment at framebuffer position
 // `frag` (pixels) and view distance `d` shades from: its block's refined list, or, without
-// one, its cluster's.
+// one, its cluster's; a count of LIST_EVERY_LIGHT when it shades from every light (its
+// cluster's list did not fit the frame's lists).
 fn light_list_range(frag: vec2<f32>, d: f32) -> vec2<u32> {
     let blocks = vec2<u32>(cluster_params.refine_blocks_x, cluster_params.refine_blocks_y);
     if blocks.x != 0u {

@@ -32,14 +32,16 @@ struct ClusterParams {
     // each light's tile rectangle (cluster_build.wgsl, `light_rects`): (tan_x, tan_y, 0,
     // margin) in perspective, (half_x, half_y, 1, margin) orthographic
     frustum: vec4<f32>,
-    // chunks (TILE_LIGHT_CHUNK lights each) of level 0 per coarse tile, at least 1: of the
-    // listed lights from the lights' side, else of all lights
+    // chunks (TILE_LIGHT_CHUNK lights each) of level 0 per coarse tile, at least 1
     light_chunks: u32,
-    // level 0 from the lights' side: the lights it marks, listed after the spheres
-    // (cluster_build.wgsl, `listed_light`)
-    listed_lights: u32,
+    // 1: level 0 runs from the lights' side (cluster_build.wgsl, `light_marks`)
+    from_lights: u32,
+    // the longest tile list the build loops over in one invocation (lavapipe's loop limit,
+    // else 0xffffffff); a cluster whose tile list is longer shades from every light
+    loop_limit: u32,
     _pad0: u32,
-    _pad1: u32,
+    // world to view (light_spheres.wgsl)
+    view_from_world: mat4x4<f32>,
 };
 
 // A u32 that orders as `d` does among floats (sign-magnitude to two's-complement order).

@@ -30,28 +30,17 @@ fn forward_fragment(in: SurfaceVertexOut, front_facing: bool) -> ForwardFragment
 
 // `f.color` plus every point and spot light, added in order.
 fn add_every_light(f: ForwardFragment) -> vec3<f32> {
-    var color = f.color;
-    // Four lights per iteration: lavapipe stops an invocation after 65 535 loop iterations,
-    // which would drop every light past the 65 535th of the reference.
-    let n = view.light_count;
-    var i = 0u;
-    for (; i + 4u <= n; i += 4u) {
-        color += shade_light(f.m.params, f.p.world_position, f.view_dir, i);
-        color += shade_light(f.m.params, f.p.world_position, f.view_dir, i + 1u);
-        color += shade_light(f.m.params, f.p.world_position, f.view_dir, i + 2u);
-        color += shade_light(f.m.params, f.p.world_position, f.view_dir, i + 3u);
-    }
-    for (; i < n; i++) {
-        color += shade_light(f.m.params, f.p.world_position, f.view_dir, i);
-    }
-    return color;
+    return add_every_light_to(f.color, f.m.params, f.p.world_position, f.view_dir, view.light_count);
 }
 
 // `f.color` plus the lights of the list of the fragment at `frag` (pixel coordinates): its
-// block's refined list or its cluster's.
+// block's refined list or its cluster's, or every light where the cluster's list did not fit.
 fn add_cluster_lights(f: ForwardFragment, frag: vec2<f32>) -> vec3<f32> {
-    var color = f.color;
     let range = light_list_range(frag, f.p.view_depth);
+    if range.y == LIST_EVERY_LIGHT {
+        return add_every_light(f);
+    }
+    var color = f.color;
     for (var i = 0u; i < range.y; i++) {
         color += shade_light(f.m.params, f.p.world_position, f.view_dir, cluster_indices[range.x + i]);
     }

@@ -27,3 +27,22 @@ fn shade_light(s: SurfaceParams, position: vec3<f32>, view_dir: vec3<f32>, k: u3
 //!endif
     return radiance;
 }
+
+// `base` plus the radiance every point and spot light (`n` of them) adds at `position`, added in
+// light order as a light list adds its lights: naive forward, and a cluster whose list did not
+// fit the frame's lists (LIST_EVERY_LIGHT). Four lights per iteration: lavapipe stops an
+// invocation after 65 535 loop iterations, which would drop every light past the 65 535th.
+fn add_every_light_to(base: vec3<f32>, s: SurfaceParams, position: vec3<f32>, view_dir: vec3<f32>, n: u32) -> vec3<f32> {
+    var color = base;
+    var i = 0u;
+    for (; i + 4u <= n; i += 4u) {
+        color += shade_light(s, position, view_dir, i);
+        color += shade_light(s, position, view_dir, i + 1u);
+        color += shade_light(s, position, view_dir, i + 2u);
+        color += shade_light(s, position, view_dir, i + 3u);
+    }
+    for (; i < n; i++) {
+        color += shade_light(s, position, view_dir, i);
+    }
+    return color;
+}

@@ -6,6 +6,7 @@ use crate::bindings::Binding;
 use crate::context::GpuContext;
 use crate::layouts::{
     CLUSTER_BUILD_GROUP, CLUSTER_DEPTH_GROUP, CLUSTER_LISTS_GROUP, GroupLayout, LIGHT_REFINE_GROUP,
+    LIGHT_SPHERES_GROUP,
 };
 use crate::shaders::ShaderDefs;
 
@@ -13,6 +14,10 @@ use crate::shaders::ShaderDefs;
 pub struct ClusterBindings {
     /// Layout of the build's group 0 ([`CLUSTER_BUILD_GROUP`]).
     pub build_layout: GroupLayout,
+    /// Layout of the build's first dispatch, the lights' view-space spheres
+    /// ([`LIGHT_SPHERES_GROUP`]; its group reads the scene's light buffer, so the pass makes
+    /// it through the binding cache).
+    pub spheres_layout: GroupLayout,
     /// Layout of the shading passes' cluster group ([`CLUSTER_LISTS_GROUP`]).
     pub lists_layout: GroupLayout,
     /// Layout of group 2 of the `cluster_depth` pass ([`CLUSTER_DEPTH_GROUP`]).
@@ -36,6 +41,7 @@ impl ClusterBindings {
         let (build_group, lists_group) = Self::groups(gpu, &build_layout, &lists_layout, buffers);
         ClusterBindings {
             build_layout,
+            spheres_layout: LIGHT_SPHERES_GROUP.create_layout(&gpu.device, defs),
             lists_layout,
             depth_layout: CLUSTER_DEPTH_GROUP.create_layout(&gpu.device, defs),
             refine_layout: LIGHT_REFINE_GROUP.create_layout(&gpu.device, defs),

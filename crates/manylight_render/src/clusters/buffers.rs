@@ -27,7 +27,8 @@ pub struct ClusterBuffers {
     pub indices: GrowableBuffer,
     /// Each cluster's bounds (`GpuClusterBounds`).
     pub bounds: GrowableBuffer,
-    /// The lights' view-space spheres (centre, radius), then the listed lights' indices.
+    /// The lights' view-space spheres (centre, radius), which the build's first dispatch writes
+    /// (`shaders/light_spheres.wgsl`; copied out for the CPU reference in tests).
     pub spheres: GrowableBuffer,
     /// Bounds of the tile columns, then of the coarse tiles.
     pub tile_bounds: GrowableBuffer,
@@ -59,7 +60,7 @@ impl ClusterBuffers {
             ranges: GrowableBuffer::new(gpu, "cluster_ranges", ranges_usage, 8 * 8192),
             indices: GrowableBuffer::new(gpu, "light_index_list", storage | copy, 4 * INITIAL_INDEX_CAPACITY),
             bounds: GrowableBuffer::new(gpu, "cluster_bounds", storage, 128 * 1024),
-            spheres: GrowableBuffer::new(gpu, "light_view_spheres", storage, 16 * 1024),
+            spheres: GrowableBuffer::new(gpu, "light_view_spheres", storage | copy, 16 * 1024),
             tile_bounds: GrowableBuffer::new(gpu, "tile_bounds", storage, 128 * 256),
             tile_ranges: GrowableBuffer::new(gpu, "tile_ranges", storage, 8 * 256),
             tile_indices: GrowableBuffer::new(

@@ -8,15 +8,16 @@
 use crate::context::{GpuContext, RenderError};
 use crate::gpu_types::{
     CLUSTER_NO_CAP, COARSE_SCATTER_TILES, CULL_AABB, CULL_BOTH, CULL_PLANES, GpuClusterBounds,
-    GpuClusterCounters, GpuClusterParams, REFINE_EDGE, REFINED_LIST_SLOTS, TILE_LIGHT_CHUNK,
+    GpuClusterCounters, GpuClusterParams, LAVAPIPE_LOOP_LIMIT, REFINE_EDGE, REFINED_LIST_SLOTS,
+    TILE_LIGHT_CHUNK,
 };
+use crate::lights::LightReach;
 use crate::readback::read_buffer;
 use crate::snapshot::RenderView;
 use glam::Mat4;
 use manylight_core::Projection;
 use manylight_core::cluster::{
-    ClusterAssignment, ClusterGrid, CullTest, ListBounder, ListBounds, ViewSphere, coarse_dims, coarse_span,
-    coarse_tiles, to_view_space,
+    ClusterAssignment, ClusterGrid, CullTest, ViewSphere, coarse_dims, coarse_span, coarse_tiles,
 };
 use serde::Serialize;
 
@@ -34,6 +35,8 @@ pub struct ClusterReport {
     pub dims: [u32; 3],
     /// Number of clusters.
     pub clusters: u32,
+    /// Lights of the frame (the light buffer's).
+    pub lights: u32,
     /// Clusters with at least one light.
     pub non_empty: u32,
     /// Entries in the light-index list.
@@ -59,17 +62,18 @@ pub struct ClusterReport {
     pub coarse_entries: u64,
     /// Tiles per coarse-tile edge (0: no coarse level).
     pub coarse_span: u32,
-    /// Times the lists had to grow after the frame was rendered (each renders it again): 0, since
-    /// the CPU bounds size them before submission, unless a bound exceeds what the device binds.
-    pub regrows: u32,
-    /// The CPU bound the light-index list was sized to (at least `total_entries`).
-    pub pair_bound: u64,
-    /// The CPU bound the per-tile lists were sized to (at least `tile_entries`).
-    pub tile_entry_bound: u64,
-    /// The CPU bound the per-coarse-tile lists were sized to (at least `coarse_entries`).
-    pub coarse_entry_bound: u64,
-    /// CPU milliseconds the list bounds took (before the frame was submitted).
-    pub bound_cpu_ms: f64,
+    /// Clusters whose list did not fit this frame's lists, which shaded from every light
+    /// instead (exact, slower; `gpu_types::LIST_EVERY_LIGHT`): 0 once the lists have grown to
+    /// what the frames need.
+    pub fallback_clusters: u32,
+    /// Capacity of the per-tile lists (entries).
+    pub tile_index_capacity: u64,
+    /// Capacity of the per-coarse-tile lists (entries).
+    pub coarse_index_capacity: u64,
+    /// The build ran before the frame, only to count, and the view waited for its counters
+    /// (the view's first frame, or the light count more than doubled since the counts the
+    /// lists were sized from): the one blocking wait of a view's lists.
+    pub counted_first: bool,
     /// Bytes of GPU buffers the cluster build and clustered shading hold (grid bounds, light
     /// spheres, per-tile and per-cluster ranges and index lists, parameters, counters).
     pub buffer_bytes: u64,
@@ -81,13 +85,9 @@ pub struct ClusterReport {
     /// tiles of its rectangle, each coarse-list entry the tiles of its coarse tile), not each
     /// (coarse) tile over its candidates; the lists are the same either way.
     pub from_lights: bool,
-    /// Invocations of level 0 per coarse tile (chunks of `TILE_LIGHT_CHUNK` lights: of the
-    /// listed ones from the lights' side, else of all) and of level 1 per tile (chunks of its
-    /// candidates: as many as the longest coarse list can need).
+    /// Invocations of level 0 per coarse tile and of level 1 per tile: chunks of
+    /// `TILE_LIGHT_CHUNK` lights, as many as the frame's lights make.
     pub chunks: [u32; 2],
-    /// From the lights' side: the lights level 0 marks, those some tile can list (the CPU's
-    /// rectangle bound is not empty); 0 per coarse tile.
-    pub listed_lights: u32,
 }
 
 impl ClusterReport {
@@ -104,6 +104,7 @@ impl ClusterReport {
         self.clusters_overflowed = c.clusters_overflowed;
         self.tile_entries = u64::from(c.tile_entries);
         self.coarse_entries = u64::from(c.coarse_entries);
+        self.fallback_clusters = c.fallback_clusters;
     }
 }
 
@@ -163,10 +164,10 @@ pub struct ClusterResources {
     pub buffers: ClusterBuffers,
     /// The layouts and bind groups over [`Self::buffers`].
     pub bindings: ClusterBindings,
-    /// The CPU bound that sizes the lists before submission.
-    sizing: ListSizing,
-    /// The view-space spheres uploaded this frame (for the CPU reference in tests and stats).
-    pub view_spheres: Vec<ViewSphere>,
+    /// What the lists needed in the latest frame whose counters came back.
+    needs: Option<ListNeeds>,
+    /// The build counted before this frame (`ClusterReport::counted_first`).
+    counted_first: bool,
     /// Levels 0 and 1 of the build run from the lights' side this frame (`grid_allows_bits`,
     /// `bits_fit`, `size_bits`).
     from_lights: bool,
@@ -181,22 +182,48 @@ pub struct ClusterResources {
     refine_blocks: Option<glam::UVec2>,
 }
 
-/// The CPU bound of the list sizes, and what it keeps between frames.
-#[derive(Default)]
-struct ListSizing {
-    /// The lights some tile can list this frame, ascending (`list_bounds`): level 0 from the
-    /// lights' side marks these only. Uploaded after the spheres.
-    listed: Vec<u32>,
-    /// Computes the list bounds on all cores, its parts' storage kept between frames.
-    bounder: ListBounder,
-    /// What this frame uploads to the spheres buffer: the spheres, then `listed` (four to an
-    /// element); kept between frames so that it is not allocated again.
-    sphere_upload: Vec<[f32; 4]>,
-    /// This frame's CPU bounds of the list sizes, which the lists were sized to before it was
-    /// submitted.
-    estimate: ListBounds,
-    /// CPU time of this frame's bound.
-    cpu_ms: f64,
+/// Entries a frame's lists needed, from its build's counters (read back without waiting):
+/// what the following frames' lists are sized to.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ListNeeds {
+    /// Entries of the cluster lists.
+    pub cluster_entries: u64,
+    /// Entries of the per-tile lists.
+    pub tile_entries: u64,
+    /// Entries of the per-coarse-tile lists.
+    pub coarse_entries: u64,
+    /// The frame's light count.
+    pub lights: u32,
+    /// The frame's grid, coarse span and culling test: counts made with another grid or test
+    /// say little about this frame's.
+    pub layout: Option<ListLayout>,
+}
+
+/// What shapes a view's lists besides its lights: grid size, coarse span, culling test.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ListLayout {
+    /// Clusters across, down and deep.
+    pub dims: [u32; 3],
+    /// Tiles per coarse-tile edge (0: no coarse level).
+    pub coarse_span: u32,
+    /// The culling test.
+    pub cull: CullTest,
+}
+
+impl ListNeeds {
+    /// What a frame's report says its lists needed.
+    pub fn of(report: &ClusterReport) -> ListNeeds {
+        let cull = [CullTest::Aabb, CullTest::Planes, CullTest::Both]
+            .into_iter()
+            .find(|c| c.name() == report.cull_test);
+        ListNeeds {
+            cluster_entries: report.total_entries,
+            tile_entries: report.tile_entries,
+            coarse_entries: report.coarse_entries,
+            lights: report.lights,
+            layout: cull.map(|cull| ListLayout { dims: report.dims, coarse_span: report.coarse_span, cull }),
+        }
+    }
 }
 
 /// Chunks of [`TILE_LIGHT_CHUNK`] lights that `lights` lights take, at least 1.
@@ -214,8 +241,8 @@ impl ClusterResources {
             params: GpuClusterParams::default(),
             buffers,
             bindings,
-            sizing: ListSizing::default(),
-            view_spheres: Vec::new(),
+            needs: None,
+            counted_first: false,
             from_lights: false,
             bounds_of: None,
             coarse: None,
@@ -225,25 +252,27 @@ impl ClusterResources {
         }
     }
 
-    /// Uploads the grid bounds (when the grid changed), the lights' view-space spheres and the
-    /// parameters, and zeroes the counters. `lights` are the (position, radius) pairs in the
-    /// order of the light buffer; `options`: depth bounds and refined lists, from the view's
-    /// plan.
+    /// Uploads the grid bounds (when the grid changed) and the parameters, sizes the lists from
+    /// the counters of the latest frame read back, and zeroes the counters: no light is visited
+    /// (the build's first dispatch puts the `light_count` lights of the light buffer in view
+    /// space). `reach` bounds what they reach, for a projection without a far plane;
+    /// `options`: depth bounds and refined lists, from the view's plan.
     pub fn prepare(
         &mut self,
         gpu: &GpuContext,
         view: &RenderView,
         view_from_world: &Mat4,
-        lights: &[(glam::Vec3, f32)],
+        (light_count, reach): (u32, &LightReach),
         options: ListOptions,
     ) -> Result<(), RenderError> {
         let settings = &view.settings.clusters;
         let depth_bounds = options.depth_bounds;
         self.depth_bounds = depth_bounds;
+        self.counted_first = false;
         self.refine_blocks =
             options.refined_lists.then(|| manylight_core::efficiency::block_dims(view.size, REFINE_EDGE));
         let grid_config = settings.grid_for(view.settings.pipeline);
-        let projection = self.place_lights(view, view_from_world, lights);
+        let projection = Self::finite_projection(view, view_from_world, reach);
         self.grid = ClusterGrid::new(view.size, &projection, &grid_config);
         self.cull = settings.cull;
         self.coarse = coarse_span(settings.coarse_tiles, settings.cull);
@@ -255,10 +284,10 @@ impl ClusterResources {
         // (with refined lists) the blocks' ranges.
         let cluster_ranges = count as u64 * if depth_bounds { 16 } else { 8 };
         self.buffers.ranges.reserve(gpu, cluster_ranges + self.refined_blocks() * 8)?;
-        let chunks = self.size_lists(gpu, settings.cull)?;
+        self.buffers.spheres.reserve(gpu, u64::from(light_count.max(1)) * 16)?;
+        let chunks = self.size_lists(gpu, light_count)?;
         let cap = settings.cap.unwrap_or(CLUSTER_NO_CAP);
-        let light_count = self.view_spheres.len() as u32;
-        self.write_params(gpu, view, light_count, cap, chunks)
+        self.write_params(gpu, view, view_from_world, light_count, cap, chunks)
     }
 
     /// Uploads the bounds of this frame's grid for a view of `size` pixels: its clusters, its
@@ -319,48 +348,15 @@ impl ClusterResources {
         Ok(())
     }
 
-    /// Sizes the lists and the tile ranges before the frame is submitted, from the CPU bound of
-    /// what the build can write, and uploads the spheres; returns the light chunks of level 0
-    /// and of level 1.
-    fn size_lists(&mut self, gpu: &GpuContext, cull: CullTest) -> Result<[u32; 2], RenderError> {
-        // Lists sized before the frame is submitted, from a CPU bound of what the build can
-        // write (`ListBounder`, on all cores): the GPU lists cannot overflow, so the frame is
-        // never rendered twice. A bound beyond what the device can bind reserves what it can;
-        // then the build's counters decide, after the frame, whether the real lists fit.
-        let started = std::time::Instant::now();
-        let all_chunks = light_chunks_of(self.view_spheres.len());
-        // Levels 0 and 1 from the lights' side where the grid allows and their bits fit (a
-        // second bound, of level 0 per coarse tile, when they do not).
-        let coarse = self.coarse;
-        self.from_lights = self.grid_allows_bits();
-        let spheres = &self.view_spheres;
-        self.sizing.estimate = self.sizing.bounder.bound(
-            &self.grid,
-            spheres,
-            cull,
-            coarse,
-            self.from_lights,
-            &mut self.sizing.listed,
-        );
-        if self.from_lights && !self.bits_fit(light_chunks_of(self.sizing.listed.len())) {
-            self.from_lights = false;
-            self.sizing.estimate =
-                self.sizing.bounder.bound(&self.grid, spheres, cull, coarse, false, &mut self.sizing.listed);
-        }
-        self.sizing.cpu_ms = started.elapsed().as_secs_f64() * 1e3;
-        // Level 0 from the lights' side runs over the listed lights, per tile over all.
-        let light_chunks =
-            if self.from_lights { light_chunks_of(self.sizing.listed.len()) } else { all_chunks };
-        self.upload_spheres(gpu)?;
-        // Level 1 loops over each tile's coarse list (every light without a coarse level) in
-        // chunks: as many as the longest list the bound allows, so a coarse list never runs
-        // past its tile's last chunk.
-        let tile_chunks = match self.coarse {
-            Some(_) => {
-                self.sizing.estimate.max_coarse_lights.div_ceil(TILE_LIGHT_CHUNK).clamp(1, light_chunks)
-            }
-            None => light_chunks,
-        };
+    /// Sizes the lists and the tile ranges for a frame of `light_count` lights from what the
+    /// latest frame read back needed (`needs`; the initial capacities before any), with a
+    /// quarter of headroom; returns the light chunks of level 0 and of level 1. A list that
+    /// still proves short makes its clusters shade from every light that frame.
+    fn size_lists(&mut self, gpu: &GpuContext, light_count: u32) -> Result<[u32; 2], RenderError> {
+        let chunks = light_chunks_of(light_count as usize);
+        let needs = self.needs.unwrap_or_default();
+        // Levels 0 and 1 from the lights' side where the grid allows and their bits fit.
+        self.from_lights = self.grid_allows_bits() && self.bits_fit(chunks, needs.coarse_entries);
         // A quarter of headroom: lights that move a little do not grow the lists every frame
         // (growing creates a buffer and rebinds), and the buffers grow in powers of two.
         let bytes =
@@ -373,40 +369,17 @@ impl ClusterResources {
             }
         };
         // The refined lists' slots follow the cluster lists.
-        let entries = self.sizing.estimate.cluster_pairs + self.refined_entries();
+        let entries = needs.cluster_entries + self.refined_entries();
         self.buffers.indices.reserve(gpu, with_headroom(entries, &self.buffers.indices))?;
         // The tile and coarse-tile lists share a buffer; the spare room is split between them.
-        let (tile_need, coarse_need) =
-            (self.sizing.estimate.tile_entries, self.sizing.estimate.coarse_entries);
-        self.buffers
-            .tile_indices
-            .reserve(gpu, with_headroom(tile_need + coarse_need, &self.buffers.tile_indices))?;
+        let shared = needs.tile_entries + Self::coarse_room(needs.coarse_entries);
+        self.buffers.tile_indices.reserve(gpu, with_headroom(shared, &self.buffers.tile_indices))?;
+        // Level 1 runs as many chunks per tile as the longest coarse list can take: all of them
+        // (chunks past a tile's list return at once).
         let tiles = self.grid.dims.x as u64 * self.grid.dims.y as u64;
         let coarse_tiles = self.coarse_dims().map_or(0, |d| u64::from(d.x) * u64::from(d.y));
-        // Room for level 0's ranges over all lights, should the bits not fit after all (`size_bits`).
-        let ranges = tiles * u64::from(tile_chunks) + coarse_tiles * u64::from(all_chunks);
-        self.buffers.tile_ranges.reserve(gpu, ranges * 8)?;
-        Ok([light_chunks, tile_chunks])
-    }
-
-    /// Uploads the view spheres, then the listed lights' indices (their bits, four to a sphere
-    /// element: `listed_light` in `shaders/cluster_build.wgsl`).
-    fn upload_spheres(&mut self, gpu: &GpuContext) -> Result<(), RenderError> {
-        let upload = &mut self.sizing.sphere_upload;
-        upload.clear();
-        upload.extend(self.view_spheres.iter().map(|s| s.center.extend(s.radius).to_array()));
-        upload.extend(self.sizing.listed.chunks(4).map(|c| {
-            let mut four = [0.0f32; 4];
-            for (slot, &light) in four.iter_mut().zip(c) {
-                *slot = f32::from_bits(light);
-            }
-            four
-        }));
-        if upload.is_empty() {
-            upload.push([0.0; 4]);
-        }
-        self.buffers.spheres.write(gpu, bytemuck::cast_slice(upload))?;
-        Ok(())
+        self.buffers.tile_ranges.reserve(gpu, (tiles + coarse_tiles) * u64::from(chunks) * 8)?;
+        Ok([chunks, chunks])
     }
 
     /// Blocks of this frame's refined lists (0 without them).
@@ -435,7 +408,7 @@ impl ClusterResources {
     /// (`coarse_room`; level 1 from the lights' side runs an invocation and keeps a bit per tile
     /// for each of their entries), the tile lists the rest (and the coarse lists what is left
     /// when the buffer could not grow to both).
-    fn tile_list_split(&self, tile_need: u64, coarse_need: u64) -> (u32, u32) {
+    fn tile_list_split(&self, (tile_need, coarse_need): (u64, u64)) -> (u32, u32) {
         let total = (self.buffers.tile_indices.capacity() / 4).min(u64::from(u32::MAX));
         let coarse = Self::coarse_room(coarse_need).min(total - tile_need.min(total));
         ((total - coarse) as u32, coarse as u32)
@@ -447,19 +420,11 @@ impl ClusterResources {
         need + need / 4 + 256
     }
 
-    /// Sets the lights' view-space spheres (`lights` in the order of the light buffer) and
-    /// returns the view's projection made finite: an infinite projection is sliced up to the
-    /// farthest light's reach, so nothing beyond it is lit and every light lies inside the grid.
-    fn place_lights(
-        &mut self,
-        view: &RenderView,
-        view_from_world: &Mat4,
-        lights: &[(glam::Vec3, f32)],
-    ) -> Projection {
-        self.view_spheres.clear();
-        self.view_spheres.extend(to_view_space(*view_from_world, lights.iter().copied()));
-        let reach = manylight_core::cluster::farthest_reach(self.view_spheres.iter().copied());
-        view.camera.map(|c| c.projection).unwrap_or_default().finite_for(reach)
+    /// The view's projection made finite: an infinite projection is sliced up to the farthest
+    /// point the lights can reach (`reach`), so nothing beyond it is lit and every light lies
+    /// inside the grid.
+    fn finite_projection(view: &RenderView, view_from_world: &Mat4, reach: &LightReach) -> Projection {
+        view.camera.map(|c| c.projection).unwrap_or_default().finite_for(reach.farthest(view_from_world))
     }
 
     /// Fills the parameters from this frame's grid, culling test and list capacities, sizes the
@@ -469,14 +434,16 @@ impl ClusterResources {
         &mut self,
         gpu: &GpuContext,
         view: &RenderView,
+        view_from_world: &Mat4,
         light_count: u32,
         cap: u32,
         [light_chunks, tile_chunks]: [u32; 2],
     ) -> Result<(), RenderError> {
         let (near, far) = (self.grid.near, self.grid.far);
         let count_ranges = self.grid.cluster_count() * if self.depth_bounds { 2 } else { 1 };
-        let (tile_lists, coarse_lists) =
-            self.tile_list_split(self.sizing.estimate.tile_entries, self.sizing.estimate.coarse_entries);
+        let needs = self.needs.unwrap_or_default();
+        let (tile_lists, coarse_lists) = self.tile_list_split((needs.tile_entries, needs.coarse_entries));
+        let loop_limited = crate::gpu_types::has_loop_limit(&gpu.info);
         self.params = GpuClusterParams {
             dims: [self.grid.dims.x, self.grid.dims.y, self.grid.dims.z, self.grid.cluster_count()],
             viewport: [view.size.x.max(1) as f32, view.size.y.max(1) as f32, near, far],
@@ -501,8 +468,10 @@ impl ClusterResources {
             refined_first: count_ranges,
             frustum: manylight_core::cluster::rect_frustum(&self.grid).to_array(),
             light_chunks,
-            listed_lights: if self.from_lights { self.sizing.listed.len() as u32 } else { 0 },
-            _pad: [0; 2],
+            from_lights: u32::from(self.from_lights),
+            loop_limit: if loop_limited { LAVAPIPE_LOOP_LIMIT } else { u32::MAX },
+            _pad: 0,
+            view_from_world: view_from_world.to_cols_array_2d(),
         };
         self.size_bits(gpu)?;
         gpu.write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(&self.params));
@@ -526,12 +495,11 @@ impl ClusterResources {
     }
 
     /// Whether the bits of levels 0 and 1 (`bit_bytes`) fit in what the device binds, with as
-    /// many coarse-list positions as this frame's bound gives the coarse lists
-    /// (`tile_list_split`).
-    fn bits_fit(&self, light_chunks: u32) -> bool {
+    /// many coarse-list positions as `coarse_need` gives the coarse lists (`tile_list_split`).
+    fn bits_fit(&self, light_chunks: u32, coarse_need: u64) -> bool {
         let span = self.coarse.unwrap_or(0);
         let dims = coarse_dims(self.grid.dims.truncate(), span.max(1));
-        let positions = Self::coarse_room(self.sizing.estimate.coarse_entries);
+        let positions = Self::coarse_room(coarse_need);
         COUNTER_BYTES + Self::bit_bytes(dims, span, light_chunks, positions)
             <= self.buffers.counters.max_bytes()
     }
@@ -547,14 +515,12 @@ impl ClusterResources {
 
     /// Makes room after the counters for this frame's bits of levels 0 and 1 when they run from
     /// the lights' side (`from_lights`), for the coarse lists' present capacity. Bits that do
-    /// not fit (only when the lists grew past the bound while the frame is checked) send the
+    /// not fit (the shared buffer had more room for the coarse lists than they asked) send the
     /// levels back to testing each (coarse) tile against its candidates.
     fn size_bits(&mut self, gpu: &GpuContext) -> Result<(), RenderError> {
         if self.from_lights && COUNTER_BYTES + self.params_bit_bytes() > self.buffers.counters.max_bytes() {
-            // Level 0 per coarse tile loops over all lights.
             self.from_lights = false;
-            self.params.light_chunks = light_chunks_of(self.params.light_count as usize);
-            self.params.listed_lights = 0;
+            self.params.from_lights = 0;
         }
         // The shader's bits array has at least one word.
         let bits = self.coarse_bits().map_or(0, |(_, bytes)| bytes);
@@ -579,10 +545,10 @@ impl ClusterResources {
         gpu: &GpuContext,
         view: &RenderView,
         view_from_world: &Mat4,
-        lights: &[(glam::Vec3, f32)],
+        (light_count, reach): (u32, &LightReach),
         lists: &ClusterAssignment,
     ) -> Result<(), RenderError> {
-        let projection = self.place_lights(view, view_from_world, lights);
+        let projection = Self::finite_projection(view, view_from_world, reach);
         self.grid = manylight_core::efficiency::pixel_grid(view.size, &projection);
         self.cull = view.settings.clusters.cull;
         self.coarse = None;
@@ -596,8 +562,8 @@ impl ClusterResources {
         if let Some(r) = lists.ranges.iter().find(|r| u64::from(r[0]) + u64::from(r[1]) > entries) {
             return Err(bad(format!("a range {r:?} reaches past the {entries} indices")));
         }
-        if let Some(l) = lists.indices.iter().find(|&&l| l as usize >= lights.len()) {
-            return Err(bad(format!("light {l} of {} lights", lights.len())));
+        if let Some(l) = lists.indices.iter().find(|&&l| l >= light_count) {
+            return Err(bad(format!("light {l} of {light_count} lights")));
         }
         self.buffers.ranges.write(gpu, bytemuck::cast_slice(&lists.ranges))?;
         if lists.indices.is_empty() {
@@ -605,12 +571,10 @@ impl ClusterResources {
         } else {
             self.buffers.indices.write(gpu, bytemuck::cast_slice(&lists.indices))?;
         }
-        self.sizing.estimate = ListBounds { cluster_pairs: entries, ..ListBounds::default() };
-        self.sizing.cpu_ms = 0.0;
         self.depth_bounds = false;
         self.refine_blocks = None;
         self.from_lights = false;
-        self.write_params(gpu, view, lights.len() as u32, CLUSTER_NO_CAP, [1, 1])
+        self.write_params(gpu, view, view_from_world, light_count, CLUSTER_NO_CAP, [1, 1])
     }
 
     /// The buffer the build writes its counters into (the renderer copies it into the frame's
@@ -647,89 +611,117 @@ impl ClusterResources {
         Ok(())
     }
 
-    /// True when the index lists are too small for what the frame needed (`counters`).
-    pub fn lists_short(&self, counters: &GpuClusterCounters) -> bool {
-        let (tiles_short, clusters_short) = self.short_lists(counters);
-        tiles_short || clusters_short
+    /// Takes what a frame read back needed (its `report`): the following frames' lists are
+    /// sized to it. A frame made with another grid or culling test than the counts the lists
+    /// were last sized from (one still in flight when the view counted for a new layout) is
+    /// passed over.
+    pub fn observe(&mut self, report: &ClusterReport) {
+        let needs = ListNeeds::of(report);
+        if self.needs.is_none_or(|n| n.layout == needs.layout) {
+            self.needs = Some(needs);
+        }
     }
 
-    /// Whether the tile-lists buffer (per-tile and per-coarse-tile lists) and the cluster index
-    /// list were too small for what the frame needed (`counters`).
-    fn short_lists(&self, counters: &GpuClusterCounters) -> (bool, bool) {
-        let tiles_short = counters.tile_entries > self.params.tile_index_capacity
-            || counters.coarse_entries > self.params.coarse_index_capacity;
-        (tiles_short, counters.total_entries > self.params.index_capacity)
+    /// Whether the lists have no counts to be sized from: no frame of the view was read back
+    /// yet, or the light count more than doubled since the one that was (a frame whose lists
+    /// fall short shades those clusters from every light, which costs most when the lights are
+    /// many). The renderer then runs the build once before the frame, only to count
+    /// ([`Self::count_first`]).
+    pub fn needs_counting(&self) -> bool {
+        self.needs.is_none_or(|n| {
+            n.layout != Some(self.layout()) || self.params.light_count > n.lights.saturating_mul(2).max(64)
+        })
     }
 
-    /// True when the index lists were too small for what the frame needed (`counters`); grows
-    /// them (to the next power of two, at most the device's binding limit) so the frame can be
-    /// rendered again. A list the device cannot bind is refused, naming the limit.
-    pub fn grow_if_needed(
-        &mut self,
-        gpu: &GpuContext,
-        counters: &GpuClusterCounters,
-    ) -> Result<bool, RenderError> {
-        let (tiles_short, clusters_short) = self.short_lists(counters);
-        if !tiles_short && !clusters_short {
-            return Ok(false);
+    /// This frame's [`ListLayout`].
+    fn layout(&self) -> ListLayout {
+        ListLayout { dims: self.grid.dims.to_array(), coarse_span: self.coarse.unwrap_or(0), cull: self.cull }
+    }
+
+    /// Sets the parameters up for a counting run of the build (`counting`: whole slices, no
+    /// depth bounds, which the frame has not drawn yet; so at least the counts of the frame)
+    /// or back for the frame, and zeroes the counters.
+    pub fn count_first(&mut self, gpu: &GpuContext, counting: bool) {
+        let mut params = self.params;
+        if counting {
+            params.depth_bounds = 0;
+            self.counted_first = true;
         }
-        if tiles_short {
-            let tiles = u64::from(counters.tile_entries.max(self.params.tile_index_capacity));
-            let coarse = u64::from(counters.coarse_entries.max(self.params.coarse_index_capacity));
-            self.buffers.tile_indices.reserve(gpu, (tiles + coarse) * 4)?;
-            (self.params.tile_index_capacity, self.params.coarse_index_capacity) =
-                self.tile_list_split(tiles, coarse);
-            self.size_bits(gpu)?;
-        }
-        if clusters_short {
-            self.buffers
-                .indices
-                .reserve(gpu, (counters.total_entries as u64 + self.refined_entries()) * 4)?;
-            self.params.index_capacity = self.cluster_index_capacity();
-        }
-        gpu.write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(&self.params));
+        gpu.write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(&params));
         gpu.write_buffer(
             self.buffers.counters.buffer(),
             0,
             bytemuck::bytes_of(&GpuClusterCounters::default()),
         );
-        self.bindings.rebind_if_grown(gpu, &self.buffers);
-        Ok(true)
+    }
+
+    /// Sizes the lists again from the counts of a counting run (`counters`); true when they grew
+    /// (the counts of a level below a short one are short too, so the build counts again).
+    pub fn grow_to_counts(
+        &mut self,
+        gpu: &GpuContext,
+        counters: &GpuClusterCounters,
+    ) -> Result<bool, RenderError> {
+        let short = counters.total_entries > self.params.index_capacity
+            || counters.tile_entries > self.params.tile_index_capacity
+            || counters.coarse_entries > self.params.coarse_index_capacity;
+        self.needs = Some(ListNeeds {
+            cluster_entries: u64::from(counters.total_entries),
+            tile_entries: u64::from(counters.tile_entries),
+            coarse_entries: u64::from(counters.coarse_entries),
+            lights: self.params.light_count,
+            layout: Some(self.layout()),
+        });
+        if short {
+            let chunks = self.size_lists(gpu, self.params.light_count)?;
+            let needs = self.needs.unwrap_or_default();
+            (self.params.tile_index_capacity, self.params.coarse_index_capacity) =
+                self.tile_list_split((needs.tile_entries, needs.coarse_entries));
+            self.params.index_capacity = self.cluster_index_capacity();
+            self.params.from_lights = u32::from(self.from_lights);
+            [self.params.light_chunks, self.params.tile_chunks] = chunks;
+            self.size_bits(gpu)?;
+            self.bindings.rebind_if_grown(gpu, &self.buffers);
+        }
+        Ok(short)
     }
 
     /// The report of a frame from its counters.
-    pub fn report(&self, c: &GpuClusterCounters, regrows: u32) -> ClusterReport {
+    pub fn report(&self, c: &GpuClusterCounters) -> ClusterReport {
         let mut report = ClusterReport {
             dims: [self.grid.dims.x, self.grid.dims.y, self.grid.dims.z],
             clusters: self.params.dims[3],
-            index_capacity: self.params.index_capacity as u64,
-            regrows,
-            pair_bound: self.sizing.estimate.cluster_pairs,
-            tile_entry_bound: self.sizing.estimate.tile_entries,
-            coarse_entry_bound: self.sizing.estimate.coarse_entries,
+            lights: self.params.light_count,
+            index_capacity: u64::from(self.params.index_capacity),
+            tile_index_capacity: u64::from(self.params.tile_index_capacity),
+            coarse_index_capacity: u64::from(self.params.coarse_index_capacity),
+            counted_first: self.counted_first,
             coarse_span: self.coarse.unwrap_or(0),
-            bound_cpu_ms: self.sizing.cpu_ms,
             buffer_bytes: self.buffers.bytes(),
             cull_test: self.cull.name().to_string(),
             z_slicing: self.grid.slicing.name().to_string(),
             from_lights: self.from_lights,
             chunks: [self.params.light_chunks, self.params.tile_chunks],
-            listed_lights: self.params.listed_lights,
             ..Default::default()
         };
         report.apply_counters(c);
         report
     }
 
-    /// True when this frame's lists might not hold what the build writes, which is known
-    /// before the frame is submitted: a bound exceeds the capacity the device could give, or,
-    /// on a `loop_limited` adapter, the longest tile list could exceed `loop_limit`. Such a
-    /// view waits for its counters instead of trusting the bound.
-    pub fn bound_can_fail(&self, loop_limited: bool, loop_limit: u32) -> bool {
-        self.sizing.estimate.cluster_pairs > u64::from(self.params.index_capacity)
-            || self.sizing.estimate.tile_entries > u64::from(self.params.tile_index_capacity)
-            || self.sizing.estimate.coarse_entries > u64::from(self.params.coarse_index_capacity)
-            || (loop_limited && self.sizing.estimate.max_tile_lights > loop_limit)
+    /// Reads the lights' view-space spheres the last submitted view's build used back (waits for
+    /// the GPU): the CPU reference (`manylight_core::cluster::assign_lights`) takes them to
+    /// compare lists light for light.
+    pub fn read_view_spheres(&self, gpu: &GpuContext) -> Result<Vec<ViewSphere>, RenderError> {
+        let n = u64::from(self.params.light_count);
+        if n == 0 {
+            return Ok(Vec::new());
+        }
+        let spheres: Vec<[f32; 4]> =
+            bytemuck::pod_collect_to_vec(&read_buffer(gpu, self.buffers.spheres.buffer(), 0, n * 16)?);
+        Ok(spheres
+            .iter()
+            .map(|s| ViewSphere { center: glam::Vec3::new(s[0], s[1], s[2]), radius: s[3] })
+            .collect())
     }
 
     /// Reads the refined lists of the last submitted view back (waits for the GPU); `None` when
@@ -764,7 +756,8 @@ impl ClusterResources {
         let ranges_bytes = read_buffer(gpu, self.buffers.ranges.buffer(), 0, count * 8)?;
         let ranges: Vec<[u32; 2]> = bytemuck::pod_collect_to_vec(&ranges_bytes);
         let counters = self.read_counters(gpu)?;
-        let total = counters.total_entries as u64;
+        // A frame whose lists fell short wrote only what fits.
+        let total = u64::from(counters.total_entries.min(self.params.index_capacity));
         let indices: Vec<u32> = if total == 0 {
             Vec::new()
         } else {

@@ -85,6 +85,18 @@ pub static CLUSTER_BUILD_GROUP: BindGroupDecl = BindGroupDecl {
     ],
 };
 
+/// Group 0 of the first dispatch of the cluster build (`shaders/light_spheres.wgsl`): the
+/// parameters (with the view's transform), the light buffer it reads and the view-space
+/// spheres it writes.
+pub static LIGHT_SPHERES_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "light_spheres",
+    entries: &[
+        BindingDecl::uniform(0, "params", COMPUTE),
+        BindingDecl::storage(1, "lights", COMPUTE),
+        BindingDecl::storage_rw(2, "spheres", COMPUTE),
+    ],
+};
+
 /// Group 2 of the passes that shade through the cluster lists (`common/cluster_lists.wgsl`,
 /// `tiled_deferred.wgsl`): the parameters, each cluster's range and the light indices.
 pub static CLUSTER_LISTS_GROUP: BindGroupDecl = BindGroupDecl {
@@ -336,6 +348,7 @@ pub static SHADER_BIND_GROUPS: &[ShaderBindGroups] = &[
     row("light_volumes.wgsl", &["vs_volume", "fs_ambient", "fs_volume"], &[SCENE, GBUFFER]),
     row("light_volumes.wgsl", &["fs_resolve"], &[SCENE, GBUFFER, &LIGHT_ACCUM_GROUP]),
     row("cluster_build.wgsl", &[], &[&CLUSTER_BUILD_GROUP]),
+    row("light_spheres.wgsl", &[], &[&LIGHT_SPHERES_GROUP]),
     row("cluster_depth.wgsl", &["cs_forward"], &[SCENE, &SHADING_DISTANCE_GROUP, &CLUSTER_DEPTH_GROUP]),
     row("cluster_depth.wgsl", &["cs_gbuffer"], &[SCENE, GBUFFER, &CLUSTER_DEPTH_GROUP]),
     row("light_refine.wgsl", &["cs_forward"], &[SCENE, &SHADING_DISTANCE_GROUP, &LIGHT_REFINE_GROUP]),

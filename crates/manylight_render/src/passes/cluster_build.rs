@@ -5,6 +5,7 @@
 //! light-index list.
 
 use super::{CLUSTER_DEPTHS, CLUSTERS};
+use crate::bindings::Binding;
 use crate::context::RenderError;
 use crate::graph::{NamedPass, Pass, PassContext, ResourceName};
 use crate::layouts::GroupLayout;
@@ -22,9 +23,11 @@ impl PipelineKey for ClusterBuildKey {
     type Pipeline = ClusterBuildPipelines;
 }
 
-/// The compute pipelines of the build, for one workgroup size: three per level, and levels 0
-/// and 1 from the lights' side (`light_marks`, `tile_marks` and the `_bits` steps).
+/// The compute pipelines of the build, for one workgroup size: the lights' view-space spheres
+/// (`shaders/light_spheres.wgsl`), three per level, and levels 0 and 1 from the lights' side
+/// (`light_marks`, `tile_marks` and the `_bits` steps).
 pub struct ClusterBuildPipelines {
+    light_spheres: wgpu::ComputePipeline,
     light_marks: wgpu::ComputePipeline,
     coarse_count_bits: wgpu::ComputePipeline,
     coarse_fill_bits: wgpu::ComputePipeline,
@@ -43,11 +46,31 @@ pub struct ClusterBuildPipelines {
 }
 
 impl ClusterBuildPipelines {
-    fn new(device: &wgpu::Device, layout: &GroupLayout, workgroup_size: u32) -> Result<Self, RenderError> {
+    fn new(
+        device: &wgpu::Device,
+        layout: &GroupLayout,
+        spheres_layout: &GroupLayout,
+        workgroup_size: u32,
+    ) -> Result<Self, RenderError> {
         let module = crate::shaders::create_module(device, "cluster_build.wgsl")?;
         crate::layouts::check_pipeline("cluster_build.wgsl", &[], &[layout])?;
         let pipeline_layout = crate::layouts::pipeline_layout(device, "cluster_build", &[layout]);
+        let spheres_module = crate::shaders::create_module(device, "light_spheres.wgsl")?;
+        crate::layouts::check_pipeline("light_spheres.wgsl", &[], &[spheres_layout])?;
+        let spheres_pipeline_layout =
+            crate::layouts::pipeline_layout(device, "light_spheres", &[spheres_layout]);
         let constants = [("WORKGROUP_SIZE", workgroup_size as f64)];
+        let light_spheres = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("light_spheres"),
+            layout: Some(&spheres_pipeline_layout),
+            module: &spheres_module,
+            entry_point: Some("main"),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants: &constants,
+                ..Default::default()
+            },
+            cache: None,
+        });
         let make = |entry: &str| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some("cluster_build"),
@@ -62,6 +85,7 @@ impl ClusterBuildPipelines {
             })
         };
         Ok(ClusterBuildPipelines {
+            light_spheres,
             light_marks: make("light_marks"),
             coarse_count_bits: make("coarse_count_bits"),
             coarse_fill_bits: make("coarse_fill_bits"),
@@ -135,10 +159,18 @@ impl Pass for ClusterBuildPass {
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
         let clusters = ctx.require_clusters("cluster_build")?;
         let wg = self.workgroup_size.clamp(1, 1024);
-        let layout = &clusters.bindings.build_layout;
+        let (layout, spheres_layout) = (&clusters.bindings.build_layout, &clusters.bindings.spheres_layout);
         let pipelines = ctx.pipelines.get_or_create(ClusterBuildKey { workgroup_size: wg }, |k| {
-            ClusterBuildPipelines::new(&ctx.gpu.device, layout, k.workgroup_size)
+            ClusterBuildPipelines::new(&ctx.gpu.device, layout, spheres_layout, k.workgroup_size)
         })?;
+        let spheres_group = ctx.bind_group(
+            spheres_layout,
+            &[
+                Binding::Buffer(&clusters.buffers.params),
+                Binding::Buffer(ctx.scene.lights.buffer()),
+                Binding::Buffer(clusters.buffers.spheres.buffer()),
+            ],
+        );
         let max_groups = ctx.gpu.device.limits().max_compute_workgroups_per_dimension;
         let groups = dispatch_size(clusters.params.dims[3], wg, max_groups)?;
         // Levels 0 and 1 run one invocation per (coarse tile or tile, chunk of candidates).
@@ -152,7 +184,7 @@ impl Pass for ClusterBuildPass {
         };
         let tiles = u64::from(p.dims[0]) * u64::from(p.dims[1]);
         let tile_groups = dispatch_size(entries(tiles, p.tile_chunks)?, wg, max_groups)?;
-        let light_groups = dispatch_size(p.listed_lights, wg, max_groups)?;
+        let light_groups = dispatch_size(p.light_count, wg, max_groups)?;
         let position_groups = dispatch_size(p.coarse_index_capacity, wg, max_groups)?;
         let coarse_tiles = u64::from(p.coarse_dims[0]) * u64::from(p.coarse_dims[1]);
         let coarse_groups = dispatch_size(entries(coarse_tiles, p.light_chunks)?, wg, max_groups)?;
@@ -166,6 +198,10 @@ impl Pass for ClusterBuildPass {
                 label: Some("cluster_build"),
                 timestamp_writes: timestamps,
             });
+            // The lights' view-space spheres first, then the build over them.
+            pass.set_bind_group(0, &spheres_group, &[]);
+            pass.set_pipeline(&pipelines.light_spheres);
+            pass.dispatch_workgroups(light_groups[0], light_groups[1], 1);
             pass.set_bind_group(0, &clusters.bindings.build_group, &[]);
             // The steps of the build (shaders/cluster_build.wgsl), in order; the scans run as
             // one workgroup.

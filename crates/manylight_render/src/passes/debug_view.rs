@@ -89,19 +89,18 @@ impl DebugViewPipeline {
 }
 
 /// Where the depth view's scale ends: at the far plane; without one, where a cluster grid
-/// would end (the farthest light's reach, [`manylight_core::Projection::finite_for`]), or at
+/// would end (as far as the lights reach, [`manylight_core::Projection::finite_for`]), or at
 /// `near × 10⁴` when there is no light.
 fn depth_view_far(scene: &crate::resources::SceneResources) -> f32 {
     let (near, near_over_far) = (scene.view.params.x, scene.view.params.y);
     if near_over_far > 0.0 {
         return near / near_over_far;
     }
-    if scene.light_spheres.is_empty() {
+    if scene.light_count == 0 {
         return near * 1e4;
     }
-    use manylight_core::cluster::{farthest_reach, to_view_space};
-    let spheres = to_view_space(scene.view.view_from_world, scene.light_spheres.iter().copied());
-    manylight_core::Projection::infinite(1.0, near).finite_for(farthest_reach(spheres)).far
+    let reach = scene.light_reach.farthest(&scene.view.view_from_world);
+    manylight_core::Projection::infinite(1.0, near).finite_for(reach).far
 }
 
 /// Writes a debug visualisation to [`OUTPUT`].
