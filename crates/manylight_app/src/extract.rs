@@ -18,7 +18,7 @@ use glam::Mat4;
 use manylight_core::{MaterialData, SpotCone, candela_from_lumens};
 use manylight_render::{
     ExtractedCamera, ExtractedDirectionalLight, ExtractedInstance, ExtractedPointLight, ExtractedView,
-    FrameSnapshot, ViewComponents, ViewRect, ViewTarget,
+    FrameSnapshot, PointLights, ViewComponents, ViewRect, ViewTarget,
 };
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -30,6 +30,48 @@ pub struct ExtractState {
     prev_cameras: HashMap<Entity, ExtractedCamera>,
     frame_index: u64,
     default_material: Option<Arc<MaterialData>>,
+    /// The point and spot lights, kept from frame to frame.
+    lights: LightSlots,
+}
+
+/// The shown point and spot lights as extraction keeps them between frames: one slot per light
+/// entity in a [`PointLights`] list, updated from change detection, so a frame visits and
+/// copies only the lights that changed (and the renderer uploads only those). A light that is
+/// despawned, hidden or loses its light component leaves its slot to the last light, which
+/// moves there.
+#[derive(Default)]
+struct LightSlots {
+    lights: PointLights,
+    slot_of: bevy_ecs::entity::EntityHashMap<usize>,
+    entity_at: Vec<Entity>,
+}
+
+impl LightSlots {
+    /// Puts `entity`'s light in its slot (a new one at the end), or frees the slot (`None`).
+    fn set(&mut self, entity: Entity, light: Option<ExtractedPointLight>) {
+        match (self.slot_of.get(&entity).copied(), light) {
+            (Some(slot), Some(light)) => {
+                self.lights.set(slot, light);
+            }
+            (None, Some(light)) => {
+                self.slot_of.insert(entity, self.lights.len());
+                self.entity_at.push(entity);
+                self.lights.push(light);
+            }
+            (Some(slot), None) => {
+                self.slot_of.remove(&entity);
+                let (Some(last), Some(last_entity)) = (self.lights.pop(), self.entity_at.pop()) else {
+                    return;
+                };
+                if slot < self.lights.len() {
+                    self.lights.set(slot, last);
+                    self.entity_at[slot] = last_entity;
+                    self.slot_of.insert(last_entity, slot);
+                }
+            }
+            (None, None) => {}
+        }
+    }
 }
 
 /// What extract reads of a camera: which one, placement, projection, target and order, and
@@ -64,13 +106,26 @@ pub type MeshItem = (
     Option<&'static InheritedVisibility>,
 );
 
-/// What extract reads of a light entity, point, spot or directional (hidden ones are skipped).
+/// What extract reads of a point or spot light entity (hidden ones are skipped).
 pub type LightItem = (
+    Entity,
     &'static GlobalTransform,
-    AnyOf<(&'static PointLight, &'static SpotLight, &'static DirectionalLight)>,
+    AnyOf<(&'static PointLight, &'static SpotLight)>,
+    Option<&'static InheritedVisibility>,
+);
+
+/// What extract reads of a directional light entity (hidden ones are skipped; an entity with a
+/// point or spot light too is that light).
+pub type DirectionalItem = (
+    &'static GlobalTransform,
+    &'static DirectionalLight,
     Option<&'static InheritedVisibility>,
     Option<&'static CascadeShadowConfig>,
 );
+
+/// The change that makes extraction look at a point or spot light again.
+pub type LightChanged =
+    Or<(Changed<GlobalTransform>, Changed<PointLight>, Changed<SpotLight>, Changed<InheritedVisibility>)>;
 
 /// Whether an entity's computed visibility lets it render (none computed yet: visible).
 fn shown(visibility: Option<&InheritedVisibility>) -> bool {
@@ -85,27 +140,34 @@ pub struct ExtractInputs<'w, 's> {
     debug: Res<'w, DebugView>,
     cameras: Query<'w, 's, CameraItem, With<Camera3d>>,
     meshes: Query<'w, 's, MeshItem>,
+    /// Point and spot lights that changed since the last extraction (added included).
+    changed_lights: Query<'w, 's, LightItem, LightChanged>,
+    /// Every point and spot light (looked up when one lost a light component).
     lights: Query<'w, 's, LightItem>,
+    removed_points: RemovedComponents<'w, 's, PointLight>,
+    removed_spots: RemovedComponents<'w, 's, SpotLight>,
+    directional_lights: Query<'w, 's, DirectionalItem, (Without<PointLight>, Without<SpotLight>)>,
 }
 
 /// Builds the frame's snapshot from the world; the components an app extracts per camera are
 /// in `camera_components`.
 pub fn build_snapshot(
     state: &mut ExtractState,
-    world: &ExtractInputs,
+    world: &mut ExtractInputs,
     camera_components: &mut HashMap<Entity, ViewComponents>,
 ) -> FrameSnapshot {
     let viewport = world.viewport.0;
     let views = extract_views(state, viewport, &world.cameras, camera_components);
     let instances = extract_instances(state, &world.meshes);
-    let lights = extract_lights(&world.lights);
+    update_lights(&mut state.lights, world);
     let snapshot = FrameSnapshot {
         frame_index: state.frame_index,
         viewport,
         views,
         instances,
-        lights: lights.point,
-        directional_lights: lights.directional,
+        // Shares every chunk no light of which changed with the frames before.
+        lights: state.lights.lights.clone(),
+        directional_lights: extract_directional_lights(&world.directional_lights),
         settings: crate::resources::frame_settings(&world.settings, &world.debug),
         pixel_light_lists: None,
         extract_cpu_ms: 0.0,
@@ -189,60 +251,71 @@ fn extract_instances(state: &mut ExtractState, meshes: &Query<MeshItem>) -> Vec<
         .collect()
 }
 
-/// The frame's shown lights, by kind.
-struct ExtractedLights {
-    /// Point and spot lights.
-    point: Vec<ExtractedPointLight>,
-    directional: Vec<ExtractedDirectionalLight>,
+/// A shown point or spot light entity as the renderer takes it (`None` when hidden). Point and
+/// spot lights come in lumens (Bevy's unit) and render in candela; a point light wins over a
+/// spot light on the same entity.
+fn point_light(
+    (_, t, (point, spot), visibility): <LightItem as QueryData>::Item<'_, '_>,
+) -> Option<ExtractedPointLight> {
+    if !shown(visibility) {
+        return None;
+    }
+    let (color, lumens, range, cone, shadow) = match (point, spot) {
+        (Some(l), _) => (linear_rgb(l.color), l.intensity, l.range, None, l.shadow()),
+        (None, Some(l)) => {
+            let direction = t.forward().into();
+            let cone = SpotCone { direction, inner_angle: l.inner_angle, outer_angle: l.outer_angle };
+            (linear_rgb(l.color), l.intensity, l.range, Some(cone), l.shadow())
+        }
+        (None, None) => return None,
+    };
+    Some(ExtractedPointLight {
+        position: t.translation(),
+        color,
+        intensity: candela_from_lumens(lumens),
+        radius: range,
+        spot: cone,
+        shadow,
+    })
 }
 
-/// Every shown light entity, in query order.
-fn extract_lights(lights: &Query<LightItem>) -> ExtractedLights {
-    let mut point_lights = Vec::new();
-    let mut directional_lights = Vec::new();
-    for (t, (point, spot, directional), visibility, cascades) in lights {
-        if !shown(visibility) {
-            continue;
-        }
-        // One light per entity: a point light wins over a spot light, which wins over a
-        // directional one. Point and spot lights come in lumens (Bevy's unit) and render in
-        // candela.
-        let (color, lumens, range, cone, shadow) = match (point, spot, directional) {
-            (Some(l), ..) => (linear_rgb(l.color), l.intensity, l.range, None, l.shadow()),
-            (None, Some(l), _) => {
-                let direction = t.forward().into();
-                let cone = SpotCone { direction, inner_angle: l.inner_angle, outer_angle: l.outer_angle };
-                (linear_rgb(l.color), l.intensity, l.range, Some(cone), l.shadow())
-            }
-            (None, None, Some(l)) => {
-                let direction = t.forward().into();
-                directional_lights.push(ExtractedDirectionalLight {
-                    direction,
-                    color: linear_rgb(l.color),
-                    illuminance: l.illuminance,
-                    shadow: l.shadow(cascades.copied().unwrap_or_default()),
-                });
-                continue;
-            }
-            (None, None, None) => continue,
-        };
-        point_lights.push(ExtractedPointLight {
-            position: t.translation(),
-            color,
-            intensity: candela_from_lumens(lumens),
-            radius: range,
-            spot: cone,
-            shadow,
-        });
+/// Brings the kept lights up to date: the lights that changed since the last extraction (the
+/// first time, all of them) and the entities that lost their light component or were
+/// despawned. Visits no light that did not change.
+fn update_lights(slots: &mut LightSlots, world: &mut ExtractInputs) {
+    for item in &world.changed_lights {
+        let entity = item.0;
+        slots.set(entity, point_light(item));
     }
-    ExtractedLights { point: point_lights, directional: directional_lights }
+    let removed: Vec<Entity> = world.removed_points.read().chain(world.removed_spots.read()).collect();
+    for entity in removed {
+        // Still a light when it lost only one of the two components.
+        let light = world.lights.get(entity).ok().and_then(point_light);
+        slots.set(entity, light);
+    }
+}
+
+/// Every shown directional light, in query order.
+fn extract_directional_lights(
+    lights: &Query<DirectionalItem, (Without<PointLight>, Without<SpotLight>)>,
+) -> Vec<ExtractedDirectionalLight> {
+    lights
+        .iter()
+        .filter(|(_, _, visibility, _)| shown(*visibility))
+        .map(|(t, l, _, cascades)| ExtractedDirectionalLight {
+            direction: t.forward().into(),
+            color: linear_rgb(l.color),
+            illuminance: l.illuminance,
+            shadow: l.shadow(cascades.copied().unwrap_or_default()),
+        })
+        .collect()
 }
 
 /// The extract system (runs in `Last`, in [`crate::ManyLightSystems::Extract`]): takes the
 /// snapshot and hands it to the renderer; [`collect_results`] runs right after it.
 pub fn extract_and_render(
     mut state: Local<ExtractState>,
-    inputs: ExtractInputs,
+    mut inputs: ExtractInputs,
     mut backend: ResMut<RenderBackend>,
     capture: Res<HeadlessCapture>,
     failure: Res<RenderFailure>,
@@ -252,7 +325,7 @@ pub fn extract_and_render(
         return;
     }
     let start = std::time::Instant::now();
-    let mut snapshot = build_snapshot(&mut state, &inputs, &mut components.0);
+    let mut snapshot = build_snapshot(&mut state, &mut inputs, &mut components.0);
     snapshot.extract_cpu_ms = start.elapsed().as_secs_f64() * 1e3;
     // The stages travel with each frame (an `Arc`, shared until the app changes them).
     backend.submit(snapshot, capture.enabled, stages.0.clone());

@@ -265,7 +265,7 @@ pub fn scene_snapshot(
                 })
             })
             .collect(),
-        lights,
+        lights: lights.into(),
         settings,
         pixel_light_lists: None,
     }

@@ -47,7 +47,8 @@ pub use shadows::{ShadowReport, ShadowSettings};
 pub use snapshot::{
     BloomChain, BloomSettings, ClusterSettings, DEFAULT_COARSE_TILES, DebugViewMode, DirectionalShadow,
     Exposure, ExtractedCamera, ExtractedDirectionalLight, ExtractedInstance, ExtractedPointLight,
-    ExtractedView, FrameSettings, FrameSnapshot, GBufferLayout, MotionBlurSettings, PipelineKind,
-    RenderSettings, RenderTextureId, RenderView, ShadowBias, ViewComponents, ViewRect, ViewTarget,
+    ExtractedView, FrameSettings, FrameSnapshot, GBufferLayout, LIGHT_CHUNK, LightChunk, MotionBlurSettings,
+    PipelineKind, PointLights, RenderSettings, RenderTextureId, RenderView, ShadowBias, ViewComponents,
+    ViewRect, ViewTarget,
 };
 pub use stats::{CpuPhases, FrameReport, PassTiming, ViewReport};

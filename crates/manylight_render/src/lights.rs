@@ -1,6 +1,7 @@
 //! Lights in one place: what kind a light is, what it can reach, how it is packed for the
-//! shaders, and which lights the frame's buffers hold. The light buffer holds the frame's valid
-//! point and spot lights in order ([`buffered_lights`]); the view uniform the first
+//! shaders, and which lights the frame's buffers hold. The light buffer holds the frame's
+//! point and spot lights in order, an invalid one as an inert zeroed light that reaches
+//! nothing ([`buffered_lights`] yields the valid ones); the view uniform the first
 //! [`MAX_DIRECTIONAL_LIGHTS`] valid directional lights ([`viewed_directional_lights`]); a
 //! light's index there is its index everywhere (cluster lists, the shadow table, probes).
 //! Clustering culls with [`bounding_sphere`], the shaders read [`gpu_point_light`]'s fields
@@ -9,7 +10,7 @@
 //! is made here once.
 
 use crate::gpu_types::{GpuDirectionalLight, GpuPointLight, MAX_DIRECTIONAL_LIGHTS};
-use crate::snapshot::{ExtractedDirectionalLight, ExtractedPointLight};
+use crate::snapshot::{ExtractedDirectionalLight, ExtractedPointLight, PointLights};
 use glam::Vec3;
 
 /// The kinds of light the renderer draws.
@@ -85,6 +86,16 @@ impl LightReach {
         });
     }
 
+    /// Adds what `other` covers.
+    pub fn merge(&mut self, other: &LightReach) {
+        if let Some((lo, hi)) = other.bounds {
+            self.bounds = Some(match self.bounds {
+                Some((min, max)) => (min.min(lo), max.max(hi)),
+                None => (lo, hi),
+            });
+        }
+    }
+
     /// The farthest view distance (along −Z of `view_from_world`) any light can reach, at
     /// least that of every light's own sphere (`manylight_core::cluster::farthest_reach`); 0
     /// when there is no light. The farthest corner of the box: a sphere's farthest point along
@@ -102,9 +113,15 @@ impl LightReach {
     }
 }
 
-/// The lights the light buffer holds, with their index in it: the valid ones, in order.
-pub fn buffered_lights(lights: &[ExtractedPointLight]) -> impl Iterator<Item = (u32, &ExtractedPointLight)> {
-    lights.iter().filter(|l| l.is_valid()).enumerate().map(|(i, l)| (i as u32, l))
+/// The valid lights of the light buffer, with their index in it (their position in `lights`).
+pub fn buffered_lights(lights: &PointLights) -> impl Iterator<Item = (u32, &ExtractedPointLight)> {
+    lights.iter().enumerate().filter(|(_, l)| l.is_valid()).map(|(i, l)| (i as u32, l))
+}
+
+/// `light` as the light buffer holds it: packed ([`gpu_point_light`]), or zeroed when it is
+/// invalid (radius 0: no list keeps it and it adds nothing where a loop meets it).
+pub fn buffered_light(light: &ExtractedPointLight) -> GpuPointLight {
+    if light.is_valid() { gpu_point_light(light) } else { bytemuck::Zeroable::zeroed() }
 }
 
 /// The directional lights the view uniform holds, with their index in it: the first
@@ -172,11 +189,12 @@ mod tests {
     }
 
     #[test]
-    fn buffers_hold_the_valid_lights_in_order() {
+    fn buffers_hold_every_light_in_order() {
         let mut lights = vec![light(None); 4];
         lights[1].position = Vec3::NAN;
-        let held: Vec<u32> = buffered_lights(&lights).map(|(i, _)| i).collect();
-        assert_eq!(held, [0, 1, 2]);
+        assert_eq!(buffered_light(&lights[1]).position_radius, [0.0; 4]);
+        let held: Vec<u32> = buffered_lights(&lights.into()).map(|(i, _)| i).collect();
+        assert_eq!(held, [0, 2, 3], "an invalid light keeps its index");
         let sun = ExtractedDirectionalLight {
             direction: Vec3::NEG_Y,
             color: Vec3::ONE,

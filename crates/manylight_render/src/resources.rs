@@ -15,14 +15,15 @@ use crate::gpu_types::{
     TEXTURE_SLOT_OCCLUSION, ViewUniform,
 };
 use crate::layouts::{GroupLayout, SCENE_GROUP};
-use crate::lights::{
-    LightReach, buffered_lights, gpu_directional_light, gpu_point_light, viewed_directional_lights,
-};
+use crate::lights::{LightReach, buffered_light, gpu_directional_light, viewed_directional_lights};
 use crate::pool::GrowableBuffer;
 use crate::shaders::ShaderDefs;
-use crate::snapshot::{FrameSnapshot, RenderView, aspect};
+use crate::snapshot::{
+    ExtractedPointLight, FrameSnapshot, LIGHT_CHUNK, LightChunk, PointLights, RenderView, aspect,
+};
 use glam::{Mat4, Vec4};
 use manylight_core::MaterialData;
+use std::sync::Arc;
 
 /// Depth format of every pass (reverse-Z: cleared to 0, compare `Greater`).
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -165,6 +166,28 @@ pub struct ShadowBindings<'a> {
     pub generation: u64,
 }
 
+/// What a frame needs to know of a chunk of lights without visiting them again: how many are
+/// invalid, and the box of what the valid ones reach.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct ChunkSummary {
+    invalid: u32,
+    reach: LightReach,
+}
+
+impl ChunkSummary {
+    fn of(lights: &[ExtractedPointLight]) -> ChunkSummary {
+        let mut summary = ChunkSummary::default();
+        for light in lights {
+            if light.is_valid() {
+                summary.reach.add(light);
+            } else {
+                summary.invalid += 1;
+            }
+        }
+        summary
+    }
+}
+
 /// A group 0 and the generations of the buffers (lights, instances, shadows) it was made from.
 type BoundView = ((u64, u64, u64), wgpu::BindGroup);
 
@@ -218,12 +241,15 @@ pub struct SceneResources {
     /// The box around what the uploaded lights can reach (the cluster grids slice a projection
     /// without a far plane to it).
     pub light_reach: LightReach,
-    /// The frame's valid point and spot lights, packed (one zeroed light when there is none:
-    /// every pipeline binds the buffer).
-    gpu_lights: Vec<GpuPointLight>,
-    /// What the light buffer holds (the last frame's `gpu_lights`; swapped with it after each
-    /// upload, so both keep their allocation); `None` until the first upload.
-    uploaded_lights: Option<Vec<GpuPointLight>>,
+    /// The chunks of lights the light buffer holds: a frame packs and writes only the lights
+    /// of chunks that are not these, and of those only the lights that differ.
+    uploaded_chunks: Vec<Arc<LightChunk>>,
+    /// Per chunk of the light list: its invalid lights and the box of what its valid ones reach,
+    /// made when the chunk changed (a frame merges them, one per chunk, not one per light).
+    chunk_summaries: Vec<ChunkSummary>,
+    /// One run of changed lights, packed (kept between frames so that it is not allocated
+    /// again).
+    packed: Vec<GpuPointLight>,
     /// The tone map's count of non-finite HDR pixels.
     pub nonfinite: NonFiniteCounter,
     /// Meshes, materials, textures and samplers on the GPU, and the material layout.
@@ -296,8 +322,9 @@ impl SceneResources {
             invalid_instances: 0,
             collapsed_instances: 0,
             light_reach: LightReach::default(),
-            gpu_lights: Vec::new(),
-            uploaded_lights: None,
+            uploaded_chunks: Vec::new(),
+            chunk_summaries: Vec::new(),
+            packed: Vec::new(),
             nonfinite: NonFiniteCounter::new(gpu),
             assets: SceneAssets::new(gpu),
             bound: [None, None],
@@ -406,19 +433,44 @@ impl SceneResources {
         });
     }
 
-    /// Writes the packed lights into the light buffer where they differ from what it holds:
-    /// lights that did not change are not uploaded again (a still scene uploads nothing after
-    /// its first frame). Returns the bytes written.
-    fn upload_lights(&mut self, gpu: &GpuContext) -> Result<u64, RenderError> {
-        if self.gpu_lights.is_empty() {
-            self.gpu_lights.push(bytemuck::Zeroable::zeroed());
-        }
-        let previous = self.uploaded_lights.as_deref().map(bytemuck::cast_slice::<GpuPointLight, u8>);
+    /// Writes the lights of `lights` that differ from what the light buffer holds: a chunk the
+    /// buffer holds already (the same `Arc`) is skipped without looking at its lights, and of
+    /// a changed chunk only the runs of lights that differ are packed and written (a still
+    /// scene uploads nothing after its first frame; moving lights, their own bytes). Updates
+    /// the chunks' summaries. Returns the bytes written.
+    fn upload_lights(&mut self, gpu: &GpuContext, lights: &PointLights) -> Result<u64, RenderError> {
         let element = std::mem::size_of::<GpuPointLight>();
-        let written =
-            self.lights.write_changed(gpu, bytemuck::cast_slice(&self.gpu_lights), previous, element)?;
-        let uploaded = self.uploaded_lights.get_or_insert_with(Vec::new);
-        std::mem::swap(&mut self.gpu_lights, uploaded);
+        // At least one light: every pipeline binds the buffer (a new buffer is zeroed).
+        if self.lights.reserve(gpu, (lights.len().max(1) * element) as u64)? {
+            self.uploaded_chunks.clear();
+        }
+        let mut written = 0;
+        self.chunk_summaries.resize(lights.chunks().len(), ChunkSummary::default());
+        for (k, chunk) in lights.chunks().iter().enumerate() {
+            let old = self.uploaded_chunks.get(k);
+            if old.is_some_and(|o| Arc::ptr_eq(o, chunk)) {
+                continue;
+            }
+            self.chunk_summaries[k] = ChunkSummary::of(chunk.lights());
+            let (old, new) = (old.map_or(&[][..], |o| o.lights()), chunk.lights());
+            let mut i = 0;
+            while i < new.len() {
+                if old.get(i) == Some(&new[i]) {
+                    i += 1;
+                    continue;
+                }
+                let start = i;
+                while i < new.len() && old.get(i) != Some(&new[i]) {
+                    i += 1;
+                }
+                self.packed.clear();
+                self.packed.extend(new[start..i].iter().map(buffered_light));
+                let offset = ((k * LIGHT_CHUNK + start) * element) as u64;
+                gpu.write_buffer(self.lights.buffer(), offset, bytemuck::cast_slice(&self.packed));
+                written += (self.packed.len() * element) as u64;
+            }
+        }
+        self.uploaded_chunks.clone_from(&lights.chunks().to_vec());
         Ok(written)
     }
 
@@ -427,15 +479,16 @@ impl SceneResources {
     pub fn prepare(&mut self, gpu: &GpuContext, snapshot: &FrameSnapshot) -> Result<(), RenderError> {
         self.assets.begin_frame();
 
-        // Lights: invalid ones (NaN, inf, negative) are dropped and counted, never uploaded.
-        // Both light Vecs keep their allocation from frame to frame.
-        self.gpu_lights.clear();
+        // Lights: invalid ones (NaN, inf, negative) keep their place as zeroed lights that
+        // reach nothing, and are counted.
+        self.light_upload_bytes = self.upload_lights(gpu, &snapshot.lights)?;
+        self.light_count = snapshot.lights.len() as u32;
         self.light_reach = LightReach::default();
-        for (_, light) in buffered_lights(&snapshot.lights) {
-            self.gpu_lights.push(gpu_point_light(light));
-            self.light_reach.add(light);
+        self.invalid_lights = 0;
+        for summary in &self.chunk_summaries {
+            self.light_reach.merge(&summary.reach);
+            self.invalid_lights += summary.invalid;
         }
-        self.invalid_lights = (snapshot.lights.len() - self.gpu_lights.len()) as u32;
         // Directional lights: the first MAX_DIRECTIONAL_LIGHTS valid ones, in the view uniform.
         let valid_count = snapshot.directional_lights.iter().filter(|l| l.is_valid()).count() as u32;
         let mut count = 0usize;
@@ -452,9 +505,6 @@ impl SceneResources {
                 self.dropped_directional_lights
             );
         }
-
-        self.light_count = self.gpu_lights.len() as u32;
-        self.light_upload_bytes = self.upload_lights(gpu)?;
 
         // Meshes, materials, instances.
         let mut instance_data = Vec::with_capacity(snapshot.instances.len());

@@ -27,10 +27,10 @@ use crate::gpu_types::{
     GpuCascade, GpuDirectionalShadow, GpuShadowDraw, GpuShadowFace, GpuShadowLight, MAX_DIRECTIONAL_LIGHTS,
     SHADOW_FACES, SHADOW_TILE_COLUMNS,
 };
-use crate::lights::{bounding_sphere, buffered_lights, viewed_directional_lights};
+use crate::lights::{bounding_sphere, viewed_directional_lights};
 use crate::pool::GrowableBuffer;
 use crate::resources::SceneResources;
-use crate::snapshot::{ExtractedCamera, ExtractedDirectionalLight, ExtractedPointLight, FrameSnapshot};
+use crate::snapshot::{ExtractedCamera, ExtractedDirectionalLight, FrameSnapshot, PointLights};
 use glam::{Mat4, UVec2, Vec3, Vec4};
 use manylight_core::{Aabb, ProjectionKind};
 use std::collections::HashMap;
@@ -641,7 +641,7 @@ struct MapInputs<'a> {
     /// The atlas texture's edge in texels.
     atlas: u32,
     /// Point and spot lights, by their index in the light buffer.
-    lights: Vec<&'a ExtractedPointLight>,
+    lights: &'a PointLights,
     /// Directional lights, by their index in the view uniform.
     directional: Vec<&'a ExtractedDirectionalLight>,
     /// The first view's camera and aspect.
@@ -856,7 +856,7 @@ impl ShadowResources {
         // The light table: every light of the buffer, edge 0 where it has no map.
         self.gpu_lights.clear();
         self.gpu_lights.resize(scene.light_count.max(1) as usize, GpuShadowLight::default());
-        let lights: Vec<_> = buffered_lights(&snapshot.lights).map(|(_, l)| l).collect();
+        let lights = &snapshot.lights;
         self.gpu_faces.clear();
         for list in &mut self.by_mesh {
             list.1.clear();
@@ -902,8 +902,9 @@ impl ShadowResources {
     ) {
         let settings = snapshot.settings.shadows;
         self.requests.clear();
-        for (k, light) in buffered_lights(&snapshot.lights) {
-            if light.shadow.is_none() || light.radius <= 0.0 {
+        // The lights with a shadow, found without visiting the chunks that hold none.
+        for (k, light) in snapshot.lights.shadowed().map(|(k, l)| (k as u32, l)) {
+            if !light.is_valid() || light.radius <= 0.0 {
                 continue;
             }
             let (center, radius) = bounding_sphere(light);
@@ -1020,7 +1021,7 @@ impl ShadowResources {
         k: u32,
         content: &mut DefaultHasher,
     ) -> GpuShadowLight {
-        let light = inputs.lights[k as usize];
+        let light = &inputs.lights[k as usize];
         let bias = light.shadow.unwrap_or_default();
         let far = light.radius;
         let near = far * SHADOW_NEAR_FRACTION;

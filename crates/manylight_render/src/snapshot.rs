@@ -515,6 +515,167 @@ pub struct ExtractedPointLight {
     pub shadow: Option<ShadowBias>,
 }
 
+/// Lights in each chunk of a [`PointLights`] list (the last chunk may hold fewer).
+pub const LIGHT_CHUNK: usize = 1024;
+
+/// The point and spot lights of a frame, in chunks of [`LIGHT_CHUNK`] shared between frames
+/// (`Arc`): extraction copies a chunk only when one of its lights changed, and the renderer
+/// packs and uploads only the lights of chunks that are not the ones it uploaded before. A
+/// light's index is its position in the list, which is its index in the light buffer, the
+/// lists and the shadow table (an invalid light keeps its place there, lighting nothing).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PointLights {
+    chunks: Vec<Arc<LightChunk>>,
+    len: usize,
+}
+
+/// [`LIGHT_CHUNK`] consecutive lights of a [`PointLights`] list, and how many of them cast
+/// shadows (so a frame finds its shadowed lights without visiting the others).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LightChunk {
+    lights: Vec<ExtractedPointLight>,
+    shadowed: usize,
+}
+
+impl LightChunk {
+    /// The chunk's lights.
+    pub fn lights(&self) -> &[ExtractedPointLight] {
+        &self.lights
+    }
+
+    /// How many of them cast shadows.
+    pub fn shadowed(&self) -> usize {
+        self.shadowed
+    }
+
+    fn recount(&mut self) {
+        self.shadowed = self.lights.iter().filter(|l| l.shadow.is_some()).count();
+    }
+}
+
+impl PointLights {
+    /// An empty list.
+    pub fn new() -> PointLights {
+        PointLights::default()
+    }
+
+    /// Number of lights.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// True when there is no light.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The chunks, in order: light `i` is light `i % LIGHT_CHUNK` of chunk `i / LIGHT_CHUNK`.
+    pub fn chunks(&self) -> &[Arc<LightChunk>] {
+        &self.chunks
+    }
+
+    /// Light `i`, if there is one.
+    pub fn get(&self, i: usize) -> Option<&ExtractedPointLight> {
+        self.chunks.get(i / LIGHT_CHUNK).and_then(|c| c.lights.get(i % LIGHT_CHUNK))
+    }
+
+    /// Every light, in order.
+    pub fn iter(&self) -> impl Iterator<Item = &ExtractedPointLight> {
+        self.chunks.iter().flat_map(|c| c.lights.iter())
+    }
+
+    /// The lights that cast shadows, with their index, visiting only the chunks that hold some.
+    pub fn shadowed(&self) -> impl Iterator<Item = (usize, &ExtractedPointLight)> {
+        self.chunks.iter().enumerate().filter(|(_, c)| c.shadowed > 0).flat_map(|(k, c)| {
+            c.lights
+                .iter()
+                .enumerate()
+                .filter(|(_, l)| l.shadow.is_some())
+                .map(move |(i, l)| (k * LIGHT_CHUNK + i, l))
+        })
+    }
+
+    /// Adds a light at the end.
+    pub fn push(&mut self, light: ExtractedPointLight) {
+        if self.len % LIGHT_CHUNK == 0 {
+            self.chunks.push(Arc::new(LightChunk { lights: Vec::with_capacity(LIGHT_CHUNK), shadowed: 0 }));
+        }
+        let chunk = Arc::make_mut(self.chunks.last_mut().expect("a chunk with room"));
+        chunk.shadowed += usize::from(light.shadow.is_some());
+        chunk.lights.push(light);
+        self.len += 1;
+    }
+
+    /// Replaces light `i` (copying its chunk if another frame still holds it); false when
+    /// there is no light `i`. A light equal to the one there leaves the chunk shared.
+    pub fn set(&mut self, i: usize, light: ExtractedPointLight) -> bool {
+        let Some(chunk) = self.chunks.get_mut(i / LIGHT_CHUNK) else { return false };
+        match chunk.lights.get(i % LIGHT_CHUNK) {
+            None => false,
+            Some(old) if *old == light => true,
+            Some(_) => {
+                let chunk = Arc::make_mut(chunk);
+                let slot = &mut chunk.lights[i % LIGHT_CHUNK];
+                chunk.shadowed =
+                    chunk.shadowed + usize::from(light.shadow.is_some()) - usize::from(slot.shadow.is_some());
+                *slot = light;
+                true
+            }
+        }
+    }
+
+    /// Removes the last light and returns it.
+    pub fn pop(&mut self) -> Option<ExtractedPointLight> {
+        let chunk = self.chunks.last_mut()?;
+        let light = Arc::make_mut(chunk).lights.pop();
+        if chunk.lights.is_empty() {
+            self.chunks.pop();
+        } else if light.is_some_and(|l| l.shadow.is_some()) {
+            Arc::make_mut(chunk).shadowed -= 1;
+        }
+        self.len -= usize::from(light.is_some());
+        light
+    }
+
+    /// Changes every light with `f`, in place.
+    pub fn update(&mut self, mut f: impl FnMut(&mut ExtractedPointLight)) {
+        for chunk in &mut self.chunks {
+            let chunk = Arc::make_mut(chunk);
+            chunk.lights.iter_mut().for_each(&mut f);
+            chunk.recount();
+        }
+    }
+}
+
+impl FromIterator<ExtractedPointLight> for PointLights {
+    fn from_iter<I: IntoIterator<Item = ExtractedPointLight>>(lights: I) -> PointLights {
+        let mut list = PointLights::new();
+        lights.into_iter().for_each(|l| list.push(l));
+        list
+    }
+}
+
+impl From<Vec<ExtractedPointLight>> for PointLights {
+    fn from(lights: Vec<ExtractedPointLight>) -> PointLights {
+        lights.into_iter().collect()
+    }
+}
+
+impl<'a> IntoIterator for &'a PointLights {
+    type Item = &'a ExtractedPointLight;
+    type IntoIter = Box<dyn Iterator<Item = &'a ExtractedPointLight> + 'a>;
+    fn into_iter(self) -> Self::IntoIter {
+        Box::new(self.iter())
+    }
+}
+
+impl std::ops::Index<usize> for PointLights {
+    type Output = ExtractedPointLight;
+    fn index(&self, i: usize) -> &ExtractedPointLight {
+        self.get(i).unwrap_or_else(|| panic!("light {i} of {}", self.len))
+    }
+}
+
 /// How a light's shadow test keeps a surface from shadowing itself (Bevy's
 /// `shadow_depth_bias` and `shadow_normal_bias`): the shaded point moves `normal` texels of the
 /// light's shadow map off the surface towards the light, and `depth` world units nearer to
@@ -750,7 +911,7 @@ pub struct FrameSnapshot {
     /// Drawn objects.
     pub instances: Vec<ExtractedInstance>,
     /// Point and spot lights.
-    pub lights: Vec<ExtractedPointLight>,
+    pub lights: PointLights,
     /// Directional lights (not clustered; at most `MAX_DIRECTIONAL_LIGHTS` are drawn, the rest
     /// dropped and counted).
     pub directional_lights: Vec<ExtractedDirectionalLight>,
@@ -892,7 +1053,7 @@ impl FrameSnapshot {
     pub fn casts_shadows(&self) -> bool {
         self.settings.shadows.enabled
             && self.views.iter().any(|v| v.shadows)
-            && (self.lights.iter().any(|l| l.shadow.is_some() && l.is_valid() && l.radius > 0.0)
+            && (self.lights.shadowed().any(|(_, l)| l.is_valid() && l.radius > 0.0)
                 || self.directional_lights.iter().any(|l| l.shadow.is_some() && l.is_valid()))
     }
 
