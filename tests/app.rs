@@ -468,3 +468,55 @@ fn only_the_lights_that_changed_are_uploaded() {
     let report = stats(&app).last.expect("a report");
     assert_eq!(report.light_upload_bytes, 0, "the app's still lights were uploaded again");
 }
+
+/// Extraction keeps a slot per light entity and copies only what changed: after the first
+/// frame a still world uploads no light; moving one light entity uploads that light's bytes;
+/// despawning one moves the last light into its slot (that light's bytes); hiding one takes it
+/// out and showing it again puts it back at the end; a light that loses its component leaves.
+#[test]
+fn extraction_follows_the_light_entities_that_changed() {
+    let _gpu = gpu();
+    let light_bytes = std::mem::size_of::<manylight::render::gpu_types::GpuPointLight>() as u64;
+    let mut app = App::new();
+    app.add_plugins(ManyLightPlugin::headless(SIZE)).add_systems(Startup, |mut commands: Commands| {
+        spawn_scene(&mut commands, &default_scene(), true, 1.5);
+        // More than one chunk of lights (LIGHT_CHUNK).
+        for i in 0..1500 {
+            let (x, z) = ((i % 50) as f32 * 0.2 - 5.0, (i / 50) as f32 * 0.2 - 3.0);
+            commands
+                .spawn((Transform::from_xyz(x, 1.0, z), PointLight { range: 1.0, ..PointLight::default() }));
+        }
+    });
+    let step = |app: &mut App| {
+        app.update();
+        finish_frames(app);
+        stats(app).last.expect("a report")
+    };
+    let first = step(&mut app);
+    let count = first.light_count;
+    assert!(count >= 1500 && first.light_upload_bytes == u64::from(count) * light_bytes, "{first:?}");
+    let still = step(&mut app);
+    assert_eq!(still.light_upload_bytes, 0, "a still world uploaded lights");
+    let lights: Vec<Entity> =
+        app.world_mut().query_filtered::<Entity, With<PointLight>>().iter(app.world()).collect();
+    app.world_mut().get_mut::<Transform>(lights[3]).expect("a light").translation.y += 0.5;
+    let moved = step(&mut app);
+    assert_eq!((moved.light_count, moved.light_upload_bytes), (count, light_bytes), "one light moved");
+    app.world_mut().despawn(lights[1]);
+    let despawned = step(&mut app);
+    assert_eq!(
+        (despawned.light_count, despawned.light_upload_bytes),
+        (count - 1, light_bytes),
+        "the last light moves into the freed slot"
+    );
+    app.world_mut().entity_mut(lights[2]).insert(Visibility::Hidden);
+    let hidden = step(&mut app);
+    assert_eq!(hidden.light_count, count - 2, "a hidden light leaves");
+    app.world_mut().entity_mut(lights[2]).insert(Visibility::Visible);
+    let shown = step(&mut app);
+    assert_eq!((shown.light_count, shown.light_upload_bytes), (count - 1, light_bytes), "and comes back");
+    app.world_mut().entity_mut(lights[4]).remove::<PointLight>();
+    let removed = step(&mut app);
+    assert_eq!(removed.light_count, count - 2, "a light without its component leaves");
+    assert_eq!(removed.nonfinite_pixels, Some(0));
+}

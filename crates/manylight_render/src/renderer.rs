@@ -451,7 +451,7 @@ impl Renderer {
             pipeline: view.settings.pipeline.name().to_string(),
             frame_gpu_ms: None,
             passes: timings,
-            light_count: self.scene.light_count,
+            light_count: self.scene.light_count - self.scene.invalid_point_lights,
             invalid_lights: self.scene.invalid_lights,
             directional_lights: self.scene.directional_count,
             dropped_directional_lights: self.scene.dropped_directional_lights,

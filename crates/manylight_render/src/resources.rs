@@ -220,8 +220,11 @@ pub struct SceneResources {
     pub blended: Vec<usize>,
     /// The frame's view constants as uploaded.
     pub view: ViewUniform,
-    /// Lights uploaded this frame.
+    /// Point and spot lights in the light buffer this frame (invalid ones included: they keep
+    /// their index and light nothing).
     pub light_count: u32,
+    /// The invalid ones among them.
+    pub invalid_point_lights: u32,
     /// This frame's directional lights as every view's uniform carries them.
     pub directional: [GpuDirectionalLight; MAX_DIRECTIONAL_LIGHTS as usize],
     /// Directional lights in `directional`.
@@ -322,6 +325,7 @@ impl SceneResources {
             invalid_instances: 0,
             collapsed_instances: 0,
             light_reach: LightReach::default(),
+            invalid_point_lights: 0,
             uploaded_chunks: Vec::new(),
             chunk_summaries: Vec::new(),
             packed: Vec::new(),
@@ -484,11 +488,12 @@ impl SceneResources {
         self.light_upload_bytes = self.upload_lights(gpu, &snapshot.lights)?;
         self.light_count = snapshot.lights.len() as u32;
         self.light_reach = LightReach::default();
-        self.invalid_lights = 0;
+        self.invalid_point_lights = 0;
         for summary in &self.chunk_summaries {
             self.light_reach.merge(&summary.reach);
-            self.invalid_lights += summary.invalid;
+            self.invalid_point_lights += summary.invalid;
         }
+        self.invalid_lights = self.invalid_point_lights;
         // Directional lights: the first MAX_DIRECTIONAL_LIGHTS valid ones, in the view uniform.
         let valid_count = snapshot.directional_lights.iter().filter(|l| l.is_valid()).count() as u32;
         let mut count = 0usize;

@@ -57,9 +57,9 @@ pub struct FrameReport {
     pub cpu: CpuPhases,
     /// Sum of the passes' GPU times, when known.
     pub frame_gpu_ms: Option<f64>,
-    /// Lights rendered.
+    /// Point and spot lights rendered (the valid ones).
     pub light_count: u32,
-    /// Lights dropped because a parameter was NaN, infinite or negative (directional ones
+    /// Lights not drawn because a parameter was NaN, infinite or negative (directional ones
     /// included).
     pub invalid_lights: u32,
     /// Directional lights drawn (at most `MAX_DIRECTIONAL_LIGHTS`).
