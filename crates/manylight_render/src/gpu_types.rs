@@ -491,9 +491,8 @@ pub struct GpuClusterParams {
     pub log_far_over_near: f32,
     /// Entries the per-tile light lists (first level of the build) can hold.
     pub tile_index_capacity: u32,
-    /// Candidate chunks of level 1 (its invocations per tile), at least 1: with a coarse level,
-    /// `ceil(longest coarse list / TILE_LIGHT_CHUNK)` from the CPU bound
-    /// (`ListBounds::max_coarse_lights`), else `light_chunks`.
+    /// Candidate chunks of level 1 (its invocations per tile), at least 1: `light_chunks`, as
+    /// many as the longest coarse list can take (chunks past a tile's list return at once).
     pub tile_chunks: u32,
     /// Coarse tiles across and down (level 0 of the build).
     pub coarse_dims: [u32; 2],

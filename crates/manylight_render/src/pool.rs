@@ -242,6 +242,22 @@ impl GrowableBuffer {
         Ok(true)
     }
 
+    /// Re-creates the buffer smaller when it holds more than four times `bytes` (rounded up to
+    /// a power of two as it grows): what a few frames needed (a count made before a frame had
+    /// its depth bounds, a burst of lights) is not held for good. Returns true when it did (the
+    /// contents are gone; bind groups that use it must be rebuilt).
+    pub fn shrink_to(&mut self, gpu: &GpuContext, bytes: u64) -> bool {
+        let wanted = bytes.max(16).next_power_of_two();
+        if self.capacity <= wanted.saturating_mul(4) {
+            return false;
+        }
+        *self = GrowableBuffer {
+            generation: self.generation + 1,
+            ..Self::new(gpu, self.label, self.usage, wanted)
+        };
+        true
+    }
+
     /// The most bytes the device can bind.
     pub fn max_bytes(&self) -> u64 {
         self.max_bytes

@@ -597,7 +597,7 @@ impl PointLights {
 
     /// Adds a light at the end.
     pub fn push(&mut self, light: ExtractedPointLight) {
-        if self.len % LIGHT_CHUNK == 0 {
+        if self.len.is_multiple_of(LIGHT_CHUNK) {
             self.chunks.push(Arc::new(LightChunk { lights: Vec::with_capacity(LIGHT_CHUNK), shadowed: 0 }));
         }
         let chunk = Arc::make_mut(self.chunks.last_mut().expect("a chunk with room"));

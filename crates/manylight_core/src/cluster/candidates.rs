@@ -37,14 +37,6 @@ pub(crate) struct Candidates {
     pub z: [u32; 2],
 }
 
-impl Candidates {
-    /// Number of clusters in the ranges.
-    pub fn size(&self) -> u64 {
-        let n = |r: [u32; 2]| u64::from(r[1] - r[0]) + 1;
-        n(self.x) * n(self.y) * n(self.z)
-    }
-}
-
 /// Everything about a grid that the per-light loop reads (module docs, step 1).
 pub(crate) struct ClusterTables {
     grid: ClusterGrid,

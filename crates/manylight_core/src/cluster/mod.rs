@@ -16,9 +16,8 @@
 //!    same three phases as the GPU compute passes — into per-cluster `(offset, count)` ranges
 //!    over one light-index list, each list in ascending light order. A per-cluster cap is
 //!    optional; what it drops is counted, never silent.
-//! 5. **List sizes** ([`list_bounds`], `bound.rs`): upper bounds of the cluster, tile and
-//!    coarse-tile lists, from each light's candidate ranges, so the GPU lists are sized before
-//!    a frame is submitted.
+//! 5. **Coarse tiles** ([`coarse_tiles`], `coarse.rs`): the GPU build's level 0, blocks of
+//!    tiles whose test ([`coarse_tile_accepts`]) keeps every light any of their columns keeps.
 //! 6. **Light rectangles** ([`RectGrid::light_tile_rect`], `rect.rs`): each light's screen rectangle of
 //!    tiles, a superset of the tiles and coarse tiles that accept it, so the GPU build's tile
 //!    levels run the sphere test only for lights near the tile.
@@ -27,8 +26,8 @@
 //!    sphere–frustum-piece distance rejects.
 
 mod assign;
-mod bound;
 mod candidates;
+mod coarse;
 mod cull;
 mod exact;
 mod grid;
@@ -40,9 +39,8 @@ mod tests;
 mod tests_edge;
 
 pub use assign::{ClusterAssignment, ClusterStats, assign_lights};
-pub use bound::{
-    BOUND_PART_LIGHTS, CoarseTile, ListBounder, ListBounds, TILE_PREFILTER_INFLATION, coarse_dims,
-    coarse_span, coarse_tile_accepts, coarse_tiles, list_bounds,
+pub use coarse::{
+    CoarseTile, TILE_PREFILTER_INFLATION, coarse_dims, coarse_span, coarse_tile_accepts, coarse_tiles,
 };
 pub use cull::{
     RADIUS_INFLATION, ViewSphere, farthest_reach, inflated_radius, sphere_intersects_aabb,
@@ -50,9 +48,7 @@ pub use cull::{
 };
 pub use exact::{false_positive_counts, sphere_touches_cluster_exact};
 pub use grid::{CLUSTER_MARGIN, ClusterGrid, GridConfig, MAX_CLUSTERS, MAX_GRID_DIM};
-pub use rect::{
-    RECT_BOUND_PAD, RECT_BOUND_SCALE, RECT_MAGNITUDE, RECT_PAD, RECT_SLACK, RectGrid, rect_frustum,
-};
+pub use rect::{RECT_MAGNITUDE, RECT_PAD, RECT_SLACK, RectGrid, rect_frustum};
 
 /// How depth slice boundaries are spread between the near and far planes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]

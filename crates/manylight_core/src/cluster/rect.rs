@@ -21,7 +21,7 @@
 //!    planes use `r · TPI²`, inflated, and its margin twice).
 //! 4. **Depth**: no tile when the sphere ends before `near` or starts past `far`.
 //! 5. **Slopes** (`x / d`, the tile edges being `ndc · tan`; orthographic: `x` and `ndc · half`):
-//!    - the box over `[near, far]`, as [`super::list_bounds`]' candidates: `[lo / (near or far),
+//!    - the box over `[near, far]`, as the CPU reference's candidates: `[lo / (near or far),
 //!      hi / (near or far)]` with `lo, hi = c.x ∓ R` (not for the planes test, which has no box);
 //!    - when the sphere lies well in front of the eye (`d > 2R`), and the test has planes, the
 //!      two tangents through the eye, intersected with the box: the side planes of a tile pass
@@ -42,11 +42,6 @@ use super::{ClusterGrid, CullTest, TILE_PREFILTER_INFLATION};
 pub const RECT_SLACK: f32 = 1e-4;
 /// Tiles added on each side of the rectangle for the rounding of its edges (step 6).
 pub const RECT_PAD: f32 = 0.125;
-/// Factor on the radius `R` of the wider rectangle a CPU bound counts
-/// ([`RectGrid::light_tile_rect_bound`]).
-pub const RECT_BOUND_SCALE: f32 = 1.001;
-/// Pad, in tiles, of the wider rectangle a CPU bound counts.
-pub const RECT_BOUND_PAD: f32 = 0.25;
 /// Largest `|c|₁ + r` the rectangle is computed for; beyond it every tile (step 2). Squares of
 /// coordinates this size stay finite in f32.
 pub const RECT_MAGNITUDE: f32 = 1e18;
@@ -89,17 +84,6 @@ impl RectGrid {
     /// `sphere.w`, view space; module docs); `None` when no tile can accept it.
     pub fn light_tile_rect(&self, sphere: Vec4, test: CullTest) -> Option<[u32; 4]> {
         rect_with(self, sphere, test, [1.0, RECT_PAD])
-    }
-
-    /// A rectangle that holds [`Self::light_tile_rect`]'s with room to spare, for CPU bounds of
-    /// what the GPU's rectangles cover: its radius `R` is [`RECT_BOUND_SCALE`] times larger and
-    /// its pad [`RECT_BOUND_PAD`] tiles, far more than the rounding of the GPU's arithmetic can
-    /// move an edge. Every step only widens the rectangle as `R` and the pad grow (the box and
-    /// the tangent cone widen, the depth and side-plane rejections and the tangent's
-    /// precondition weaken), so this holds the GPU's rectangle as long as its rounding stays
-    /// within those margins.
-    pub fn light_tile_rect_bound(&self, sphere: Vec4, test: CullTest) -> Option<[u32; 4]> {
-        rect_with(self, sphere, test, [RECT_BOUND_SCALE, RECT_BOUND_PAD])
     }
 }
 

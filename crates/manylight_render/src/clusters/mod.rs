@@ -370,10 +370,17 @@ impl ClusterResources {
         };
         // The refined lists' slots follow the cluster lists.
         let entries = needs.cluster_entries + self.refined_entries();
-        self.buffers.indices.reserve(gpu, with_headroom(entries, &self.buffers.indices))?;
         // The tile and coarse-tile lists share a buffer; the spare room is split between them.
         let shared = needs.tile_entries + Self::coarse_room(needs.coarse_entries);
-        self.buffers.tile_indices.reserve(gpu, with_headroom(shared, &self.buffers.tile_indices))?;
+        for (need, buffer) in [(entries, &mut self.buffers.indices), (shared, &mut self.buffers.tile_indices)]
+        {
+            // Counts read back from a frame (not a counting run, which has no depth bounds)
+            // let a list far larger than they need shrink.
+            if self.needs.is_some() && !self.counted_first {
+                buffer.shrink_to(gpu, bytes(need + need / 4, buffer));
+            }
+            buffer.reserve(gpu, with_headroom(need, buffer))?;
+        }
         // Level 1 runs as many chunks per tile as the longest coarse list can take: all of them
         // (chunks past a tile's list return at once).
         let tiles = self.grid.dims.x as u64 * self.grid.dims.y as u64;
