@@ -28,8 +28,8 @@ pub struct CpuPhases {
     /// Bytes handed to the GPU while the frame was prepared and recorded, every phase
     /// (`GpuCounts::bytes_uploaded`).
     pub upload_bytes: u64,
-    /// Each view's constants, cluster grid, light spheres and list bounds
-    /// (`Renderer::prepare_view`), summed over the views.
+    /// Each view's constants, cluster grid and list sizes (`Renderer::prepare_view`), summed
+    /// over the views.
     pub prepare_ms: f64,
     /// Recording the passes, summed over the views.
     pub record_ms: f64,
@@ -109,8 +109,9 @@ pub struct FrameReport {
     pub device_recoveries: u32,
     /// Times the CPU blocked until the GPU finished work while this frame was prepared and
     /// recorded: 0 in steady state. A frame waits when every read-back slot is still in
-    /// flight, when a list bound could fail (`ClusterReport::regrows`), and when pixels are
-    /// read back (a capture, a render-to-texture camera).
+    /// flight, when a view's lists have no counts to be sized from
+    /// (`ClusterReport::counted_first`), and when pixels are read back (a capture, a
+    /// render-to-texture camera).
     pub blocking_waits: u64,
     /// GPU buffers created while this frame was prepared and recorded (0 in steady state: only
     /// new meshes, materials, grown lists and changed sizes create any).
