@@ -79,11 +79,7 @@ impl LightReach {
     /// Adds what `light` can reach.
     pub fn add(&mut self, light: &ExtractedPointLight) {
         let r = Vec3::splat(light.radius);
-        let (lo, hi) = (light.position - r, light.position + r);
-        self.bounds = Some(match self.bounds {
-            Some((min, max)) => (min.min(lo), max.max(hi)),
-            None => (lo, hi),
-        });
+        self.merge(&LightReach { bounds: Some((light.position - r, light.position + r)) });
     }
 
     /// Adds what `other` covers.

@@ -474,7 +474,9 @@ impl SceneResources {
                 written += (self.packed.len() * element) as u64;
             }
         }
-        self.uploaded_chunks.clone_from(&lights.chunks().to_vec());
+        // The chunks as the buffer now holds them (the Vec keeps its allocation).
+        self.uploaded_chunks.clear();
+        self.uploaded_chunks.extend(lights.chunks().iter().cloned());
         Ok(written)
     }
 
