@@ -432,7 +432,8 @@ fn only_the_lights_that_changed_are_uploaded() {
     let _gpu = gpu();
     let scene = default_scene();
     let rig = manylight::scene::light_rig(64, scene.bounds(), 3).expect("64 lights fit");
-    let lights: Vec<_> = rig.iter().map(|l| extracted_light(&l.at(0.0))).collect();
+    let lights: Vec<_> =
+        rig.iter().map(|l| extracted_light(&manylight::scene::animated_light_at(l, 0.0))).collect();
     let snapshot = |lights: &[manylight::render::ExtractedPointLight], frame: u64| {
         scene_snapshot(&scene, lights.to_vec(), SIZE, manylight::render::FrameSettings::default(), frame)
     };
@@ -519,4 +520,69 @@ fn extraction_follows_the_light_entities_that_changed() {
     let removed = step(&mut app);
     assert_eq!(removed.light_count, count - 2, "a light without its component leaves");
     assert_eq!(removed.nonfinite_pixels, Some(0));
+}
+
+/// The compute pass animates the rig's lights as `animate_lights` does on the CPU: after the
+/// same frames (the same times, far enough apart that the pass takes its angles again at a new
+/// epoch) both images match (FLIP, STRICT). On the GPU path a frame uploads no animated light,
+/// only the pass's 16 B of parameters, and the lights' components stay where they were
+/// spawned; a light that casts shadows animates on the CPU on both paths.
+#[test]
+fn gpu_light_animation_matches_the_cpu_one() {
+    use manylight::app::LightAnimationMode;
+    use manylight::render::gpu_types::{GpuLightAnimationParams, GpuLightMotion, GpuPointLight};
+    let _gpu = gpu();
+    let size = UVec2::new(128, 96);
+    // 37.3 s a frame: frame 3 is more than EPOCH_SPAN_SECS past frame 1's epoch.
+    let step = Duration::from_secs_f64(37.3);
+    let run = |mode: LightAnimationMode| {
+        let mut app = App::new();
+        app.add_plugins(ManyLightPlugin::headless(size))
+            .insert_resource(mode)
+            .insert_resource(TimeUpdateStrategy::ManualDuration(step))
+            .add_systems(Startup, |mut commands: Commands| {
+                let scene = default_scene();
+                spawn_scene(&mut commands, &scene, true, 1.5);
+                spawn_light_rig(&mut commands, 200, scene.bounds(), 11).expect("the rig's lights fit");
+                let rig = manylight::scene::light_rig(1, scene.bounds(), 5).expect("one light");
+                commands.spawn((
+                    Transform::from_translation(rig[0].position_at(0.0)),
+                    PointLight { intensity: 4000.0, range: 4.0, shadows_enabled: true, ..default() },
+                    LightAnimation(rig[0]),
+                ));
+            });
+        for _ in 0..4 {
+            app.update();
+        }
+        finish_frames(&mut app);
+        assert!(app.world().resource::<RenderFailure>().0.is_none(), "{mode:?}");
+        app
+    };
+    let (mut cpu, mut gpu_app) = (run(LightAnimationMode::Cpu), run(LightAnimationMode::Gpu));
+    let image = |app: &App| app.world().resource::<HeadlessCapture>().image.clone().expect("an image");
+    support::assert_similar("gpu_light_animation", &image(&cpu), &image(&gpu_app), support::STRICT);
+
+    let bytes = |n: usize| n as u64;
+    let report = stats(&gpu_app).last.expect("a report");
+    let (light, motion, params) = (
+        bytes(std::mem::size_of::<GpuPointLight>()),
+        bytes(std::mem::size_of::<GpuLightMotion>()),
+        bytes(std::mem::size_of::<GpuLightAnimationParams>()),
+    );
+    // The shadowed light (its record and its zeroed motion) and the time.
+    assert_eq!(report.light_upload_bytes, light + motion + params, "{report:?}");
+    let cpu_report = stats(&cpu).last.expect("a report");
+    assert_eq!(cpu_report.light_upload_bytes, 201 * light, "every light moved on the CPU path");
+
+    let spawned = |app: &mut App| -> Vec<(Vec3, Vec3, bool)> {
+        let mut query = app.world_mut().query::<(&Transform, &LightAnimation, &PointLight)>();
+        query
+            .iter(app.world())
+            .map(|(t, a, p)| (t.translation, a.0.position_at(0.0), p.shadows_enabled))
+            .collect()
+    };
+    for (at, start, shadowed) in spawned(&mut gpu_app) {
+        assert_eq!(at == start, !shadowed, "GPU path: only the shadowed light moves on the CPU");
+    }
+    assert!(spawned(&mut cpu).iter().all(|(at, start, _)| at != start), "CPU path: every light moves");
 }

@@ -25,7 +25,7 @@ fn rig(scene: &Scene, count: usize, seed: u64) -> Vec<ExtractedPointLight> {
     manylight::scene::light_rig(count, scene.bounds(), seed)
         .expect("the rig's lights fit")
         .iter()
-        .map(|a| extracted_light(&a.at(0.0)))
+        .map(|a| extracted_light(&manylight::scene::animated_light_at(a, 0.0)))
         .collect()
 }
 
@@ -44,7 +44,15 @@ fn shell_lights() -> Vec<ExtractedPointLight> {
 }
 
 fn light(position: Vec3, radius: f32) -> ExtractedPointLight {
-    ExtractedPointLight { position, color: Vec3::ONE, intensity: 1.0, radius, spot: None, shadow: None }
+    ExtractedPointLight {
+        position,
+        color: Vec3::ONE,
+        intensity: 1.0,
+        radius,
+        spot: None,
+        shadow: None,
+        animation: None,
+    }
 }
 
 /// Clustered forward with whole slices: the lists the CPU reference (`assign_lights`) builds.

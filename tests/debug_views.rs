@@ -161,7 +161,7 @@ fn count_views_show_the_cpu_reference_of_each_pixels_cluster() {
         .lights
         .iter()
         .map(extracted_light)
-        .chain(rig.iter().map(|a| extracted_light(&a.at(0.0))))
+        .chain(rig.iter().map(|a| extracted_light(&manylight::scene::animated_light_at(a, 0.0))))
         .collect();
     let mut renderer = HeadlessRenderer::new().expect("adapter");
     for (mode, cap) in [
@@ -250,7 +250,8 @@ fn the_depth_view_scales_to_the_far_plane_or_to_the_lights_reach() {
     let _gpu = gpu();
     let mut scene = default_scene();
     let rig = manylight::scene::light_rig(64, scene.bounds(), 1).expect("64 lights");
-    let lights: Vec<_> = rig.iter().map(|a| extracted_light(&a.at(0.0))).collect();
+    let lights: Vec<_> =
+        rig.iter().map(|a| extracted_light(&manylight::scene::animated_light_at(a, 0.0))).collect();
     let camera = scene.camera_or_fit(SIZE.x as f32 / SIZE.y as f32);
     let mut renderer = HeadlessRenderer::new().expect("adapter");
     for far in [60.0, f32::INFINITY] {

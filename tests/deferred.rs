@@ -230,6 +230,7 @@ fn light_volumes_plan_only_what_they_need() {
         radius: 2.0,
         spot: None,
         shadow: None,
+        animation: None,
     };
     let settings = FrameSettings {
         render: RenderSettings { pipeline: PipelineKind::LightVolumes, ..Default::default() },

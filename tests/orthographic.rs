@@ -82,7 +82,7 @@ fn orthographic_gpu_lists_equal_the_cpu_reference() {
     let mut lights: Vec<_> = manylight::scene::light_rig(300, scene.bounds(), 5)
         .expect("300 lights")
         .iter()
-        .map(|a| extracted_light(&a.at(0.0)))
+        .map(|a| extracted_light(&manylight::scene::animated_light_at(a, 0.0)))
         .collect();
     let view = eye();
     // A light at the camera, one just behind its plane, one on the view's edge.
@@ -97,6 +97,7 @@ fn orthographic_gpu_lists_equal_the_cpu_reference() {
             radius,
             spot: None,
             shadow: None,
+            animation: None,
         });
     }
     for cull in [CullTest::Aabb, CullTest::Planes, CullTest::Both] {

@@ -476,6 +476,7 @@ fn many_casting_lights() -> Vec<manylight::render::ExtractedPointLight> {
             radius: 3.0,
             spot: None,
             shadow: Some(manylight::render::ShadowBias::POINT),
+            animation: None,
         })
         .collect()
 }
@@ -558,6 +559,7 @@ fn three_lights(shift: f32) -> Vec<manylight::render::ExtractedPointLight> {
             radius: if at.y > 1.0 { 3.0 } else { 1.0 },
             spot: None,
             shadow: Some(manylight::render::ShadowBias::POINT),
+            animation: None,
         })
         .collect()
 }
@@ -692,6 +694,7 @@ fn a_thousand_moving_shadowed_lights_are_all_accounted_for() {
                 radius: 2.0,
                 spot: None,
                 shadow: Some(manylight::render::ShadowBias::POINT),
+                animation: None,
             })
             .collect()
     };

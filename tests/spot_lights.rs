@@ -19,7 +19,7 @@ fn spot_scene(count: usize) -> Scene {
     for (i, anim) in light_rig(count, scene.bounds(), 7).expect("the rig's lights fit").iter().enumerate() {
         let a = i as f32 * 2.399;
         let outer = [0.05, 0.35, 0.7, 1.2, std::f32::consts::FRAC_PI_2][i % 5];
-        let mut light = anim.at(0.0);
+        let mut light = manylight::scene::animated_light_at(anim, 0.0);
         light.intensity *= 3.0;
         light.spot = Some(SpotCone {
             direction: Vec3::new(a.cos(), (i % 5) as f32 / 2.0 - 1.5, a.sin()),

@@ -437,7 +437,9 @@ pub struct Mesh3d(pub Arc<MeshData>);
 pub struct Material(pub Arc<MaterialData>);
 
 /// Animates a light: the plugin moves its [`Transform`] (relative to its parent, if it has one)
-/// and tints its [`PointLight`] each frame, by [`bevy_time::Time`].
+/// and tints its [`PointLight`] each frame, by [`bevy_time::Time`]; with
+/// [`LightAnimationMode::Gpu`](crate::LightAnimationMode::Gpu) a compute pass does it instead,
+/// on the light buffer, for the lights it can take.
 #[derive(Component, Clone, Copy, Debug)]
 pub struct LightAnimation(pub manylight_scene::AnimatedLight);
 

@@ -7,9 +7,12 @@ use crate::components::{
     GlobalTransform, InheritedVisibility, LightAnimation, Material, Mesh3d, MotionBlur, PointLight,
     Projection, RenderTarget, SpotLight, Transform, from_linear_rgb, linear_rgb,
 };
-use crate::resources::{DebugView, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize};
+use crate::resources::{
+    DebugView, HeadlessCapture, LightAnimationMode, RenderFailure, RenderSettings, ViewportSize,
+};
 use crate::stages::{ExtractedCameraComponents, RenderStages};
 use bevy_app::AppExit;
+use bevy_ecs::hierarchy::ChildOf;
 use bevy_ecs::prelude::*;
 use bevy_ecs::query::QueryData;
 use bevy_ecs::system::SystemParam;
@@ -106,12 +109,15 @@ pub type MeshItem = (
     Option<&'static InheritedVisibility>,
 );
 
-/// What extract reads of a point or spot light entity (hidden ones are skipped).
+/// What extract reads of a point or spot light entity (hidden ones are skipped): its
+/// animation, and whether it has a parent, say whether it animates on the GPU.
 pub type LightItem = (
     Entity,
     &'static GlobalTransform,
     AnyOf<(&'static PointLight, &'static SpotLight)>,
     Option<&'static InheritedVisibility>,
+    Option<&'static LightAnimation>,
+    Has<ChildOf>,
 );
 
 /// What extract reads of a directional light entity (hidden ones are skipped; an entity with a
@@ -124,8 +130,14 @@ pub type DirectionalItem = (
 );
 
 /// The change that makes extraction look at a point or spot light again.
-pub type LightChanged =
-    Or<(Changed<GlobalTransform>, Changed<PointLight>, Changed<SpotLight>, Changed<InheritedVisibility>)>;
+pub type LightChanged = Or<(
+    Changed<GlobalTransform>,
+    Changed<PointLight>,
+    Changed<SpotLight>,
+    Changed<InheritedVisibility>,
+    Changed<LightAnimation>,
+    Changed<ChildOf>,
+)>;
 
 /// Whether an entity's computed visibility lets it render (none computed yet: visible).
 fn shown(visibility: Option<&InheritedVisibility>) -> bool {
@@ -137,6 +149,8 @@ fn shown(visibility: Option<&InheritedVisibility>) -> bool {
 pub struct ExtractInputs<'w, 's> {
     viewport: Res<'w, ViewportSize>,
     settings: Res<'w, RenderSettings>,
+    time: Res<'w, Time>,
+    animation_mode: Res<'w, LightAnimationMode>,
     debug: Res<'w, DebugView>,
     cameras: Query<'w, 's, CameraItem, With<Camera3d>>,
     meshes: Query<'w, 's, MeshItem>,
@@ -171,6 +185,7 @@ pub fn build_snapshot(
         settings: crate::resources::frame_settings(&world.settings, &world.debug),
         pixel_light_lists: None,
         extract_cpu_ms: 0.0,
+        elapsed_secs: world.time.elapsed_secs(),
     };
     state.frame_index += 1;
     snapshot
@@ -251,11 +266,27 @@ fn extract_instances(state: &mut ExtractState, meshes: &Query<MeshItem>) -> Vec<
         .collect()
 }
 
+/// Whether a light animates on the GPU in `mode` ([`LightAnimationMode::Gpu`]): an animated
+/// point light that casts no shadow and has no parent.
+pub fn animates_on_gpu(
+    mode: LightAnimationMode,
+    animation: Option<&LightAnimation>,
+    point: Option<&PointLight>,
+    has_parent: bool,
+) -> bool {
+    mode == LightAnimationMode::Gpu
+        && animation.is_some()
+        && point.is_some_and(|p| !p.shadows_enabled)
+        && !has_parent
+}
+
 /// A shown point or spot light entity as the renderer takes it (`None` when hidden). Point and
 /// spot lights come in lumens (Bevy's unit) and render in candela; a point light wins over a
-/// spot light on the same entity.
+/// spot light on the same entity. A light that animates on the GPU in `mode` carries its
+/// animation (its position and colour are the animation's centre and base colour).
 fn point_light(
-    (_, t, (point, spot), visibility): <LightItem as QueryData>::Item<'_, '_>,
+    (_, t, (point, spot), visibility, animation, has_parent): <LightItem as QueryData>::Item<'_, '_>,
+    mode: LightAnimationMode,
 ) -> Option<ExtractedPointLight> {
     if !shown(visibility) {
         return None;
@@ -269,28 +300,39 @@ fn point_light(
         }
         (None, None) => return None,
     };
+    let animation =
+        animates_on_gpu(mode, animation, point, has_parent).then(|| animation.map(|a| a.0)).flatten();
     Some(ExtractedPointLight {
-        position: t.translation(),
-        color,
+        position: animation.map_or_else(|| t.translation(), |a| a.center),
+        color: animation.map_or(color, |a| a.color),
         intensity: candela_from_lumens(lumens),
         radius: range,
         spot: cone,
         shadow,
+        animation,
     })
 }
 
 /// Brings the kept lights up to date: the lights that changed since the last extraction (the
 /// first time, all of them) and the entities that lost their light component or were
 /// despawned. Visits no light that did not change.
+/// A change of [`LightAnimationMode`] takes every animated light again.
 fn update_lights(slots: &mut LightSlots, world: &mut ExtractInputs) {
+    let mode = *world.animation_mode;
+    if world.animation_mode.is_changed() && !world.animation_mode.is_added() {
+        for item in world.lights.iter().filter(|item| item.4.is_some()) {
+            let entity = item.0;
+            slots.set(entity, point_light(item, mode));
+        }
+    }
     for item in &world.changed_lights {
         let entity = item.0;
-        slots.set(entity, point_light(item));
+        slots.set(entity, point_light(item, mode));
     }
     let removed: Vec<Entity> = world.removed_points.read().chain(world.removed_spots.read()).collect();
     for entity in removed {
         // Still a light when it lost only one of the two components.
-        let light = world.lights.get(entity).ok().and_then(point_light);
+        let light = world.lights.get(entity).ok().and_then(|item| point_light(item, mode));
         slots.set(entity, light);
     }
 }
@@ -344,13 +386,18 @@ pub fn collect_results(world: &mut World) {
 }
 
 /// Moves and tints lights that carry a [`LightAnimation`], at [`Time`]'s elapsed seconds (a
-/// fixed step headless, wall time in a window).
+/// fixed step headless, wall time in a window), except those a compute pass animates
+/// ([`LightAnimationMode::Gpu`], [`animates_on_gpu`]).
 pub fn animate_lights(
     time: Res<Time>,
-    mut lights: Query<(&LightAnimation, &mut Transform, &mut PointLight)>,
+    mode: Res<LightAnimationMode>,
+    mut lights: Query<(&LightAnimation, &mut Transform, &mut PointLight, Has<ChildOf>)>,
 ) {
     let t = time.elapsed_secs();
-    for (anim, mut transform, mut light) in &mut lights {
+    for (anim, mut transform, mut light, has_parent) in &mut lights {
+        if animates_on_gpu(*mode, Some(anim), Some(&light), has_parent) {
+            continue;
+        }
         transform.translation = anim.0.position_at(t);
         light.color = from_linear_rgb(anim.0.color_at(t));
     }

@@ -35,8 +35,8 @@ pub use components::{
 };
 pub use plugin::{HEADLESS_TIME_STEP, HeadlessConfig, ManyLightPlugin, ManyLightSystems, OutputMode};
 pub use resources::{
-    DebugView, FrameStats, FrameTotals, FramesInFlight, HeadlessCapture, LightControls, RenderFailure,
-    RenderSettings, RenderedImages, ViewportSize,
+    DebugView, FrameStats, FrameTotals, FramesInFlight, HeadlessCapture, LightAnimationMode, LightControls,
+    RenderFailure, RenderSettings, RenderedImages, ViewportSize,
 };
 pub use window::{Overlay, PressedKeys, WindowConfig, WindowRequests};
 
@@ -55,7 +55,8 @@ pub mod prelude {
     };
     pub use crate::plugin::{ManyLightPlugin, ManyLightSystems};
     pub use crate::resources::{
-        DebugView, FrameStats, HeadlessCapture, LightControls, RenderSettings, RenderedImages,
+        DebugView, FrameStats, HeadlessCapture, LightAnimationMode, LightControls, RenderSettings,
+        RenderedImages,
     };
     pub use crate::scene::{spawn_light_rig, spawn_scene};
     pub use crate::stages::{ExtractCameraComponentPlugin, ManyLightAppExt, RenderStages};

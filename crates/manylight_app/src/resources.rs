@@ -176,6 +176,25 @@ impl RenderedImages {
 #[derive(Resource, Clone, Debug, Default)]
 pub struct RenderFailure(pub Option<String>);
 
+/// Where the lights with a [`LightAnimation`](crate::LightAnimation) move and flicker.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LightAnimationMode {
+    /// On the CPU: [`animate_lights`](crate::extract::animate_lights), an `Update` system, sets
+    /// each light's `Transform` and `PointLight::color`, so every animated light is a changed
+    /// light that extraction copies and the renderer uploads each frame. The light's components
+    /// always say where it is.
+    #[default]
+    Cpu,
+    /// On the GPU: the animation is extracted once (and again only when a component of the
+    /// light changes), and each frame one compute pass writes every animated light's position
+    /// and colour at `Time::elapsed_secs` into the light buffer; 100 000 moving lights cost the
+    /// CPU nothing per frame. The light's `Transform` and `PointLight::color` are left as they
+    /// are (the position and colour live on the GPU). Lights that cast shadows, spot lights and
+    /// lights with a parent (`ChildOf`) still animate on the CPU: their shadow views, cones
+    /// and parents' transforms are placed on the CPU.
+    Gpu,
+}
+
 /// Light count and radius multiplier a user asks for at run time (the window overlay edits
 /// them when this resource exists); an app that spawns lights reads them, as the `stress`
 /// example does.

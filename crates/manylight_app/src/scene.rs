@@ -194,6 +194,7 @@ pub fn extracted_light(l: &SceneLight) -> ExtractedPointLight {
         radius: l.radius,
         spot: l.spot,
         shadow: None,
+        animation: None,
     }
 }
 
@@ -244,6 +245,7 @@ pub fn scene_snapshot(
     FrameSnapshot {
         directional_lights,
         extract_cpu_ms: 0.0,
+        elapsed_secs: 0.0,
         frame_index,
         viewport: size,
         views: vec![ExtractedView::main(ExtractedCamera {

@@ -24,7 +24,7 @@ pub fn snapshot(
     settings: FrameSettings,
     frame_index: u64,
 ) -> FrameSnapshot {
-    let rig_lights = rig.iter().map(|a| extracted_light(&a.at(t)));
+    let rig_lights = rig.iter().map(|a| extracted_light(&manylight_scene::animated_light_at(a, t)));
     let lights = scene.lights.iter().map(extracted_light).chain(rig_lights).collect();
     scene_snapshot(scene, lights, size, settings, frame_index)
 }

@@ -310,6 +310,7 @@ mod tests {
                 radius: 4.0,
                 spot: None,
                 shadow: Some(ShadowBias::POINT),
+                animation: None,
             })
             .to_vec();
         (scene, lights)

@@ -4,6 +4,7 @@
 //! mirrors these functions and GPU tests compare the two.
 #![warn(missing_docs)]
 
+pub mod animation;
 pub mod attenuation;
 pub mod brdf;
 pub mod camera;
@@ -19,6 +20,7 @@ pub mod shadow_oracle;
 pub mod spot;
 pub mod tonemap;
 
+pub use animation::{AngleRate, AnimatedLight, MotionAngles};
 pub use attenuation::{
     LIGHT_MIN_DISTANCE, attenuation, candela_from_lumens, lumens_from_candela, radius_for_intensity,
 };

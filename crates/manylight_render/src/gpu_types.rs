@@ -220,6 +220,52 @@ pub struct GpuPointLight {
     pub spot: [f32; 4],
 }
 
+/// An animated light's motion as the light animation pass reads it (`GpuLightMotion` in
+/// `shaders/light_animation.wgsl`; one per light of the light buffer, at the same index):
+/// the parameters of [`manylight_core::AnimatedLight`], its five angles at `epoch` and their
+/// speeds ([`crate::lights::gpu_light_motion`]).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuLightMotion {
+    /// Centre of the orbit.
+    pub center: [f32; 3],
+    /// Orbit radius in the XZ plane.
+    pub orbit_radius: f32,
+    /// Base linear RGB colour.
+    pub color: [f32; 3],
+    /// Vertical bob amplitude.
+    pub bob_amplitude: f32,
+    /// Radians per second of the orbit, the bob, the hue drift and the first flicker wave.
+    pub speeds: [f32; 4],
+    /// Those four angles at `epoch`, in [0, 2π).
+    pub angles: [f32; 4],
+    /// Radians per second of the second flicker wave.
+    pub flicker2_speed: f32,
+    /// Its angle at `epoch`.
+    pub flicker2_angle: f32,
+    /// Seconds at which the angles were taken.
+    pub epoch: f32,
+    /// Candela, multiplying the colour.
+    pub intensity: f32,
+    /// 1: the pass writes this light's position and colour; 0: it leaves the light as uploaded.
+    pub animated: u32,
+    /// Keeps the size a multiple of 16 bytes.
+    pub pad: [u32; 3],
+}
+
+/// The light animation pass's parameters (`LightAnimationParams` in
+/// `shaders/light_animation.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuLightAnimationParams {
+    /// The frame's time in seconds ([`crate::FrameSnapshot::elapsed_secs`]).
+    pub elapsed_secs: f32,
+    /// Lights in the light buffer.
+    pub light_count: u32,
+    /// Keeps the size a multiple of 16 bytes.
+    pub pad: [u32; 2],
+}
+
 pub use crate::settings::{MAX_CASCADES, SHADOW_FACES, SHADOW_TILE_COLUMNS};
 
 /// One cascade of a directional light's shadow (`GpuCascade` in

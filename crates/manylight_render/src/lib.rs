@@ -8,6 +8,7 @@
 /// dependency to keep in step).
 pub use wgpu;
 
+pub mod animation;
 pub mod assets;
 pub mod atlas;
 pub mod bindings;

@@ -9,7 +9,7 @@
 //! shadows take their lights from the same two functions, so a new light kind or a new reach
 //! is made here once.
 
-use crate::gpu_types::{GpuDirectionalLight, GpuPointLight, MAX_DIRECTIONAL_LIGHTS};
+use crate::gpu_types::{GpuDirectionalLight, GpuLightMotion, GpuPointLight, MAX_DIRECTIONAL_LIGHTS};
 use crate::snapshot::{ExtractedDirectionalLight, ExtractedPointLight, PointLights};
 use glam::Vec3;
 
@@ -57,6 +57,33 @@ pub fn gpu_point_light(light: &ExtractedPointLight) -> GpuPointLight {
     }
 }
 
+/// `light`'s animation as the light animation pass reads it, its angles taken at `epoch`
+/// seconds ([`manylight_core::AnimatedLight::angles_at`], in f64): the pass adds
+/// `speed × (t − epoch)` to each, so the GPU's f32 keeps its precision as long as `t` stays
+/// near the epoch ([`crate::animation::EPOCH_SPAN_SECS`]). Zeroed (the pass leaves the light as
+/// uploaded) for a light without an animation or an invalid one.
+pub fn gpu_light_motion(light: &ExtractedPointLight, epoch: f32) -> GpuLightMotion {
+    let Some(a) = light.animation.filter(|_| light.is_valid()) else {
+        return bytemuck::Zeroable::zeroed();
+    };
+    let [orbit, bob, drift, flicker, flicker2] = a.rates().map(|r| r.speed);
+    let angles = a.angles_at(epoch);
+    GpuLightMotion {
+        center: a.center.to_array(),
+        orbit_radius: a.orbit_radius,
+        color: a.color.to_array(),
+        bob_amplitude: a.bob_amplitude,
+        speeds: [orbit, bob, drift, flicker],
+        angles: [angles.orbit, angles.bob, angles.drift, angles.flicker],
+        flicker2_speed: flicker2,
+        flicker2_angle: angles.flicker2,
+        epoch,
+        intensity: light.intensity,
+        animated: 1,
+        pad: [0; 3],
+    }
+}
+
 /// `light` as the view uniform holds it.
 pub fn gpu_directional_light(light: &ExtractedDirectionalLight) -> GpuDirectionalLight {
     GpuDirectionalLight {
@@ -66,7 +93,7 @@ pub fn gpu_directional_light(light: &ExtractedDirectionalLight) -> GpuDirectiona
 }
 
 /// The box around everything the light buffer's lights can reach (each light's range around
-/// its position, which holds a spot light's smaller sphere too), kept as the lights are
+/// its position or around the box an animated light moves in, which holds a spot light's smaller sphere too), kept as the lights are
 /// packed: what slicing a projection without a far plane needs ([`LightReach::farthest`]),
 /// without visiting the lights again for each view.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -79,7 +106,8 @@ impl LightReach {
     /// Adds what `light` can reach.
     pub fn add(&mut self, light: &ExtractedPointLight) {
         let r = Vec3::splat(light.radius);
-        self.merge(&LightReach { bounds: Some((light.position - r, light.position + r)) });
+        let (lo, hi) = light.position_bounds();
+        self.merge(&LightReach { bounds: Some((lo - r, hi + r)) });
     }
 
     /// Adds what `other` covers.
@@ -146,6 +174,7 @@ mod tests {
             radius: 4.0,
             spot,
             shadow: None,
+            animation: None,
         }
     }
 

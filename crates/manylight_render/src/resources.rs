@@ -253,6 +253,8 @@ pub struct SceneResources {
     /// One run of changed lights, packed (kept between frames so that it is not allocated
     /// again).
     packed: Vec<GpuPointLight>,
+    /// The motions of the lights that animate on the GPU, and the pass that applies them.
+    pub motions: crate::animation::LightMotions,
     /// The tone map's count of non-finite HDR pixels.
     pub nonfinite: NonFiniteCounter,
     /// Meshes, materials, textures and samplers on the GPU, and the material layout.
@@ -329,6 +331,7 @@ impl SceneResources {
             uploaded_chunks: Vec::new(),
             chunk_summaries: Vec::new(),
             packed: Vec::new(),
+            motions: Default::default(),
             nonfinite: NonFiniteCounter::new(gpu),
             assets: SceneAssets::new(gpu),
             bound: [None, None],
@@ -442,10 +445,12 @@ impl SceneResources {
     /// a changed chunk only the runs of lights that differ are packed and written (a still
     /// scene uploads nothing after its first frame; moving lights, their own bytes). Updates
     /// the chunks' summaries. Returns the bytes written.
-    fn upload_lights(&mut self, gpu: &GpuContext, lights: &PointLights) -> Result<u64, RenderError> {
+    fn upload_lights(&mut self, gpu: &GpuContext, lights: &PointLights, t: f32) -> Result<u64, RenderError> {
         let element = std::mem::size_of::<GpuPointLight>();
-        // At least one light: every pipeline binds the buffer (a new buffer is zeroed).
-        if self.lights.reserve(gpu, (lights.len().max(1) * element) as u64)? {
+        // At least one light: every pipeline binds the buffer (a new buffer is zeroed). A new
+        // light or motion buffer is written whole.
+        let new_lights = self.lights.reserve(gpu, (lights.len().max(1) * element) as u64)?;
+        if self.motions.reserve(gpu, lights)? | new_lights {
             self.uploaded_chunks.clear();
         }
         let mut written = 0;
@@ -472,8 +477,10 @@ impl SceneResources {
                 let offset = ((k * LIGHT_CHUNK + start) * element) as u64;
                 gpu.write_buffer(self.lights.buffer(), offset, bytemuck::cast_slice(&self.packed));
                 written += (self.packed.len() * element) as u64;
+                written += self.motions.write(gpu, k * LIGHT_CHUNK + start, &new[start..i], t);
             }
         }
+        written += self.motions.refresh_epochs(gpu, lights, t);
         // The chunks as the buffer now holds them (the Vec keeps its allocation).
         self.uploaded_chunks.clear();
         self.uploaded_chunks.extend(lights.chunks().iter().cloned());
@@ -487,8 +494,11 @@ impl SceneResources {
 
         // Lights: invalid ones (NaN, inf, negative) keep their place as zeroed lights that
         // reach nothing, and are counted.
-        self.light_upload_bytes = self.upload_lights(gpu, &snapshot.lights)?;
+        self.light_upload_bytes = self.upload_lights(gpu, &snapshot.lights, snapshot.elapsed_secs)?;
         self.light_count = snapshot.lights.len() as u32;
+        // Animated lights take their place for the frame's time before any view reads them.
+        self.light_upload_bytes +=
+            self.motions.animate(gpu, &self.lights, self.light_count, snapshot.elapsed_secs)?;
         self.light_reach = LightReach::default();
         self.invalid_point_lights = 0;
         for summary in &self.chunk_summaries {

@@ -38,6 +38,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("depth_prepass.wgsl", include_str!("../shaders/depth_prepass.wgsl")),
     ("cluster_build.wgsl", include_str!("../shaders/cluster_build.wgsl")),
     ("light_spheres.wgsl", include_str!("../shaders/light_spheres.wgsl")),
+    ("light_animation.wgsl", include_str!("../shaders/light_animation.wgsl")),
     ("cluster_depth.wgsl", include_str!("../shaders/cluster_depth.wgsl")),
     ("light_refine.wgsl", include_str!("../shaders/light_refine.wgsl")),
     ("clustered_forward.wgsl", include_str!("../shaders/clustered_forward.wgsl")),

@@ -513,6 +513,11 @@ pub struct ExtractedPointLight {
     pub spot: Option<SpotCone>,
     /// The light casts shadows, with these biases (`None`: it lights through everything).
     pub shadow: Option<ShadowBias>,
+    /// The light moves and flickers on the GPU (`None`: it stays as extracted): each frame a
+    /// compute pass writes its position and colour at [`FrameSnapshot::elapsed_secs`] into the
+    /// light buffer (`shaders/light_animation.wgsl`), so its motion costs the CPU nothing.
+    /// `position` and `color` are then unused; `intensity`, `radius` and `spot` still apply.
+    pub animation: Option<manylight_core::AnimatedLight>,
 }
 
 /// Lights in each chunk of a [`PointLights`] list (the last chunk may hold fewer).
@@ -530,11 +535,12 @@ pub struct PointLights {
 }
 
 /// [`LIGHT_CHUNK`] consecutive lights of a [`PointLights`] list, and how many of them cast
-/// shadows (so a frame finds its shadowed lights without visiting the others).
+/// shadows or animate on the GPU (so a frame finds them without visiting the others).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct LightChunk {
     lights: Vec<ExtractedPointLight>,
     shadowed: usize,
+    animated: usize,
 }
 
 impl LightChunk {
@@ -548,8 +554,27 @@ impl LightChunk {
         self.shadowed
     }
 
+    /// How many of them animate on the GPU ([`ExtractedPointLight::animation`]).
+    pub fn animated(&self) -> usize {
+        self.animated
+    }
+
     fn recount(&mut self) {
         self.shadowed = self.lights.iter().filter(|l| l.shadow.is_some()).count();
+        self.animated = self.lights.iter().filter(|l| l.animation.is_some()).count();
+    }
+
+    /// Counts `light` in (`add`) or out.
+    fn count(&mut self, light: &ExtractedPointLight, add: bool) {
+        let (shadowed, animated) =
+            (usize::from(light.shadow.is_some()), usize::from(light.animation.is_some()));
+        if add {
+            self.shadowed += shadowed;
+            self.animated += animated;
+        } else {
+            self.shadowed -= shadowed;
+            self.animated -= animated;
+        }
     }
 }
 
@@ -584,6 +609,11 @@ impl PointLights {
         self.chunks.iter().flat_map(|c| c.lights.iter())
     }
 
+    /// How many lights animate on the GPU (one visit per chunk).
+    pub fn animated(&self) -> usize {
+        self.chunks.iter().map(|c| c.animated).sum()
+    }
+
     /// The lights that cast shadows, with their index, visiting only the chunks that hold some.
     pub fn shadowed(&self) -> impl Iterator<Item = (usize, &ExtractedPointLight)> {
         self.chunks.iter().enumerate().filter(|(_, c)| c.shadowed > 0).flat_map(|(k, c)| {
@@ -598,10 +628,11 @@ impl PointLights {
     /// Adds a light at the end.
     pub fn push(&mut self, light: ExtractedPointLight) {
         if self.len.is_multiple_of(LIGHT_CHUNK) {
-            self.chunks.push(Arc::new(LightChunk { lights: Vec::with_capacity(LIGHT_CHUNK), shadowed: 0 }));
+            let lights = Vec::with_capacity(LIGHT_CHUNK);
+            self.chunks.push(Arc::new(LightChunk { lights, shadowed: 0, animated: 0 }));
         }
         let chunk = Arc::make_mut(self.chunks.last_mut().expect("a chunk with room"));
-        chunk.shadowed += usize::from(light.shadow.is_some());
+        chunk.count(&light, true);
         chunk.lights.push(light);
         self.len += 1;
     }
@@ -615,10 +646,9 @@ impl PointLights {
             Some(old) if *old == light => true,
             Some(_) => {
                 let chunk = Arc::make_mut(chunk);
-                let slot = &mut chunk.lights[i % LIGHT_CHUNK];
-                chunk.shadowed =
-                    chunk.shadowed + usize::from(light.shadow.is_some()) - usize::from(slot.shadow.is_some());
-                *slot = light;
+                let old = std::mem::replace(&mut chunk.lights[i % LIGHT_CHUNK], light);
+                chunk.count(&light, true);
+                chunk.count(&old, false);
                 true
             }
         }
@@ -630,8 +660,8 @@ impl PointLights {
         let light = Arc::make_mut(chunk).lights.pop();
         if chunk.lights.is_empty() {
             self.chunks.pop();
-        } else if light.is_some_and(|l| l.shadow.is_some()) {
-            Arc::make_mut(chunk).shadowed -= 1;
+        } else if let Some(light) = &light {
+            Arc::make_mut(chunk).count(light, false);
         }
         self.len -= usize::from(light.is_some());
         light
@@ -711,7 +741,8 @@ impl Default for ShadowBias {
 
 impl ExtractedPointLight {
     /// True when every parameter is finite, the radius and intensity are not negative, and the
-    /// emitted colour (`color × intensity`) does not overflow to infinity.
+    /// emitted colour (`color × intensity`) does not overflow to infinity; for an animated
+    /// light, also the box its orbit and bob stay in, and its base colour with twice the room.
     pub fn is_valid(&self) -> bool {
         self.position.is_finite()
             && self.color.is_finite()
@@ -721,6 +752,15 @@ impl ExtractedPointLight {
             && self.radius >= 0.0
             && self.intensity >= 0.0
             && self.shadow.is_none_or(|b| b.is_valid())
+            && self
+                .animation
+                .is_none_or(|a| a.position_bounds().is_some() && (a.color * self.intensity * 2.0).is_finite())
+    }
+
+    /// The box holding the light's position at every time: its position, or the box its
+    /// animation stays in.
+    pub fn position_bounds(&self) -> (Vec3, Vec3) {
+        self.animation.and_then(|a| a.position_bounds()).unwrap_or((self.position, self.position))
     }
 }
 
@@ -927,6 +967,9 @@ pub struct FrameSnapshot {
     /// CPU time the main world took to extract this snapshot, in milliseconds (0 for a snapshot
     /// made without an app); reported as `CpuPhases::extract_ms`.
     pub extract_cpu_ms: f64,
+    /// Seconds since the app started (Bevy's `Time::elapsed_secs`): the time at which the
+    /// lights with an [`ExtractedPointLight::animation`] are shown.
+    pub elapsed_secs: f32,
 }
 
 /// A directional light as extracted for rendering: light travelling along `direction`

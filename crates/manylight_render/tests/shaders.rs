@@ -6,8 +6,8 @@ use manylight_render::gpu_types::{
     GpuCascade, GpuDirectionalShadow, GpuShadowDraw, GpuShadowFace, GpuShadowLight, GpuShadowProbe,
 };
 use manylight_render::gpu_types::{
-    GpuClusterBounds, GpuClusterCounters, GpuClusterParams, GpuDirectionalLight, GpuInstance, GpuMaterial,
-    GpuPointLight, GpuTextureUv, ViewUniform,
+    GpuClusterBounds, GpuClusterCounters, GpuClusterParams, GpuDirectionalLight, GpuInstance,
+    GpuLightAnimationParams, GpuLightMotion, GpuMaterial, GpuPointLight, GpuTextureUv, ViewUniform,
 };
 use manylight_render::layouts::{BindingKind, Presence, SHADER_BIND_GROUPS, shader_bind_groups};
 use manylight_render::resources::SurfaceVariant;
@@ -210,6 +210,34 @@ fn shared_structs_match_rust() {
         "GpuShadowDraw",
         size_of::<GpuShadowDraw>(),
         &[("instance", offset_of!(GpuShadowDraw, instance)), ("face", offset_of!(GpuShadowDraw, face))],
+    );
+    let animation = validate("light_animation.wgsl");
+    offsets(
+        &animation,
+        "GpuLightMotion",
+        size_of::<GpuLightMotion>(),
+        &[
+            ("center", offset_of!(GpuLightMotion, center)),
+            ("orbit_radius", offset_of!(GpuLightMotion, orbit_radius)),
+            ("color", offset_of!(GpuLightMotion, color)),
+            ("bob_amplitude", offset_of!(GpuLightMotion, bob_amplitude)),
+            ("speeds", offset_of!(GpuLightMotion, speeds)),
+            ("angles", offset_of!(GpuLightMotion, angles)),
+            ("flicker2_speed", offset_of!(GpuLightMotion, flicker2_speed)),
+            ("flicker2_angle", offset_of!(GpuLightMotion, flicker2_angle)),
+            ("epoch", offset_of!(GpuLightMotion, epoch)),
+            ("intensity", offset_of!(GpuLightMotion, intensity)),
+            ("animated", offset_of!(GpuLightMotion, animated)),
+        ],
+    );
+    offsets(
+        &animation,
+        "LightAnimationParams",
+        size_of::<GpuLightAnimationParams>(),
+        &[
+            ("elapsed_secs", offset_of!(GpuLightAnimationParams, elapsed_secs)),
+            ("light_count", offset_of!(GpuLightAnimationParams, light_count)),
+        ],
     );
     offsets(
         &validate("shadow_probe.wgsl"),

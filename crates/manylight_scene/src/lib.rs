@@ -18,8 +18,8 @@ pub use gltf_loader::{
     LoadOptions, MAX_DOWNSCALED_SOURCE, OversizedTextures, blinn_phong_from_pbr, load_gltf,
 };
 pub use light_rig::{
-    AnimatedLight, RIG_RADIUS_K, SHELL_LIGHT_RANGE, SHELL_RADIUS, SplitMix64, intensity_for_radius,
-    light_rig, sphere_shell_lights, sphere_shell_scene, studio_lights,
+    AnimatedLight, RIG_RADIUS_K, SHELL_LIGHT_RANGE, SHELL_RADIUS, SplitMix64, animated_light_at,
+    intensity_for_radius, light_rig, sphere_shell_lights, sphere_shell_scene, studio_lights,
 };
 pub use scene_ops::{camera_looking_at, load_scene};
 

@@ -15,85 +15,16 @@ use std::sync::Arc;
 /// With `K = 1` a point of the volume lies inside `4/3 π K³ ≈ 4.2` light spheres on average.
 pub const RIG_RADIUS_K: f32 = 1.0;
 
-/// A point light that orbits a centre in XZ, bobs in Y and slowly shifts hue and flickers.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct AnimatedLight {
-    /// Centre of the orbit.
-    pub center: Vec3,
-    /// Orbit radius in the XZ plane.
-    pub orbit_radius: f32,
-    /// Orbit angular speed in radians per second (sign = direction).
-    pub orbit_speed: f32,
-    /// Phase offset in radians (orbit, bob and flicker).
-    pub phase: f32,
-    /// Vertical bobbing amplitude.
-    pub bob_amplitude: f32,
-    /// Bobbing angular speed in radians per second.
-    pub bob_speed: f32,
-    /// Base linear RGB colour.
-    pub color: Vec3,
-    /// Flicker angular speed in radians per second (hue drift is ten times slower).
-    pub flicker_speed: f32,
-    /// Luminous intensity in candela (multiplies the colour).
-    pub intensity: f32,
-    /// Distance at which the light's contribution reaches zero.
-    pub radius: f32,
-}
+pub use manylight_core::AnimatedLight;
 
-/// `(phase + speed * t) mod 2π`, computed in f64 so large `t` keeps its precision and never
-/// overflows; non-finite inputs give 0.
-fn angle(phase: f32, speed: f32, t: f32) -> f32 {
-    let a = (phase as f64 + speed as f64 * t as f64).rem_euclid(TAU);
-    if a.is_finite() { a as f32 } else { 0.0 }
-}
-
-/// Rotates an RGB colour around the grey axis by `theta` (a hue shift), clamped to >= 0.
-fn hue_rotate(c: Vec3, theta: f32) -> Vec3 {
-    let k = Vec3::ONE.normalize();
-    let (s, co) = theta.sin_cos();
-    (c * co + k.cross(c) * s + k * k.dot(c) * (1.0 - co)).max(Vec3::ZERO)
-}
-
-impl AnimatedLight {
-    /// World position at time `t` seconds: orbit in XZ around `center`, bob in Y.
-    pub fn position_at(&self, t: f32) -> Vec3 {
-        let a = angle(self.phase, self.orbit_speed, t);
-        let b = angle(self.phase, self.bob_speed, t);
-        let p = self.center
-            + Vec3::new(
-                self.orbit_radius * a.cos(),
-                self.bob_amplitude * b.sin(),
-                self.orbit_radius * a.sin(),
-            );
-        if p.is_finite() {
-            p
-        } else if self.center.is_finite() {
-            self.center
-        } else {
-            Vec3::ZERO
-        }
-    }
-
-    /// Colour at time `t` (to be scaled by `intensity`): the base colour
-    /// with a slow hue drift of ±20° and a ±15 % flicker. Finite and non-negative.
-    pub fn color_at(&self, t: f32) -> Vec3 {
-        let drift = angle(self.phase, 0.1 * self.flicker_speed, t).sin() * 0.35;
-        let f1 = angle(3.0 * self.phase, self.flicker_speed, t).sin();
-        let f2 = angle(self.phase, 2.7 * self.flicker_speed, t).sin();
-        let flicker = 0.85 + 0.15 * (0.6 * f1 + 0.4 * f2);
-        let c = hue_rotate(self.color.max(Vec3::ZERO), drift) * flicker;
-        if c.is_finite() { c } else { Vec3::ZERO }
-    }
-
-    /// The light at time `t` as a scene light.
-    pub fn at(&self, t: f32) -> SceneLight {
-        SceneLight {
-            position: self.position_at(t),
-            color: self.color_at(t),
-            intensity: self.intensity,
-            radius: self.radius,
-            spot: None,
-        }
+/// `light` at time `t` as a scene light.
+pub fn animated_light_at(light: &AnimatedLight, t: f32) -> SceneLight {
+    SceneLight {
+        position: light.position_at(t),
+        color: light.color_at(t),
+        intensity: light.intensity,
+        radius: light.radius,
+        spot: None,
     }
 }
 

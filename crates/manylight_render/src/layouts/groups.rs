@@ -97,6 +97,17 @@ pub static LIGHT_SPHERES_GROUP: BindGroupDecl = BindGroupDecl {
     ],
 };
 
+/// Group 0 of the light animation pass (`shaders/light_animation.wgsl`): its parameters (the
+/// frame's time), the lights' motions it reads and the light buffer it writes.
+pub static LIGHT_ANIMATION_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "light_animation",
+    entries: &[
+        BindingDecl::uniform(0, "params", COMPUTE),
+        BindingDecl::storage(1, "motions", COMPUTE),
+        BindingDecl::storage_rw(2, "lights", COMPUTE),
+    ],
+};
+
 /// Group 2 of the passes that shade through the cluster lists (`common/cluster_lists.wgsl`,
 /// `tiled_deferred.wgsl`): the parameters, each cluster's range and the light indices.
 pub static CLUSTER_LISTS_GROUP: BindGroupDecl = BindGroupDecl {
@@ -349,6 +360,7 @@ pub static SHADER_BIND_GROUPS: &[ShaderBindGroups] = &[
     row("light_volumes.wgsl", &["fs_resolve"], &[SCENE, GBUFFER, &LIGHT_ACCUM_GROUP]),
     row("cluster_build.wgsl", &[], &[&CLUSTER_BUILD_GROUP]),
     row("light_spheres.wgsl", &[], &[&LIGHT_SPHERES_GROUP]),
+    row("light_animation.wgsl", &[], &[&LIGHT_ANIMATION_GROUP]),
     row("cluster_depth.wgsl", &["cs_forward"], &[SCENE, &SHADING_DISTANCE_GROUP, &CLUSTER_DEPTH_GROUP]),
     row("cluster_depth.wgsl", &["cs_gbuffer"], &[SCENE, GBUFFER, &CLUSTER_DEPTH_GROUP]),
     row("light_refine.wgsl", &["cs_forward"], &[SCENE, &SHADING_DISTANCE_GROUP, &LIGHT_REFINE_GROUP]),
