@@ -3,11 +3,14 @@
 //! ```text
 //! cargo run --release --example stress -- [--lights N] [--scene default|sphere-shell|PATH.glb]
 //!     [--pipeline NAME] [--size WxH] [--frames F --warmup W] [--headless OUT.png] [--no-overlay]
+//!     [--gpu-animation]
 //! ```
 //!
 //! - `--scene default` (the embedded hall) or a glTF path: `--lights N` (default 4096) lights
 //!   that orbit, bob and flicker in colour, moved by [`animate_lights`], an ordinary `Update`
-//!   system on `Transform` and `PointLight` you can copy into your own app.
+//!   system on `Transform` and `PointLight` you can copy into your own app. With
+//!   `--gpu-animation` they carry a [`LightAnimation`] instead and the renderer's compute pass
+//!   moves them ([`LightAnimationMode::Gpu`]): no light changes on the CPU after it is spawned.
 //! - `--scene sphere-shell`: the many-lights layout other engines publish. N lights (default
 //!   100 000) of range 0.3 with random hues on a golden-ratio (Fibonacci) lattice just inside a
 //!   white inward-facing sphere of radius 50, a 5×5×5 box at (0, 50, 0), and a camera at the
@@ -82,6 +85,10 @@ pub struct Args {
     /// Seed of the light placement and colours.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Animate the rig's lights in the renderer's compute pass (`LightAnimationMode::Gpu`)
+    /// instead of an `Update` system on their components.
+    #[arg(long)]
+    pub gpu_animation: bool,
 }
 
 /// Where the example's lights go: the rig's bounds, or the sphere shell.
@@ -93,6 +100,8 @@ pub struct StressLayout {
     pub bounds: Aabb,
     /// Placement and colour seed.
     pub seed: u64,
+    /// The rig's lights carry a [`LightAnimation`] and animate on the GPU.
+    pub gpu_animation: bool,
 }
 
 /// An animated light: orbit, bob and colour flicker parameters (see [`animate_lights`]).
@@ -133,17 +142,30 @@ pub struct FrameTimes {
 }
 
 /// Moves each animated light along its orbit, bobs it, flickers its colour, and applies the
-/// radius multiplier: a plain system on `Transform` and `PointLight`.
+/// radius multiplier: a plain system on `Transform` and `PointLight`. Lights that carry a
+/// [`LightAnimation`] (`--gpu-animation`) are the renderer's to move.
 pub fn animate_lights(
     time: Res<Time>,
     controls: Res<LightControls>,
-    mut lights: Query<(&StressLight, &mut Transform, &mut PointLight)>,
+    mut lights: Query<(&StressLight, &mut Transform, &mut PointLight), Without<LightAnimation>>,
 ) {
     let t = time.elapsed_secs();
     for (light, mut transform, mut point) in &mut lights {
         transform.translation = light.0.position_at(t); // orbit in XZ + bob in Y
         point.color = manylight::app::from_linear_rgb(light.0.color_at(t)); // hue drift + flicker
         point.range = light.0.radius * controls.radius_scale;
+    }
+}
+
+/// Applies the radius multiplier to the lights animated on the GPU when it changes.
+pub fn scale_gpu_animated_lights(
+    controls: Res<LightControls>,
+    mut lights: Query<(&StressLight, &mut PointLight), With<LightAnimation>>,
+) {
+    if controls.is_changed() {
+        for (light, mut point) in &mut lights {
+            point.range = light.0.radius * controls.radius_scale;
+        }
     }
 }
 
@@ -198,7 +220,7 @@ pub fn sync_light_count(
             Ok(rig) => rig,
             Err(e) => return eprintln!("error: {e}"),
         };
-        commands.spawn_batch(rig.into_iter().map(move |a| {
+        let light = move |a: AnimatedLight| {
             (
                 Transform::from_translation(a.position_at(0.0)),
                 PointLight {
@@ -210,7 +232,12 @@ pub fn sync_light_count(
                 },
                 StressLight(a),
             )
-        }));
+        };
+        if layout.gpu_animation {
+            commands.spawn_batch(rig.into_iter().map(move |a| (light(a), LightAnimation(a))));
+        } else {
+            commands.spawn_batch(rig.into_iter().map(light));
+        }
     }
 }
 
@@ -321,7 +348,11 @@ pub fn setup(app: &mut App, args: &Args, exit_when_done: bool) -> Result<()> {
         bail!("--lights {count}: at most {} lights", 1 << 20);
     }
     let aspect = args.size.x as f32 / args.size.y.max(1) as f32;
-    let layout = StressLayout { shell, bounds: scene.bounds(), seed: args.seed };
+    if shell && args.gpu_animation {
+        bail!("--gpu-animation: the sphere-shell lights do not move (it animates the rig's lights)");
+    }
+    let layout =
+        StressLayout { shell, bounds: scene.bounds(), seed: args.seed, gpu_animation: args.gpu_animation };
     let mut settings = RenderSettings {
         pipeline: args.pipeline.unwrap_or(if shell {
             PipelineKind::ForwardPlus
@@ -336,7 +367,9 @@ pub fn setup(app: &mut App, args: &Args, exit_when_done: bool) -> Result<()> {
     // Below SHELL_REFINE_FROM shell lights the pairs refined lists would save are too few to
     // pay for their pass (docs/benchmarks.md, "Refined light lists").
     settings.clusters.refined_lists = args.refined_lists.unwrap_or(!shell || count >= SHELL_REFINE_FROM);
+    let animation = if args.gpu_animation { LightAnimationMode::Gpu } else { LightAnimationMode::Cpu };
     app.insert_resource(settings)
+        .insert_resource(animation)
         .insert_resource(layout)
         .insert_resource(LightControls { count, radius_scale: 1.0 })
         .insert_resource(FrameTimes {
@@ -354,7 +387,15 @@ pub fn setup(app: &mut App, args: &Args, exit_when_done: bool) -> Result<()> {
         })
         .add_systems(
             Update,
-            (sync_light_count, animate_lights, scale_shell_lights, turn_camera, time_frames).chain(),
+            (
+                sync_light_count,
+                animate_lights,
+                scale_gpu_animated_lights,
+                scale_shell_lights,
+                turn_camera,
+                time_frames,
+            )
+                .chain(),
         );
     Ok(())
 }

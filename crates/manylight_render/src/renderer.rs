@@ -338,7 +338,18 @@ impl Renderer {
         let textures = self.acquire_textures(passes, view.size, output);
         let mut encoder =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        // The frame's first encoder animates the lights first, before any pass reads them.
+        let animation = crate::animation::LightAnimationPass;
+        let mut with_animation = Vec::new();
+        let passes = if self.scene.motions.pending() {
+            with_animation.push(&animation as &dyn Pass);
+            with_animation.extend_from_slice(passes);
+            &with_animation[..]
+        } else {
+            passes
+        };
         let timings = self.record_passes(passes, &mut encoder, view.index, &textures, output_format)?;
+        self.scene.motions.recorded();
         // The view's counters go to the frame's read-back slot, after the passes wrote them.
         let clusters = self.clusters.get(view.index).and_then(Option::as_ref);
         let tonemapped = passes.iter().any(|p| crate::graph::is::<crate::passes::tonemap::TonemapPass>(*p));

@@ -253,6 +253,10 @@ pub struct SceneResources {
     /// One run of changed lights, packed (kept between frames so that it is not allocated
     /// again).
     packed: Vec<GpuPointLight>,
+    /// This frame's instances as packed, and the ones the instance buffer held before (what a
+    /// frame compares with to write only the instances that changed).
+    instance_data: Vec<GpuInstance>,
+    uploaded_instances: Vec<GpuInstance>,
     /// The motions of the lights that animate on the GPU, and the pass that applies them.
     pub motions: crate::animation::LightMotions,
     /// The tone map's count of non-finite HDR pixels.
@@ -331,6 +335,8 @@ impl SceneResources {
             uploaded_chunks: Vec::new(),
             chunk_summaries: Vec::new(),
             packed: Vec::new(),
+            instance_data: Vec::new(),
+            uploaded_instances: Vec::new(),
             motions: Default::default(),
             nonfinite: NonFiniteCounter::new(gpu),
             assets: SceneAssets::new(gpu),
@@ -498,7 +504,7 @@ impl SceneResources {
         self.light_count = snapshot.lights.len() as u32;
         // Animated lights take their place for the frame's time before any view reads them.
         self.light_upload_bytes +=
-            self.motions.animate(gpu, &self.lights, self.light_count, snapshot.elapsed_secs)?;
+            self.motions.prepare(gpu, &self.lights, self.light_count, snapshot.elapsed_secs)?;
         self.light_reach = LightReach::default();
         self.invalid_point_lights = 0;
         for summary in &self.chunk_summaries {
@@ -524,7 +530,11 @@ impl SceneResources {
         }
 
         // Meshes, materials, instances.
-        let mut instance_data = Vec::with_capacity(snapshot.instances.len());
+        // Last frame's instances become the comparison; this frame's are packed into the other
+        // Vec (both keep their allocations).
+        std::mem::swap(&mut self.instance_data, &mut self.uploaded_instances);
+        let mut instance_data = std::mem::take(&mut self.instance_data);
+        instance_data.clear();
         self.draws.clear();
         (self.invalid_instances, self.collapsed_instances) = (0, 0);
         for inst in &snapshot.instances {
@@ -570,7 +580,11 @@ impl SceneResources {
         if instance_data.is_empty() {
             instance_data.push(GpuInstance::new(Mat4::IDENTITY));
         }
-        self.instances.write(gpu, bytemuck::cast_slice(&instance_data))?;
+        // Only the instances that differ from the buffer's: still objects upload nothing.
+        let element = std::mem::size_of::<GpuInstance>();
+        let previous = bytemuck::cast_slice(&self.uploaded_instances);
+        self.instances.write_changed(gpu, bytemuck::cast_slice(&instance_data), Some(previous), element)?;
+        self.instance_data = instance_data;
 
         self.assets.evict_unused();
         Ok(())
