@@ -468,6 +468,11 @@ fn only_the_lights_that_changed_are_uploaded() {
     finish_frames(&mut app);
     let report = stats(&app).last.expect("a report");
     assert_eq!(report.light_upload_bytes, 0, "the app's still lights were uploaded again");
+    // Nor are its still objects: the frame's bytes are the view's constants, fewer than the
+    // instances' own.
+    let instance_bytes = u64::from(report.instance_count)
+        * std::mem::size_of::<manylight::render::gpu_types::GpuInstance>() as u64;
+    assert!(report.cpu.upload_bytes < instance_bytes, "{} B uploaded", report.cpu.upload_bytes);
 }
 
 /// Extraction keeps a slot per light entity and copies only what changed: after the first
@@ -526,7 +531,8 @@ fn extraction_follows_the_light_entities_that_changed() {
 /// same frames (the same times, far enough apart that the pass takes its angles again at a new
 /// epoch) both images match (FLIP, STRICT). On the GPU path a frame uploads no animated light,
 /// only the pass's 16 B of parameters, and the lights' components stay where they were
-/// spawned; a light that casts shadows animates on the CPU on both paths.
+/// spawned; a light that casts shadows animates on the CPU on both paths. Switching back to
+/// the CPU path takes every animated light again.
 #[test]
 fn gpu_light_animation_matches_the_cpu_one() {
     use manylight::app::LightAnimationMode;
@@ -585,4 +591,14 @@ fn gpu_light_animation_matches_the_cpu_one() {
         assert_eq!(at == start, !shadowed, "GPU path: only the shadowed light moves on the CPU");
     }
     assert!(spawned(&mut cpu).iter().all(|(at, start, _)| at != start), "CPU path: every light moves");
+
+    // Back to the CPU: every animated light is extracted again and shows where the CPU puts it.
+    gpu_app.insert_resource(LightAnimationMode::Cpu);
+    for app in [&mut cpu, &mut gpu_app] {
+        app.update();
+        finish_frames(app);
+    }
+    support::assert_similar("gpu_light_animation_back", &image(&cpu), &image(&gpu_app), support::STRICT);
+    let back = stats(&gpu_app).last.expect("a report");
+    assert_eq!(back.light_upload_bytes, 201 * light, "{back:?}");
 }

@@ -1111,6 +1111,53 @@ impl FrameSnapshot {
 mod tests {
     use super::*;
 
+    /// Each chunk counts its shadowed and animated lights through every change, so a frame
+    /// finds them (and knows whether any light animates) from one count per chunk.
+    #[test]
+    fn light_chunks_count_their_shadowed_and_animated_lights() {
+        let plain = ExtractedPointLight {
+            position: Vec3::ZERO,
+            color: Vec3::ONE,
+            intensity: 1.0,
+            radius: 1.0,
+            spot: None,
+            shadow: None,
+            animation: None,
+        };
+        let motion = manylight_core::AnimatedLight {
+            center: Vec3::ONE,
+            orbit_radius: 1.0,
+            orbit_speed: 0.5,
+            phase: 0.0,
+            bob_amplitude: 0.2,
+            bob_speed: 1.0,
+            color: Vec3::ONE,
+            flicker_speed: 1.0,
+            intensity: 1.0,
+            radius: 1.0,
+        };
+        let animated = ExtractedPointLight { animation: Some(motion), ..plain };
+        let shadowed = ExtractedPointLight { shadow: Some(ShadowBias::POINT), ..plain };
+        let mut lights: PointLights = (0..LIGHT_CHUNK + 10).map(|_| plain).collect();
+        let recount = |l: &PointLights| {
+            let animated = l.iter().filter(|l| l.animation.is_some()).count();
+            (l.animated(), l.shadowed().count(), animated, l.iter().filter(|l| l.shadow.is_some()).count())
+        };
+        assert_eq!(recount(&lights), (0, 0, 0, 0));
+        lights.set(3, animated);
+        lights.set(LIGHT_CHUNK + 2, animated);
+        lights.set(LIGHT_CHUNK + 9, shadowed);
+        assert_eq!(recount(&lights), (2, 1, 2, 1));
+        lights.set(3, shadowed);
+        assert_eq!(recount(&lights), (1, 2, 1, 2));
+        assert_eq!(lights.pop(), Some(shadowed));
+        lights.push(animated);
+        assert_eq!(recount(&lights), (2, 1, 2, 1));
+        lights.update(|l| l.animation = None);
+        assert_eq!(recount(&lights), (0, 1, 0, 1));
+        assert_eq!(lights.chunks().iter().map(|c| c.animated()).sum::<usize>(), 0);
+    }
+
     /// An exposure of NaN would render an all-black frame with no non-finite pixel counted:
     /// values no frame can render with are refused, naming the field.
     #[test]
