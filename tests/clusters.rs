@@ -327,8 +327,10 @@ fn short_lists_shade_from_every_light_then_grow() {
     for frame in 0..6u32 {
         let radius = 0.5 * 2f32.powi(frame as i32).min(24.0);
         let shift = Vec3::new(frame as f32 * 1.5, 0.0, 0.0);
-        let lights: Vec<_> =
-            base.iter().map(|l| ExtractedPointLight { radius, position: l.position + shift, ..*l }).collect();
+        let lights: Vec<_> = base
+            .iter()
+            .map(|l| ExtractedPointLight { radius, position: l.position + shift, ..l.clone() })
+            .collect();
         let snap =
             scene_snapshot(&scene, size, lights, clustered(CullTest::Aabb, ZSlicing::Exponential, None));
         let (report, image) = r.render(snap.clone(), true).expect("renders");
@@ -526,7 +528,7 @@ fn spot_rig(points: &[ExtractedPointLight]) -> Vec<ExtractedPointLight> {
             let inner = if i % 3 == 0 { outer } else { outer * 0.5 };
             ExtractedPointLight {
                 spot: Some(SpotCone { direction, inner_angle: inner, outer_angle: outer }),
-                ..*l
+                ..l.clone()
             }
         })
         .collect()

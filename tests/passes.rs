@@ -509,7 +509,7 @@ fn the_shadow_pass_runs_only_where_a_light_casts_and_lights_are_shaded() {
         let p = Point { lights: true, bloom: false, motion_blur: false, deferred, debug: false };
         let casting = || {
             let mut s = snapshot(p);
-            s.lights.update(|l| *l = manylight::app::scene::with_shadow(*l, true));
+            s.lights.update(|l| *l = manylight::app::scene::with_shadow(l.clone(), true));
             s
         };
         let mut with_shadows = vec!["shadow_maps"];
@@ -524,7 +524,7 @@ fn the_shadow_pass_runs_only_where_a_light_casts_and_lights_are_shaded() {
         // A debug view that replaces shading draws no shadow maps.
         let debug = Point { debug: true, ..p };
         let mut s = snapshot(debug);
-        s.lights.update(|l| *l = manylight::app::scene::with_shadow(*l, true));
+        s.lights.update(|l| *l = manylight::app::scene::with_shadow(l.clone(), true));
         assert_eq!(plan_passes(s).unwrap(), expected(debug), "{debug:?}");
         // A casting sun alone (no point light): the shadow pass, then the frame of no lights.
         let unlit = Point { lights: false, ..p };

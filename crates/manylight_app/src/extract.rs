@@ -130,14 +130,13 @@ pub type DirectionalItem = (
 );
 
 /// The change that makes extraction look at a point or spot light again.
-pub type LightChanged = Or<(
-    Changed<GlobalTransform>,
-    Changed<PointLight>,
-    Changed<SpotLight>,
-    Changed<InheritedVisibility>,
-    Changed<LightAnimation>,
-    Changed<ChildOf>,
-)>;
+pub type LightChanged =
+    Or<(Changed<GlobalTransform>, Changed<PointLight>, Changed<SpotLight>, Changed<InheritedVisibility>)>;
+
+/// The changes that also make extraction look at a light again while lights animate on the GPU
+/// ([`LightAnimationMode::Gpu`]: whether a light does depends on them). Not read otherwise, so
+/// that a frame's scan for changes reads no more tick columns than it needs.
+pub type AnimationChanged = Or<(Changed<LightAnimation>, Changed<ChildOf>)>;
 
 /// Whether an entity's computed visibility lets it render (none computed yet: visible).
 fn shown(visibility: Option<&InheritedVisibility>) -> bool {
@@ -156,6 +155,8 @@ pub struct ExtractInputs<'w, 's> {
     meshes: Query<'w, 's, MeshItem>,
     /// Point and spot lights that changed since the last extraction (added included).
     changed_lights: Query<'w, 's, LightItem, LightChanged>,
+    /// Lights whose animation or parent changed (read with [`LightAnimationMode::Gpu`]).
+    changed_animations: Query<'w, 's, LightItem, AnimationChanged>,
     /// Every point and spot light (looked up when one lost a light component).
     lights: Query<'w, 's, LightItem>,
     removed_points: RemovedComponents<'w, 's, PointLight>,
@@ -300,8 +301,7 @@ fn point_light(
         }
         (None, None) => return None,
     };
-    let animation =
-        animates_on_gpu(mode, animation, point, has_parent).then(|| animation.map(|a| a.0)).flatten();
+    let animation = animation.filter(|_| animates_on_gpu(mode, animation, point, has_parent)).map(|a| a.0);
     Some(ExtractedPointLight {
         position: animation.map_or_else(|| t.translation(), |a| a.center),
         color: animation.map_or(color, |a| a.color),
@@ -309,7 +309,7 @@ fn point_light(
         radius: range,
         spot: cone,
         shadow,
-        animation,
+        animation: animation.map(Arc::new),
     })
 }
 
@@ -328,6 +328,12 @@ fn update_lights(slots: &mut LightSlots, world: &mut ExtractInputs) {
     for item in &world.changed_lights {
         let entity = item.0;
         slots.set(entity, point_light(item, mode));
+    }
+    if mode == LightAnimationMode::Gpu {
+        for item in &world.changed_animations {
+            let entity = item.0;
+            slots.set(entity, point_light(item, mode));
+        }
     }
     let removed: Vec<Entity> = world.removed_points.read().chain(world.removed_spots.read()).collect();
     for entity in removed {

@@ -32,7 +32,7 @@ pub fn snapshot(
 /// Makes every light of `snapshot` cast a shadow, with its kind's default biases (what
 /// `--shadows on` means for a scene: glTF has no shadow flag).
 pub fn cast_every_shadow(snapshot: &mut FrameSnapshot) {
-    snapshot.lights.update(|light| *light = manylight_app::scene::with_shadow(*light, true));
+    snapshot.lights.update(|light| *light = manylight_app::scene::with_shadow(light.clone(), true));
     for light in &mut snapshot.directional_lights {
         light.shadow = Some(manylight_render::DirectionalShadow::default());
     }

@@ -63,7 +63,7 @@ pub fn gpu_point_light(light: &ExtractedPointLight) -> GpuPointLight {
 /// near the epoch ([`crate::animation::EPOCH_SPAN_SECS`]). Zeroed (the pass leaves the light as
 /// uploaded) for a light without an animation or an invalid one.
 pub fn gpu_light_motion(light: &ExtractedPointLight, epoch: f32) -> GpuLightMotion {
-    let Some(a) = light.animation.filter(|_| light.is_valid()) else {
+    let Some(a) = light.animation.as_deref().filter(|_| light.is_valid()) else {
         return bytemuck::Zeroable::zeroed();
     };
     let [orbit, bob, drift, flicker, flicker2] = a.rates().map(|r| r.speed);

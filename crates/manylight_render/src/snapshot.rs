@@ -499,7 +499,7 @@ pub struct ExtractedInstance {
 }
 
 /// One point light.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ExtractedPointLight {
     /// World position.
     pub position: Vec3,
@@ -517,7 +517,7 @@ pub struct ExtractedPointLight {
     /// compute pass writes its position and colour at [`FrameSnapshot::elapsed_secs`] into the
     /// light buffer (`shaders/light_animation.wgsl`), so its motion costs the CPU nothing.
     /// `position` and `color` are then unused; `intensity`, `radius` and `spot` still apply.
-    pub animation: Option<manylight_core::AnimatedLight>,
+    pub animation: Option<Arc<manylight_core::AnimatedLight>>,
 }
 
 /// Lights in each chunk of a [`PointLights`] list (the last chunk may hold fewer).
@@ -646,8 +646,8 @@ impl PointLights {
             Some(old) if *old == light => true,
             Some(_) => {
                 let chunk = Arc::make_mut(chunk);
-                let old = std::mem::replace(&mut chunk.lights[i % LIGHT_CHUNK], light);
                 chunk.count(&light, true);
+                let old = std::mem::replace(&mut chunk.lights[i % LIGHT_CHUNK], light);
                 chunk.count(&old, false);
                 true
             }
@@ -754,13 +754,14 @@ impl ExtractedPointLight {
             && self.shadow.is_none_or(|b| b.is_valid())
             && self
                 .animation
+                .as_deref()
                 .is_none_or(|a| a.position_bounds().is_some() && (a.color * self.intensity * 2.0).is_finite())
     }
 
     /// The box holding the light's position at every time: its position, or the box its
     /// animation stays in.
     pub fn position_bounds(&self) -> (Vec3, Vec3) {
-        self.animation.and_then(|a| a.position_bounds()).unwrap_or((self.position, self.position))
+        self.animation.as_deref().and_then(|a| a.position_bounds()).unwrap_or((self.position, self.position))
     }
 }
 
@@ -1136,19 +1137,19 @@ mod tests {
             intensity: 1.0,
             radius: 1.0,
         };
-        let animated = ExtractedPointLight { animation: Some(motion), ..plain };
-        let shadowed = ExtractedPointLight { shadow: Some(ShadowBias::POINT), ..plain };
-        let mut lights: PointLights = (0..LIGHT_CHUNK + 10).map(|_| plain).collect();
+        let animated = ExtractedPointLight { animation: Some(Arc::new(motion)), ..plain.clone() };
+        let shadowed = ExtractedPointLight { shadow: Some(ShadowBias::POINT), ..plain.clone() };
+        let mut lights: PointLights = (0..LIGHT_CHUNK + 10).map(|_| plain.clone()).collect();
         let recount = |l: &PointLights| {
             let animated = l.iter().filter(|l| l.animation.is_some()).count();
             (l.animated(), l.shadowed().count(), animated, l.iter().filter(|l| l.shadow.is_some()).count())
         };
         assert_eq!(recount(&lights), (0, 0, 0, 0));
-        lights.set(3, animated);
-        lights.set(LIGHT_CHUNK + 2, animated);
-        lights.set(LIGHT_CHUNK + 9, shadowed);
+        lights.set(3, animated.clone());
+        lights.set(LIGHT_CHUNK + 2, animated.clone());
+        lights.set(LIGHT_CHUNK + 9, shadowed.clone());
         assert_eq!(recount(&lights), (2, 1, 2, 1));
-        lights.set(3, shadowed);
+        lights.set(3, shadowed.clone());
         assert_eq!(recount(&lights), (1, 2, 1, 2));
         assert_eq!(lights.pop(), Some(shadowed));
         lights.push(animated);
