@@ -29,7 +29,7 @@ struct LightAnimationParams {
     pad: vec2<u32>,
 };
 
-@group(0) @binding(0) var<uniform> params: LightAnimationParams;
+@group(0) @binding(0) var<storage, read> params: LightAnimationParams;
 @group(0) @binding(1) var<storage, read> motions: array<GpuLightMotion>;
 @group(0) @binding(2) var<storage, read_write> lights: array<GpuPointLight>;
 

@@ -236,7 +236,7 @@ impl AnimationPipeline {
         let params = gpu.create_buffer(&wgpu::BufferDescriptor {
             label: Some("light_animation_params"),
             size: std::mem::size_of::<GpuLightAnimationParams>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         Ok(AnimationPipeline { layout, pipeline, params })

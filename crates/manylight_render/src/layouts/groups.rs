@@ -98,11 +98,12 @@ pub static LIGHT_SPHERES_GROUP: BindGroupDecl = BindGroupDecl {
 };
 
 /// Group 0 of the light animation pass (`shaders/light_animation.wgsl`): its parameters (the
-/// frame's time), the lights' motions it reads and the light buffer it writes.
+/// frame's time; a storage binding, as a uniform that changes every frame makes lavapipe compile
+/// the shader again), the lights' motions it reads and the light buffer it writes.
 pub static LIGHT_ANIMATION_GROUP: BindGroupDecl = BindGroupDecl {
     label: "light_animation",
     entries: &[
-        BindingDecl::uniform(0, "params", COMPUTE),
+        BindingDecl::storage(0, "params", COMPUTE),
         BindingDecl::storage(1, "motions", COMPUTE),
         BindingDecl::storage_rw(2, "lights", COMPUTE),
     ],
