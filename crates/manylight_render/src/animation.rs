@@ -1,7 +1,7 @@
 //! The light animation pass: lights with an [`ExtractedPointLight::animation`] move and
 //! flicker on the GPU. Their motions live in a buffer beside the light buffer (one
 //! [`GpuLightMotion`] per light, at the light's index), written only when a light changed; each
-//! frame one dispatch (`shaders/light_animation.wgsl`, [`LightAnimationPass`], first in the
+//! frame one dispatch (`shaders/light_animation.wgsl`, `passes::light_animation`, first in the
 //! frame's first command encoder) writes every animated light's position and colour at
 //! [`crate::FrameSnapshot::elapsed_secs`] into the light buffer, before any pass reads it. A scene without animated lights has neither the buffer nor the dispatch.
 //!
@@ -25,7 +25,7 @@ use crate::snapshot::{ExtractedPointLight, LIGHT_CHUNK, PointLights};
 pub const EPOCH_SPAN_SECS: f32 = 64.0;
 
 /// Invocations per workgroup of the pass.
-const WORKGROUP_SIZE: u32 = 64;
+pub const WORKGROUP_SIZE: u32 = 64;
 
 /// The pass's pipeline and parameters, made the first time a frame animates a light.
 struct AnimationPipeline {
@@ -55,8 +55,8 @@ pub struct LightMotions {
     cursor: usize,
     /// One run of motions, packed (kept so that it is not allocated again).
     packed: Vec<GpuLightMotion>,
-    /// The workgroups of the frame's dispatch, readied and not recorded yet.
-    pending: Option<[u32; 2]>,
+    /// The frame's dispatch is readied and not recorded yet.
+    pending: bool,
 }
 
 impl LightMotions {
@@ -127,7 +127,7 @@ impl LightMotions {
 
     /// Readies the frame's dispatch, which writes each animated light's position and colour at
     /// `t` seconds into `lights` (`light_count` lights): nothing while no light animates. The
-    /// renderer records it ([`LightAnimationPass`]) at the start of the frame's first command
+    /// renderer records it (`passes::light_animation::LightAnimationPass`) at the start of the frame's first command
     /// encoder, before any pass reads the lights. Returns the bytes written (the parameters).
     pub fn prepare(
         &mut self,
@@ -136,7 +136,7 @@ impl LightMotions {
         light_count: u32,
         t: f32,
     ) -> Result<u64, RenderError> {
-        self.pending = None;
+        self.pending = false;
         let Some(motions) = &self.motions else { return Ok(0) };
         let pipeline = match &mut self.pipeline {
             Some(p) => p,
@@ -156,61 +156,25 @@ impl LightMotions {
             );
             self.bound = Some((generations, group));
         }
-        let max_groups = gpu.device.limits().max_compute_workgroups_per_dimension;
-        self.pending =
-            Some(crate::passes::cluster_build::dispatch_size(light_count, WORKGROUP_SIZE, max_groups)?);
+        self.pending = true;
         Ok(std::mem::size_of::<GpuLightAnimationParams>() as u64)
     }
 
     /// Whether the frame's dispatch is readied and not recorded yet.
     pub fn pending(&self) -> bool {
-        self.pending.is_some()
+        self.pending
+    }
+
+    /// The pipeline and bind group of the frame's dispatch (one invocation per light, in
+    /// workgroups of [`WORKGROUP_SIZE`]), while it is readied and not recorded yet.
+    pub fn dispatch(&self) -> Option<(&wgpu::ComputePipeline, &wgpu::BindGroup)> {
+        let (pipeline, (_, group)) = (self.pipeline.as_ref()?, self.bound.as_ref()?);
+        self.pending.then_some((&pipeline.pipeline, group))
     }
 
     /// Marks the frame's dispatch recorded.
     pub fn recorded(&mut self) {
-        self.pending = None;
-    }
-}
-
-/// The frame's light animation dispatch as a pass, recorded by the renderer first in the
-/// frame's first command encoder when [`LightMotions::pending`] (not a pass of a view's graph:
-/// it runs once per frame, whatever the views).
-pub struct LightAnimationPass;
-
-impl crate::graph::Pass for LightAnimationPass {
-    fn name(&self) -> &'static str {
-        "light_animation"
-    }
-
-    fn reads(&self) -> Vec<crate::graph::ResourceName> {
-        Vec::new()
-    }
-
-    fn writes(&self) -> Vec<crate::graph::ResourceName> {
-        Vec::new()
-    }
-
-    fn is_compute(&self) -> bool {
-        true
-    }
-
-    fn record(&self, ctx: &mut crate::graph::PassContext<'_>) -> Result<(), RenderError> {
-        let motions = &ctx.scene.motions;
-        let (Some([x, y]), Some(pipeline), Some((_, group))) =
-            (motions.pending, &motions.pipeline, &motions.bound)
-        else {
-            return Ok(());
-        };
-        let timestamps = ctx.compute_timestamps(true, true);
-        let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("light_animation"),
-            timestamp_writes: timestamps,
-        });
-        pass.set_pipeline(&pipeline.pipeline);
-        pass.set_bind_group(0, group, &[]);
-        pass.dispatch_workgroups(x, y, 1);
-        Ok(())
+        self.pending = false;
     }
 }
 

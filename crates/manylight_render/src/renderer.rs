@@ -339,7 +339,7 @@ impl Renderer {
         let mut encoder =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         // The frame's first encoder animates the lights first, before any pass reads them.
-        let animation = crate::animation::LightAnimationPass;
+        let animation = crate::passes::light_animation::LightAnimationPass;
         let mut with_animation = Vec::new();
         let passes = if self.scene.motions.pending() {
             with_animation.push(&animation as &dyn Pass);

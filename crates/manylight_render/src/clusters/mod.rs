@@ -216,13 +216,19 @@ impl ListNeeds {
         let cull = [CullTest::Aabb, CullTest::Planes, CullTest::Both]
             .into_iter()
             .find(|c| c.name() == report.cull_test);
-        ListNeeds {
-            cluster_entries: report.total_entries,
-            tile_entries: report.tile_entries,
-            coarse_entries: report.coarse_entries,
-            lights: report.lights,
-            layout: cull.map(|cull| ListLayout { dims: report.dims, coarse_span: report.coarse_span, cull }),
-        }
+        let layout = cull.map(|cull| ListLayout { dims: report.dims, coarse_span: report.coarse_span, cull });
+        let entries = [report.total_entries, report.tile_entries, report.coarse_entries];
+        ListNeeds::from_counts(entries, report.lights, layout)
+    }
+
+    /// The needs of a frame of `lights` lights and `layout` whose cluster, tile and coarse
+    /// lists held `[cluster, tile, coarse]` entries.
+    pub fn from_counts(
+        [cluster_entries, tile_entries, coarse_entries]: [u64; 3],
+        lights: u32,
+        layout: Option<ListLayout>,
+    ) -> ListNeeds {
+        ListNeeds { cluster_entries, tile_entries, coarse_entries, lights, layout }
     }
 }
 
@@ -411,11 +417,14 @@ impl ClusterResources {
     }
 
     /// The entries of the tile-lists buffer for the per-tile lists (first) and the
-    /// per-coarse-tile lists: the coarse lists get what they need and a quarter more
+    /// per-coarse-tile lists, from what the lists last needed (`self.needs`): the coarse lists
+    /// get what they need and a quarter more
     /// (`coarse_room`; level 1 from the lights' side runs an invocation and keeps a bit per tile
     /// for each of their entries), the tile lists the rest (and the coarse lists what is left
     /// when the buffer could not grow to both).
-    fn tile_list_split(&self, (tile_need, coarse_need): (u64, u64)) -> (u32, u32) {
+    fn tile_list_split(&self) -> (u32, u32) {
+        let needs = self.needs.unwrap_or_default();
+        let (tile_need, coarse_need) = (needs.tile_entries, needs.coarse_entries);
         let total = (self.buffers.tile_indices.capacity() / 4).min(u64::from(u32::MAX));
         let coarse = Self::coarse_room(coarse_need).min(total - tile_need.min(total));
         ((total - coarse) as u32, coarse as u32)
@@ -448,8 +457,7 @@ impl ClusterResources {
     ) -> Result<(), RenderError> {
         let (near, far) = (self.grid.near, self.grid.far);
         let count_ranges = self.grid.cluster_count() * if self.depth_bounds { 2 } else { 1 };
-        let needs = self.needs.unwrap_or_default();
-        let (tile_lists, coarse_lists) = self.tile_list_split((needs.tile_entries, needs.coarse_entries));
+        let (tile_lists, coarse_lists) = self.tile_list_split();
         let loop_limited = crate::gpu_types::has_loop_limit(&gpu.info);
         self.params = GpuClusterParams {
             dims: [self.grid.dims.x, self.grid.dims.y, self.grid.dims.z, self.grid.cluster_count()],
@@ -481,14 +489,19 @@ impl ClusterResources {
             view_from_world: view_from_world.to_cols_array_2d(),
         };
         self.size_bits(gpu)?;
-        gpu.write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(&self.params));
+        self.upload_params(gpu, &self.params);
+        self.bindings.rebind_if_grown(gpu, &self.buffers);
+        Ok(())
+    }
+
+    /// Uploads `params` and zeroes the counters (before a run of the build).
+    fn upload_params(&self, gpu: &GpuContext, params: &GpuClusterParams) {
+        gpu.write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(params));
         gpu.write_buffer(
             self.buffers.counters.buffer(),
             0,
             bytemuck::bytes_of(&GpuClusterCounters::default()),
         );
-        self.bindings.rebind_if_grown(gpu, &self.buffers);
-        Ok(())
     }
 
     /// Whether the grid lets levels 0 and 1 of the build run from the lights' side: a coarse
@@ -654,12 +667,7 @@ impl ClusterResources {
             params.depth_bounds = 0;
             self.counted_first = true;
         }
-        gpu.write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(&params));
-        gpu.write_buffer(
-            self.buffers.counters.buffer(),
-            0,
-            bytemuck::bytes_of(&GpuClusterCounters::default()),
-        );
+        self.upload_params(gpu, &params);
     }
 
     /// Sizes the lists again from the counts of a counting run (`counters`); true when they grew
@@ -672,18 +680,11 @@ impl ClusterResources {
         let short = counters.total_entries > self.params.index_capacity
             || counters.tile_entries > self.params.tile_index_capacity
             || counters.coarse_entries > self.params.coarse_index_capacity;
-        self.needs = Some(ListNeeds {
-            cluster_entries: u64::from(counters.total_entries),
-            tile_entries: u64::from(counters.tile_entries),
-            coarse_entries: u64::from(counters.coarse_entries),
-            lights: self.params.light_count,
-            layout: Some(self.layout()),
-        });
+        let entries = [counters.total_entries, counters.tile_entries, counters.coarse_entries].map(u64::from);
+        self.needs = Some(ListNeeds::from_counts(entries, self.params.light_count, Some(self.layout())));
         if short {
             let chunks = self.size_lists(gpu, self.params.light_count)?;
-            let needs = self.needs.unwrap_or_default();
-            (self.params.tile_index_capacity, self.params.coarse_index_capacity) =
-                self.tile_list_split((needs.tile_entries, needs.coarse_entries));
+            (self.params.tile_index_capacity, self.params.coarse_index_capacity) = self.tile_list_split();
             self.params.index_capacity = self.cluster_index_capacity();
             self.params.from_lights = u32::from(self.from_lights);
             [self.params.light_chunks, self.params.tile_chunks] = chunks;

@@ -114,30 +114,7 @@ pub struct ClusterBuildPass {
     pub depth_bounds: bool,
 }
 
-/// Workgroups `[x, y]` for `invocations` invocations of `workgroup_size`: one row while it fits
-/// in `max_per_dimension` (the device's `max_compute_workgroups_per_dimension`), else rows of
-/// `max_per_dimension` workgroups (the shader's `linear_index` undoes the split; invocations
-/// past the end return at once). Refused, naming the limit, past `max_per_dimension²`.
-pub fn dispatch_size(
-    invocations: u32,
-    workgroup_size: u32,
-    max_per_dimension: u32,
-) -> Result<[u32; 2], RenderError> {
-    let groups = invocations.div_ceil(workgroup_size.max(1)).max(1);
-    let max = max_per_dimension.max(1);
-    if groups <= max {
-        return Ok([groups, 1]);
-    }
-    let rows = groups.div_ceil(max);
-    // The padded grid's linear indices must stay below 2^32, or they would wrap onto real ones.
-    let padded = u64::from(max) * u64::from(rows) * u64::from(workgroup_size.max(1));
-    if rows > max || padded > 1 << 32 {
-        return Err(RenderError::UnsupportedSettings(format!(
-            "the cluster build needs {groups} workgroups, more than {max}² (max_compute_workgroups_per_dimension)"
-        )));
-    }
-    Ok([max, rows])
-}
+pub use super::common::dispatch_size;
 
 impl NamedPass for ClusterBuildPass {
     const NAME: &'static str = "cluster_build";

@@ -16,6 +16,7 @@ pub mod depth_prepass;
 pub mod forward;
 pub mod gbuffer;
 pub mod gbuffer_layout;
+pub mod light_animation;
 pub mod light_refine;
 pub mod light_volumes;
 pub mod motion_blur;

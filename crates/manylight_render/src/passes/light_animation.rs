@@ -1,0 +1,51 @@
+//! The light animation pass: the frame's one dispatch of `shaders/light_animation.wgsl`, which
+//! writes every GPU-animated light's position and colour into the light buffer
+//! ([`crate::animation`]). Not a pass of a view's graph: the renderer records it first in the
+//! frame's first command encoder, whatever the views, when the frame readied it.
+
+use super::common::dispatch_size;
+use crate::animation::WORKGROUP_SIZE;
+use crate::context::RenderError;
+use crate::graph::{NamedPass, Pass, PassContext, ResourceName};
+
+/// Records the frame's light animation dispatch ([`crate::animation::LightMotions::dispatch`]).
+pub struct LightAnimationPass;
+
+impl NamedPass for LightAnimationPass {
+    const NAME: &'static str = "light_animation";
+}
+
+impl Pass for LightAnimationPass {
+    fn name(&self) -> &'static str {
+        Self::NAME
+    }
+
+    fn reads(&self) -> Vec<ResourceName> {
+        Vec::new()
+    }
+
+    fn writes(&self) -> Vec<ResourceName> {
+        Vec::new()
+    }
+
+    fn is_compute(&self) -> bool {
+        true
+    }
+
+    fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
+        let Some((pipeline, group)) = ctx.scene.motions.dispatch() else {
+            return Ok(());
+        };
+        let max_groups = ctx.gpu.device.limits().max_compute_workgroups_per_dimension;
+        let [x, y] = dispatch_size(ctx.scene.light_count, WORKGROUP_SIZE, max_groups)?;
+        let timestamps = ctx.compute_timestamps(true, true);
+        let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(Self::NAME),
+            timestamp_writes: timestamps,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, group, &[]);
+        pass.dispatch_workgroups(x, y, 1);
+        Ok(())
+    }
+}
