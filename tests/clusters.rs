@@ -44,15 +44,7 @@ fn shell_lights() -> Vec<ExtractedPointLight> {
 }
 
 fn light(position: Vec3, radius: f32) -> ExtractedPointLight {
-    ExtractedPointLight {
-        position,
-        color: Vec3::ONE,
-        intensity: 1.0,
-        radius,
-        spot: None,
-        shadow: None,
-        animation: None,
-    }
+    ExtractedPointLight::point(position, Vec3::ONE, 1.0, radius)
 }
 
 /// Clustered forward with whole slices: the lists the CPU reference (`assign_lights`) builds.

@@ -90,15 +90,7 @@ fn orthographic_gpu_lists_equal_the_cpu_reference() {
         [(Vec3::ZERO, 3.0), (Vec3::new(0.0, 0.0, 0.4), 1.0), (Vec3::new(7.0 * 1.5, 0.0, -10.0), 2.0)]
     {
         let position = view.transform_point(local);
-        lights.push(manylight::render::ExtractedPointLight {
-            position,
-            color: Vec3::ONE,
-            intensity: 1.0,
-            radius,
-            spot: None,
-            shadow: None,
-            animation: None,
-        });
+        lights.push(manylight::render::ExtractedPointLight::point(position, Vec3::ONE, 1.0, radius));
     }
     for cull in [CullTest::Aabb, CullTest::Planes, CullTest::Both] {
         for pipeline in [PipelineKind::ClusteredForward, PipelineKind::ForwardPlus] {

@@ -27,10 +27,10 @@ pub const EPOCH_SPAN_SECS: f32 = 64.0;
 /// Invocations per workgroup of the pass.
 pub const WORKGROUP_SIZE: u32 = 64;
 
-/// The pass's pipeline and parameters, made the first time a frame animates a light.
-struct AnimationPipeline {
+/// The pass's group layout and parameters, made the first time a frame animates a light (the
+/// pass makes its pipeline through the renderer's pipeline cache).
+struct AnimationBindings {
     layout: GroupLayout,
-    pipeline: wgpu::ComputePipeline,
     params: wgpu::Buffer,
 }
 
@@ -46,7 +46,7 @@ struct EpochRange {
 pub struct LightMotions {
     /// One motion per light of the light buffer (`None` while no light animates).
     motions: Option<GrowableBuffer>,
-    pipeline: Option<AnimationPipeline>,
+    bindings: Option<AnimationBindings>,
     /// The bind group and the generations of the (light, motion) buffers it was made from.
     bound: Option<((u64, u64), wgpu::BindGroup)>,
     /// Per chunk of lights, the epochs of its animated lights (`None`: it has none).
@@ -138,18 +138,15 @@ impl LightMotions {
     ) -> Result<u64, RenderError> {
         self.pending = false;
         let Some(motions) = &self.motions else { return Ok(0) };
-        let pipeline = match &mut self.pipeline {
-            Some(p) => p,
-            None => self.pipeline.insert(AnimationPipeline::new(gpu)?),
-        };
+        let bindings = self.bindings.get_or_insert_with(|| AnimationBindings::new(gpu));
         let params = GpuLightAnimationParams { elapsed_secs: t, light_count, pad: [0; 2] };
-        gpu.write_buffer(&pipeline.params, 0, bytemuck::bytes_of(&params));
+        gpu.write_buffer(&bindings.params, 0, bytemuck::bytes_of(&params));
         let generations = (lights.generation(), motions.generation());
         if self.bound.as_ref().is_none_or(|(g, _)| *g != generations) {
-            let group = pipeline.layout.create_bind_group(
+            let group = bindings.layout.create_bind_group(
                 gpu,
                 &[
-                    Binding::Buffer(&pipeline.params),
+                    Binding::Buffer(&bindings.params),
                     Binding::Buffer(motions.buffer()),
                     Binding::Buffer(lights.buffer()),
                 ],
@@ -165,11 +162,11 @@ impl LightMotions {
         self.pending
     }
 
-    /// The pipeline and bind group of the frame's dispatch (one invocation per light, in
+    /// The group layout and bind group of the frame's dispatch (one invocation per light, in
     /// workgroups of [`WORKGROUP_SIZE`]), while it is readied and not recorded yet.
-    pub fn dispatch(&self) -> Option<(&wgpu::ComputePipeline, &wgpu::BindGroup)> {
-        let (pipeline, (_, group)) = (self.pipeline.as_ref()?, self.bound.as_ref()?);
-        self.pending.then_some((&pipeline.pipeline, group))
+    pub fn dispatch(&self) -> Option<(&GroupLayout, &wgpu::BindGroup)> {
+        let (bindings, (_, group)) = (self.bindings.as_ref()?, self.bound.as_ref()?);
+        self.pending.then_some((&bindings.layout, group))
     }
 
     /// Marks the frame's dispatch recorded.
@@ -178,31 +175,15 @@ impl LightMotions {
     }
 }
 
-impl AnimationPipeline {
-    fn new(gpu: &GpuContext) -> Result<AnimationPipeline, RenderError> {
-        let device = &gpu.device;
-        let layout = LIGHT_ANIMATION_GROUP.create_layout(device, ShaderDefs::default());
-        let module = crate::shaders::create_module(device, "light_animation.wgsl")?;
-        crate::layouts::check_pipeline("light_animation.wgsl", &[], &[&layout])?;
-        let pipeline_layout = crate::layouts::pipeline_layout(device, "light_animation", &[&layout]);
-        let constants = [("WORKGROUP_SIZE", WORKGROUP_SIZE as f64)];
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("light_animation"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some("main"),
-            compilation_options: wgpu::PipelineCompilationOptions {
-                constants: &constants,
-                ..Default::default()
-            },
-            cache: None,
-        });
+impl AnimationBindings {
+    fn new(gpu: &GpuContext) -> AnimationBindings {
+        let layout = LIGHT_ANIMATION_GROUP.create_layout(&gpu.device, ShaderDefs::default());
         let params = gpu.create_buffer(&wgpu::BufferDescriptor {
             label: Some("light_animation_params"),
             size: std::mem::size_of::<GpuLightAnimationParams>() as u64,
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        Ok(AnimationPipeline { layout, pipeline, params })
+        AnimationBindings { layout, params }
     }
 }

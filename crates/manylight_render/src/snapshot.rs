@@ -740,6 +740,11 @@ impl Default for ShadowBias {
 }
 
 impl ExtractedPointLight {
+    /// A point light (no cone, no shadow, no animation).
+    pub fn point(position: Vec3, color: Vec3, intensity: f32, radius: f32) -> ExtractedPointLight {
+        ExtractedPointLight { position, color, intensity, radius, spot: None, shadow: None, animation: None }
+    }
+
     /// True when every parameter is finite, the radius and intensity are not negative, and the
     /// emitted colour (`color × intensity`) does not overflow to infinity; for an animated
     /// light, also the box its orbit and bob stay in, and its base colour with twice the room.

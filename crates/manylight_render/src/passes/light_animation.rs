@@ -3,10 +3,19 @@
 //! ([`crate::animation`]). Not a pass of a view's graph: the renderer records it first in the
 //! frame's first command encoder, whatever the views, when the frame readied it.
 
-use super::common::dispatch_size;
+use super::common::{compute_pipeline, dispatch_size};
 use crate::animation::WORKGROUP_SIZE;
 use crate::context::RenderError;
 use crate::graph::{NamedPass, Pass, PassContext, ResourceName};
+use crate::pipelines::PipelineKey;
+
+/// The pipeline key of [`LightAnimationPass`] (one pipeline).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct LightAnimationKey;
+
+impl PipelineKey for LightAnimationKey {
+    type Pipeline = wgpu::ComputePipeline;
+}
 
 /// Records the frame's light animation dispatch ([`crate::animation::LightMotions::dispatch`]).
 pub struct LightAnimationPass;
@@ -33,9 +42,14 @@ impl Pass for LightAnimationPass {
     }
 
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
-        let Some((pipeline, group)) = ctx.scene.motions.dispatch() else {
+        let Some((layout, group)) = ctx.scene.motions.dispatch() else {
             return Ok(());
         };
+        let device = &ctx.gpu.device;
+        let pipeline = ctx.pipelines.get_or_create(LightAnimationKey, |_| {
+            let constants = [("WORKGROUP_SIZE", f64::from(WORKGROUP_SIZE))];
+            compute_pipeline(device, Self::NAME, "light_animation.wgsl", &[layout], "main", &constants)
+        })?;
         let max_groups = ctx.gpu.device.limits().max_compute_workgroups_per_dimension;
         let [x, y] = dispatch_size(ctx.scene.light_count, WORKGROUP_SIZE, max_groups)?;
         let timestamps = ctx.compute_timestamps(true, true);
@@ -43,7 +57,7 @@ impl Pass for LightAnimationPass {
             label: Some(Self::NAME),
             timestamp_writes: timestamps,
         });
-        pass.set_pipeline(pipeline);
+        pass.set_pipeline(&pipeline);
         pass.set_bind_group(0, group, &[]);
         pass.dispatch_workgroups(x, y, 1);
         Ok(())
