@@ -453,11 +453,10 @@ impl ClusterResources {
         view_from_world: &Mat4,
         light_count: u32,
         cap: u32,
-        [light_chunks, tile_chunks]: [u32; 2],
+        chunks: [u32; 2],
     ) -> Result<(), RenderError> {
         let (near, far) = (self.grid.near, self.grid.far);
         let count_ranges = self.grid.cluster_count() * if self.depth_bounds { 2 } else { 1 };
-        let (tile_lists, coarse_lists) = self.tile_list_split();
         let loop_limited = crate::gpu_types::has_loop_limit(&gpu.info);
         self.params = GpuClusterParams {
             dims: [self.grid.dims.x, self.grid.dims.y, self.grid.dims.z, self.grid.cluster_count()],
@@ -469,27 +468,41 @@ impl ClusterResources {
                 CullTest::Planes => CULL_PLANES,
                 CullTest::Both => CULL_BOTH,
             },
-            index_capacity: self.cluster_index_capacity(),
+            // The capacities, chunks and `from_lights`: `apply_list_sizes`.
+            index_capacity: 0,
             slicing: self.grid.slicing.gpu_id(),
             log_far_over_near: (far / near).ln(),
-            tile_index_capacity: tile_lists,
-            tile_chunks,
+            tile_index_capacity: 0,
+            tile_chunks: 0,
             coarse_dims: self.coarse_dims().unwrap_or(glam::UVec2::ZERO).to_array(),
-            coarse_index_capacity: coarse_lists,
+            coarse_index_capacity: 0,
             coarse_span: self.coarse.unwrap_or(0),
             depth_bounds: u32::from(self.depth_bounds),
             refine_blocks_x: self.refine_blocks.map_or(0, |b| b.x),
             refine_blocks_y: self.refine_blocks.map_or(0, |b| b.y),
             refined_first: count_ranges,
             frustum: manylight_core::cluster::rect_frustum(&self.grid).to_array(),
-            light_chunks,
-            from_lights: u32::from(self.from_lights),
+            light_chunks: 0,
+            from_lights: 0,
             loop_limit: if loop_limited { LAVAPIPE_LOOP_LIMIT } else { u32::MAX },
             _pad: 0,
             view_from_world: view_from_world.to_cols_array_2d(),
         };
-        self.size_bits(gpu)?;
+        self.apply_list_sizes(gpu, chunks)?;
         self.upload_params(gpu, &self.params);
+        Ok(())
+    }
+
+    /// Puts the lists' sizes (`size_lists`, whose chunks of lights are `[light_chunks,
+    /// tile_chunks]`) into the parameters: the cluster, tile and coarse capacities and whether
+    /// levels 0 and 1 run from the lights' side; sizes their bits and rebinds the buffers that
+    /// grew.
+    fn apply_list_sizes(&mut self, gpu: &GpuContext, chunks: [u32; 2]) -> Result<(), RenderError> {
+        (self.params.tile_index_capacity, self.params.coarse_index_capacity) = self.tile_list_split();
+        self.params.index_capacity = self.cluster_index_capacity();
+        self.params.from_lights = u32::from(self.from_lights);
+        [self.params.light_chunks, self.params.tile_chunks] = chunks;
+        self.size_bits(gpu)?;
         self.bindings.rebind_if_grown(gpu, &self.buffers);
         Ok(())
     }
@@ -684,12 +697,7 @@ impl ClusterResources {
         self.needs = Some(ListNeeds::from_counts(entries, self.params.light_count, Some(self.layout())));
         if short {
             let chunks = self.size_lists(gpu, self.params.light_count)?;
-            (self.params.tile_index_capacity, self.params.coarse_index_capacity) = self.tile_list_split();
-            self.params.index_capacity = self.cluster_index_capacity();
-            self.params.from_lights = u32::from(self.from_lights);
-            [self.params.light_chunks, self.params.tile_chunks] = chunks;
-            self.size_bits(gpu)?;
-            self.bindings.rebind_if_grown(gpu, &self.buffers);
+            self.apply_list_sizes(gpu, chunks)?;
         }
         Ok(short)
     }
