@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # Installs what manylight needs at run time on Debian/Ubuntu: a Vulkan driver (Mesa's lavapipe
-# renders on the CPU when there is no GPU), the Vulkan loader, and Xvfb for the window test.
+# renders on the CPU when there is no GPU), the Vulkan loader, Xvfb for the window test, and
+# for the web demo's tests Chromium, its WebDriver and Python (which serves the page).
 # Safe to run again: it installs only what is missing. On other systems install a Vulkan
 # driver for your GPU and skip this script.
 set -euo pipefail
 
-packages=(mesa-vulkan-drivers libvulkan1 xvfb xauth)
+packages=(mesa-vulkan-drivers libvulkan1 xvfb xauth chromium chromium-driver python3)
 missing=()
 if command -v dpkg >/dev/null 2>&1; then
     for p in "${packages[@]}"; do

@@ -72,6 +72,18 @@ pub trait FrameSink: Send + Sync + 'static {
         let _ = when;
     }
 
+    /// The adapter the sink renders with, once it has a device.
+    fn adapter(&self) -> Option<&wgpu::AdapterInfo> {
+        None
+    }
+
+    /// Whether the next frame can be rendered without waiting for the GPU (every frame in
+    /// flight has a free read-back slot). Where nothing may block (a browser) the app updates
+    /// only when its sink is ready.
+    fn ready(&self) -> bool {
+        true
+    }
+
     /// The images the last frame's render-to-texture cameras drew (none by default).
     fn take_textures(&mut self) -> Vec<(RenderTextureId, image::RgbaImage)> {
         Vec::new()
@@ -97,6 +109,14 @@ impl FrameSink for crate::render_world::HeadlessRenderer {
 
     fn take_textures(&mut self) -> Vec<(RenderTextureId, image::RgbaImage)> {
         self.render_world.take_textures()
+    }
+
+    fn ready(&self) -> bool {
+        self.render_world.renderer().can_begin_frame()
+    }
+
+    fn adapter(&self) -> Option<&wgpu::AdapterInfo> {
+        Some(&self.render_world.gpu().info)
     }
 }
 
@@ -232,7 +252,42 @@ pub enum RenderBackend {
     Failed(String),
 }
 
+/// Whether this platform renders on a thread of its own: everywhere but a browser, whose
+/// WebAssembly has no threads (there the synchronous path renders each frame on the caller).
+pub const HAS_RENDER_THREAD: bool = cfg!(not(target_arch = "wasm32"));
+
 impl RenderBackend {
+    /// The backend for `sink`: pipelined on a render thread when asked and the platform has
+    /// threads ([`HAS_RENDER_THREAD`]), synchronous otherwise.
+    pub fn start(sink: Box<dyn FrameSink>, pipelined: bool) -> RenderBackend {
+        if !(pipelined && HAS_RENDER_THREAD) {
+            return RenderBackend::sync(sink);
+        }
+        match RenderThread::spawn(sink) {
+            Ok(t) => RenderBackend::Pipelined(t),
+            Err(e) => RenderBackend::Failed(format!("could not start the render thread: {e}")),
+        }
+    }
+
+    /// Whether a frame submitted now renders without a blocking wait: a synchronous sink with
+    /// a free read-back slot, or a render thread (which waits on its own thread). No renderer
+    /// yet (the device is still being requested) is not ready.
+    pub fn ready(&self) -> bool {
+        match self {
+            RenderBackend::Sync { sink, .. } => sink.ready(),
+            RenderBackend::Pipelined(_) | RenderBackend::Failed(_) => true,
+            RenderBackend::Pending => false,
+        }
+    }
+
+    /// The adapter of a synchronous sink (a render thread keeps its sink to itself: `None`).
+    pub fn adapter(&self) -> Option<&wgpu::AdapterInfo> {
+        match self {
+            RenderBackend::Sync { sink, .. } => sink.adapter(),
+            _ => None,
+        }
+    }
+
     /// Renders on the calling thread through `sink`.
     pub fn sync(sink: Box<dyn FrameSink>) -> RenderBackend {
         RenderBackend::Sync { sink, pending: Vec::new(), last_frame: 0 }

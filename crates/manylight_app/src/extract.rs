@@ -372,7 +372,7 @@ pub fn extract_and_render(
     if failure.0.is_some() {
         return;
     }
-    let start = std::time::Instant::now();
+    let start = web_time::Instant::now();
     let mut snapshot = build_snapshot(&mut state, &mut inputs, &mut components.0);
     snapshot.extract_cpu_ms = start.elapsed().as_secs_f64() * 1e3;
     // The stages travel with each frame (an `Arc`, shared until the app changes them).

@@ -1,6 +1,6 @@
 //! `ManyLightPlugin`: adds the components' systems, the extract step and the renderer.
 
-use crate::backend::{RenderBackend, RenderThread};
+use crate::backend::RenderBackend;
 use crate::extract::{animate_lights, collect_results, extract_and_render};
 use crate::render_world::HeadlessRenderer;
 use crate::resources::{
@@ -184,11 +184,7 @@ impl Plugin for ManyLightPlugin {
             }
             OutputMode::Headless(config) => {
                 let backend = match HeadlessRenderer::with_frames_in_flight(self.frames_in_flight) {
-                    Ok(r) if self.pipelined => match RenderThread::spawn(Box::new(r)) {
-                        Ok(t) => RenderBackend::Pipelined(t),
-                        Err(e) => RenderBackend::Failed(format!("could not start the render thread: {e}")),
-                    },
-                    Ok(r) => RenderBackend::sync(Box::new(r)),
+                    Ok(r) => RenderBackend::start(Box::new(r), self.pipelined),
                     Err(e) => RenderBackend::Failed(e.to_string()),
                 };
                 let config = config.clone();

@@ -92,6 +92,30 @@ pub struct FrameStats {
     pub totals: FrameTotals,
 }
 
+impl FrameStats {
+    /// The statistics as a document to serialise: what `manylight render --stats-json`
+    /// writes and a web page's `manylight.stats()` returns.
+    pub fn document(&self) -> StatsDocument<'_> {
+        StatsDocument {
+            frames_rendered: self.frames_rendered,
+            frames_submitted: self.submitted,
+            last_frame: self.last.as_ref(),
+        }
+    }
+}
+
+/// [`FrameStats`] as a serialisable document ([`FrameStats::document`]).
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct StatsDocument<'a> {
+    /// Frames rendered so far.
+    pub frames_rendered: u64,
+    /// The latest frame handed to the GPU.
+    pub frames_submitted: u64,
+    /// The last frame whose statistics arrived: its counters (`blocking_waits`,
+    /// `frames_in_flight`, `buffers_created`, `bind_groups_created`) are in it.
+    pub last_frame: Option<&'a FrameReport>,
+}
+
 /// Sums over the reported frames (see [`FrameStats::totals`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FrameTotals {

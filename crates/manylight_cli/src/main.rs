@@ -544,13 +544,8 @@ fn select_camera(scene: &mut Scene, choice: &str) -> Result<()> {
 }
 
 fn stats_json(stats: &FrameStats) -> serde_json::Value {
-    serde_json::json!({
-        "frames_rendered": stats.frames_rendered,
-        "frames_submitted": stats.submitted,
-        // The last frame whose statistics arrived: its counters (`blocking_waits`,
-        // `frames_in_flight`, `buffers_created`, `bind_groups_created`) are in it.
-        "last_frame": stats.last,
-    })
+    // Plain data with string keys: it serialises to a value whatever it holds.
+    serde_json::to_value(stats.document()).unwrap_or(serde_json::Value::Null)
 }
 
 /// Times `snapshot`'s shading passes against the oracle's (the same frame shaded from exact

@@ -12,6 +12,7 @@ pub mod cluster;
 pub mod codec;
 pub mod efficiency;
 pub mod icosphere;
+#[cfg(not(target_arch = "wasm32"))]
 pub mod image_metrics;
 pub mod light_count;
 pub mod material;

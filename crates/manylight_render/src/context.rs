@@ -114,6 +114,10 @@ pub enum RenderError {
         /// Why the renderer gave up.
         why: String,
     },
+    /// Something asked to wait for the GPU in a browser, where nothing may block (a read-back
+    /// that is not asynchronous, or more frames in flight than the ring holds).
+    #[error("a blocking wait for the GPU was asked for, and a browser cannot block")]
+    BlockingWait,
     /// The GPU did not finish submitted work within [`GPU_WAIT_TIMEOUT`] (a hung or lost
     /// device); the frame is abandoned instead of freezing the caller.
     #[error(
@@ -202,7 +206,13 @@ impl GpuContext {
 
     /// Waits until the GPU has finished `submission` (all submitted work when `None`), at most
     /// [`GPU_WAIT_TIMEOUT`]; counted in [`GpuCounts::blocking_waits`].
+    ///
+    /// A browser cannot block: there this returns [`RenderError::BlockingWait`] and counts
+    /// nothing, so a path that would wait fails with a message instead of freezing the page.
     pub fn wait_for(&self, submission: Option<wgpu::SubmissionIndex>) -> Result<(), RenderError> {
+        if cfg!(target_arch = "wasm32") {
+            return Err(RenderError::BlockingWait);
+        }
         self.counters.blocking_waits.fetch_add(1, Ordering::Relaxed);
         self.device
             .poll(wgpu::PollType::Wait { submission_index: submission, timeout: Some(GPU_WAIT_TIMEOUT) })
@@ -211,6 +221,12 @@ impl GpuContext {
                 seconds: GPU_WAIT_TIMEOUT.as_secs(),
                 message: e.to_string(),
             })
+    }
+
+    /// Whether the CPU may wait for the GPU here: everywhere but a browser, where a wait would
+    /// freeze the page (there read-backs arrive between animation frames).
+    pub fn can_block(&self) -> bool {
+        cfg!(not(target_arch = "wasm32"))
     }
 
     /// Lets finished GPU work run its callbacks (mapped read-backs) without waiting.
@@ -289,18 +305,35 @@ impl GpuContext {
         }
     }
 
-    /// Creates a context without a surface (headless rendering, tests, benchmarks).
+    /// Creates a context without a surface (headless rendering, tests, benchmarks). Blocks
+    /// until the device arrives: native only (a browser uses [`GpuContext::request`]).
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn headless() -> Result<GpuContext, RenderError> {
         let instance = new_instance();
         Self::with_instance(instance, None)
     }
 
     /// Creates a context on `instance` whose adapter can present to `surface` (if given).
+    /// Blocks until the device arrives: native only (a browser uses [`GpuContext::request`]).
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn with_instance(
         instance: wgpu::Instance,
         surface: Option<&wgpu::Surface<'_>>,
     ) -> Result<GpuContext, RenderError> {
-        let adapter = request_adapter(&instance, surface)?;
+        pollster::block_on(Self::request(instance, surface))
+    }
+
+    /// Requests an adapter and a device on `instance` (one able to present to `surface`, if
+    /// given) and resolves to the context when the device arrives. Native callers block on it
+    /// ([`GpuContext::with_instance`]); a browser awaits it, as its API is asynchronous.
+    ///
+    /// The device gets the adapter's limits, so a browser's WebGPU adapter that offers more
+    /// than WebGPU's defaults (storage buffers per stage, colour attachment bytes) lends them.
+    pub async fn request(
+        instance: wgpu::Instance,
+        surface: Option<&wgpu::Surface<'_>>,
+    ) -> Result<GpuContext, RenderError> {
+        let adapter = request_adapter(&instance, surface).await?;
         let info = adapter.get_info();
         let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
         let mut required_features = wgpu::Features::empty();
@@ -321,26 +354,16 @@ impl GpuContext {
         if adapter.features().contains(wgpu::Features::CLIP_DISTANCES) {
             required_features |= wgpu::Features::CLIP_DISTANCES;
         }
-        let adapter_limits = adapter.limits();
-        let required_limits = wgpu::Limits {
-            max_texture_dimension_2d: adapter_limits.max_texture_dimension_2d,
-            max_storage_buffer_binding_size: adapter_limits.max_storage_buffer_binding_size,
-            max_buffer_size: adapter_limits.max_buffer_size,
-            max_compute_workgroup_storage_size: adapter_limits.max_compute_workgroup_storage_size,
-            max_compute_invocations_per_workgroup: adapter_limits.max_compute_invocations_per_workgroup,
-            max_compute_workgroup_size_x: adapter_limits.max_compute_workgroup_size_x,
-            // The Full and Packed G-buffers write 40 bytes per pixel (WebGPU's default is 32;
-            // Vulkan, Metal and D3D12 adapters report more).
-            max_color_attachment_bytes_per_sample: adapter_limits.max_color_attachment_bytes_per_sample,
-            ..wgpu::Limits::default()
-        };
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("manylight"),
-            required_features,
-            required_limits,
-            ..Default::default()
-        }))
-        .map_err(|e| RenderError::NoDevice { adapter: info.name.clone(), message: e.to_string() })?;
+        let required_limits = required_limits(&adapter.limits());
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("manylight"),
+                required_features,
+                required_limits,
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| RenderError::NoDevice { adapter: info.name.clone(), message: e.to_string() })?;
         let errors = Arc::new(std::sync::Mutex::new(Vec::new()));
         let sink = errors.clone();
         device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
@@ -377,8 +400,20 @@ impl GpuContext {
 
     /// A new device and queue on the same instance, after this one was lost; `surface`, when
     /// given, is a window surface the new adapter must be able to present to.
+    ///
+    /// In a browser a device arrives asynchronously, so it cannot be recreated within a frame:
+    /// the loss is returned as [`RenderError::DeviceLost`] and the page reloads to recover.
     pub fn recreate(&self, surface: Option<&wgpu::Surface<'_>>) -> Result<GpuContext, RenderError> {
-        Self::with_instance(self.instance.clone(), surface)
+        #[cfg(not(target_arch = "wasm32"))]
+        return Self::with_instance(self.instance.clone(), surface);
+        #[cfg(target_arch = "wasm32")]
+        {
+            let _ = surface;
+            Err(RenderError::DeviceLost {
+                reason: self.lost().unwrap_or_else(|| "lost".into()),
+                why: "a browser's device arrives asynchronously; reload the page".into(),
+            })
+        }
     }
 
     /// Why the device was lost, if it was. Polls the device without waiting first, so a loss
@@ -414,23 +449,45 @@ impl GpuContext {
 }
 
 /// The adapter a context on `instance` renders with (one able to present to `surface`, if given).
-fn request_adapter(
+async fn request_adapter(
     instance: &wgpu::Instance,
     surface: Option<&wgpu::Surface<'_>>,
 ) -> Result<wgpu::Adapter, RenderError> {
-    pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-        power_preference: wgpu::PowerPreference::HighPerformance,
-        force_fallback_adapter: false,
-        compatible_surface: surface,
-        apply_limit_buckets: false,
-    }))
-    .map_err(|e| RenderError::NoAdapter(e.to_string()))
+    instance
+        .request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: surface,
+            apply_limit_buckets: false,
+        })
+        .await
+        .map_err(|e| RenderError::NoAdapter(e.to_string()))
+}
+
+/// The limits a device is requested with: WebGPU's defaults (`wgpu::Limits::default()`, what
+/// every adapter gives), raised to the adapter's where the renderer benefits: texture and
+/// buffer sizes bound the light count and the target size, the compute limits the cluster
+/// build's workgroups, the colour attachment bytes the Full and Packed G-buffers (40 bytes a
+/// pixel; WebGPU's default is 32). Everything else stays at WebGPU's defaults, so what
+/// runs natively fits a browser's device.
+pub fn required_limits(adapter: &wgpu::Limits) -> wgpu::Limits {
+    wgpu::Limits {
+        max_texture_dimension_2d: adapter.max_texture_dimension_2d,
+        max_storage_buffer_binding_size: adapter.max_storage_buffer_binding_size,
+        max_buffer_size: adapter.max_buffer_size,
+        max_compute_workgroup_storage_size: adapter.max_compute_workgroup_storage_size,
+        max_compute_invocations_per_workgroup: adapter.max_compute_invocations_per_workgroup,
+        max_compute_workgroup_size_x: adapter.max_compute_workgroup_size_x,
+        max_color_attachment_bytes_per_sample: adapter.max_color_attachment_bytes_per_sample,
+        ..wgpu::Limits::default()
+    }
 }
 
 /// The light limit of the adapter a headless context would render with, read without creating
 /// a device: for checking a light count before anything is allocated.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn adapter_light_limit() -> Result<LightLimit, RenderError> {
-    let adapter = request_adapter(&new_instance(), None)?;
+    let adapter = pollster::block_on(request_adapter(&new_instance(), None))?;
     Ok(light_limit_of(&adapter.limits()))
 }
 

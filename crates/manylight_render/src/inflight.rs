@@ -107,6 +107,15 @@ impl FrameRing {
         self.queue.len() as u32
     }
 
+    /// Whether the next frame can begin without waiting: its slot is free, or the figures of
+    /// the frame that used it have arrived. A browser, which cannot wait, renders a frame only
+    /// then.
+    pub fn can_begin(&self, gpu: &GpuContext) -> bool {
+        gpu.poll();
+        let slot = &self.slots[self.next];
+        slot.frame.is_none() || slot.state.load(Ordering::Acquire) != MAPPING
+    }
+
     /// Starts recording a frame of `views` views: takes the next slot, waiting for the frame
     /// that used it when that one is still on the GPU (returned reports: every frame collected
     /// on the way, oldest first).

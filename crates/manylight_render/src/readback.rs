@@ -70,31 +70,9 @@ pub fn read_texture(
     bytes_per_pixel: u32,
 ) -> Result<Vec<u8>, RenderError> {
     let (width, height) = (texture.width(), texture.height());
+    let (buffer, padded) = copy_to_buffer(gpu, texture, aspect, bytes_per_pixel);
     let row = width * bytes_per_pixel;
-    let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-    let size = padded as u64 * height as u64;
-    let buffer = gpu.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("texture_readback"),
-        size,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    let mut encoder = gpu
-        .device
-        .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("texture_readback") });
-    encoder.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo { texture, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect },
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(padded),
-                rows_per_image: Some(height),
-            },
-        },
-        wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-    );
-    gpu.queue.submit([encoder.finish()]);
+    let size = buffer.size();
     let bytes = read_buffer(gpu, &buffer, 0, size)?;
     let mut out = Vec::with_capacity((row * height) as usize);
     for y in 0..height as usize {
@@ -152,4 +130,106 @@ pub fn read_buffer(
     let data = slice.get_mapped_range().map(|range| range.to_vec());
     source.unmap();
     data.map_err(|e| RenderError::Readback(e.to_string()))
+}
+
+/// Records and submits a copy of one aspect of `texture` into a new mappable buffer whose rows
+/// are padded to wgpu's copy alignment; returns the buffer and its padded row bytes.
+fn copy_to_buffer(
+    gpu: &GpuContext,
+    texture: &wgpu::Texture,
+    aspect: wgpu::TextureAspect,
+    bytes_per_pixel: u32,
+) -> (wgpu::Buffer, u32) {
+    let (width, height) = (texture.width(), texture.height());
+    let row = width * bytes_per_pixel;
+    let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let buffer = gpu.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("texture_readback"),
+        size: padded as u64 * height as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = gpu
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("texture_readback") });
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo { texture, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded),
+                rows_per_image: Some(height),
+            },
+        },
+        wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+    );
+    gpu.queue.submit([encoder.finish()]);
+    (buffer, padded)
+}
+
+const MAP_PENDING: u8 = 0;
+const MAP_DONE: u8 = 1;
+const MAP_ERROR: u8 = 2;
+
+/// An 8-bit RGBA or BGRA colour texture on its way to the CPU without a wait: the copy is
+/// submitted and mapped when this is made, and [`PendingImage::try_take`] hands the image
+/// over once the GPU has mapped it (in a browser, between two animation frames).
+pub struct PendingImage {
+    buffer: wgpu::Buffer,
+    width: u32,
+    height: u32,
+    padded_row: u32,
+    bgra: bool,
+    state: std::sync::Arc<std::sync::atomic::AtomicU8>,
+}
+
+impl PendingImage {
+    /// Starts copying `texture` (`Rgba8*` or `Bgra8*`, copyable) to the CPU.
+    pub fn start(gpu: &GpuContext, texture: &wgpu::Texture) -> Result<PendingImage, RenderError> {
+        use wgpu::TextureFormat as F;
+        let format = texture.format();
+        let bgra = matches!(format, F::Bgra8Unorm | F::Bgra8UnormSrgb);
+        if !bgra && !matches!(format, F::Rgba8Unorm | F::Rgba8UnormSrgb) {
+            return Err(RenderError::Readback(format!("{format:?} is not an 8-bit RGBA or BGRA format")));
+        }
+        let (buffer, padded_row) = copy_to_buffer(gpu, texture, wgpu::TextureAspect::All, 4);
+        let state = std::sync::Arc::new(std::sync::atomic::AtomicU8::new(MAP_PENDING));
+        let mapped = state.clone();
+        buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+            mapped.store(if r.is_ok() { MAP_DONE } else { MAP_ERROR }, std::sync::atomic::Ordering::Release);
+        });
+        Ok(PendingImage { buffer, width: texture.width(), height: texture.height(), padded_row, bgra, state })
+    }
+
+    /// The image once the GPU has mapped the copy (`None` until then; polls without waiting).
+    pub fn try_take(&self, gpu: &GpuContext) -> Option<Result<image::RgbaImage, RenderError>> {
+        gpu.poll();
+        match self.state.load(std::sync::atomic::Ordering::Acquire) {
+            MAP_PENDING => None,
+            MAP_ERROR => Some(Err(RenderError::Readback("mapping the image copy failed".into()))),
+            _ => Some(self.unpack()),
+        }
+    }
+
+    fn unpack(&self) -> Result<image::RgbaImage, RenderError> {
+        let row = (self.width * 4) as usize;
+        let data = self.buffer.slice(..).get_mapped_range().map(|bytes| {
+            let mut out = Vec::with_capacity(row * self.height as usize);
+            for y in 0..self.height as usize {
+                let start = y * self.padded_row as usize;
+                out.extend_from_slice(&bytes[start..start + row]);
+            }
+            out
+        });
+        self.buffer.unmap();
+        let mut pixels = data.map_err(|e| RenderError::Readback(e.to_string()))?;
+        if self.bgra {
+            for pixel in pixels.chunks_exact_mut(4) {
+                pixel.swap(0, 2);
+            }
+        }
+        image::RgbaImage::from_raw(self.width, self.height, pixels)
+            .ok_or_else(|| RenderError::Readback("size mismatch".into()))
+    }
 }

@@ -20,7 +20,7 @@ use crate::resources::SceneResources;
 use crate::snapshot::{FrameSnapshot, RenderView};
 use crate::stats::{CpuPhases, FrameReport, PassTiming};
 use std::collections::HashMap;
-use std::time::Instant;
+use web_time::Instant;
 
 /// Everything that lives across frames on the render side.
 pub struct Renderer {
@@ -81,6 +81,12 @@ impl Renderer {
     /// The most frames that can be in flight.
     pub fn frames_in_flight(&self) -> u32 {
         self.ring.frames_in_flight()
+    }
+
+    /// Whether the next frame can start without waiting for the GPU (see
+    /// [`FrameRing::can_begin`]).
+    pub fn can_begin_frame(&self) -> bool {
+        self.ring.can_begin(&self.gpu)
     }
 
     /// Uploads the data the frame's views share (the `Prepare` step): lights, instances,
@@ -200,7 +206,8 @@ impl Renderer {
     /// frame (exact, slower), so no light is lost and no frame is rendered twice. Only when the
     /// lists have no counts to go by (the view's first frame, or the light count more than
     /// doubled) does the view run its build once before the frame, only to count, and wait for
-    /// those counters (`ClusterReport::counted_first`).
+    /// those counters (`ClusterReport::counted_first`), and only where the CPU may wait
+    /// ([`GpuContext::can_block`]).
     pub fn execute(
         &mut self,
         graph: &RenderGraph,
@@ -225,7 +232,12 @@ impl Renderer {
                 limit: LAVAPIPE_LOOP_LIMIT,
             });
         }
-        if builds_clusters && self.view_clusters(view.index).is_some_and(ClusterResources::needs_counting) {
+        // Where nothing may wait (a browser) the lists go uncounted: their short clusters shade
+        // from every light until the frame's counters come back and size them.
+        if builds_clusters
+            && self.gpu.can_block()
+            && self.view_clusters(view.index).is_some_and(ClusterResources::needs_counting)
+        {
             self.count_lists(snapshot, view, output, output_format)?;
         }
         let mut report =

@@ -190,7 +190,7 @@ const SUPPORTED_REQUIRED: &[&str] =
 /// Every malformed input is reported as a [`SceneError`] naming the file; nothing is fetched
 /// over the network and no file outside the glTF file's folder is read.
 pub fn load_gltf(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
-    let start = std::time::Instant::now();
+    let start = web_time::Instant::now();
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| load_inner(path, options)));
     let scene = match result {
         Ok(r) => r?,

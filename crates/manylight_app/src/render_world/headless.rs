@@ -21,9 +21,26 @@ impl HeadlessRenderer {
 
     /// Creates a headless GPU context and render world; at most `frames_in_flight` frames are
     /// submitted and not yet read back.
+    ///
+    /// The device is requested with a blocking wait, which a browser cannot do: there this
+    /// fails with [`RenderError::BlockingWait`]; request a [`GpuContext`] asynchronously
+    /// ([`GpuContext::request`]) and use [`HeadlessRenderer::with_context`].
     pub fn with_frames_in_flight(frames_in_flight: u32) -> Result<HeadlessRenderer, RenderError> {
-        let render_world = RenderWorld::with_frames_in_flight(GpuContext::headless()?, frames_in_flight);
-        Ok(HeadlessRenderer { render_world, target: None })
+        #[cfg(not(target_arch = "wasm32"))]
+        return Ok(Self::with_context(GpuContext::headless()?, frames_in_flight));
+        #[cfg(target_arch = "wasm32")]
+        {
+            let _ = frames_in_flight;
+            Err(RenderError::BlockingWait)
+        }
+    }
+
+    /// A headless renderer on a context the caller requested.
+    pub fn with_context(gpu: GpuContext, frames_in_flight: u32) -> HeadlessRenderer {
+        HeadlessRenderer {
+            render_world: RenderWorld::with_frames_in_flight(gpu, frames_in_flight),
+            target: None,
+        }
     }
 
     /// Renders a snapshot and waits for it (the reference path for tests and measurements: the

@@ -208,7 +208,7 @@ impl RenderWorld {
         output: &wgpu::TextureView,
         format: wgpu::TextureFormat,
     ) -> Result<FrameReport, RenderError> {
-        let start = std::time::Instant::now();
+        let start = web_time::Instant::now();
         let mut snapshot = snapshot;
         let invalid_cameras = snapshot.reject_invalid_camera();
         let sanitized_cameras = snapshot.sanitized_cameras();

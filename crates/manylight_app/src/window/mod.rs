@@ -24,13 +24,13 @@ pub mod xvfb;
 pub use overlay::{OVERLAY_PASS, Overlay};
 pub use surface::SurfaceSink;
 
-use crate::backend::{RenderBackend, RenderThread};
+use crate::backend::RenderBackend;
 use crate::resources::{RenderFailure, ViewportSize};
 use bevy_app::{App, AppExit, PluginsState};
 use bevy_ecs::prelude::*;
 use glam::UVec2;
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use web_time::{Duration, Instant};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, KeyEvent, WindowEvent};
@@ -58,6 +58,10 @@ pub struct WindowConfig {
     pub any_thread: bool,
     /// Show the egui overlay (settings and timings; F1 or the [`Overlay`] resource hides it).
     pub overlay: bool,
+    /// In a browser: the canvas to draw into, sized by the page's CSS (`width` and `height`
+    /// are then ignored). `None` appends a new canvas of `width × height` to the page's body.
+    #[cfg(target_arch = "wasm32")]
+    pub canvas: Option<web_sys::HtmlCanvasElement>,
 }
 
 impl Default for WindowConfig {
@@ -69,6 +73,8 @@ impl Default for WindowConfig {
             vsync: true,
             any_thread: false,
             overlay: true,
+            #[cfg(target_arch = "wasm32")]
+            canvas: None,
         }
     }
 }
@@ -122,8 +128,19 @@ impl WindowRequests {
     }
 }
 
+/// What reaches the event loop from outside a window event.
+enum RunnerEvent {
+    /// The window's renderer, once its device arrived (in a browser the device is requested
+    /// asynchronously after the window exists).
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
+    Renderer(Box<Result<SurfaceSink, manylight_render::RenderError>>),
+}
+
 /// The winit application: owns the app and the window, and turns window events into updates.
 struct WinitRunner {
+    /// Sends the renderer to the loop when its device arrives.
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
+    proxy: winit::event_loop::EventLoopProxy<RunnerEvent>,
     app: App,
     config: WindowConfig,
     pipelined: bool,
@@ -175,6 +192,14 @@ impl WinitRunner {
     /// One frame: update the app, then act on `AppExit` and on the window requests.
     fn update(&mut self, event_loop: &ActiveEventLoop) {
         if self.exit.is_some() {
+            return;
+        }
+        // Without a render thread nothing may wait for the GPU: while the renderer is not
+        // there yet or has no free frame slot, the app does not update (the next redraw asks
+        // again).
+        if !crate::backend::HAS_RENDER_THREAD
+            && !self.app.world().get_resource::<RenderBackend>().is_some_and(RenderBackend::ready)
+        {
             return;
         }
         self.publish_viewport();
@@ -271,24 +296,40 @@ impl WinitRunner {
     }
 }
 
-impl ApplicationHandler for WinitRunner {
-    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
-        if self.window.is_some() || self.exit.is_some() {
-            return;
-        }
-        let attributes = Window::default_attributes()
-            .with_title(self.config.title.clone())
+impl WinitRunner {
+    /// The window's attributes: title and size; in a browser, the canvas (the page's, or a new
+    /// one appended to its body).
+    fn window_attributes(&self) -> winit::window::WindowAttributes {
+        let attributes = Window::default_attributes().with_title(self.config.title.clone());
+        let sized = attributes
+            .clone()
             .with_inner_size(PhysicalSize::new(self.config.width.max(1), self.config.height.max(1)));
-        let window = match event_loop.create_window(attributes) {
-            Ok(w) => Arc::new(w),
-            Err(e) => return self.fail(event_loop, format!("could not open a window: {e}")),
+        #[cfg(target_arch = "wasm32")]
+        {
+            use winit::platform::web::WindowAttributesExtWebSys;
+            match self.config.canvas.clone() {
+                Some(canvas) => attributes.with_canvas(Some(canvas)),
+                None => sized.with_append(true),
+            }
+        }
+        #[cfg(not(target_arch = "wasm32"))]
+        {
+            let _ = attributes;
+            sized
+        }
+    }
+
+    /// Starts drawing into `window` through `sink`: the overlay, the backend (pipelined when
+    /// asked and possible), the first redraw.
+    fn start_rendering(
+        &mut self,
+        event_loop: &ActiveEventLoop,
+        sink: Result<SurfaceSink, manylight_render::RenderError>,
+    ) {
+        let Some(window) = self.window.clone() else {
+            return;
         };
-        let frames_in_flight = self
-            .app
-            .world()
-            .get_resource::<crate::resources::FramesInFlight>()
-            .map_or(manylight_render::DEFAULT_FRAMES_IN_FLIGHT, |f| f.0);
-        let mut sink = match SurfaceSink::new(window.clone(), self.config.vsync, frames_in_flight) {
+        let mut sink = match sink {
             Ok(s) => s,
             Err(e) => return self.fail(event_loop, e.to_string()),
         };
@@ -298,19 +339,56 @@ impl ApplicationHandler for WinitRunner {
             self.overlay = Some(host);
             self.app.world_mut().init_resource::<Overlay>();
         }
-        let backend = if self.pipelined {
-            match RenderThread::spawn(Box::new(sink)) {
-                Ok(t) => RenderBackend::Pipelined(t),
-                Err(e) => return self.fail(event_loop, format!("could not start the render thread: {e}")),
-            }
-        } else {
-            RenderBackend::sync(Box::new(sink))
-        };
+        let backend = RenderBackend::start(Box::new(sink), self.pipelined);
+        if let RenderBackend::Failed(message) = backend {
+            return self.fail(event_loop, message);
+        }
         self.app.world_mut().insert_resource(backend);
         let size = window.inner_size();
         self.window_size = UVec2::new(size.width, size.height);
         window.request_redraw();
-        self.window = Some(window);
+    }
+
+    fn frames_in_flight(&self) -> u32 {
+        self.app
+            .world()
+            .get_resource::<crate::resources::FramesInFlight>()
+            .map_or(manylight_render::DEFAULT_FRAMES_IN_FLIGHT, |f| f.0)
+    }
+}
+
+impl ApplicationHandler<RunnerEvent> for WinitRunner {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.window.is_some() || self.exit.is_some() {
+            return;
+        }
+        let window = match event_loop.create_window(self.window_attributes()) {
+            Ok(w) => Arc::new(w),
+            Err(e) => return self.fail(event_loop, format!("could not open a window: {e}")),
+        };
+        self.window = Some(window.clone());
+        let (vsync, frames_in_flight) = (self.config.vsync, self.frames_in_flight());
+        // A browser answers the device request asynchronously: the renderer arrives as a
+        // `RunnerEvent` and the app updates from then on. Natively the request blocks here.
+        #[cfg(target_arch = "wasm32")]
+        {
+            let _ = event_loop;
+            let proxy = self.proxy.clone();
+            wasm_bindgen_futures::spawn_local(async move {
+                let sink = SurfaceSink::request(window, vsync, frames_in_flight).await;
+                if proxy.send_event(RunnerEvent::Renderer(Box::new(sink))).is_err() {
+                    tracing::debug!("the event loop ended before the GPU device arrived");
+                }
+            });
+        }
+        #[cfg(not(target_arch = "wasm32"))]
+        self.start_rendering(event_loop, SurfaceSink::new(window, vsync, frames_in_flight));
+    }
+
+    fn user_event(&mut self, event_loop: &ActiveEventLoop, event: RunnerEvent) {
+        match event {
+            RunnerEvent::Renderer(sink) => self.start_rendering(event_loop, *sink),
+        }
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
@@ -336,11 +414,12 @@ impl ApplicationHandler for WinitRunner {
             WindowEvent::CloseRequested | WindowEvent::Destroyed => {
                 self.exit_with(event_loop, AppExit::Success);
             }
+            // A page is closed by its tab, not by a key.
             WindowEvent::KeyboardInput {
                 event:
                     KeyEvent { logical_key: Key::Named(NamedKey::Escape), state: ElementState::Pressed, .. },
                 ..
-            } => self.exit_with(event_loop, AppExit::Success),
+            } if crate::backend::HAS_RENDER_THREAD => self.exit_with(event_loop, AppExit::Success),
             WindowEvent::KeyboardInput {
                 event: KeyEvent { logical_key, state: ElementState::Pressed, .. },
                 ..
@@ -408,8 +487,8 @@ impl ApplicationHandler for WinitRunner {
     }
 }
 
-fn build_event_loop(config: &WindowConfig) -> Result<EventLoop<()>, winit::error::EventLoopError> {
-    let mut builder = EventLoop::builder();
+fn build_event_loop(config: &WindowConfig) -> Result<EventLoop<RunnerEvent>, winit::error::EventLoopError> {
+    let mut builder = EventLoop::with_user_event();
     #[cfg(all(
         unix,
         not(any(target_os = "macos", target_os = "ios", target_os = "android", target_os = "emscripten"))
@@ -443,9 +522,14 @@ fn build_event_loop(config: &WindowConfig) -> Result<EventLoop<()>, winit::error
 /// Runs `app` in a window until it is closed, Esc is pressed, a system sends `AppExit` or
 /// calls [`WindowRequests::request_close`]. Returns the app's exit status (an error when
 /// rendering failed, also in a frame that was still in flight at the close).
+///
+/// In a browser the event loop belongs to the page: this hands the app to it and returns at
+/// once; the app runs on each animation frame, and a failure is recorded in
+/// [`RenderFailure`] (the page reads it).
 pub fn run_window(mut app: App, config: WindowConfig, pipelined: bool) -> AppExit {
     if app.plugins_state() != PluginsState::Cleaned {
         while app.plugins_state() == PluginsState::Adding {
+            #[cfg(not(target_arch = "wasm32"))]
             std::thread::yield_now();
         }
         app.finish();
@@ -461,7 +545,8 @@ pub fn run_window(mut app: App, config: WindowConfig, pipelined: bool) -> AppExi
     };
     event_loop.set_control_flow(ControlFlow::Poll);
     let size = UVec2::new(config.width, config.height);
-    let mut runner = WinitRunner {
+    let runner = WinitRunner {
+        proxy: event_loop.create_proxy(),
         app,
         config,
         pipelined,
@@ -473,6 +558,19 @@ pub fn run_window(mut app: App, config: WindowConfig, pipelined: bool) -> AppExi
         exit: None,
         overlay: None,
     };
+    #[cfg(target_arch = "wasm32")]
+    {
+        use winit::platform::web::EventLoopExtWebSys;
+        event_loop.spawn_app(runner);
+        AppExit::Success
+    }
+    #[cfg(not(target_arch = "wasm32"))]
+    run_to_exit(event_loop, runner)
+}
+
+/// Runs the event loop on this thread until the app exits.
+#[cfg(not(target_arch = "wasm32"))]
+fn run_to_exit(event_loop: EventLoop<RunnerEvent>, mut runner: WinitRunner) -> AppExit {
     let result = event_loop.run_app(&mut runner);
     // `exiting` has already stopped the renderer; this covers a loop that ended without it.
     runner.shut_down_renderer();

@@ -27,7 +27,7 @@ use manylight_core::codec::NormalCodec;
 use manylight_render::{DebugViewMode, GBufferLayout, GpuContext, PassTiming, PipelineKind};
 use std::collections::VecDeque;
 use std::sync::{Arc, Mutex};
-use std::time::Instant;
+use web_time::Instant;
 use winit::window::Window;
 
 /// Name of the overlay's pass in frame reports.

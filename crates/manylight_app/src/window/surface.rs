@@ -21,16 +21,30 @@ pub struct SurfaceSink {
     warned_too_large: bool,
     warned_readback: bool,
     overlay: Option<OverlayPainter>,
+    /// A frame's image on its way to the CPU, where read-back cannot wait (a browser).
+    pending_image: Option<manylight_render::readback::PendingImage>,
 }
 
 impl SurfaceSink {
     /// Creates the surface and a GPU context able to present to it; at most
-    /// `frames_in_flight` frames are submitted and not yet read back.
+    /// `frames_in_flight` frames are submitted and not yet read back. Blocks until the device
+    /// arrives (native; a browser awaits [`SurfaceSink::request`]).
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn new(window: Arc<Window>, vsync: bool, frames_in_flight: u32) -> Result<SurfaceSink, RenderError> {
+        pollster::block_on(Self::request(window, vsync, frames_in_flight))
+    }
+
+    /// Creates the surface, then requests a GPU context able to present to it; resolves when
+    /// the device arrives.
+    pub async fn request(
+        window: Arc<Window>,
+        vsync: bool,
+        frames_in_flight: u32,
+    ) -> Result<SurfaceSink, RenderError> {
         let instance = manylight_render::context::new_instance();
         let surface =
             instance.create_surface(window.clone()).map_err(|e| RenderError::Surface(e.to_string()))?;
-        let gpu = GpuContext::with_instance(instance, Some(&surface))?;
+        let gpu = GpuContext::request(instance, Some(&surface)).await?;
         Ok(SurfaceSink {
             window,
             surface,
@@ -40,6 +54,7 @@ impl SurfaceSink {
             warned_too_large: false,
             warned_readback: false,
             overlay: None,
+            pending_image: None,
         })
     }
 
@@ -74,7 +89,9 @@ impl SurfaceSink {
             present_mode,
             desired_maximum_frame_latency: 2,
             alpha_mode: caps.alpha_modes.first().copied().unwrap_or(wgpu::CompositeAlphaMode::Auto),
-            view_formats: vec![],
+            // A surface without an sRGB format (a WebGPU canvas) is drawn through an sRGB view
+            // of it, so the tone map's output is encoded as everywhere else.
+            view_formats: if format.is_srgb() { vec![] } else { vec![format.add_srgb_suffix()] },
             color_space: wgpu::SurfaceColorSpace::Auto,
         };
         tracing::debug!("configuring the window surface: {}x{} {format:?}", size.x, size.y);
@@ -131,24 +148,56 @@ impl SurfaceSink {
         Ok(None)
     }
 
-    /// The frame's image as RGBA8, when the surface can be copied from and is an 8-bit RGBA or
-    /// BGRA format; `None` (with one warning) otherwise.
-    fn read_back(&mut self, texture: &wgpu::Texture) -> Result<Option<image::RgbaImage>, RenderError> {
+    /// Whether the surface can be read back: copyable and 8-bit RGBA or BGRA (one warning
+    /// when it cannot).
+    fn readable(&mut self, texture: &wgpu::Texture) -> bool {
         use wgpu::TextureFormat as F;
         let copyable = self.config.as_ref().is_some_and(|c| c.usage.contains(wgpu::TextureUsages::COPY_SRC));
         let format = texture.format();
-        let bgra = matches!(format, F::Bgra8Unorm | F::Bgra8UnormSrgb);
-        if !copyable || !(bgra || matches!(format, F::Rgba8Unorm | F::Rgba8UnormSrgb)) {
-            if !self.warned_readback {
-                tracing::warn!("the window surface ({format:?}) cannot be read back: no images captured");
-                self.warned_readback = true;
+        let readable = copyable
+            && matches!(format, F::Bgra8Unorm | F::Bgra8UnormSrgb | F::Rgba8Unorm | F::Rgba8UnormSrgb);
+        if !readable && !self.warned_readback {
+            tracing::warn!("the window surface ({format:?}) cannot be read back: no images captured");
+            self.warned_readback = true;
+        }
+        readable
+    }
+
+    /// Read-back without a wait: a frame asked to be read back starts a copy when none is on
+    /// its way; the image comes back with the first later frame that finds the copy mapped
+    /// (the frame asked for, not the one it comes back with).
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
+    fn read_back_later(
+        &mut self,
+        texture: Option<&wgpu::Texture>,
+    ) -> Result<Option<image::RgbaImage>, RenderError> {
+        let gpu = self.render_world.gpu();
+        if let Some(pending) = &self.pending_image {
+            let taken = pending.try_take(gpu);
+            if taken.is_some() {
+                self.pending_image = None;
             }
+            return taken.transpose();
+        }
+        if let Some(texture) = texture.filter(|t| self.readable(t)) {
+            let gpu = self.render_world.gpu();
+            self.pending_image = Some(manylight_render::readback::PendingImage::start(gpu, texture)?);
+        }
+        Ok(None)
+    }
+
+    /// The frame's image as RGBA8, when the surface can be copied from and is an 8-bit RGBA or
+    /// BGRA format; `None` (with one warning) otherwise.
+    #[cfg_attr(target_arch = "wasm32", allow(dead_code))]
+    fn read_back(&mut self, texture: &wgpu::Texture) -> Result<Option<image::RgbaImage>, RenderError> {
+        use wgpu::TextureFormat as F;
+        if !self.readable(texture) {
             return Ok(None);
         }
         let gpu = self.render_world.gpu();
         let mut image =
             manylight_render::readback::read_texture_rgba8(gpu, texture, texture.width(), texture.height())?;
-        if bgra {
+        if matches!(texture.format(), F::Bgra8Unorm | F::Bgra8UnormSrgb) {
             for pixel in image.pixels_mut() {
                 pixel.0.swap(0, 2);
             }
@@ -176,6 +225,14 @@ impl FrameSink for SurfaceSink {
 
     fn drain(&mut self) -> Result<Vec<FrameReport>, RenderError> {
         self.render_world.take_reports(true)
+    }
+
+    fn ready(&self) -> bool {
+        self.render_world.renderer().can_begin_frame()
+    }
+
+    fn adapter(&self) -> Option<&wgpu::AdapterInfo> {
+        Some(&self.render_world.gpu().info)
     }
 }
 
@@ -223,10 +280,15 @@ impl DeviceSink for SurfaceSink {
         let Some(frame) = self.acquire(size)? else {
             return Ok((Some(self.render_world.report_empty(empty_report(&snapshot))), None));
         };
-        let format = frame.texture.format();
-        let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
+        let format = frame.texture.format().add_srgb_suffix();
+        let view = frame
+            .texture
+            .create_view(&wgpu::TextureViewDescriptor { format: Some(format), ..Default::default() });
         let mut report = self.render_world.render(snapshot, &view, format)?;
+        #[cfg(not(target_arch = "wasm32"))]
         let image = if readback { self.read_back(&frame.texture)? } else { None };
+        #[cfg(target_arch = "wasm32")]
+        let image = self.read_back_later(readback.then_some(&frame.texture))?;
         if let Some(painter) = self.overlay.as_mut() {
             let renderer = self.render_world.renderer_mut();
             if let Some((timing, timed)) =

@@ -1,0 +1,19 @@
+//! The manylight web demo: the embedded hall lit by a thousand animated lights in a browser
+//! canvas, on WebGPU. `scripts/web.sh` builds it with wasm-bindgen and serves `web/index.html`.
+//!
+//! The page contract (for people and tests):
+//! - URL query parameters ([`options::WebOptions`]): `lights`, `pipeline`, `shadows`,
+//!   `debug-view`, `scene` (`hall` or `sphere-shell`), `size`, `overlay`, `clock`, `capture`.
+//!   A bad one shows its error on the page.
+//! - After the first frame `document.title` is `manylight: ready`.
+//! - `manylight.stats()`: the last frame's statistics, the document of
+//!   `manylight render --stats-json` plus `backend` (`webgpu` or `webgl2`).
+//! - `manylight.error()`: the first error, or `undefined`.
+//! - `manylight.capture()`: the image of the update `capture` names, as a PNG data URL, once
+//!   read back.
+#![warn(missing_docs)]
+
+pub mod demo;
+pub mod options;
+#[cfg(target_arch = "wasm32")]
+pub mod page;

@@ -1,0 +1,220 @@
+//! The page side: starts the app in the page's canvas, and answers the page contract.
+//!
+//! 1. `start` (run when the module is initialised) parses the URL query, builds the app with
+//!    the manylight plugin drawing into `<canvas id="manylight">`, and hands it to the page's
+//!    event loop. The device is requested asynchronously; the app updates once it arrives.
+//! 2. Each update, `publish` keeps the last frame's statistics as JSON, sets
+//!    `document.title` to `manylight: ready` after the first frame, and shows a failure.
+//! 3. `stats()`, `error()` and `capture()` are what `window.manylight` calls (`index.html`).
+
+use crate::demo::add_scene;
+use crate::options::WebOptions;
+use base64::Engine;
+use manylight::app::backend::RenderBackend;
+use manylight::app::window::WindowConfig;
+use manylight::app::{FrameStats, HeadlessCapture, RenderFailure};
+use manylight::prelude::*;
+use std::cell::RefCell;
+use wasm_bindgen::JsCast;
+use wasm_bindgen::prelude::*;
+
+/// The title the page gets once the first frame's statistics arrived.
+pub const READY_TITLE: &str = "manylight: ready";
+
+/// What the page contract reads; the app writes it each update.
+#[derive(Default)]
+struct PageState {
+    stats: Option<String>,
+    stats_frame: Option<u64>,
+    error: Option<String>,
+    capture: Option<String>,
+}
+
+thread_local! {
+    static PAGE: RefCell<PageState> = RefCell::new(PageState::default());
+}
+
+/// The last frame's statistics as JSON (`manylight render --stats-json`'s document, plus
+/// `backend`: `webgpu` or `webgl2`); `undefined` before the first frame.
+#[wasm_bindgen]
+pub fn stats() -> Option<String> {
+    PAGE.with(|p| p.borrow().stats.clone())
+}
+
+/// The first error the page met (a bad URL parameter, a device that could not be had, a failed
+/// frame); `undefined` while there is none.
+#[wasm_bindgen]
+pub fn error() -> Option<String> {
+    PAGE.with(|p| p.borrow().error.clone())
+}
+
+/// The image of the update the `capture` parameter named, as a PNG data URL, once it has
+/// been read back; `undefined` until then.
+#[wasm_bindgen]
+pub fn capture() -> Option<String> {
+    PAGE.with(|p| p.borrow().capture.clone())
+}
+
+/// Records `message` as the page's error (the first one stays) and shows it on the page.
+fn fail(message: &str) {
+    let first = PAGE.with(|p| {
+        let mut p = p.borrow_mut();
+        let first = p.error.is_none();
+        p.error.get_or_insert_with(|| message.to_string());
+        first
+    });
+    if !first {
+        return;
+    }
+    web_sys::console::error_1(&JsValue::from_str(message));
+    let element =
+        web_sys::window().and_then(|w| w.document()).and_then(|d| d.get_element_by_id("manylight-error"));
+    if let Some(element) = element {
+        element.set_text_content(Some(message));
+        let _ = element.set_attribute("class", "shown");
+    }
+}
+
+/// Writes log lines to the browser's console (warnings and errors as such).
+struct ConsoleWriter(Vec<u8>);
+
+impl std::io::Write for ConsoleWriter {
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+        self.0.extend_from_slice(bytes);
+        Ok(bytes.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+impl Drop for ConsoleWriter {
+    fn drop(&mut self) {
+        let line = String::from_utf8_lossy(&self.0);
+        let line = JsValue::from_str(line.trim_end());
+        if self.0.starts_with(b"ERROR") {
+            web_sys::console::error_1(&line);
+        } else if self.0.starts_with(b" WARN") {
+            web_sys::console::warn_1(&line);
+        } else {
+            web_sys::console::log_1(&line);
+        }
+    }
+}
+
+/// Runs when the module is initialised.
+#[wasm_bindgen(start)]
+pub fn start() {
+    std::panic::set_hook(Box::new(|info| fail(&format!("manylight stopped: {info}"))));
+    // `info` and above to the console (the page has no clock for timestamps: std's panics).
+    let _ = tracing_subscriber::fmt()
+        .with_writer(|| ConsoleWriter(Vec::new()))
+        .with_ansi(false)
+        .without_time()
+        .with_max_level(tracing::Level::INFO)
+        .try_init();
+    if let Err(message) = run() {
+        fail(&message);
+    }
+}
+
+fn run() -> Result<(), String> {
+    let window = web_sys::window().ok_or("no window: manylight_web runs in a page")?;
+    let document = window.document().ok_or("the window has no document")?;
+    let query = window.location().search().map_err(|e| format!("cannot read the URL: {e:?}"))?;
+    let options = WebOptions::from_query(&query).map_err(|e| e.to_string())?;
+    let canvas = document
+        .get_element_by_id("manylight")
+        .and_then(|e| e.dyn_into::<web_sys::HtmlCanvasElement>().ok())
+        .ok_or("the page has no <canvas id=\"manylight\">")?;
+    if let Some(size) = options.size {
+        // A fixed size instead of the page's: the page's CSS sizes the canvas by its class.
+        let style = format!("width: {}px; height: {}px", size.x, size.y);
+        canvas.set_attribute("style", &style).map_err(|e| format!("cannot size the canvas: {e:?}"))?;
+        canvas.set_attribute("class", "fixed").map_err(|e| format!("cannot size the canvas: {e:?}"))?;
+    }
+    let (width, height) = match options.size {
+        Some(size) => (size.x, size.y),
+        None => (canvas.client_width().max(1) as u32, canvas.client_height().max(1) as u32),
+    };
+    let config = WindowConfig {
+        title: "manylight".into(),
+        width,
+        height,
+        overlay: options.overlay,
+        canvas: Some(canvas),
+        ..WindowConfig::default()
+    };
+    let mut app = App::new();
+    app.add_plugins(ManyLightPlugin::window(config));
+    add_scene(&mut app, &options, width as f32 / height as f32);
+    app.insert_resource(CaptureAt(options.capture))
+        .add_systems(First, arm_capture)
+        .add_systems(Last, publish.after(ManyLightSystems::Extract));
+    app.run();
+    Ok(())
+}
+
+/// The update whose image `capture()` returns (the `capture` parameter).
+#[derive(Resource)]
+struct CaptureAt(Option<u64>);
+
+/// Asks for the image of the update named by [`CaptureAt`] (counted from 1), and only that one.
+fn arm_capture(at: Res<CaptureAt>, mut capture: ResMut<HeadlessCapture>, mut updates: Local<u64>) {
+    *updates += 1;
+    capture.enabled = at.0 == Some(*updates);
+}
+
+/// Publishes the statistics, the ready title, the captured image and a failure to the page.
+fn publish(
+    stats: Res<FrameStats>,
+    failure: Res<RenderFailure>,
+    backend: Res<RenderBackend>,
+    mut capture: ResMut<HeadlessCapture>,
+) {
+    if let Some(message) = &failure.0 {
+        fail(message);
+    }
+    if let Some(image) = capture.image.take() {
+        let mut png = Vec::new();
+        match image.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png) {
+            Ok(()) => {
+                let url = format!(
+                    "data:image/png;base64,{}",
+                    base64::engine::general_purpose::STANDARD.encode(&png)
+                );
+                PAGE.with(|p| p.borrow_mut().capture = Some(url));
+            }
+            Err(e) => fail(&format!("cannot encode the captured image: {e}")),
+        }
+    }
+    let Some(frame) = stats.last.as_ref().map(|r| r.frame_index) else {
+        return;
+    };
+    if PAGE.with(|p| p.borrow().stats_frame) == Some(frame) {
+        return;
+    }
+    let mut json = serde_json::to_value(stats.document()).unwrap_or(serde_json::Value::Null);
+    json["backend"] =
+        serde_json::Value::from(backend.adapter().map_or("unknown", |info| backend_name(info.backend)));
+    let first = PAGE.with(|p| {
+        let mut p = p.borrow_mut();
+        let first = p.stats.is_none();
+        p.stats = Some(json.to_string());
+        p.stats_frame = Some(frame);
+        first
+    });
+    if first && let Some(document) = web_sys::window().and_then(|w| w.document()) {
+        document.set_title(READY_TITLE);
+    }
+}
+
+/// The page contract's name of a wgpu backend.
+fn backend_name(backend: manylight::render::wgpu::Backend) -> &'static str {
+    match backend {
+        manylight::render::wgpu::Backend::BrowserWebGpu => "webgpu",
+        manylight::render::wgpu::Backend::Gl => "webgl2",
+        other => other.to_str(),
+    }
+}
