@@ -40,7 +40,9 @@ fn mark_cluster_depth(frag: vec2<f32>, d: f32) {
     // A distance that is not finite bounds nothing: its cluster keeps every light.
     if !(abs(d) <= 3.0e38) {
         near = 0.0;
-        far = bitcast<f32>(0x7f800000u);
+        // +infinity, made from `d` at run time: WGSL refuses an infinite constant (Tint, in
+        // browsers, rejects `bitcast<f32>(0x7f800000u)`), and naga accepts either.
+        far = bitcast<f32>((bitcast<u32>(d) & 0u) | 0x7f800000u);
     }
     let first = cluster_index(cluster_params, frag, near);
     let last = cluster_index(cluster_params, frag, far);

@@ -39,7 +39,7 @@ const ANIMATION_TAU: f32 = 6.2831855f;
 
 // Finite (neither NaN nor infinite).
 fn finite1(x: f32) -> bool {
-    return abs(x) <= 3.4028235e38f;
+    return abs(x) <= 3.40282346e38f;
 }
 
 fn finite3(v: vec3<f32>) -> bool {

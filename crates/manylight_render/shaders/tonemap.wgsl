@@ -21,8 +21,9 @@ fn aces_fitted(x: vec3<f32>) -> vec3<f32> {
 @fragment
 fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     let color = textureLoad(hdr, vec2<i32>(in.position.xy), 0).rgb;
-    // NaN fails `x == x`; ±inf fails `abs(x) <= max f32` (as does NaN).
-    let finite = abs(color) <= vec3<f32>(3.40282347e38);
+    // NaN fails `x == x`; ±inf fails `abs(x) <= max f32` (as does NaN). 3.40282346e38 rounds
+    // to max f32; a literal above it (3.40282347e38) is refused by browsers' WGSL compilers.
+    let finite = abs(color) <= vec3<f32>(3.40282346e38);
     if !all(finite) {
         atomicAdd(&nonfinite_pixels, 1u);
     }

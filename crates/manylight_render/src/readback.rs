@@ -33,6 +33,11 @@ impl HeadlessTarget {
         HeadlessTarget { texture, view, width, height }
     }
 
+    /// The texture the graph writes (to read it back without waiting: [`PendingImage`]).
+    pub fn texture(&self) -> &wgpu::Texture {
+        &self.texture
+    }
+
     /// The view the graph writes as `OUTPUT`.
     pub fn view(&self) -> &wgpu::TextureView {
         &self.view

@@ -206,8 +206,8 @@ impl Renderer {
     /// frame (exact, slower), so no light is lost and no frame is rendered twice. Only when the
     /// lists have no counts to go by (the view's first frame, or the light count more than
     /// doubled) does the view run its build once before the frame, only to count, and wait for
-    /// those counters (`ClusterReport::counted_first`), and only where the CPU may wait
-    /// ([`GpuContext::can_block`]).
+    /// those counters (`ClusterReport::counted_first`); where the CPU may not wait
+    /// ([`GpuContext::can_block`]) the lists are sized for every light instead.
     pub fn execute(
         &mut self,
         graph: &RenderGraph,
@@ -232,13 +232,14 @@ impl Renderer {
                 limit: LAVAPIPE_LOOP_LIMIT,
             });
         }
-        // Where nothing may wait (a browser) the lists go uncounted: their short clusters shade
-        // from every light until the frame's counters come back and size them.
-        if builds_clusters
-            && self.gpu.can_block()
-            && self.view_clusters(view.index).is_some_and(ClusterResources::needs_counting)
-        {
-            self.count_lists(snapshot, view, output, output_format)?;
+        if builds_clusters && self.view_clusters(view.index).is_some_and(ClusterResources::needs_counting) {
+            if self.gpu.can_block() {
+                self.count_lists(snapshot, view, output, output_format)?;
+            } else if let Some(clusters) = self.clusters.get_mut(view.index).and_then(Option::as_mut) {
+                // Where nothing may wait (a browser) the lists are sized for every light until
+                // the frame's counters come back and size them.
+                clusters.size_for_every_light(&self.gpu)?;
+            }
         }
         let mut report =
             self.execute_once(&passes, builds_clusters, snapshot, view, output, output_format)?;

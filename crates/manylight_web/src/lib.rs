@@ -3,7 +3,8 @@
 //!
 //! The page contract (for people and tests):
 //! - URL query parameters ([`options::WebOptions`]): `lights`, `pipeline`, `shadows`,
-//!   `debug-view`, `scene` (`hall` or `sphere-shell`), `size`, `overlay`, `clock`, `capture`.
+//!   `debug-view`, `scene` (`hall` or `sphere-shell`), `size`, `overlay`, `clock`, `capture`,
+//!   `present` (`canvas` or `read-back`).
 //!   A bad one shows its error on the page.
 //! - After the first frame `document.title` is `manylight: ready`.
 //! - `manylight.stats()`: the last frame's statistics, the document of
@@ -17,3 +18,5 @@ pub mod demo;
 pub mod options;
 #[cfg(target_arch = "wasm32")]
 pub mod page;
+#[cfg(target_arch = "wasm32")]
+pub mod readback_canvas;

@@ -41,6 +41,17 @@ pub enum WebClock {
     Fixed,
 }
 
+/// How frames reach the page's canvas.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WebPresent {
+    /// A WebGPU canvas presents each frame, with the egui overlay drawn over it.
+    Canvas,
+    /// Each frame is rendered offscreen, read back without a wait and drawn into a 2D canvas
+    /// (no overlay): for browsers whose WebGPU canvas cannot present, such as headless
+    /// Chromium on SwiftShader.
+    ReadBack,
+}
+
 /// What the page renders, from its URL query.
 #[derive(Clone, Debug, PartialEq)]
 pub struct WebOptions {
@@ -62,6 +73,8 @@ pub struct WebOptions {
     pub clock: WebClock,
     /// `capture`: the update whose image is read back (from 1), for `manylight.capture()`.
     pub capture: Option<u64>,
+    /// `present`: `canvas` (default) or `read-back`.
+    pub present: WebPresent,
 }
 
 impl Default for WebOptions {
@@ -76,6 +89,7 @@ impl Default for WebOptions {
             overlay: true,
             clock: WebClock::Wall,
             capture: None,
+            present: WebPresent::Canvas,
         }
     }
 }
@@ -108,8 +122,18 @@ pub enum ParamError {
 }
 
 /// The parameters the page takes.
-const KNOWN: [&str; 9] =
-    ["lights", "pipeline", "shadows", "debug-view", "scene", "size", "overlay", "clock", "capture"];
+const KNOWN: [&str; 10] = [
+    "lights",
+    "pipeline",
+    "shadows",
+    "debug-view",
+    "scene",
+    "size",
+    "overlay",
+    "clock",
+    "capture",
+    "present",
+];
 
 impl WebOptions {
     /// Parses a URL query (`location.search`, with or without its leading `?`).
@@ -161,6 +185,13 @@ impl WebOptions {
                     _ => return Err("expected wall or fixed".into()),
                 }
             }
+            "present" => {
+                self.present = match value {
+                    "canvas" => WebPresent::Canvas,
+                    "read-back" => WebPresent::ReadBack,
+                    _ => return Err("expected canvas or read-back".into()),
+                }
+            }
             "capture" => match value.parse::<u64>() {
                 Ok(n) if n >= 1 => self.capture = Some(n),
                 _ => return Err("expected the number of an update, from 1".into()),
@@ -189,7 +220,7 @@ mod tests {
     #[test]
     fn every_parameter_parses() {
         let o = WebOptions::from_query(
-            "?lights=100000&pipeline=clustered-deferred&shadows=on&debug-view=light-count&scene=sphere-shell&size=128x96&overlay=off&clock=fixed&capture=3",
+            "?lights=100000&pipeline=clustered-deferred&shadows=on&debug-view=light-count&scene=sphere-shell&size=128x96&overlay=off&clock=fixed&capture=3&present=read-back",
         )
         .unwrap();
         assert_eq!(o.lights, 100_000);
@@ -201,6 +232,7 @@ mod tests {
         assert!(!o.overlay);
         assert_eq!(o.clock, WebClock::Fixed);
         assert_eq!(o.capture, Some(3));
+        assert_eq!(o.present, WebPresent::ReadBack);
     }
 
     #[test]
@@ -221,6 +253,7 @@ mod tests {
             ("size=0x0", "`size=0x0`"),
             ("capture=0", "`capture=0`"),
             ("clock=slow", "expected wall or fixed"),
+            ("present=screen", "expected canvas or read-back"),
             ("debug-view=%FF", "`debug-view=\u{FFFD}`"),
         ];
         for (query, expected) in cases {

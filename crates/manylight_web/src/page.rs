@@ -8,13 +8,17 @@
 //! 3. `stats()`, `error()` and `capture()` are what `window.manylight` calls (`index.html`).
 
 use crate::demo::add_scene;
-use crate::options::WebOptions;
+use crate::options::{WebOptions, WebPresent};
+use crate::readback_canvas::{DisplaySlot, ReadBackSink};
 use base64::Engine;
 use manylight::app::backend::RenderBackend;
+use manylight::app::render_world::HeadlessRenderer;
 use manylight::app::window::WindowConfig;
 use manylight::app::{FrameStats, HeadlessCapture, RenderFailure};
 use manylight::prelude::*;
+use manylight::render::GpuContext;
 use std::cell::RefCell;
+use std::rc::Rc;
 use wasm_bindgen::JsCast;
 use wasm_bindgen::prelude::*;
 
@@ -138,23 +142,125 @@ fn run() -> Result<(), String> {
         Some(size) => (size.x, size.y),
         None => (canvas.client_width().max(1) as u32, canvas.client_height().max(1) as u32),
     };
-    let config = WindowConfig {
-        title: "manylight".into(),
-        width,
-        height,
-        overlay: options.overlay,
-        canvas: Some(canvas),
-        ..WindowConfig::default()
-    };
     let mut app = App::new();
-    app.add_plugins(ManyLightPlugin::window(config));
+    match options.present {
+        WebPresent::Canvas => {
+            let config = WindowConfig {
+                title: "manylight".into(),
+                width,
+                height,
+                overlay: options.overlay,
+                canvas: Some(canvas.clone()),
+                ..WindowConfig::default()
+            };
+            app.add_plugins(ManyLightPlugin::window(config));
+        }
+        WebPresent::ReadBack => {
+            app.add_plugins(ManyLightPlugin::headless(UVec2::new(width, height)))
+                .insert_resource(TimeUpdateStrategy::Automatic);
+        }
+    }
     add_scene(&mut app, &options, width as f32 / height as f32);
     app.insert_resource(CaptureAt(options.capture))
+        .insert_resource(Presenting(options.present))
         .add_systems(First, arm_capture)
         .add_systems(Last, publish.after(ManyLightSystems::Extract));
-    app.run();
+    match options.present {
+        WebPresent::Canvas => {
+            app.run();
+        }
+        WebPresent::ReadBack => run_read_back(app, canvas)?,
+    }
     Ok(())
 }
+
+/// Runs `app` (headless plugin) on the page's animation frames, drawing each frame that has
+/// been read back into `canvas` through its 2D context. The device is requested first; the
+/// app updates once it has arrived and only while a read-back slot is free.
+fn run_read_back(mut app: App, canvas: web_sys::HtmlCanvasElement) -> Result<(), String> {
+    let context = canvas
+        .get_context("2d")
+        .ok()
+        .flatten()
+        .and_then(|c| c.dyn_into::<web_sys::CanvasRenderingContext2d>().ok())
+        .ok_or("the canvas has no 2D context")?;
+    manylight::app::headless::finish_plugins(&mut app);
+    // Headless rendering asks for its device with a blocking wait, which a page cannot make:
+    // the app waits for the one requested below.
+    app.insert_resource(RenderBackend::Pending);
+    let frames_in_flight = app.world().resource::<manylight::app::FramesInFlight>().0;
+    let app = Rc::new(RefCell::new(app));
+    let display = DisplaySlot::default();
+    {
+        let (app, display) = (app.clone(), display.clone());
+        wasm_bindgen_futures::spawn_local(async move {
+            let instance = manylight::render::context::new_instance();
+            match GpuContext::request(instance, None).await {
+                Ok(gpu) => {
+                    let renderer = HeadlessRenderer::with_context(gpu, frames_in_flight);
+                    let sink = ReadBackSink::new(renderer, display);
+                    app.borrow_mut().insert_resource(RenderBackend::start(Box::new(sink), false));
+                }
+                Err(e) => fail(&e.to_string()),
+            }
+        });
+    }
+    // Each animation frame: update when the renderer can take a frame, then show the newest
+    // frame that came back.
+    let tick: FrameCallback = Rc::new(RefCell::new(None));
+    let next = tick.clone();
+    *tick.borrow_mut() = Some(Closure::new(move || {
+        {
+            let mut app = app.borrow_mut();
+            if app.world().resource::<RenderBackend>().ready() && app.should_exit().is_none() {
+                app.update();
+            }
+        }
+        if let Some(image) = display.lock().ok().and_then(|mut slot| slot.take()) {
+            show(&canvas, &context, &image);
+        }
+        if let Some(closure) = next.borrow().as_ref() {
+            request_animation_frame(closure);
+        }
+    }));
+    if let Some(closure) = tick.borrow().as_ref() {
+        request_animation_frame(closure);
+    }
+    Ok(())
+}
+
+/// The animation-frame callback, which asks for the next frame with itself.
+type FrameCallback = Rc<RefCell<Option<Closure<dyn FnMut()>>>>;
+
+fn request_animation_frame(closure: &Closure<dyn FnMut()>) {
+    if let Some(window) = web_sys::window() {
+        let _ = window.request_animation_frame(closure.as_ref().unchecked_ref());
+    }
+}
+
+/// Draws `image` into the 2D canvas at its own size.
+fn show(
+    canvas: &web_sys::HtmlCanvasElement,
+    context: &web_sys::CanvasRenderingContext2d,
+    image: &image::RgbaImage,
+) {
+    let (width, height) = image.dimensions();
+    if canvas.width() != width || canvas.height() != height {
+        canvas.set_width(width);
+        canvas.set_height(height);
+    }
+    let pixels = wasm_bindgen::Clamped(image.as_raw().as_slice());
+    match web_sys::ImageData::new_with_u8_clamped_array_and_sh(pixels, width, height) {
+        Ok(data) => {
+            let _ = context.put_image_data(&data, 0.0, 0.0);
+        }
+        Err(e) => fail(&format!("cannot show the frame: {e:?}")),
+    }
+}
+
+/// How the page shows its frames (the `present` parameter).
+#[derive(Resource)]
+struct Presenting(WebPresent);
 
 /// The update whose image `capture()` returns (the `capture` parameter).
 #[derive(Resource)]
@@ -171,10 +277,17 @@ fn publish(
     stats: Res<FrameStats>,
     failure: Res<RenderFailure>,
     backend: Res<RenderBackend>,
+    presenting: Res<Presenting>,
     mut capture: ResMut<HeadlessCapture>,
 ) {
     if let Some(message) = &failure.0 {
-        fail(message);
+        let hint = if presenting.0 == WebPresent::Canvas && message.contains("lost") {
+            " (a browser that cannot present a WebGPU canvas, such as headless Chromium on \
+             SwiftShader, loses its device: add present=read-back to the URL)"
+        } else {
+            ""
+        };
+        fail(&format!("{message}{hint}"));
     }
     if let Some(image) = capture.image.take() {
         let mut png = Vec::new();

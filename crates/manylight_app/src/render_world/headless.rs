@@ -35,6 +35,11 @@ impl HeadlessRenderer {
         }
     }
 
+    /// The offscreen target the last frame was drawn into (none before the first frame).
+    pub fn target(&self) -> Option<&HeadlessTarget> {
+        self.target.as_ref()
+    }
+
     /// A headless renderer on a context the caller requested.
     pub fn with_context(gpu: GpuContext, frames_in_flight: u32) -> HeadlessRenderer {
         HeadlessRenderer {

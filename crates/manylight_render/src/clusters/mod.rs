@@ -232,6 +232,11 @@ impl ListNeeds {
     }
 }
 
+/// Most entries a list level is given before any counts exist where the CPU may not wait for
+/// them ([`ClusterResources::size_for_every_light`]): 64 MiB of indices. A frame whose lists
+/// need more shades the clusters that do not fit from every light, once.
+const MAX_UNCOUNTED_ENTRIES: u64 = 1 << 24;
+
 /// Chunks of [`TILE_LIGHT_CHUNK`] lights that `lights` lights take, at least 1.
 fn light_chunks_of(lights: usize) -> u32 {
     u32::try_from(lights).unwrap_or(u32::MAX).div_ceil(TILE_LIGHT_CHUNK).max(1)
@@ -664,6 +669,24 @@ impl ClusterResources {
         self.needs.is_none_or(|n| {
             n.layout != Some(self.layout()) || self.params.light_count > n.lights.saturating_mul(2).max(64)
         })
+    }
+
+    /// Sizes the lists for every light in every cluster, tile and coarse tile (at most 2^24
+    /// entries a level, and as far as the device's largest binding allows): for a view whose
+    /// lists have no counts where the CPU may not wait for a counting run (a browser). The
+    /// frame's clusters then hold their lights instead of shading from every light, and the
+    /// counts the frame reads back ([`Self::observe`]) size the lists from the next frame on.
+    pub fn size_for_every_light(&mut self, gpu: &GpuContext) -> Result<(), RenderError> {
+        let lights = u64::from(self.params.light_count);
+        let dims = self.grid.dims.as_u64vec3();
+        let coarse_tiles = self.coarse_dims().map_or(0, |d| u64::from(d.x) * u64::from(d.y));
+        let entries = [dims.x * dims.y * dims.z, dims.x * dims.y, coarse_tiles]
+            .map(|n| n.saturating_mul(lights).min(MAX_UNCOUNTED_ENTRIES));
+        self.needs = Some(ListNeeds::from_counts(entries, self.params.light_count, Some(self.layout())));
+        let chunks = self.size_lists(gpu, self.params.light_count)?;
+        self.apply_list_sizes(gpu, chunks)?;
+        self.upload_params(gpu, &self.params);
+        Ok(())
     }
 
     /// This frame's [`ListLayout`].
