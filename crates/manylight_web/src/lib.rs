@@ -6,6 +6,8 @@
 //!   `debug-view`, `scene` (`hall` or `sphere-shell`), `size`, `overlay`, `clock`, `capture`,
 //!   `present` (`canvas` or `read-back`).
 //!   A bad one shows its error on the page.
+//! - The camera: drag to look, W/A/S/D or the arrows to move, Q/E down and up, Shift faster
+//!   ([`controls`]).
 //! - After the first frame `document.title` is `manylight: ready`.
 //! - `manylight.stats()`: the last frame's statistics, the document of
 //!   `manylight render --stats-json` plus `backend` (`webgpu` or `webgl2`).
@@ -14,6 +16,7 @@
 //!   read back.
 #![warn(missing_docs)]
 
+pub mod controls;
 pub mod demo;
 pub mod options;
 #[cfg(target_arch = "wasm32")]

@@ -7,6 +7,7 @@
 //!    `document.title` to `manylight: ready` after the first frame, and shows a failure.
 //! 3. `stats()`, `error()` and `capture()` are what `window.manylight` calls (`index.html`).
 
+use crate::controls::{FlyInput, fly};
 use crate::demo::add_scene;
 use crate::options::{WebOptions, WebPresent};
 use crate::readback_canvas::{DisplaySlot, ReadBackSink};
@@ -34,8 +35,21 @@ struct PageState {
     capture: Option<String>,
 }
 
+/// The user's input since the last update, gathered by the DOM listeners.
+#[derive(Default)]
+struct PointerKeys {
+    /// `KeyboardEvent.code` of the keys held.
+    held: std::collections::BTreeSet<String>,
+    shift: bool,
+    /// A mouse button is held over the canvas.
+    dragging: bool,
+    /// Pixels dragged since the last update.
+    drag: Vec2,
+}
+
 thread_local! {
     static PAGE: RefCell<PageState> = RefCell::new(PageState::default());
+    static INPUT: RefCell<PointerKeys> = RefCell::new(PointerKeys::default());
 }
 
 /// The last frame's statistics as JSON (`manylight render --stats-json`'s document, plus
@@ -161,8 +175,10 @@ fn run() -> Result<(), String> {
         }
     }
     add_scene(&mut app, &options, width as f32 / height as f32);
+    listen_for_input(&canvas)?;
     app.insert_resource(CaptureAt(options.capture))
         .insert_resource(Presenting(options.present))
+        .add_systems(Update, fly_camera)
         .add_systems(First, arm_capture)
         .add_systems(Last, publish.after(ManyLightSystems::Extract));
     match options.present {
@@ -255,6 +271,85 @@ fn show(
             let _ = context.put_image_data(&data, 0.0, 0.0);
         }
         Err(e) => fail(&format!("cannot show the frame: {e:?}")),
+    }
+}
+
+/// Keeps [`INPUT`] up to date from the page's keyboard and mouse events (the canvas takes the
+/// mouse; the keys are read wherever the page has focus).
+fn listen_for_input(canvas: &web_sys::HtmlCanvasElement) -> Result<(), String> {
+    let window = web_sys::window().ok_or("no window")?;
+    let listen = |target: &web_sys::EventTarget, kind: &str, f: Closure<dyn FnMut(web_sys::Event)>| {
+        let added = target.add_event_listener_with_callback(kind, f.as_ref().unchecked_ref());
+        // The listeners live as long as the page.
+        f.forget();
+        added.map_err(|e| format!("cannot listen for {kind}: {e:?}"))
+    };
+    let key = |down: bool| {
+        Closure::<dyn FnMut(web_sys::Event)>::new(move |e: web_sys::Event| {
+            if let Some(e) = e.dyn_ref::<web_sys::KeyboardEvent>() {
+                INPUT.with(|i| {
+                    let mut i = i.borrow_mut();
+                    i.shift = e.shift_key();
+                    if down {
+                        i.held.insert(e.code());
+                    } else {
+                        i.held.remove(&e.code());
+                    }
+                });
+            }
+        })
+    };
+    listen(&window, "keydown", key(true))?;
+    listen(&window, "keyup", key(false))?;
+    listen(
+        &window,
+        "blur",
+        Closure::new(|_: web_sys::Event| INPUT.with(|i| *i.borrow_mut() = PointerKeys::default())),
+    )?;
+    listen(
+        canvas,
+        "mousedown",
+        Closure::new(|_: web_sys::Event| INPUT.with(|i| i.borrow_mut().dragging = true)),
+    )?;
+    listen(
+        &window,
+        "mouseup",
+        Closure::new(|_: web_sys::Event| INPUT.with(|i| i.borrow_mut().dragging = false)),
+    )?;
+    listen(
+        &window,
+        "mousemove",
+        Closure::new(|e: web_sys::Event| {
+            if let Some(e) = e.dyn_ref::<web_sys::MouseEvent>() {
+                INPUT.with(|i| {
+                    let mut i = i.borrow_mut();
+                    if i.dragging {
+                        i.drag += Vec2::new(e.movement_x() as f32, e.movement_y() as f32);
+                    }
+                });
+            }
+        }),
+    )?;
+    Ok(())
+}
+
+/// Moves the cameras by the input since the last update ([`crate::controls::fly`]).
+fn fly_camera(time: Res<Time>, mut cameras: Query<&mut Transform, With<Camera3d>>) {
+    let input = INPUT.with(|i| {
+        let mut i = i.borrow_mut();
+        let input = FlyInput {
+            direction: FlyInput::direction_of(i.held.iter().map(String::as_str)),
+            fast: i.shift,
+            drag: i.drag,
+        };
+        i.drag = Vec2::ZERO;
+        input
+    });
+    if input == FlyInput::default() {
+        return;
+    }
+    for mut transform in &mut cameras {
+        fly(&mut transform, &input, time.delta_secs());
     }
 }
 
