@@ -2,8 +2,8 @@
 //! Q/E to go down and up, Shift to move faster. The page gathers its input from the DOM
 //! (`page.rs`); this module turns one update's input into a camera move, with no browser in it.
 
-use manylight::prelude::*;
 use glam::EulerRot;
+use manylight::prelude::*;
 
 /// Metres a second the camera moves (times [`FAST`] with Shift).
 pub const SPEED: f32 = 4.0;
