@@ -217,6 +217,19 @@ impl PendingImage {
         }
     }
 
+    /// Takes the image out of `slot` once its copy has arrived: `None` while it is on its way
+    /// or when the slot is empty; the slot is emptied when the image (or an error) comes back.
+    pub fn take_arrived(
+        slot: &mut Option<PendingImage>,
+        gpu: &GpuContext,
+    ) -> Result<Option<image::RgbaImage>, RenderError> {
+        let taken = slot.as_ref().and_then(|p| p.try_take(gpu));
+        if taken.is_some() {
+            *slot = None;
+        }
+        taken.transpose()
+    }
+
     fn unpack(&self) -> Result<image::RgbaImage, RenderError> {
         let row = (self.width * 4) as usize;
         let data = self.buffer.slice(..).get_mapped_range().map(|bytes| {

@@ -28,31 +28,19 @@ impl ReadBackSink {
     pub fn new(renderer: HeadlessRenderer, display: DisplaySlot) -> ReadBackSink {
         ReadBackSink { renderer, display, shown: None, captured: None }
     }
-
-    /// Takes a read-back that has arrived out of `slot`.
-    fn arrived(
-        renderer: &HeadlessRenderer,
-        slot: &mut Option<PendingImage>,
-    ) -> Result<Option<image::RgbaImage>, RenderError> {
-        let taken = slot.as_ref().and_then(|p| p.try_take(renderer.render_world.gpu()));
-        if taken.is_some() {
-            *slot = None;
-        }
-        taken.transpose()
-    }
 }
 
 impl FrameSink for ReadBackSink {
     fn render_frame(&mut self, snapshot: FrameSnapshot, readback: bool) -> Result<SinkFrame, RenderError> {
         let mut frame = self.renderer.render_in_flight(snapshot, false)?;
-        if let Some(image) = Self::arrived(&self.renderer, &mut self.shown)?
+        let gpu = self.renderer.render_world.gpu();
+        if let Some(image) = PendingImage::take_arrived(&mut self.shown, gpu)?
             && let Ok(mut slot) = self.display.lock()
         {
             *slot = Some(image);
         }
-        frame.image = Self::arrived(&self.renderer, &mut self.captured)?;
+        frame.image = PendingImage::take_arrived(&mut self.captured, gpu)?;
         if let Some(target) = self.renderer.target() {
-            let gpu = self.renderer.render_world.gpu();
             if self.shown.is_none() {
                 self.shown = Some(PendingImage::start(gpu, target.texture())?);
             }

@@ -171,13 +171,9 @@ impl SurfaceSink {
         &mut self,
         texture: Option<&wgpu::Texture>,
     ) -> Result<Option<image::RgbaImage>, RenderError> {
-        let gpu = self.render_world.gpu();
-        if let Some(pending) = &self.pending_image {
-            let taken = pending.try_take(gpu);
-            if taken.is_some() {
-                self.pending_image = None;
-            }
-            return taken.transpose();
+        if self.pending_image.is_some() {
+            let gpu = self.render_world.gpu();
+            return manylight_render::readback::PendingImage::take_arrived(&mut self.pending_image, gpu);
         }
         if let Some(texture) = texture.filter(|t| self.readable(t)) {
             let gpu = self.render_world.gpu();
