@@ -11,7 +11,6 @@
 
 use clap::Parser;
 use manylight::app::window::WindowConfig;
-use manylight::math::Aabb;
 use manylight::math::light_count::check_app_lights;
 use manylight::prelude::*;
 use std::path::PathBuf;
@@ -36,13 +35,6 @@ struct Args {
     /// Render one 1280x720 frame to this PNG instead of opening a window.
     #[arg(long, value_name = "OUT.png")]
     headless: Option<PathBuf>,
-}
-
-/// The scene's bounds, thickened so that flat scenes (a single plane) get lights above them
-/// too: each side is at least a quarter of the diagonal.
-fn rig_bounds(bounds: Aabb) -> Aabb {
-    let pad = (Vec3::splat(bounds.size().length() * 0.25) - bounds.size()).max(Vec3::ZERO) * 0.5;
-    Aabb { min: bounds.min - pad, max: bounds.max + pad }
 }
 
 fn main() -> ExitCode {
@@ -94,7 +86,7 @@ fn main() -> ExitCode {
         .add_systems(Startup, move |mut commands: Commands| {
             spawn_scene(&mut commands, &scene, true, aspect);
             if lights > 0 {
-                spawn_light_rig(&mut commands, lights, rig_bounds(scene.bounds()), 1)
+                spawn_light_rig(&mut commands, lights, manylight::scene::rig_bounds(scene.bounds()), 1)
                     .expect("--lights was checked before the app was built");
             }
         })

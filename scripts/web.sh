@@ -39,6 +39,8 @@ cargo build -p manylight_web --lib --target wasm32-unknown-unknown --release
 wasm-bindgen --target web --no-typescript --out-dir "$out/pkg" \
     target/wasm32-unknown-unknown/release/manylight_web.wasm
 cp crates/manylight_web/web/index.html "$out/index.html"
+# The page fetches glTF files (`?scene=PATH`) from assets/ beside it.
+ln -sfn ../../assets "$out/assets"
 echo "web.sh: built $out" >&2
 
 if $serve; then

@@ -20,6 +20,7 @@ mod support;
 use base64::Engine;
 use image::RgbaImage;
 use manylight::prelude::*;
+use manylight_web::demo::DemoScene;
 use manylight_web::options::WebOptions;
 use serde_json::{Value, json};
 use std::net::TcpListener;
@@ -270,22 +271,26 @@ fn page_matches_native(pipeline: &str) {
     let expected = {
         let _gpu = support::gpu();
         manylight::app::headless::render_headless(UVec2::new(128, 128), 3, |app| {
-            manylight_web::demo::add_scene(app, &options, 1.0);
+            manylight_web::demo::add_scene(app, &options, DemoScene::Hall, 1.0);
         })
         .expect("the native frame")
     };
+    // The native frame is held to its stored reference (a changed shader fails here).
+    support::assert_matches_reference(&format!("web_hall_{pipeline}"), &expected.image, support::STRICT);
+    page_matches(&format!("web_{pipeline}"), &query, &expected);
+}
+
+/// The page's capture for `query` against the native `expected` frame (another device:
+/// `CROSS_DEVICE`), and their passes.
+fn page_matches(name: &str, query: &str, expected: &manylight::app::headless::HeadlessFrame) {
     let browser = browser();
-    let session = Session::open(&browser, &query, true);
+    let session = Session::open(&browser, query, true);
     session.wait_ready();
     let url = session.wait_for("return manylight.capture();", Duration::from_secs(60), "the captured image");
     let data = url.as_str().and_then(|u| u.strip_prefix("data:image/png;base64,")).expect("a PNG data URL");
     let actual = decode_png(data);
-    // The native frame is held to its stored reference (a changed shader fails here), the
-    // page's frame to the native one (another device: `CROSS_DEVICE`).
-    support::assert_matches_reference(&format!("web_hall_{pipeline}"), &expected.image, support::STRICT);
-    let flip =
-        support::assert_similar(&format!("web_{pipeline}"), &expected.image, &actual, support::CROSS_DEVICE);
-    println!("{pipeline}: page against native FLIP mean {:.4}, p99 {:.4}", flip.mean, flip.p99);
+    let flip = support::assert_similar(name, &expected.image, &actual, support::CROSS_DEVICE);
+    println!("{name}: page against native FLIP mean {:.4}, p99 {:.4}", flip.mean, flip.p99);
     let names = |frame: &Value| -> Vec<String> {
         frame["passes"]
             .as_array()
@@ -309,6 +314,35 @@ fn clustered_deferred_image_equals_native() {
     page_matches_native("clustered-deferred");
 }
 
+/// A glTF file with an external buffer and image, fetched by the page from `assets/`, renders
+/// as the native renderer renders the file loaded from disk.
+#[test]
+fn a_gltf_scene_is_fetched_and_matches_native() {
+    let scene = "BoxTextured/BoxTextured.gltf";
+    let query =
+        format!("?scene={scene}&lights=64&size=128x128&overlay=off&clock=fixed&capture=3&present=read-back");
+    let options = WebOptions::from_query(&query).expect("a valid query");
+    let loaded = manylight::scene::load_gltf(&root().join("assets").join(scene), &LoadOptions::default())
+        .expect("the asset loads");
+    let expected = {
+        let _gpu = support::gpu();
+        manylight::app::headless::render_headless(UVec2::new(128, 128), 3, |app| {
+            manylight_web::demo::add_scene(app, &options, DemoScene::Loaded(Box::new(loaded)), 1.0);
+        })
+        .expect("the native frame")
+    };
+    assert_eq!(expected.stats.last.as_ref().map(|f| f.light_count), Some(64));
+    page_matches("web_gltf_box", &query, &expected);
+}
+
+#[test]
+fn a_gltf_scene_that_is_not_there_is_an_error_on_the_page() {
+    let browser = browser();
+    let session = Session::open(&browser, "?scene=Missing/missing.glb&present=read-back", true);
+    let message = wait_error(&session, "a missing glTF file");
+    assert!(message.contains("cannot fetch `assets/Missing/missing.glb`: HTTP 404"), "{message}");
+}
+
 #[test]
 fn sphere_shell_with_100000_lights_renders() {
     let browser = browser();
@@ -324,19 +358,23 @@ fn sphere_shell_with_100000_lights_renders() {
 fn a_bad_parameter_is_shown_on_the_page() {
     let browser = browser();
     let session = Session::open(&browser, "?lights=lots", true);
-    let start = Instant::now();
-    let error = loop {
-        let error = session.eval("return manylight.error() ?? null;");
-        if !error.is_null() {
-            break error;
-        }
-        assert!(start.elapsed() < Duration::from_secs(30), "no error for ?lights=lots");
-        std::thread::sleep(Duration::from_millis(200));
-    };
-    let message = error.as_str().unwrap_or_default().to_string();
+    let message = wait_error(&session, "?lights=lots");
     assert!(message.contains("`lights=lots`"), "{message}");
     let shown = session
         .eval("const e = document.getElementById('manylight-error'); return [e.className, e.textContent];");
     assert_eq!(shown[0], "shown", "{shown}");
     assert_eq!(shown[1], message.as_str());
+}
+
+/// The page's error message, once it has one (at most 30 s).
+fn wait_error(session: &Session, what: &str) -> String {
+    let start = Instant::now();
+    loop {
+        let error = session.eval("return manylight.error() ?? null;");
+        if let Some(message) = error.as_str() {
+            return message.to_string();
+        }
+        assert!(start.elapsed() < Duration::from_secs(30), "no error for {what}");
+        std::thread::sleep(Duration::from_millis(200));
+    }
 }

@@ -10,7 +10,8 @@
 //!    validation (normalised first where the crate's types refuse what the specification
 //!    allows, see `normalize.rs`); every index is looked up with a bounds check that turns
 //!    into a [`SceneError::MissingReference`].
-//! 2. Buffers are loaded from the GLB chunk, `data:` URIs or local files (never the network);
+//! 2. Buffers are loaded from the GLB chunk, `data:` URIs, local files, or the files a caller
+//!    fetched beforehand ([`load_gltf_fetched`]; the loader itself never uses the network);
 //!    their declared lengths count against `max_buffer_bytes` before each is read, and of a
 //!    file only `byteLength` bytes are read. A buffer without `uri` that is not the GLB chunk
 //!    is refused only when a buffer view reads it. Views and accessors are range-checked
@@ -48,6 +49,7 @@ mod normalize;
 mod uri;
 
 pub use materials::blinn_phong_from_pbr;
+pub use uri::{FetchedFiles, ReferencedFile};
 
 use crate::{Scene, SceneError};
 use manylight_core::TextureData;
@@ -190,8 +192,60 @@ const SUPPORTED_REQUIRED: &[&str] =
 /// Every malformed input is reported as a [`SceneError`] naming the file; nothing is fetched
 /// over the network and no file outside the glTF file's folder is read.
 pub fn load_gltf(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
+    guarded_load(path, || {
+        let bytes = read_scene_file(path, options)?;
+        load_inner(path, &bytes, uri::FileSource::Disk, options)
+    })
+}
+
+/// Loads a `.gltf` or `.glb` file whose bytes and referenced files were fetched beforehand
+/// (where there is no file system, as in a browser): `path` is the file's name for messages
+/// and the folder its URIs are relative to, `bytes` its contents, `files` what
+/// [`referenced_files`] listed. Checked as [`load_gltf`] checks a file on disk; a URI naming a
+/// file that `files` lacks is a [`SceneError::ReferencedFile`].
+pub fn load_gltf_fetched(
+    path: &Path,
+    bytes: &[u8],
+    files: &FetchedFiles,
+    options: &LoadOptions,
+) -> Result<Scene, SceneError> {
+    guarded_load(path, || {
+        check_scene_size(path, bytes, options)?;
+        load_inner(path, bytes, uri::FileSource::Fetched(files), options)
+    })
+}
+
+/// The files that the `.gltf` or `.glb` file with contents `bytes` (named `path`) refers to by
+/// relative URIs, each once, for a caller to fetch before [`load_gltf_fetched`]. A URI that
+/// would leave the file's folder or names the network is refused here already.
+pub fn referenced_files(
+    path: &Path,
+    bytes: &[u8],
+    options: &LoadOptions,
+) -> Result<Vec<ReferencedFile>, SceneError> {
+    check_scene_size(path, bytes, options)?;
+    let parsed = parse_scene_bytes(path, bytes, options)?;
+    let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let buffers =
+        parsed.root.buffers.iter().enumerate().map(|(i, b)| (format!("buffer {i}"), b.uri.as_deref()));
+    let images = parsed.root.images.iter().enumerate().map(|(i, m)| (format!("image {i}"), m.uri.as_deref()));
+    let mut out: Vec<ReferencedFile> = Vec::new();
+    for (what, uri) in buffers.chain(images) {
+        if let Some(uri) = uri
+            && let Some(file) = uri::referenced_file(path, &base_dir, &what, uri)?
+            && !out.iter().any(|f| f.name == file.name)
+        {
+            out.push(file);
+        }
+    }
+    Ok(out)
+}
+
+/// Runs `load` under `catch_unwind` (a loader bug becomes [`SceneError::Internal`]) and logs
+/// what it loaded.
+fn guarded_load(path: &Path, load: impl FnOnce() -> Result<Scene, SceneError>) -> Result<Scene, SceneError> {
     let start = web_time::Instant::now();
-    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| load_inner(path, options)));
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(load));
     let scene = match result {
         Ok(r) => r?,
         Err(payload) => {
@@ -296,11 +350,7 @@ fn read_scene_file(path: &Path, options: &LoadOptions) -> Result<Vec<u8>, SceneE
     }
     let mut bytes = Vec::new();
     (&file).take(4).read_to_end(&mut bytes).map_err(io_err)?;
-    let (limit, option) = if bytes == b"glTF" {
-        (options.max_glb_bytes, "max_glb_bytes")
-    } else {
-        (options.max_json_bytes, "max_json_bytes")
-    };
+    let (limit, option) = size_budget(&bytes, options);
     let too_large = |size: u64| over_budget(path, "the file", size, "bytes", limit, option);
     if meta.len() > limit {
         return Err(too_large(meta.len()));
@@ -317,6 +367,25 @@ fn read_scene_file(path: &Path, options: &LoadOptions) -> Result<Vec<u8>, SceneE
         return Err(too_large(bytes.len() as u64));
     }
     Ok(bytes)
+}
+
+/// The budget of a scene file starting with `head`: `max_glb_bytes` for a GLB (its magic),
+/// else `max_json_bytes`; with the option's name.
+fn size_budget(head: &[u8], options: &LoadOptions) -> (u64, &'static str) {
+    if head.starts_with(b"glTF") {
+        (options.max_glb_bytes, "max_glb_bytes")
+    } else {
+        (options.max_json_bytes, "max_json_bytes")
+    }
+}
+
+/// Refuses scene bytes over their [`size_budget`].
+fn check_scene_size(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<(), SceneError> {
+    let (limit, option) = size_budget(bytes, options);
+    if bytes.len() as u64 > limit {
+        return Err(over_budget(path, "the file", bytes.len() as u64, "bytes", limit, option));
+    }
+    Ok(())
 }
 
 /// How many JSON values (objects, arrays, strings including keys, numbers, literals) `json`
@@ -356,16 +425,30 @@ fn count_json_values(json: &[u8]) -> u64 {
     count
 }
 
-fn load_inner(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
-    let bytes = read_scene_file(path, options)?;
+/// A scene file's container split and its JSON parsed.
+struct ParsedScene<'b> {
+    /// The JSON text (without a byte-order mark).
+    json: &'b [u8],
+    /// `Some(binary chunk)` for a GLB file, `None` for a `.gltf` file.
+    glb: Option<Option<&'b [u8]>>,
+    /// The parsed, unvalidated JSON.
+    root: gltf::json::Root,
+}
+
+/// Splits a GLB container and parses the JSON within its budgets.
+fn parse_scene_bytes<'b>(
+    path: &Path,
+    bytes: &'b [u8],
+    options: &LoadOptions,
+) -> Result<ParsedScene<'b>, SceneError> {
     if bytes.iter().all(|b| b.is_ascii_whitespace()) {
         return Err(SceneError::Empty { path: path.to_owned() });
     }
     let (json_bytes, glb) = if bytes.starts_with(b"glTF") {
-        let (json, bin) = split_glb(path, &bytes)?;
+        let (json, bin) = split_glb(path, bytes)?;
         (json, Some(bin))
     } else {
-        (&bytes[..], None)
+        (bytes, None)
     };
     if json_bytes.len() as u64 > options.max_json_bytes {
         let what = "the GLB JSON chunk";
@@ -392,6 +475,17 @@ fn load_inner(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
     // A UTF-8 byte-order mark is not valid JSON but harmless; accept it.
     let json_bytes = json_bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(json_bytes);
     let root = normalize::parse_root(path, json_bytes)?;
+    Ok(ParsedScene { json: json_bytes, glb, root })
+}
+
+/// Loads the scene file with contents `bytes`, its URIs resolved in `files`.
+fn load_inner(
+    path: &Path,
+    bytes: &[u8],
+    files: uri::FileSource<'_>,
+    options: &LoadOptions,
+) -> Result<Scene, SceneError> {
+    let ParsedScene { json: json_bytes, glb, root } = parse_scene_bytes(path, bytes, options)?;
     let material_extensions = materials::material_extensions(path, json_bytes);
     for ext in &root.extensions_required {
         if UNSUPPORTED_REQUIRED.contains(&ext.as_str()) {
@@ -402,10 +496,11 @@ fn load_inner(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
         }
     }
     let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let buffers = data::load_buffers(path, &base_dir, &root, glb, options)?;
+    let buffers = data::load_buffers(path, &base_dir, files, &root, glb, options)?;
     let mut ctx = Ctx {
         path,
         base_dir,
+        files,
         root: &root,
         buffers,
         options,
@@ -447,6 +542,8 @@ struct Ctx<'a> {
     path: &'a Path,
     /// Folder that URIs resolve in; they may not leave it.
     base_dir: PathBuf,
+    /// Where the files that URIs name are read from.
+    files: uri::FileSource<'a>,
     /// The parsed, unvalidated JSON.
     root: &'a gltf::json::Root,
     /// Buffer contents, each cut to its `byteLength` (or why a buffer has none).

@@ -15,11 +15,12 @@ mod textures;
 pub use default_scene::default_scene;
 pub use error::SceneError;
 pub use gltf_loader::{
-    LoadOptions, MAX_DOWNSCALED_SOURCE, OversizedTextures, blinn_phong_from_pbr, load_gltf,
+    FetchedFiles, LoadOptions, MAX_DOWNSCALED_SOURCE, OversizedTextures, ReferencedFile,
+    blinn_phong_from_pbr, load_gltf, load_gltf_fetched, referenced_files,
 };
 pub use light_rig::{
     AnimatedLight, RIG_RADIUS_K, SHELL_LIGHT_RANGE, SHELL_RADIUS, SplitMix64, animated_light_at,
-    intensity_for_radius, light_rig, sphere_shell_lights, sphere_shell_scene, studio_lights,
+    intensity_for_radius, light_rig, rig_bounds, sphere_shell_lights, sphere_shell_scene, studio_lights,
 };
 pub use scene_ops::{camera_looking_at, load_scene};
 

@@ -85,6 +85,13 @@ fn usable_bounds(bounds: Aabb) -> Aabb {
     if usable { bounds } else { Aabb { min: Vec3::splat(-1.0), max: Vec3::ONE } }
 }
 
+/// A model's bounds made into a volume for [`light_rig`] around it: each side at least a
+/// quarter of the diagonal, so a flat scene (a single plane) gets lights above it too.
+pub fn rig_bounds(bounds: Aabb) -> Aabb {
+    let pad = (Vec3::splat(bounds.size().length() * 0.25) - bounds.size()).max(Vec3::ZERO) * 0.5;
+    Aabb { min: bounds.min - pad, max: bounds.max + pad }
+}
+
 /// `count` animated lights placed deterministically (for `seed`) inside `bounds`.
 ///
 /// Centres are uniform in `bounds` shrunk by 5 % of its size on each side, and orbit and bob

@@ -10,24 +10,69 @@ use percent_encoding::percent_decode_str;
 pub const DEFAULT_LIGHTS: usize = 1024;
 
 /// The scenes the page can show.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub enum WebScene {
     /// The embedded hall (six warm lights of its own) with a rig of animated lights.
     Hall,
     /// The sphere-shell stress scene: still lights on a sphere around the camera.
     SphereShell,
+    /// A glTF file under the site's `assets/` folder, fetched by the page, with a rig of
+    /// animated lights around it.
+    Gltf(AssetPath),
 }
 
 impl WebScene {
-    /// Every scene, in the order the error message lists them.
-    pub const ALL: [WebScene; 2] = [WebScene::Hall, WebScene::SphereShell];
+    /// The built-in scenes, in the order the error message lists them.
+    pub const BUILT_IN: [WebScene; 2] = [WebScene::Hall, WebScene::SphereShell];
 
-    /// The name the `scene` parameter takes.
-    pub fn name(self) -> &'static str {
+    /// The value the `scene` parameter takes for it.
+    pub fn name(&self) -> &str {
         match self {
             WebScene::Hall => "hall",
             WebScene::SphereShell => "sphere-shell",
+            WebScene::Gltf(path) => path.as_str(),
         }
+    }
+}
+
+/// The path of a `.gltf` or `.glb` file under the site's `assets/` folder: `/`-separated
+/// names of letters, digits, `-`, `_` and `.`, none of them `.` or `..`, so the URL the page
+/// fetches it from (`assets/` + the path) stays in that folder.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct AssetPath(String);
+
+impl AssetPath {
+    /// The folder, relative to the page, that glTF files are fetched from.
+    pub const FOLDER: &'static str = "assets/";
+
+    /// `path` if it names a `.gltf` or `.glb` file inside [`AssetPath::FOLDER`].
+    pub fn parse(path: &str) -> Result<AssetPath, String> {
+        let lower = path.to_ascii_lowercase();
+        if !(lower.ends_with(".gltf") || lower.ends_with(".glb")) {
+            return Err("expected hall, sphere-shell, or a .gltf or .glb file under assets/ \
+                 (such as DamagedHelmet/DamagedHelmet.glb)"
+                .into());
+        }
+        for part in path.split('/') {
+            let plain = part.chars().all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c));
+            if part.is_empty() || part == "." || part == ".." || !plain {
+                return Err(format!(
+                    "`{part}` is not a plain file or folder name (letters, digits, `-`, `_`, `.`): \
+                     the file must lie under assets/"
+                ));
+            }
+        }
+        Ok(AssetPath(path.to_owned()))
+    }
+
+    /// The path as given (under [`AssetPath::FOLDER`]).
+    pub fn as_str(&self) -> &str {
+        &self.0
+    }
+
+    /// The URL the page fetches the file from, relative to the page.
+    pub fn url(&self) -> String {
+        format!("{}{}", AssetPath::FOLDER, self.0)
     }
 }
 
@@ -63,7 +108,7 @@ pub struct WebOptions {
     pub shadows: bool,
     /// `debug-view`: a debug view instead of the image. Default none.
     pub debug_view: DebugViewMode,
-    /// `scene`: `hall` (default) or `sphere-shell`.
+    /// `scene`: `hall` (default), `sphere-shell`, or a `.gltf`/`.glb` file under `assets/`.
     pub scene: WebScene,
     /// `size`: `WxH` fixes the canvas size; by default the canvas fills the page.
     pub size: Option<UVec2>,
@@ -171,10 +216,10 @@ impl WebOptions {
             "shadows" => self.shadows = parse_on_off(value)?,
             "debug-view" => self.debug_view = parse_debug_view(value)?,
             "scene" => {
-                self.scene = WebScene::ALL.into_iter().find(|s| s.name() == value).ok_or_else(|| {
-                    let names: Vec<_> = WebScene::ALL.iter().map(|s| s.name()).collect();
-                    format!("unknown scene (expected one of: {})", names.join(", "))
-                })?;
+                self.scene = match WebScene::BUILT_IN.into_iter().find(|s| s.name() == value) {
+                    Some(scene) => scene,
+                    None => WebScene::Gltf(AssetPath::parse(value)?),
+                };
             }
             "size" => self.size = Some(parse_size(value)?),
             "overlay" => self.overlay = parse_on_off(value)?,
@@ -236,6 +281,14 @@ mod tests {
     }
 
     #[test]
+    fn a_gltf_scene_is_a_file_under_assets() {
+        let o = WebOptions::from_query("scene=DamagedHelmet/DamagedHelmet.glb").unwrap();
+        let WebScene::Gltf(path) = &o.scene else { panic!("{:?}", o.scene) };
+        assert_eq!(path.url(), "assets/DamagedHelmet/DamagedHelmet.glb");
+        assert_eq!(o.scene.name(), "DamagedHelmet/DamagedHelmet.glb");
+    }
+
+    #[test]
     fn escapes_are_decoded() {
         assert_eq!(WebOptions::from_query("scene=sphere%2Dshell").unwrap().scene, WebScene::SphereShell);
     }
@@ -249,7 +302,11 @@ mod tests {
             ("lights=99999999999", "`lights=99999999999`"),
             ("pipeline=fast", "`pipeline=fast`: unknown pipeline"),
             ("shadows=yes", "`shadows=yes`"),
-            ("scene=moon", "unknown scene (expected one of: hall, sphere-shell)"),
+            ("scene=moon", "expected hall, sphere-shell, or a .gltf or .glb file under assets/"),
+            ("scene=../secret.glb", "`..` is not a plain file or folder name"),
+            ("scene=/etc/x.gltf", "`` is not a plain file or folder name"),
+            ("scene=https://example.com/x.glb", "`https:` is not a plain file or folder name"),
+            ("scene=a//b.glb", "`` is not a plain file or folder name"),
             ("size=0x0", "`size=0x0`"),
             ("capture=0", "`capture=0`"),
             ("clock=slow", "expected wall or fixed"),

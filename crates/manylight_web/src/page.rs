@@ -1,15 +1,16 @@
 //! The page side: starts the app in the page's canvas, and answers the page contract.
 //!
-//! 1. `start` (run when the module is initialised) parses the URL query, builds the app with
-//!    the manylight plugin drawing into `<canvas id="manylight">`, and hands it to the page's
-//!    event loop. The device is requested asynchronously; the app updates once it arrives.
+//! 1. `start` (run when the module is initialised) parses the URL query, fetches and loads the
+//!    glTF file the `scene` parameter names (if it names one), builds the app with the
+//!    manylight plugin drawing into `<canvas id="manylight">`, and hands it to the page's event
+//!    loop. The device is requested asynchronously; the app updates once it arrives.
 //! 2. Each update, `publish` keeps the last frame's statistics as JSON, sets
 //!    `document.title` to `manylight: ready` after the first frame, and shows a failure.
 //! 3. `stats()`, `error()` and `capture()` are what `window.manylight` calls (`index.html`).
 
 use crate::controls::{FlyInput, fly};
-use crate::demo::add_scene;
-use crate::options::{WebOptions, WebPresent};
+use crate::demo::{DemoScene, add_scene};
+use crate::options::{AssetPath, WebOptions, WebPresent, WebScene};
 use crate::readback_canvas::{DisplaySlot, ReadBackSink};
 use base64::Engine;
 use manylight::app::backend::RenderBackend;
@@ -152,6 +153,79 @@ fn run() -> Result<(), String> {
         canvas.set_attribute("style", &style).map_err(|e| format!("cannot size the canvas: {e:?}"))?;
         canvas.set_attribute("class", "fixed").map_err(|e| format!("cannot size the canvas: {e:?}"))?;
     }
+    listen_for_input(&canvas)?;
+    match DemoScene::built_in(&options.scene) {
+        Some(scene) => start_app(options, canvas, scene),
+        None => {
+            wasm_bindgen_futures::spawn_local(async move {
+                let loaded = match &options.scene {
+                    WebScene::Gltf(path) => load_asset(path).await,
+                    _ => unreachable!("a built-in scene needs no load"),
+                };
+                let started =
+                    loaded.and_then(|scene| start_app(options, canvas, DemoScene::Loaded(Box::new(scene))));
+                if let Err(message) = started {
+                    fail(&message);
+                }
+            });
+            Ok(())
+        }
+    }
+}
+
+/// Fetches the glTF file at `path` and every file it refers to, and loads it.
+async fn load_asset(path: &AssetPath) -> Result<Scene, String> {
+    use manylight::scene::{FetchedFiles, load_gltf_fetched, referenced_files};
+    let url = path.url();
+    let options = LoadOptions::default();
+    let named = std::path::Path::new(&url);
+    let failed = |e: manylight::scene::SceneError| format!("scene `{}` did not load: {e}", path.as_str());
+    let bytes = fetch_bytes(&url, options.max_glb_bytes.max(options.max_json_bytes)).await?;
+    let mut files = FetchedFiles::new();
+    let folder = &url[..url.rfind('/').map_or(0, |i| i + 1)];
+    for file in referenced_files(named, &bytes, &options).map_err(failed)? {
+        let data = fetch_bytes(&format!("{folder}{}", file.uri), options.max_buffer_bytes).await?;
+        files.insert(file.name, data);
+    }
+    load_gltf_fetched(named, &bytes, &files, &options).map_err(failed)
+}
+
+/// The body of the response to a GET of `url` (relative to the page), refused when the server
+/// answers with an error or it is over `limit` bytes.
+async fn fetch_bytes(url: &str, limit: u64) -> Result<Vec<u8>, String> {
+    use wasm_bindgen_futures::JsFuture;
+    let cannot = |why: String| format!("cannot fetch `{url}`: {why}");
+    let window = web_sys::window().ok_or_else(|| cannot("no window".into()))?;
+    let response: web_sys::Response = JsFuture::from(window.fetch_with_str(url))
+        .await
+        .map_err(|e| cannot(format!("{e:?}")))?
+        .dyn_into()
+        .map_err(|_| cannot("the answer is not a response".into()))?;
+    if !response.ok() {
+        return Err(cannot(format!("HTTP {} {}", response.status(), response.status_text())));
+    }
+    let too_large = |size: u64| cannot(format!("it is {size} bytes, over the limit of {limit}"));
+    // The declared length is refused before the body is read; the body is checked again.
+    let declared =
+        response.headers().get("content-length").ok().flatten().and_then(|l| l.parse::<u64>().ok());
+    if let Some(size) = declared.filter(|&size| size > limit) {
+        return Err(too_large(size));
+    }
+    let body = response.array_buffer().map_err(|e| cannot(format!("{e:?}")))?;
+    let body = JsFuture::from(body).await.map_err(|e| cannot(format!("{e:?}")))?;
+    let array = js_sys::Uint8Array::new(&body);
+    if u64::from(array.length()) > limit {
+        return Err(too_large(u64::from(array.length())));
+    }
+    Ok(array.to_vec())
+}
+
+/// Builds the app for `options` showing `scene` in `canvas`, and starts it.
+fn start_app(
+    options: WebOptions,
+    canvas: web_sys::HtmlCanvasElement,
+    scene: DemoScene,
+) -> Result<(), String> {
     let (width, height) = match options.size {
         Some(size) => (size.x, size.y),
         None => (canvas.client_width().max(1) as u32, canvas.client_height().max(1) as u32),
@@ -174,8 +248,7 @@ fn run() -> Result<(), String> {
                 .insert_resource(TimeUpdateStrategy::Automatic);
         }
     }
-    add_scene(&mut app, &options, width as f32 / height as f32);
-    listen_for_input(&canvas)?;
+    add_scene(&mut app, &options, scene, width as f32 / height as f32);
     app.insert_resource(CaptureAt(options.capture))
         .insert_resource(Presenting(options.present))
         .add_systems(Update, fly_camera)

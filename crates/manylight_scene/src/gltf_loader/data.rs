@@ -1,7 +1,7 @@
 //! Binary data of a glTF file: buffers (GLB chunk, `data:` URIs, files in the glTF file's
 //! folder), buffer views and accessors, each range-checked before a byte is read.
 
-use super::uri::{UriSource, resolve_uri};
+use super::uri::{FileSource, UriSource, resolve_uri};
 use super::{Ctx, LoadOptions, over_budget};
 use crate::SceneError;
 use gltf::json::accessor::{ComponentType, Type};
@@ -22,6 +22,7 @@ pub(super) type BufferData<'a> = Result<Cow<'a, [u8]>, &'static str>;
 pub(super) fn load_buffers<'a>(
     path: &Path,
     base_dir: &Path,
+    files: FileSource<'_>,
     root: &gltf::json::Root,
     glb: Option<Option<&'a [u8]>>,
     options: &LoadOptions,
@@ -49,8 +50,8 @@ pub(super) fn load_buffers<'a>(
             return Err(over_budget(path, what, total, "bytes of buffers", limit, "max_buffer_bytes"));
         }
         let data: Cow<'a, [u8]> = match &buffer.uri {
-            Some(uri) => match resolve_uri(path, base_dir, &what, uri)? {
-                UriSource::Data { bytes, .. } => Cow::Owned(bytes),
+            Some(uri) => match resolve_uri(path, base_dir, files, &what, uri)? {
+                UriSource::Bytes { bytes } => Cow::Owned(bytes),
                 UriSource::File(file) => {
                     if file.size < declared {
                         return Err(SceneError::BadBuffer {

@@ -34,7 +34,7 @@ const MAX_IMAGE_FILE_BYTES: u64 = 256 << 20;
 /// Where an image's encoded bytes come from; images with the same source share one decode.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub(super) enum ImageSource<'a> {
-    /// A `data:` URI, by its text.
+    /// A `data:` URI, or a file fetched before the load, by its URI text.
     Data(&'a str),
     /// A file in the glTF file's folder, by its canonical path.
     File(PathBuf),
@@ -432,10 +432,10 @@ impl<'a> Ctx<'a> {
         // Resolve the source (a file is opened and checked, not read).
         let (source, file) = match (&img.uri, img.buffer_view) {
             (Some(uri), _) if is_data_uri(uri) => (ImageSource::Data(uri.as_str()), None),
-            (Some(uri), _) => match resolve_uri(self.path, &self.base_dir, &what, uri)? {
+            (Some(uri), _) => match resolve_uri(self.path, &self.base_dir, self.files, &what, uri)? {
                 UriSource::File(file) => (ImageSource::File(file.path.clone()), Some(file)),
-                // `resolve_uri` decodes only `data:` URIs, handled above.
-                UriSource::Data { .. } => (ImageSource::Data(uri.as_str()), None),
+                // A fetched file, keyed by its URI as a `data:` URI is.
+                UriSource::Bytes { .. } => (ImageSource::Data(uri.as_str()), None),
             },
             (None, Some(view)) => (ImageSource::View(view.value()), None),
             (None, None) => {
@@ -483,8 +483,8 @@ impl<'a> Ctx<'a> {
             }
             (_, None) => {
                 let uri = img.uri.as_deref().unwrap_or_default();
-                let bytes = match resolve_uri(self.path, &self.base_dir, &what, uri)? {
-                    UriSource::Data { bytes, .. } => bytes,
+                let bytes = match resolve_uri(self.path, &self.base_dir, self.files, &what, uri)? {
+                    UriSource::Bytes { bytes } => bytes,
                     UriSource::File(file) => file.read_prefix(self.path, &what, MAX_IMAGE_FILE_BYTES)?,
                 };
                 (Cow::Owned(bytes), format!("{} image {index}", self.file_name()))

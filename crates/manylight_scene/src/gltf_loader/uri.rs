@@ -14,19 +14,75 @@
 //!
 //! Callers learn the file's size before reading and read at most what they need
 //! ([`LocalFile::read_prefix`]).
+//!
+//! A load from [`FetchedFiles`] (a page fetched what the file refers to) passes the same text
+//! checks and then looks the relative path up among the fetched files instead of the disk.
 
 use crate::SceneError;
 use base64::Engine as _;
+use std::collections::HashMap;
 use std::fs::File;
 use std::io::Read;
 use std::path::{Component, Path, PathBuf};
 
 /// Where the bytes named by a `uri` come from.
 pub(super) enum UriSource {
-    /// Decoded `data:` URI payload.
-    Data { bytes: Vec<u8> },
+    /// The bytes themselves: a decoded `data:` URI payload, or a fetched file's copy.
+    Bytes { bytes: Vec<u8> },
     /// An opened regular file inside the glTF file's folder.
     File(LocalFile),
+}
+
+/// The files a glTF file refers to, fetched before the load (where there is no file system,
+/// as in a browser): each keyed by its [`ReferencedFile::name`]. Filled from what
+/// [`referenced_files`](super::referenced_files) lists and read by
+/// [`load_gltf_fetched`](super::load_gltf_fetched).
+#[derive(Clone, Debug, Default)]
+pub struct FetchedFiles {
+    files: HashMap<String, Vec<u8>>,
+}
+
+impl FetchedFiles {
+    /// No files.
+    pub fn new() -> FetchedFiles {
+        FetchedFiles::default()
+    }
+
+    /// Adds (or replaces) the file named `name` (a [`ReferencedFile::name`]).
+    pub fn insert(&mut self, name: impl Into<String>, bytes: Vec<u8>) {
+        self.files.insert(name.into(), bytes);
+    }
+
+    /// How many files there are.
+    pub fn len(&self) -> usize {
+        self.files.len()
+    }
+
+    /// True when there are none.
+    pub fn is_empty(&self) -> bool {
+        self.files.is_empty()
+    }
+}
+
+/// A file a glTF file refers to by a relative URI (not a `data:` URI), which a caller without
+/// a file system fetches before [`load_gltf_fetched`](super::load_gltf_fetched).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ReferencedFile {
+    /// The URI as the file writes it (percent-encoded), to resolve against the glTF file's
+    /// own URL.
+    pub uri: String,
+    /// The path it names inside the glTF file's folder, `/`-separated and percent-decoded: the
+    /// key of [`FetchedFiles`].
+    pub name: String,
+}
+
+/// Where the files that URIs name are read from.
+#[derive(Clone, Copy)]
+pub(super) enum FileSource<'a> {
+    /// The glTF file's folder on disk.
+    Disk,
+    /// Files fetched before the load.
+    Fetched(&'a FetchedFiles),
 }
 
 /// A regular file inside the glTF file's folder, opened and checked, not yet read.
@@ -218,9 +274,94 @@ pub(super) fn open_options() -> std::fs::OpenOptions {
 pub(super) fn resolve_uri(
     path: &Path,
     base_dir: &Path,
+    files: FileSource<'_>,
     what: &str,
     uri: &str,
 ) -> Result<UriSource, SceneError> {
+    let relative = match check_uri(path, base_dir, what, uri)? {
+        CheckedUri::Data(bytes) => return Ok(UriSource::Bytes { bytes }),
+        CheckedUri::Relative(relative) => relative,
+    };
+    let io_err = |file: &Path, source| SceneError::ReferencedFile {
+        path: path.to_owned(),
+        what: what.to_owned(),
+        file: file.to_owned(),
+        source,
+    };
+    let base_dir = if base_dir.as_os_str().is_empty() { Path::new(".") } else { base_dir };
+    let joined = base_dir.join(&relative);
+    let fetched = match files {
+        FileSource::Fetched(fetched) => fetched,
+        FileSource::Disk => {
+            let folder = base_dir.canonicalize().map_err(|e| io_err(base_dir, e))?;
+            let file = joined.canonicalize().map_err(|e| io_err(&joined, e))?;
+            if !file.starts_with(&folder) {
+                let reason = format!("it resolves outside the folder (symlink) to `{}`", file.display());
+                return Err(outside(path, base_dir, what, uri, reason));
+            }
+            return open_regular(path, what, file, &folder).map(UriSource::File).map_err(|e| match e {
+                OpenError::Outside(reason) => outside(path, base_dir, what, uri, reason),
+                OpenError::Scene(e) => e,
+            });
+        }
+    };
+    match fetched.files.get(&fetched_name(&relative)) {
+        Some(bytes) => Ok(UriSource::Bytes { bytes: bytes.clone() }),
+        None => {
+            let missing =
+                std::io::Error::new(std::io::ErrorKind::NotFound, "it was not among the fetched files");
+            Err(io_err(&joined, missing))
+        }
+    }
+}
+
+/// The key of [`FetchedFiles`] for a checked relative path: its components joined by `/`.
+fn fetched_name(relative: &Path) -> String {
+    let parts: Vec<_> = relative.components().map(|c| c.as_os_str().to_string_lossy()).collect();
+    parts.join("/")
+}
+
+/// A URI that passed the text checks.
+pub(super) enum CheckedUri {
+    /// A `data:` URI's decoded bytes.
+    Data(Vec<u8>),
+    /// A relative path made of plain names (percent-decoded), inside the glTF file's folder.
+    Relative(PathBuf),
+}
+
+/// The error for a URI that names something outside `base_dir`.
+fn outside(path: &Path, base_dir: &Path, what: &str, uri: &str, reason: String) -> SceneError {
+    SceneError::UriOutsideFolder {
+        path: path.to_owned(),
+        what: what.to_owned(),
+        uri: short_uri(uri),
+        folder: base_dir.to_owned(),
+        reason,
+    }
+}
+
+/// The [`ReferencedFile`] that `uri` names, `None` for a `data:` URI; refused as
+/// [`resolve_uri`] refuses it.
+pub(super) fn referenced_file(
+    path: &Path,
+    base_dir: &Path,
+    what: &str,
+    uri: &str,
+) -> Result<Option<ReferencedFile>, SceneError> {
+    if is_data_uri(uri) {
+        return Ok(None);
+    }
+    match check_uri(path, base_dir, what, uri)? {
+        CheckedUri::Data(_) => Ok(None),
+        CheckedUri::Relative(relative) => {
+            Ok(Some(ReferencedFile { uri: uri.to_owned(), name: fetched_name(&relative) }))
+        }
+    }
+}
+
+/// Checks the text of a buffer or image URI: a `data:` URI is decoded, a network URI or any
+/// other scheme is refused, anything else must be a relative path of plain names.
+fn check_uri(path: &Path, base_dir: &Path, what: &str, uri: &str) -> Result<CheckedUri, SceneError> {
     let bad = |reason: &str| SceneError::BadUri {
         path: path.to_owned(),
         what: what.to_owned(),
@@ -228,13 +369,7 @@ pub(super) fn resolve_uri(
         reason: reason.to_owned(),
     };
     let base_dir = if base_dir.as_os_str().is_empty() { Path::new(".") } else { base_dir };
-    let outside = |reason: String| SceneError::UriOutsideFolder {
-        path: path.to_owned(),
-        what: what.to_owned(),
-        uri: short_uri(uri),
-        folder: base_dir.to_owned(),
-        reason,
-    };
+    let outside = |reason: String| outside(path, base_dir, what, uri, reason);
     let lower = uri.get(..8).unwrap_or(uri).to_ascii_lowercase();
     if lower.starts_with("http://") || lower.starts_with("https://") || uri.starts_with("//") {
         return Err(SceneError::ExternalUri {
@@ -244,8 +379,7 @@ pub(super) fn resolve_uri(
         });
     }
     if is_data_uri(uri) {
-        let bytes = decode_data_uri(uri).map_err(|reason| bad(&reason))?;
-        return Ok(UriSource::Data { bytes });
+        return decode_data_uri(uri).map(CheckedUri::Data).map_err(|reason| bad(&reason));
     }
     // A scheme is letters/digits/+/-/. before the first ':' that comes before any '/'; a
     // single letter there is a Windows drive.
@@ -267,22 +401,7 @@ pub(super) fn resolve_uri(
     if decoded.contains('\0') {
         return Err(bad("NUL byte in path"));
     }
-    let joined = base_dir.join(relative_path(&decoded).map_err(outside)?);
-    let io_err = |file: &Path, source| SceneError::ReferencedFile {
-        path: path.to_owned(),
-        what: what.to_owned(),
-        file: file.to_owned(),
-        source,
-    };
-    let folder = base_dir.canonicalize().map_err(|e| io_err(base_dir, e))?;
-    let file = joined.canonicalize().map_err(|e| io_err(&joined, e))?;
-    if !file.starts_with(&folder) {
-        return Err(outside(format!("it resolves outside the folder (symlink) to `{}`", file.display())));
-    }
-    open_regular(path, what, file, &folder).map(UriSource::File).map_err(|e| match e {
-        OpenError::Outside(reason) => outside(reason),
-        OpenError::Scene(e) => e,
-    })
+    relative_path(&decoded).map(CheckedUri::Relative).map_err(outside)
 }
 
 /// Why [`open_regular`] refused a file.
