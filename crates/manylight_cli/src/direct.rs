@@ -6,6 +6,7 @@ use anyhow::{Context, Result};
 use glam::UVec2;
 use manylight_app::render_world::HeadlessRenderer;
 use manylight_app::scene::{extracted_light, scene_snapshot};
+use manylight_core::cluster::ClusterAssignment;
 use manylight_core::efficiency::{
     CullingEfficiency, culling_efficiency, depth_bounded_lists, depth_masked_lists, exact_pixel_lists,
     pixel_grid, zbinned_lists,
@@ -136,6 +137,14 @@ pub fn oracle_snapshot(
         _ => PipelineKind::ClusteredForward,
     };
     snapshot.pixel_light_lists = None;
+    if manylight_render::lights::buffered_lights(&snapshot.lights).next().is_none() {
+        // No point or spot light, so no clusters: directional lights shade every pixel without
+        // a list, and every pixel's exact list is empty.
+        let pixels = snapshot.viewport.x as usize * snapshot.viewport.y as usize;
+        let empty = ClusterAssignment { ranges: vec![[0, 0]; pixels], ..ClusterAssignment::default() };
+        snapshot.pixel_light_lists = Some(Arc::new(empty));
+        return Ok((snapshot, CullingEfficiency::default()));
+    }
     let f = render_and_read_lists(renderer, snapshot.clone())?;
     let lists = exact_pixel_lists(&f.grid, &f.projection, &f.assignment, &f.spheres, &f.depth);
     // The oracle's own lists measured the same way: 1 by construction.

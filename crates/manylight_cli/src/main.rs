@@ -594,6 +594,12 @@ fn measure_shadow_accuracy(
         a.rays,
         a.ray_cast_ms
     );
+    if !scene.directional_lights.is_empty() {
+        println!(
+            "shadow oracle: the {} directional light(s) are not measured (the reference keeps their cascades)",
+            scene.directional_lights.len()
+        );
+    }
     Ok(a)
 }
 
@@ -655,7 +661,12 @@ fn add_render_lights(scene: &mut Scene, args: &RenderArgs) -> Result<RenderLight
     // 0.3 just inside the radius-50 sphere), not by the animated rig.
     let shell = args.scene == "sphere-shell";
     let shell_lights = if shell { args.lights.unwrap_or(100_000) } else { 0 };
-    let unlit = if shell { shell_lights == 0 } else { scene.lights.is_empty() };
+    // A scene lit only by directional lights is lit: studio lights are for scenes with none.
+    let unlit = if shell {
+        shell_lights == 0
+    } else {
+        scene.lights.is_empty() && scene.directional_lights.is_empty()
+    };
     let lights = if shell { 0 } else { args.lights.unwrap_or(0) };
     let studio = args.studio_lights.unwrap_or(if unlit && args.lights.is_none() { 32 } else { 0 });
     let total = [scene.lights.len(), shell_lights, lights, studio].into_iter().fold(0, usize::saturating_add);

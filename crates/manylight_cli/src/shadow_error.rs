@@ -12,8 +12,10 @@
 //!    light reaches the point: inside its range, in front of the surface, inside a spot's
 //!    cone): a filtered test half-lit at a lit pair counts one half.
 //! 5. The **shadow reference image** is the light-list oracle with every blocked pair removed
-//!    from its lists and no shadow map: naive forward's image with exact visibility. The frame
-//!    is compared with it by FLIP.
+//!    from its lists and no point or spot light's shadow map: naive forward's image with exact
+//!    visibility. The frame is compared with it by FLIP. Directional lights are not measured:
+//!    the reference keeps the frame's cascades, and a scene lit only by directional lights
+//!    has no pairs to measure (its error is 0 over 0 pairs).
 
 use crate::direct::oracle_snapshot;
 use anyhow::{Context, Result};
@@ -113,7 +115,8 @@ pub fn measure_shadows(
     let contributing_pairs = exact.len() as u64;
     let blocked_pairs = exact.iter().filter(|&&v| !v).count() as u64;
 
-    let reference = shadow_reference(renderer, oracle, &lists, &pairs.entries, &visible)?;
+    let reference =
+        shadow_reference(renderer, oracle, snapshot.settings.shadows, &lists, &pairs.entries, &visible)?;
     let (flip, _) =
         flip_compare(reference.dimensions(), reference.as_raw(), image.dimensions(), image.as_raw())?;
     let per_pair = |sum: f64| if contributing_pairs == 0 { 0.0 } else { sum / contributing_pairs as f64 };
@@ -220,10 +223,13 @@ fn test_errors(tested: &[f32], exact: &[bool]) -> TestErrors {
 }
 
 /// Renders the shadow reference: the `oracle` snapshot's `lists` without the blocked pairs
-/// (`entries` whose segment is not `visible`), no shadow maps.
+/// (`entries` whose segment is not `visible`) and no point or spot light's shadow map.
+/// Directional lights keep the measured frame's cascades (`shadows`): the oracle measures
+/// point and spot lights, so the reference differs from the frame only in their shadows.
 fn shadow_reference(
     renderer: &mut HeadlessRenderer,
     oracle: FrameSnapshot,
+    shadows: manylight_render::ShadowSettings,
     lists: &ClusterAssignment,
     entries: &[(u32, bool)],
     visible: &[bool],
@@ -231,7 +237,10 @@ fn shadow_reference(
     let blocked: Vec<u32> =
         entries.iter().zip(visible).filter(|(_, v)| !**v).map(|((entry, _), _)| *entry).collect();
     let mut reference_snapshot = oracle;
-    reference_snapshot.settings.shadows.enabled = false;
+    reference_snapshot.settings.shadows = shadows;
+    reference_snapshot
+        .lights
+        .update(|light| *light = manylight_app::scene::with_shadow(light.clone(), false));
     reference_snapshot.pixel_light_lists = Some(Arc::new(without_entries(lists, &blocked)));
     let (_, reference) = renderer.render(reference_snapshot, true)?;
     reference.context("the reference was not read back")

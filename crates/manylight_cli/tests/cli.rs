@@ -389,6 +389,43 @@ fn shadow_measurements_come_out_of_render_bench_and_report() {
     assert_figures(&plots, &["report_shadows_accuracy_vs_time", "report_shadows_passes"]);
 }
 
+/// A glTF scene lit only by a directional light (`tests/data/sun_only.gltf`: a floor, a cube
+/// and a sun) is lit: `render` adds no studio lights to it, and `--shadow-oracle` measures it
+/// (no point or spot light, so no pairs) instead of failing for want of clusters.
+#[test]
+fn a_scene_lit_only_by_the_sun_is_rendered_as_lit_and_measured() {
+    let _gpu = GPU.lock().unwrap_or_else(|e| e.into_inner());
+    let dir = root().join("target/cli-tests");
+    std::fs::create_dir_all(&dir).expect("mkdir");
+    let json = dir.join("sun_only.json");
+    let scene = root().join("tests/data/sun_only.gltf");
+    let out = manylight(&[
+        "render",
+        "--scene",
+        scene.to_str().expect("utf-8"),
+        "--size",
+        "64x48",
+        "--shadows",
+        "on",
+        "--shadow-oracle",
+        "--out",
+        dir.join("sun_only.png").to_str().expect("utf-8"),
+        "--stats-json",
+        json.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("the 1 directional light(s) are not measured"), "{stdout}");
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).expect("json")).expect("valid");
+    assert_eq!(stats["last_frame"]["light_count"].as_u64(), Some(0), "no studio lights were added");
+    assert_eq!(stats["shadow_oracle"]["contributing_pairs"].as_u64(), Some(0));
+    assert_eq!(stats["shadow_oracle"]["flip_vs_shadow_reference"].as_f64(), Some(0.0));
+    let image = image::open(dir.join("sun_only.png")).expect("png").to_rgba8();
+    let lit = image.pixels().filter(|p| p[0] > 64).count();
+    assert!(lit > image.pixels().len() / 4, "the sun lights the floor: {lit} bright pixels");
+}
+
 /// Arguments that used to allocate before any limit was checked (`--lights 4294967295` aborted
 /// on a 240 GB allocation, `--lights 18446744073709551615` panicked with "capacity overflow",
 /// `--lights 10000000` reached 2.9 GB spawning entities past lavapipe's 2 796 202-light
