@@ -3,7 +3,7 @@
 //! overlaps the rendering of frame N; the channel holds one frame, so the simulation never runs
 //! more than one frame ahead).
 
-use crate::render_world::{DeviceLoss, SinkFrame};
+use crate::render_world::{DeviceLoss, SinkFrame, panic_message};
 use crate::resources::{FrameStats, HeadlessCapture, RenderFailure, RenderedImages};
 use bevy_ecs::prelude::*;
 use crossbeam_channel::{Receiver, Sender, bounded, unbounded};
@@ -118,15 +118,6 @@ impl FrameSink for crate::render_world::HeadlessRenderer {
     fn adapter(&self) -> Option<&wgpu::AdapterInfo> {
         Some(&self.render_world.gpu().info)
     }
-}
-
-/// The message of a panic payload (`panic!` with a string or a formatted message).
-pub(crate) fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
-    payload
-        .downcast_ref::<&str>()
-        .map(|s| s.to_string())
-        .or_else(|| payload.downcast_ref::<String>().cloned())
-        .unwrap_or_else(|| "a panic without a message".to_string())
 }
 
 /// Renders one frame, turning a panic of the renderer into an error like any other failed

@@ -1,9 +1,21 @@
 //! The headless runner: renders a number of frames and writes the last one as PNG.
 
 use crate::backend::RenderBackend;
-use crate::plugin::HeadlessConfig;
 use crate::resources::{FrameStats, HeadlessCapture, RenderFailure};
 use bevy_app::{App, AppExit};
+use glam::UVec2;
+use std::path::PathBuf;
+
+/// Headless parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeadlessConfig {
+    /// Target size in pixels.
+    pub size: UVec2,
+    /// With `App::run`: how many frames to render before exiting (default 1).
+    pub frames: u32,
+    /// With `App::run`: where to write the last frame as PNG.
+    pub output: Option<PathBuf>,
+}
 
 /// Runs `config.frames` updates (or until a system exits), then writes the last frame to
 /// `config.output` if set.

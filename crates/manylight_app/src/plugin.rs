@@ -2,10 +2,12 @@
 
 use crate::backend::RenderBackend;
 use crate::extract::{animate_lights, collect_results, extract_and_render};
+pub use crate::headless::HeadlessConfig;
 use crate::render_world::HeadlessRenderer;
 use crate::resources::{
     DebugView, FrameStats, FramesInFlight, HeadlessCapture, RenderFailure, RenderSettings, ViewportSize,
 };
+pub use crate::stages::ManyLightSystems;
 use crate::window::WindowConfig;
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
@@ -19,28 +21,6 @@ use std::time::Duration;
 /// animated frames are the same on every run and machine. Replace the plugin's
 /// `TimeUpdateStrategy` resource to change it.
 pub const HEADLESS_TIME_STEP: Duration = Duration::from_nanos(16_666_667);
-
-/// Public system sets, so user systems can be ordered around the plugin's.
-#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum ManyLightSystems {
-    /// `Update`: the plugin's own animation (light rigs). User systems that move things can
-    /// run before or after it.
-    Animate,
-    /// `Last`: the snapshot of the world is taken and handed to the renderer. Anything that
-    /// should show in this frame must run before it (any `Update` system does).
-    Extract,
-}
-
-/// Headless parameters.
-#[derive(Clone, Debug, PartialEq)]
-pub struct HeadlessConfig {
-    /// Target size in pixels.
-    pub size: UVec2,
-    /// With `App::run`: how many frames to render before exiting (default 1).
-    pub frames: u32,
-    /// With `App::run`: where to write the last frame as PNG.
-    pub output: Option<PathBuf>,
-}
 
 /// Where frames go.
 #[derive(Clone, Debug, PartialEq)]

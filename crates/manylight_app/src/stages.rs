@@ -30,13 +30,23 @@
 //! ```
 
 use crate::components::Camera3d;
-use crate::plugin::ManyLightSystems;
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
 use manylight_render::{FramePlanner, Pass, Stage, StageError, ViewComponents};
 use std::collections::HashMap;
 use std::marker::PhantomData;
 use std::sync::Arc;
+
+/// Public system sets, so user systems can be ordered around the plugin's.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ManyLightSystems {
+    /// `Update`: the plugin's own animation (light rigs). User systems that move things can
+    /// run before or after it.
+    Animate,
+    /// `Last`: the snapshot of the world is taken and handed to the renderer. Anything that
+    /// should show in this frame must run before it (any `Update` system does).
+    Extract,
+}
 
 /// The stages views are planned with: the built-in ones and those the app added. Extraction
 /// hands them to the render world with each frame

@@ -13,6 +13,7 @@ mod targets;
 
 pub use headless::HeadlessRenderer;
 pub(crate) use recovery::DeviceSink;
+pub(crate) use recovery::panic_message;
 pub use recovery::{DEVICE_LOSS_WINDOW, DeviceLoss, MAX_DEVICE_LOSSES, SinkFrame, empty_report};
 
 use bevy_derive::{Deref, DerefMut};

@@ -6,6 +6,15 @@
 use super::{RenderWorld, Stages};
 use manylight_render::{FrameReport, FrameSnapshot, GpuContext, PipelineKind, RenderError};
 
+/// The message of a panic payload (`panic!` with a string or a formatted message).
+pub(crate) fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "a panic without a message".to_string())
+}
+
 /// A lost device is recreated at most this many times within [`DEVICE_LOSS_WINDOW`] frames;
 /// one more loss ends rendering with [`RenderError::DeviceLost`] instead of a device that keeps
 /// dying being recreated forever.
@@ -170,7 +179,7 @@ pub(crate) trait DeviceSink {
         let result = match rendered {
             Ok(result) => result,
             Err(panic) if self.gpu().lost().is_some() => {
-                Err(RenderError::Device(format!("panicked: {}", crate::backend::panic_message(&*panic))))
+                Err(RenderError::Device(format!("panicked: {}", panic_message(&*panic))))
             }
             Err(panic) => std::panic::resume_unwind(panic),
         };
