@@ -140,7 +140,7 @@ fn unquantised_forms_are_nearly_exact() {
 
 #[test]
 fn wgsl_twin_uses_the_rust_constants_and_names() {
-    let wgsl = include_str!("../../../manylight_render/shaders/common/packing.wgsl");
+    let wgsl = include_str!("../../../../shaders/common/packing.wgsl");
     use std::f32::consts::{FRAC_1_PI, PI, TAU};
     let constants = [
         ("PACKING_MIN_POSITIVE", f32::MIN_POSITIVE),
