@@ -3,6 +3,7 @@
 // triangle, brought in by the include below.
 //!include common/fullscreen.wgsl
 
+// `VignettePass::Params` in examples/custom_pass.rs.
 struct VignetteParams {
     // How dark the corners get: 0 none, 1 black.
     strength: f32,
@@ -16,7 +17,7 @@ struct VignetteParams {
 @group(0) @binding(1) var source: texture_2d<f32>;
 
 @fragment
-fn fs_vignette(in: FullscreenOut) -> @location(0) vec4<f32> {
+fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     let colour = textureLoad(source, vec2<i32>(in.position.xy), 0);
     // 0 at the centre, 1 in the corners, whatever the aspect ratio.
     let d = length(in.uv * 2.0 - 1.0) / sqrt(2.0);

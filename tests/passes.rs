@@ -597,15 +597,18 @@ fn an_app_pass_runs_only_for_the_camera_that_carries_its_component() {
 /// include the library does not have is an error naming it.
 #[test]
 fn an_app_shader_composes_with_the_library_includes_and_validates() {
-    let code = manylight::render::shaders::compose_source("custom_pass.wgsl", custom_pass::VIGNETTE_WGSL)
-        .expect("composes");
+    let code = manylight::render::shaders::compose_source(
+        "custom_pass.wgsl",
+        <custom_pass::VignettePass as manylight::render::ext::PostPass>::WGSL,
+    )
+    .expect("composes");
     let module =
         naga::front::wgsl::parse_str(&code).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&code)));
     naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
         .validate(&module)
         .unwrap_or_else(|e| panic!("custom_pass.wgsl: {e:?}"));
     let entries: Vec<&str> = module.entry_points.iter().map(|e| e.name.as_str()).collect();
-    assert_eq!(entries, ["fullscreen_vs", "fs_vignette"]);
+    assert_eq!(entries, ["fullscreen_vs", "fs_main"]);
     let missing = manylight::render::shaders::compose_source("mine.wgsl", "//!include common/nothing.wgsl\n");
     assert!(
         matches!(&missing, Err(manylight::render::shaders::ShaderError::Unknown(f)) if f == "common/nothing.wgsl"),

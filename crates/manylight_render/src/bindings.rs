@@ -52,9 +52,20 @@ enum Resource {
 /// A bind group's layout and resources by binding index.
 type GroupKey = (wgpu::BindGroupLayout, Vec<(u32, Resource)>);
 
-/// Key of a persistent uniform buffer: the pass's name and a number that tells its uniforms
-/// apart within one view (a chain's level).
-pub type UniformKey = (&'static str, u64);
+/// Key of a persistent uniform buffer: the type of the pass that owns it, the type of its
+/// contents, and a number that tells a pass's uniforms of one type apart within a view (a
+/// chain's level). Two passes never share a buffer, whatever they are called.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct UniformKey {
+    /// The owning pass's type.
+    pub pass: std::any::TypeId,
+    /// The contents' type.
+    pub contents: std::any::TypeId,
+    /// Which of the pass's uniforms of that type.
+    pub index: u64,
+    /// The buffer's label: the contents' type name.
+    pub label: &'static str,
+}
 
 struct Uniform {
     buffer: wgpu::Buffer,
@@ -119,7 +130,7 @@ impl BindingCache {
         let mut uniforms = self.uniforms.lock().unwrap_or_else(|e| e.into_inner());
         let create = || Uniform {
             buffer: gpu.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(key.0),
+                label: Some(key.label),
                 size: (contents.len() as u64).max(16).next_multiple_of(16),
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,

@@ -121,6 +121,8 @@ pub struct PassContext<'a> {
     pub(crate) timer: Option<&'a wgpu::QuerySet>,
     pub(crate) pass_index: u32,
     pub(crate) stamps: (bool, bool),
+    /// The type of the pass recording (the owner of its uniforms).
+    pub(crate) pass_type: std::any::TypeId,
 }
 
 impl<'a> PassContext<'a> {
@@ -142,9 +144,22 @@ impl<'a> PassContext<'a> {
         self.bindings.bind_group(self.gpu, layout.decl().label, layout.raw(), &numbered)
     }
 
-    /// A persistent uniform buffer holding `contents` ([`crate::bindings::BindingCache::uniform`]).
-    pub fn uniform(&self, key: crate::bindings::UniformKey, contents: &[u8]) -> wgpu::Buffer {
-        self.bindings.uniform(self.gpu, key, contents)
+    /// A persistent uniform buffer holding `value`, the recording pass's one of type `T`
+    /// ([`crate::bindings::BindingCache::uniform`]; rewritten only when `value` changes).
+    pub fn uniform<T: bytemuck::Pod>(&self, value: &T) -> wgpu::Buffer {
+        self.uniform_at(0, value)
+    }
+
+    /// The recording pass's uniform `index` of type `T` holding `value`, for a pass that binds
+    /// several (a chain's levels).
+    pub fn uniform_at<T: bytemuck::Pod>(&self, index: u64, value: &T) -> wgpu::Buffer {
+        let key = crate::bindings::UniformKey {
+            pass: self.pass_type,
+            contents: std::any::TypeId::of::<T>(),
+            index,
+            label: std::any::type_name::<T>(),
+        };
+        self.bindings.uniform(self.gpu, key, bytemuck::bytes_of(value))
     }
 
     /// The view of a graph texture (transient or [`OUTPUT`]). [`HDR`] is the HDR image as the

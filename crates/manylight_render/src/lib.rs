@@ -14,6 +14,7 @@ pub mod atlas;
 pub mod bindings;
 pub mod clusters;
 pub mod context;
+pub mod ext;
 pub mod gpu_types;
 pub mod graph;
 pub mod inflight;

@@ -443,6 +443,7 @@ impl Renderer {
                 timer: timer.map(|(query_set, _)| query_set),
                 pass_index: timer.map_or(0, |(_, index)| index),
                 stamps: (false, false),
+                pass_type: (&**pass as &dyn std::any::Any).type_id(),
             };
             let start = Instant::now();
             pass.record(&mut ctx)?;

@@ -191,8 +191,10 @@ fn draw(
     let device = &ctx.gpu.device;
     let pipeline =
         ctx.pipelines.get_or_create(BloomKey { stage }, |k| BloomPipeline::new(device, k.stage))?;
-    // One uniform per draw of the chain: its stage and the level it writes.
-    let params = ctx.uniform((target.name(), stage as u64), bytemuck::bytes_of(&params));
+    // One uniform per draw of the chain: each stage is a pass type of its own, and a stage's
+    // passes write different levels.
+    let level = BLOOM_LEVELS.iter().chain(&BLOOM_TEMPS).position(|&n| n == target).map_or(u64::MAX, |i| i as u64);
+    let params = ctx.uniform_at(level, &params);
     let textures = sources.iter().map(|&name| ctx.texture(name)).collect::<Result<Vec<_>, _>>()?;
     let mut bindings = vec![Binding::Buffer(&params), Binding::Sampler(&pipeline.sampler)];
     bindings.extend(textures.into_iter().map(Binding::Texture));

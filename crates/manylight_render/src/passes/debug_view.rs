@@ -168,10 +168,7 @@ impl Pass for DebugViewPass {
         let pipeline =
             ctx.pipelines.get_or_create(key, |k| DebugViewPipeline::new(device, k.family, k.format))?;
         let depth_far = depth_view_far(ctx.scene);
-        let params = ctx.uniform(
-            ("debug_view", 0),
-            bytemuck::cast_slice(&[self.view.gpu_id(), self.heatmap_max.max(1), depth_far.to_bits(), 0]),
-        );
+        let params = ctx.uniform(&[self.view.gpu_id(), self.heatmap_max.max(1), depth_far.to_bits(), 0]);
         let mut bindings = vec![
             Binding::Buffer(&ctx.scene.view_buffer),
             Binding::Texture(ctx.texture(DEPTH)?),

@@ -90,7 +90,7 @@ pub fn gbuffer_read_bind_group(
     clear_color: [f32; 3],
 ) -> Result<wgpu::BindGroup, RenderError> {
     let [r, g, b] = clear_color;
-    let clear = ctx.uniform(("gbuffer_clear_color", 0), bytemuck::cast_slice(&[r, g, b, 1.0f32]));
+    let clear = ctx.uniform(&[r, g, b, 1.0f32]);
     let mut resources = Vec::new();
     for t in targets(layout) {
         resources.push(Binding::Texture(ctx.texture(t.name)?));

@@ -120,7 +120,7 @@ impl Pass for MotionBlurPass {
             max_pixels: if s.max_pixels.is_finite() { s.max_pixels.max(0.0) } else { 0.0 },
             _pad: [0; 2],
         };
-        let params = ctx.uniform(("motion_blur", 0), bytemuck::bytes_of(&params));
+        let params = ctx.uniform(&params);
         let depth = ctx.texture(DEPTH)?;
         let target = ctx.post_process_write()?;
         let blur_group = ctx.bind_group(
