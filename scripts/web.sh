@@ -7,7 +7,7 @@
 #
 # Installs what it needs and is missing: the wasm32-unknown-unknown target and wasm-bindgen-cli
 # at the version of the wasm-bindgen crate in Cargo.lock (the two must be equal). The page's
-# URL parameters and its scripting contract are in the README.
+# URL parameters and its scripting contract are in docs/guide.md ("In a browser").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

@@ -5,7 +5,8 @@
 //!
 //! Add [`prelude::ManyLightPlugin`] to an `App`, spawn entities with `Transform`, `Camera3d`,
 //! `PointLight`, `Mesh3d` and `Material`, and run: you get a window, or a headless image.
-//! See `examples/add_as_plugin.rs` and `docs/architecture.md`.
+//! See `examples/add_as_plugin.rs`, `docs/guide.md` (how to use it) and `docs/architecture.md`
+//! (how it is built).
 #![warn(missing_docs)]
 
 pub use manylight_app as app;
