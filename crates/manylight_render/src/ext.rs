@@ -9,6 +9,8 @@
 //!   value changes), [`PassContext::bind_group`], [`PassContext::post_process_write`].
 //! - A stage ([`Stage`]) places the pass next to a built-in one by type: the built-in passes'
 //!   types are re-exported here ([`TonemapPass`], …).
+//! - A graph resource of the app's own is declared with [`resource!`]: a handle whose identity
+//!   is its declaration, so two passes that pick the same label never share it by accident.
 //!
 //! ```no_run
 //! use manylight_render::ext::{PostPass, bytemuck};
@@ -53,6 +55,7 @@ pub use crate::passes::{
 };
 pub use crate::plan::PlanInputs;
 pub use crate::planner::{FramePlanner, Stage, StageError, StageId};
+pub use crate::resource;
 pub use crate::resources::HDR_FORMAT;
 pub use crate::snapshot::ViewComponents;
 pub use bytemuck;
@@ -163,11 +166,13 @@ impl<P: PostPass> Pass for P {
 
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
         let device = &ctx.gpu.device;
-        let pipeline =
-            ctx.pipelines.get_or_create(PostPipelineKey::<P>(PhantomData), |_| PostPipeline::new::<P>(device))?;
+        let pipeline = ctx
+            .pipelines
+            .get_or_create(PostPipelineKey::<P>(PhantomData), |_| PostPipeline::new::<P>(device))?;
         let params = ctx.uniform(&self.params());
         let target = ctx.post_process_write()?;
-        let group = ctx.bind_group(&pipeline.layout, &[Binding::Buffer(&params), Binding::Texture(target.source)]);
+        let group =
+            ctx.bind_group(&pipeline.layout, &[Binding::Buffer(&params), Binding::Texture(target.source)]);
         let timestamps = ctx.render_timestamps(true, true);
         draw_fullscreen(ctx.encoder, P::NAME, target.destination, timestamps, &pipeline.pipeline, &[&group]);
         Ok(())

@@ -14,40 +14,107 @@ use crate::pipelines::PipelineCache;
 use crate::resources::SceneResources;
 use std::collections::HashMap;
 
+/// A graph resource's declaration: its label (snake_case; also its texture's label). Each
+/// declaration is one resource, whatever its label: declare one with [`resource!`].
+#[derive(Debug)]
+pub struct GraphResource {
+    label: &'static str,
+}
+
+impl GraphResource {
+    /// A declaration labelled `label`; its address is the resource's identity, so it must be
+    /// a `static` ([`resource!`] makes one).
+    pub const fn new(label: &'static str) -> GraphResource {
+        GraphResource { label }
+    }
+}
+
 /// A graph resource (a texture or buffer slot): passes say what they read and write with these
-/// handles, declared once as constants (`passes::HDR`, `passes::DEPTH`, …), never as bare
-/// strings.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct ResourceName(&'static str);
+/// handles, declared once with [`resource!`] (`passes::HDR`, `passes::DEPTH`, …). A handle is
+/// its declaration, not its label: two declarations with the same label are two resources.
+#[derive(Clone, Copy)]
+pub struct ResourceName(&'static GraphResource);
 
 impl ResourceName {
-    /// The resource called `name` (snake_case; also the label of its texture).
-    pub const fn new(name: &'static str) -> ResourceName {
-        ResourceName(name)
+    /// The resource declared by `declaration` (a `static`; see [`resource!`]).
+    pub const fn of(declaration: &'static GraphResource) -> ResourceName {
+        ResourceName(declaration)
     }
 
-    /// Its name.
+    /// Its label (for texture labels and messages).
     pub const fn name(self) -> &'static str {
-        self.0
+        self.0.label
+    }
+}
+
+impl PartialEq for ResourceName {
+    fn eq(&self, other: &Self) -> bool {
+        std::ptr::eq(self.0, other.0)
+    }
+}
+
+impl Eq for ResourceName {}
+
+impl std::hash::Hash for ResourceName {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        std::ptr::hash(self.0, state);
+    }
+}
+
+impl PartialOrd for ResourceName {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for ResourceName {
+    /// By label, then by declaration (two declarations of one label stay apart).
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        let address = |r: &ResourceName| r.0 as *const GraphResource as usize;
+        self.name().cmp(other.name()).then_with(|| address(self).cmp(&address(other)))
+    }
+}
+
+impl std::fmt::Debug for ResourceName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "ResourceName({})", self.name())
     }
 }
 
 impl std::fmt::Display for ResourceName {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.0)
+        f.write_str(self.name())
     }
 }
 
+/// Declares a graph resource labelled `$label`: a [`ResourceName`] of its own, unequal to every
+/// other declaration's (each expansion makes one `static`).
+///
+/// ```
+/// use manylight_render::{ResourceName, resource};
+/// const BLURRED: ResourceName = resource!("blurred");
+/// const ALSO_BLURRED: ResourceName = resource!("blurred");
+/// assert_ne!(BLURRED, ALSO_BLURRED);
+/// assert_eq!(BLURRED.name(), "blurred");
+/// ```
+#[macro_export]
+macro_rules! resource {
+    ($label:literal) => {{
+        static DECLARATION: $crate::graph::GraphResource = $crate::graph::GraphResource::new($label);
+        $crate::graph::ResourceName::of(&DECLARATION)
+    }};
+}
+
 /// The external resource every frame ends in: the swapchain image or the headless target.
-pub const OUTPUT: ResourceName = ResourceName::new("output");
+pub const OUTPUT: ResourceName = crate::resource!("output");
 
 /// The HDR scene colour (`passes::HDR`): the shading passes create it, the post passes filter
 /// it, the tone map reads it.
-pub const HDR: ResourceName = ResourceName::new("hdr");
+pub const HDR: ResourceName = crate::resource!("hdr");
 
 /// The second HDR image, which a post-processing pass writes into while it reads [`HDR`]
 /// ([`PassContext::post_process_write`] swaps the two; `passes::HDR_SWAP`).
-pub const HDR_SWAP: ResourceName = ResourceName::new("hdr_swap");
+pub const HDR_SWAP: ResourceName = crate::resource!("hdr_swap");
 
 /// A transient texture a pass creates: sized relative to the viewport.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -165,10 +232,13 @@ impl<'a> PassContext<'a> {
     /// The view of a graph texture (transient or [`OUTPUT`]). [`HDR`] is the HDR image as the
     /// passes before left it, wherever [`PassContext::post_process_write`] put it.
     pub fn texture(&self, name: ResourceName) -> Result<&'a wgpu::TextureView, RenderError> {
-        let name = match name {
-            HDR if self.hdr_swapped.get() => HDR_SWAP,
-            HDR_SWAP if self.hdr_swapped.get() => HDR,
-            name => name,
+        let swapped = self.hdr_swapped.get();
+        let name = if swapped && name == HDR {
+            HDR_SWAP
+        } else if swapped && name == HDR_SWAP {
+            HDR
+        } else {
+            name
         };
         self.textures
             .get(&name)
@@ -365,6 +435,17 @@ impl RenderGraph {
 mod tests {
     use super::*;
 
+    #[test]
+    fn two_declarations_with_one_label_are_two_resources() {
+        const A: ResourceName = crate::resource!("scratch");
+        const B: ResourceName = crate::resource!("scratch");
+        assert_eq!(A, A);
+        assert_ne!(A, B);
+        assert_eq!(A.name(), B.name());
+        let set: std::collections::HashSet<ResourceName> = [A, B, A].into_iter().collect();
+        assert_eq!(set.len(), 2);
+    }
+
     struct Fake(&'static str, Vec<ResourceName>, Vec<ResourceName>);
     impl Pass for Fake {
         fn name(&self) -> &'static str {
@@ -385,9 +466,9 @@ mod tests {
     fn orders_by_dependencies_and_drops_unread_passes() {
         let mut g = RenderGraph::new();
         g.add(Fake("tonemap", vec![HDR], vec![OUTPUT]));
-        g.add(Fake("unused", vec![], vec![ResourceName::new("scratch")]));
+        g.add(Fake("unused", vec![], vec![crate::resource!("scratch")]));
         g.add(Fake("bloom", vec![HDR], vec![HDR]));
-        g.add(Fake("forward", vec![], vec![HDR, ResourceName::new("depth")]));
+        g.add(Fake("forward", vec![], vec![HDR, crate::resource!("depth")]));
         assert_eq!(g.pass_names().unwrap(), vec!["forward", "bloom", "tonemap"]);
     }
 

@@ -25,22 +25,22 @@ pub use crate::settings::{BloomChain, BloomSettings, MAX_BLOOM_LEVELS};
 
 /// Graph resources: the blurred levels of the chain.
 pub const BLOOM_LEVELS: [ResourceName; MAX_BLOOM_LEVELS] = [
-    ResourceName::new("bloom_0"),
-    ResourceName::new("bloom_1"),
-    ResourceName::new("bloom_2"),
-    ResourceName::new("bloom_3"),
-    ResourceName::new("bloom_4"),
-    ResourceName::new("bloom_5"),
+    crate::resource!("bloom_0"),
+    crate::resource!("bloom_1"),
+    crate::resource!("bloom_2"),
+    crate::resource!("bloom_3"),
+    crate::resource!("bloom_4"),
+    crate::resource!("bloom_5"),
 ];
 
 /// Graph resources: the horizontally blurred intermediate of each level.
 pub const BLOOM_TEMPS: [ResourceName; MAX_BLOOM_LEVELS] = [
-    ResourceName::new("bloom_tmp_0"),
-    ResourceName::new("bloom_tmp_1"),
-    ResourceName::new("bloom_tmp_2"),
-    ResourceName::new("bloom_tmp_3"),
-    ResourceName::new("bloom_tmp_4"),
-    ResourceName::new("bloom_tmp_5"),
+    crate::resource!("bloom_tmp_0"),
+    crate::resource!("bloom_tmp_1"),
+    crate::resource!("bloom_tmp_2"),
+    crate::resource!("bloom_tmp_3"),
+    crate::resource!("bloom_tmp_4"),
+    crate::resource!("bloom_tmp_5"),
 ];
 
 /// The passes of `bloom`, in order.
@@ -193,7 +193,8 @@ fn draw(
         ctx.pipelines.get_or_create(BloomKey { stage }, |k| BloomPipeline::new(device, k.stage))?;
     // One uniform per draw of the chain: each stage is a pass type of its own, and a stage's
     // passes write different levels.
-    let level = BLOOM_LEVELS.iter().chain(&BLOOM_TEMPS).position(|&n| n == target).map_or(u64::MAX, |i| i as u64);
+    let level =
+        BLOOM_LEVELS.iter().chain(&BLOOM_TEMPS).position(|&n| n == target).map_or(u64::MAX, |i| i as u64);
     let params = ctx.uniform_at(level, &params);
     let textures = sources.iter().map(|&name| ctx.texture(name)).collect::<Result<Vec<_>, _>>()?;
     let mut bindings = vec![Binding::Buffer(&params), Binding::Sampler(&pipeline.sampler)];

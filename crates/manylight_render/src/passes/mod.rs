@@ -57,36 +57,34 @@ pub fn post_process_texture() -> crate::graph::TextureSpec {
     }
 }
 /// Graph resource: the depth buffer (reverse-Z).
-pub const DEPTH: crate::graph::ResourceName = crate::graph::ResourceName::new("depth");
+pub const DEPTH: crate::graph::ResourceName = crate::resource!("depth");
 /// Graph resource: G-buffer position (Full layout).
-pub const GBUFFER_POSITION: crate::graph::ResourceName = crate::graph::ResourceName::new("gbuffer_position");
+pub const GBUFFER_POSITION: crate::graph::ResourceName = crate::resource!("gbuffer_position");
 /// Graph resource: G-buffer normal (Full layout).
-pub const GBUFFER_NORMAL: crate::graph::ResourceName = crate::graph::ResourceName::new("gbuffer_normal");
+pub const GBUFFER_NORMAL: crate::graph::ResourceName = crate::resource!("gbuffer_normal");
 /// Graph resource: G-buffer albedo (Full layout).
-pub const GBUFFER_ALBEDO: crate::graph::ResourceName = crate::graph::ResourceName::new("gbuffer_albedo");
+pub const GBUFFER_ALBEDO: crate::graph::ResourceName = crate::resource!("gbuffer_albedo");
 /// Graph resource: the single G-buffer target of the Compact layout.
-pub const GBUFFER_COMPACT: crate::graph::ResourceName = crate::graph::ResourceName::new("gbuffer_compact");
+pub const GBUFFER_COMPACT: crate::graph::ResourceName = crate::resource!("gbuffer_compact");
 /// Packed G-buffer: albedo + material parameters + first normal component (rgba32f).
-pub const GBUFFER_PACKED_ALBEDO: crate::graph::ResourceName =
-    crate::graph::ResourceName::new("gbuffer_packed_albedo");
+pub const GBUFFER_PACKED_ALBEDO: crate::graph::ResourceName = crate::resource!("gbuffer_packed_albedo");
 /// Packed G-buffer: world position + second normal component (rgba32f).
-pub const GBUFFER_PACKED_POSITION: crate::graph::ResourceName =
-    crate::graph::ResourceName::new("gbuffer_packed_position");
+pub const GBUFFER_PACKED_POSITION: crate::graph::ResourceName = crate::resource!("gbuffer_packed_position");
 /// Emitted radiance (rgb) and ambient occlusion (a) of every G-buffer layout.
-pub const GBUFFER_EMISSIVE: crate::graph::ResourceName = crate::graph::ResourceName::new("gbuffer_emissive");
+pub const GBUFFER_EMISSIVE: crate::graph::ResourceName = crate::resource!("gbuffer_emissive");
 /// Light volumes: the sum of the lights, in f32 where the device can blend it.
-pub const LIGHT_ACCUM: crate::graph::ResourceName = crate::graph::ResourceName::new("light_accum");
+pub const LIGHT_ACCUM: crate::graph::ResourceName = crate::resource!("light_accum");
 /// Graph resource: the shadow atlas (a persistent texture, [`crate::shadows`]), written by the
 /// shadow pass and read by every shading pass of a frame whose lights cast shadows.
-pub const SHADOW_ATLAS: crate::graph::ResourceName = crate::graph::ResourceName::new("shadow_atlas");
+pub const SHADOW_ATLAS: crate::graph::ResourceName = crate::resource!("shadow_atlas");
 /// Graph resource: the cluster light lists (persistent buffers, ordered through the graph).
-pub const CLUSTERS: crate::graph::ResourceName = crate::graph::ResourceName::new("clusters");
+pub const CLUSTERS: crate::graph::ResourceName = crate::resource!("clusters");
 /// Graph resource: each pixel's view distance as forward shading computes it (the depth
 /// pre-pass writes it for per-cluster depth bounds and refined light lists).
-pub const SHADING_DISTANCE: crate::graph::ResourceName = crate::graph::ResourceName::new("shading_distance");
+pub const SHADING_DISTANCE: crate::graph::ResourceName = crate::resource!("shading_distance");
 /// Graph resource: the depth range of every cluster's pixels (after the cluster ranges, in the
 /// same buffer), which the cluster build cuts clusters to.
-pub const CLUSTER_DEPTHS: crate::graph::ResourceName = crate::graph::ResourceName::new("cluster_depths");
+pub const CLUSTER_DEPTHS: crate::graph::ResourceName = crate::resource!("cluster_depths");
 
 /// Usages of the depth buffer: attachment, sampled by debug views, copied for readback.
 pub const DEPTH_USAGE: wgpu::TextureUsages = wgpu::TextureUsages::RENDER_ATTACHMENT
