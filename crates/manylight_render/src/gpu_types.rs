@@ -102,7 +102,7 @@ pub const CULL_BOTH: u32 = 2;
 
 /// Constants emitted into WGSL as `const NAME: u32 = VALUE;`.
 pub fn shared_u32_constants() -> Vec<(&'static str, u32)> {
-    use crate::snapshot::DebugViewMode as DebugView;
+    use crate::settings::DebugViewMode as DebugView;
     use manylight_core::cluster::ZSlicing;
     vec![
         ("MAX_DIRECTIONAL_LIGHTS", MAX_DIRECTIONAL_LIGHTS),

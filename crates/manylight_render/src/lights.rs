@@ -1,8 +1,10 @@
-//! Lights in one place: what kind a light is, what it can reach, how it is packed for the
-//! shaders, and which lights the frame's buffers hold. The light buffer holds the frame's
-//! point and spot lights in order, an invalid one as an inert zeroed light that reaches
-//! nothing ([`buffered_lights`] yields the valid ones); the view uniform the first
-//! [`MAX_DIRECTIONAL_LIGHTS`] valid directional lights ([`viewed_directional_lights`]); a
+//! Lights in one place: the point, spot and directional lights a frame is rendered from
+//! ([`ExtractedPointLight`], [`ExtractedDirectionalLight`]) and the list that holds the first
+//! in chunks shared between frames ([`PointLights`]); what kind a light is, what it can reach,
+//! how it is packed for the shaders, and which lights the frame's buffers hold. The light
+//! buffer holds the frame's point and spot lights in order, an invalid one as an inert zeroed
+//! light that reaches nothing ([`buffered_lights`] yields the valid ones); the view uniform the
+//! first [`MAX_DIRECTIONAL_LIGHTS`] valid directional lights ([`viewed_directional_lights`]); a
 //! light's index there is its index everywhere (cluster lists, the shadow table, probes).
 //! Clustering culls with [`bounding_sphere`], the shaders read [`gpu_point_light`]'s fields
 //! through `shaders/common/lights.wgsl` (its twin: the same packing and attenuation), and the
@@ -10,8 +12,326 @@
 //! is made here once.
 
 use crate::gpu_types::{GpuDirectionalLight, GpuLightMotion, GpuPointLight, MAX_DIRECTIONAL_LIGHTS};
-use crate::snapshot::{ExtractedDirectionalLight, ExtractedPointLight, PointLights};
+use crate::settings::CascadeShadowConfig;
 use glam::Vec3;
+use manylight_core::SpotCone;
+use std::sync::Arc;
+
+/// One point light.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExtractedPointLight {
+    /// World position.
+    pub position: Vec3,
+    /// Linear RGB colour.
+    pub color: Vec3,
+    /// Luminous intensity in candela, multiplying `color`.
+    pub intensity: f32,
+    /// Radius of influence (contribution is exactly 0 at and beyond it).
+    pub radius: f32,
+    /// The cone of a spot light (`None`: a point light, lighting every direction).
+    pub spot: Option<SpotCone>,
+    /// The light casts shadows, with these biases (`None`: it lights through everything).
+    pub shadow: Option<ShadowBias>,
+    /// The light moves and flickers on the GPU (`None`: it stays as extracted): each frame a
+    /// compute pass writes its position and colour at
+    /// [`FrameSnapshot::elapsed_secs`](crate::snapshot::FrameSnapshot::elapsed_secs) into the
+    /// light buffer (`shaders/light_animation.wgsl`), so its motion costs the CPU nothing.
+    /// `position` and `color` are then unused; `intensity`, `radius` and `spot` still apply.
+    pub animation: Option<Arc<manylight_core::AnimatedLight>>,
+}
+
+/// How a light's shadow test keeps a surface from shadowing itself (Bevy's
+/// `shadow_depth_bias` and `shadow_normal_bias`): the shaded point moves `normal` texels of the
+/// light's shadow map off the surface towards the light, and `depth` world units nearer to
+/// it along the ray. Larger values remove acne and detach shadows from their casters
+/// (peter-panning).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowBias {
+    /// World units along the ray from the light.
+    pub depth: f32,
+    /// Texels of the shadow map at the shaded point, along the surface normal.
+    pub normal: f32,
+}
+
+impl ShadowBias {
+    /// Bevy's `PointLight` defaults.
+    pub const POINT: ShadowBias = ShadowBias { depth: 0.08, normal: 0.6 };
+    /// Bevy's `SpotLight` defaults.
+    pub const SPOT: ShadowBias = ShadowBias { depth: 0.02, normal: 1.8 };
+    /// Bevy's `DirectionalLight` defaults.
+    pub const DIRECTIONAL: ShadowBias = ShadowBias { depth: 0.02, normal: 1.8 };
+
+    /// True when both biases are finite and not negative.
+    pub fn is_valid(&self) -> bool {
+        self.depth.is_finite() && self.normal.is_finite() && self.depth >= 0.0 && self.normal >= 0.0
+    }
+}
+
+impl Default for ShadowBias {
+    fn default() -> Self {
+        ShadowBias::POINT
+    }
+}
+
+impl ExtractedPointLight {
+    /// A point light (no cone, no shadow, no animation).
+    pub fn point(position: Vec3, color: Vec3, intensity: f32, radius: f32) -> ExtractedPointLight {
+        ExtractedPointLight { position, color, intensity, radius, spot: None, shadow: None, animation: None }
+    }
+
+    /// True when every parameter is finite, the radius and intensity are not negative, and the
+    /// emitted colour (`color × intensity`) does not overflow to infinity; for an animated
+    /// light, also the box its orbit and bob stay in, and its base colour with twice the room.
+    pub fn is_valid(&self) -> bool {
+        self.position.is_finite()
+            && self.color.is_finite()
+            && self.intensity.is_finite()
+            && (self.color * self.intensity).is_finite()
+            && self.radius.is_finite()
+            && self.radius >= 0.0
+            && self.intensity >= 0.0
+            && self.shadow.is_none_or(|b| b.is_valid())
+            && self
+                .animation
+                .as_deref()
+                .is_none_or(|a| a.position_bounds().is_some() && (a.color * self.intensity * 2.0).is_finite())
+    }
+
+    /// The box holding the light's position at every time: its position, or the box its
+    /// animation stays in.
+    pub fn position_bounds(&self) -> (Vec3, Vec3) {
+        self.animation.as_deref().and_then(|a| a.position_bounds()).unwrap_or((self.position, self.position))
+    }
+}
+
+/// A directional light as extracted for rendering: light travelling along `direction`
+/// everywhere (the sun).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ExtractedDirectionalLight {
+    /// Unit direction the light travels, from the light into the scene.
+    pub direction: Vec3,
+    /// Linear RGB colour.
+    pub color: Vec3,
+    /// Illuminance (lux in glTF), multiplying `color`.
+    pub illuminance: f32,
+    /// The light casts shadows (`None`: it lights through everything).
+    pub shadow: Option<DirectionalShadow>,
+}
+
+/// A directional light's shadow: its biases (the normal bias in texels of the cascade at the
+/// point) and how its cascades split the view.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DirectionalShadow {
+    /// Depth and normal bias.
+    pub bias: ShadowBias,
+    /// The cascades.
+    pub cascades: CascadeShadowConfig,
+}
+
+impl Default for DirectionalShadow {
+    fn default() -> Self {
+        DirectionalShadow { bias: ShadowBias::DIRECTIONAL, cascades: Default::default() }
+    }
+}
+
+impl ExtractedDirectionalLight {
+    /// True when every parameter is finite, the direction is not zero, the illuminance is not
+    /// negative and `color × illuminance` does not overflow.
+    pub fn is_valid(&self) -> bool {
+        self.direction.is_finite()
+            && self.direction.length_squared() > 0.0
+            && self.color.is_finite()
+            && self.illuminance.is_finite()
+            && self.illuminance >= 0.0
+            && (self.color * self.illuminance).is_finite()
+    }
+}
+
+/// Lights in each chunk of a [`PointLights`] list (the last chunk may hold fewer).
+pub const LIGHT_CHUNK: usize = 1024;
+
+/// The point and spot lights of a frame, in chunks of [`LIGHT_CHUNK`] shared between frames
+/// (`Arc`): extraction copies a chunk only when one of its lights changed, and the renderer
+/// packs and uploads only the lights of chunks that are not the ones it uploaded before. A
+/// light's index is its position in the list, which is its index in the light buffer, the
+/// lists and the shadow table (an invalid light keeps its place there, lighting nothing).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PointLights {
+    chunks: Vec<Arc<LightChunk>>,
+    len: usize,
+}
+
+/// [`LIGHT_CHUNK`] consecutive lights of a [`PointLights`] list, and how many of them cast
+/// shadows or animate on the GPU (so a frame finds them without visiting the others).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LightChunk {
+    lights: Vec<ExtractedPointLight>,
+    shadowed: usize,
+    animated: usize,
+}
+
+impl LightChunk {
+    /// The chunk's lights.
+    pub fn lights(&self) -> &[ExtractedPointLight] {
+        &self.lights
+    }
+
+    /// How many of them cast shadows.
+    pub fn shadowed(&self) -> usize {
+        self.shadowed
+    }
+
+    /// How many of them animate on the GPU ([`ExtractedPointLight::animation`]).
+    pub fn animated(&self) -> usize {
+        self.animated
+    }
+
+    fn recount(&mut self) {
+        self.shadowed = self.lights.iter().filter(|l| l.shadow.is_some()).count();
+        self.animated = self.lights.iter().filter(|l| l.animation.is_some()).count();
+    }
+
+    /// Counts `light` in (`add`) or out.
+    fn count(&mut self, light: &ExtractedPointLight, add: bool) {
+        let (shadowed, animated) =
+            (usize::from(light.shadow.is_some()), usize::from(light.animation.is_some()));
+        if add {
+            self.shadowed += shadowed;
+            self.animated += animated;
+        } else {
+            self.shadowed -= shadowed;
+            self.animated -= animated;
+        }
+    }
+}
+
+impl PointLights {
+    /// An empty list.
+    pub fn new() -> PointLights {
+        PointLights::default()
+    }
+
+    /// Number of lights.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// True when there is no light.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The chunks, in order: light `i` is light `i % LIGHT_CHUNK` of chunk `i / LIGHT_CHUNK`.
+    pub fn chunks(&self) -> &[Arc<LightChunk>] {
+        &self.chunks
+    }
+
+    /// Light `i`, if there is one.
+    pub fn get(&self, i: usize) -> Option<&ExtractedPointLight> {
+        self.chunks.get(i / LIGHT_CHUNK).and_then(|c| c.lights.get(i % LIGHT_CHUNK))
+    }
+
+    /// Every light, in order.
+    pub fn iter(&self) -> impl Iterator<Item = &ExtractedPointLight> {
+        self.chunks.iter().flat_map(|c| c.lights.iter())
+    }
+
+    /// How many lights animate on the GPU (one visit per chunk).
+    pub fn animated(&self) -> usize {
+        self.chunks.iter().map(|c| c.animated).sum()
+    }
+
+    /// The lights that cast shadows, with their index, visiting only the chunks that hold some.
+    pub fn shadowed(&self) -> impl Iterator<Item = (usize, &ExtractedPointLight)> {
+        self.chunks.iter().enumerate().filter(|(_, c)| c.shadowed > 0).flat_map(|(k, c)| {
+            c.lights
+                .iter()
+                .enumerate()
+                .filter(|(_, l)| l.shadow.is_some())
+                .map(move |(i, l)| (k * LIGHT_CHUNK + i, l))
+        })
+    }
+
+    /// Adds a light at the end.
+    pub fn push(&mut self, light: ExtractedPointLight) {
+        if self.len.is_multiple_of(LIGHT_CHUNK) {
+            let lights = Vec::with_capacity(LIGHT_CHUNK);
+            self.chunks.push(Arc::new(LightChunk { lights, shadowed: 0, animated: 0 }));
+        }
+        let chunk = Arc::make_mut(self.chunks.last_mut().expect("a chunk with room"));
+        chunk.count(&light, true);
+        chunk.lights.push(light);
+        self.len += 1;
+    }
+
+    /// Replaces light `i` (copying its chunk if another frame still holds it); false when
+    /// there is no light `i`. A light equal to the one there leaves the chunk shared.
+    pub fn set(&mut self, i: usize, light: ExtractedPointLight) -> bool {
+        let Some(chunk) = self.chunks.get_mut(i / LIGHT_CHUNK) else { return false };
+        match chunk.lights.get(i % LIGHT_CHUNK) {
+            None => false,
+            Some(old) if *old == light => true,
+            Some(_) => {
+                let chunk = Arc::make_mut(chunk);
+                chunk.count(&light, true);
+                let old = std::mem::replace(&mut chunk.lights[i % LIGHT_CHUNK], light);
+                chunk.count(&old, false);
+                true
+            }
+        }
+    }
+
+    /// Removes the last light and returns it.
+    pub fn pop(&mut self) -> Option<ExtractedPointLight> {
+        let chunk = self.chunks.last_mut()?;
+        let light = Arc::make_mut(chunk).lights.pop();
+        if chunk.lights.is_empty() {
+            self.chunks.pop();
+        } else if let Some(light) = &light {
+            Arc::make_mut(chunk).count(light, false);
+        }
+        self.len -= usize::from(light.is_some());
+        light
+    }
+
+    /// Changes every light with `f`, in place.
+    pub fn update(&mut self, mut f: impl FnMut(&mut ExtractedPointLight)) {
+        for chunk in &mut self.chunks {
+            let chunk = Arc::make_mut(chunk);
+            chunk.lights.iter_mut().for_each(&mut f);
+            chunk.recount();
+        }
+    }
+}
+
+impl FromIterator<ExtractedPointLight> for PointLights {
+    fn from_iter<I: IntoIterator<Item = ExtractedPointLight>>(lights: I) -> PointLights {
+        let mut list = PointLights::new();
+        lights.into_iter().for_each(|l| list.push(l));
+        list
+    }
+}
+
+impl From<Vec<ExtractedPointLight>> for PointLights {
+    fn from(lights: Vec<ExtractedPointLight>) -> PointLights {
+        lights.into_iter().collect()
+    }
+}
+
+impl<'a> IntoIterator for &'a PointLights {
+    type Item = &'a ExtractedPointLight;
+    type IntoIter = Box<dyn Iterator<Item = &'a ExtractedPointLight> + 'a>;
+    fn into_iter(self) -> Self::IntoIter {
+        Box::new(self.iter())
+    }
+}
+
+impl std::ops::Index<usize> for PointLights {
+    type Output = ExtractedPointLight;
+    fn index(&self, i: usize) -> &ExtractedPointLight {
+        self.get(i).unwrap_or_else(|| panic!("light {i} of {}", self.len))
+    }
+}
 
 /// The kinds of light the renderer draws.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -164,7 +484,6 @@ pub fn viewed_directional_lights(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use manylight_core::SpotCone;
 
     fn light(spot: Option<SpotCone>) -> ExtractedPointLight {
         ExtractedPointLight {
@@ -230,5 +549,52 @@ mod tests {
         suns[0].direction = Vec3::ZERO;
         assert_eq!(viewed_directional_lights(&suns).count(), MAX_DIRECTIONAL_LIGHTS as usize);
         assert_eq!(gpu_directional_light(&sun).direction, [0.0, -1.0, 0.0, 0.0]);
+    }
+
+    /// Each chunk counts its shadowed and animated lights through every change, so a frame
+    /// finds them (and knows whether any light animates) from one count per chunk.
+    #[test]
+    fn light_chunks_count_their_shadowed_and_animated_lights() {
+        let plain = ExtractedPointLight {
+            position: Vec3::ZERO,
+            color: Vec3::ONE,
+            intensity: 1.0,
+            radius: 1.0,
+            spot: None,
+            shadow: None,
+            animation: None,
+        };
+        let motion = manylight_core::AnimatedLight {
+            center: Vec3::ONE,
+            orbit_radius: 1.0,
+            orbit_speed: 0.5,
+            phase: 0.0,
+            bob_amplitude: 0.2,
+            bob_speed: 1.0,
+            color: Vec3::ONE,
+            flicker_speed: 1.0,
+            intensity: 1.0,
+            radius: 1.0,
+        };
+        let animated = ExtractedPointLight { animation: Some(Arc::new(motion)), ..plain.clone() };
+        let shadowed = ExtractedPointLight { shadow: Some(ShadowBias::POINT), ..plain.clone() };
+        let mut lights: PointLights = (0..LIGHT_CHUNK + 10).map(|_| plain.clone()).collect();
+        let recount = |l: &PointLights| {
+            let animated = l.iter().filter(|l| l.animation.is_some()).count();
+            (l.animated(), l.shadowed().count(), animated, l.iter().filter(|l| l.shadow.is_some()).count())
+        };
+        assert_eq!(recount(&lights), (0, 0, 0, 0));
+        lights.set(3, animated.clone());
+        lights.set(LIGHT_CHUNK + 2, animated.clone());
+        lights.set(LIGHT_CHUNK + 9, shadowed.clone());
+        assert_eq!(recount(&lights), (2, 1, 2, 1));
+        lights.set(3, shadowed.clone());
+        assert_eq!(recount(&lights), (1, 2, 1, 2));
+        assert_eq!(lights.pop(), Some(shadowed));
+        lights.push(animated);
+        assert_eq!(recount(&lights), (2, 1, 2, 1));
+        lights.update(|l| l.animation = None);
+        assert_eq!(recount(&lights), (0, 1, 0, 1));
+        assert_eq!(lights.chunks().iter().map(|c| c.animated()).sum::<usize>(), 0);
     }
 }
