@@ -8,7 +8,9 @@ use crate::direct::{interleaved, snapshot};
 use crate::report::Report;
 use anyhow::Result;
 use glam::{Mat4, UVec2};
-use manylight_render::{BloomSettings, FrameReport, FrameSettings, FrameSnapshot, MotionBlurSettings};
+use manylight_render::{
+    BloomSettings, FrameReport, FrameSettings, FrameSnapshot, MotionBlurSettings, PassTiming,
+};
 use manylight_scene::{Scene, light_rig};
 use std::fmt::Write as _;
 
@@ -63,7 +65,17 @@ fn apply(mut snap: FrameSnapshot, config: &Config) -> FrameSnapshot {
 /// the sum and the count (the blur passes repeat once per iteration).
 fn post_gpu_ms(report: &FrameReport) -> (f64, Vec<(String, f64, u32)>) {
     let mut grouped: Vec<(String, f64, u32)> = Vec::new();
-    for p in report.passes.iter().filter(|p| p.name.starts_with("bloom") || p.name == "motion_blur") {
+    use manylight_render::passes::{
+        BloomBlurPass, BloomBrightPass, BloomCompositePass, BloomUpsamplePass, MotionBlurPass,
+    };
+    let post = |p: &PassTiming| {
+        p.is::<BloomBrightPass>()
+            || p.is::<BloomBlurPass>()
+            || p.is::<BloomUpsamplePass>()
+            || p.is::<BloomCompositePass>()
+            || p.is::<MotionBlurPass>()
+    };
+    for p in report.passes.iter().filter(|p| post(p)) {
         // A pass that recorded nothing (motion blur under a still camera) has no GPU time.
         let ms = p.gpu_ms.unwrap_or(0.0);
         match grouped.iter_mut().find(|(n, _, _)| *n == p.name) {

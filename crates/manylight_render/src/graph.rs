@@ -15,7 +15,7 @@ use crate::resources::SceneResources;
 use std::collections::HashMap;
 
 /// A graph resource's declaration: its label (snake_case; also its texture's label). Each
-/// declaration is one resource, whatever its label: declare one with [`resource!`].
+/// declaration is one resource, whatever its label: declare one with [`resource!`](crate::resource!).
 #[derive(Debug)]
 pub struct GraphResource {
     label: &'static str,
@@ -23,20 +23,20 @@ pub struct GraphResource {
 
 impl GraphResource {
     /// A declaration labelled `label`; its address is the resource's identity, so it must be
-    /// a `static` ([`resource!`] makes one).
+    /// a `static` ([`resource!`](crate::resource!) makes one).
     pub const fn new(label: &'static str) -> GraphResource {
         GraphResource { label }
     }
 }
 
 /// A graph resource (a texture or buffer slot): passes say what they read and write with these
-/// handles, declared once with [`resource!`] (`passes::HDR`, `passes::DEPTH`, …). A handle is
+/// handles, declared once with [`resource!`](crate::resource!) (`passes::HDR`, `passes::DEPTH`, …). A handle is
 /// its declaration, not its label: two declarations with the same label are two resources.
 #[derive(Clone, Copy)]
 pub struct ResourceName(&'static GraphResource);
 
 impl ResourceName {
-    /// The resource declared by `declaration` (a `static`; see [`resource!`]).
+    /// The resource declared by `declaration` (a `static`; see [`resource!`](crate::resource!)).
     pub const fn of(declaration: &'static GraphResource) -> ResourceName {
         ResourceName(declaration)
     }

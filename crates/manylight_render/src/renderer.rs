@@ -453,6 +453,7 @@ impl Renderer {
             self.ring.pass_recorded(timed);
             timings.push(PassTiming {
                 name: pass.name().to_string(),
+                pass_type: Some((&**pass as &dyn std::any::Any).type_id()),
                 gpu_ms: None,
                 gpu_trusted: !(pass.is_compute() && self.cpu_adapter),
                 cpu_ms,

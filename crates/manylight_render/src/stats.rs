@@ -7,12 +7,23 @@ use serde::Serialize;
 pub struct PassTiming {
     /// The pass name (also its wgpu label).
     pub name: String,
+    /// The pass's type, which code finds it by ([`PassTiming::is`], [`FrameReport::pass`]);
+    /// `None` for a timing not made by the renderer.
+    #[serde(skip)]
+    pub pass_type: Option<std::any::TypeId>,
     /// GPU time from timestamp queries, when the adapter supports them.
     pub gpu_ms: Option<f64>,
     /// False when the figure is known to be unreliable (compute passes on lavapipe).
     pub gpu_trusted: bool,
     /// CPU time spent recording the pass.
     pub cpu_ms: f64,
+}
+
+impl PassTiming {
+    /// True when the pass timed is a `P`.
+    pub fn is<P: crate::graph::Pass>(&self) -> bool {
+        self.pass_type == Some(std::any::TypeId::of::<P>())
+    }
 }
 
 /// Where a frame's CPU time went, by phase (milliseconds), and how many bytes it handed to the
@@ -154,12 +165,12 @@ impl FrameReport {
     }
 
     /// The timing of the first pass of type `P` this frame ran, if it ran one.
-    pub fn pass<P: crate::graph::NamedPass>(&self) -> Option<&PassTiming> {
-        self.passes.iter().find(|p| p.name == P::NAME)
+    pub fn pass<P: crate::graph::Pass>(&self) -> Option<&PassTiming> {
+        self.passes.iter().find(|p| p.is::<P>())
     }
 
     /// GPU milliseconds of the first pass of type `P`, if it ran and was timed.
-    pub fn pass_gpu_ms<P: crate::graph::NamedPass>(&self) -> Option<f64> {
+    pub fn pass_gpu_ms<P: crate::graph::Pass>(&self) -> Option<f64> {
         self.pass::<P>().and_then(|p| p.gpu_ms)
     }
 }

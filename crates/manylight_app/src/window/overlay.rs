@@ -372,7 +372,7 @@ fn shadows_ui(ui: &mut egui::Ui, world: &mut World) {
         ui.label("no shadow pass this frame");
         return;
     };
-    let pass_ms = report.passes.iter().find(|p| p.name == "shadow_maps").and_then(|p| p.gpu_ms);
+    let pass_ms = report.pass_gpu_ms::<manylight_render::passes::ShadowMapsPass>();
     ui.monospace(format!(
         "{} casting, maps {} drawn ({} cascades) / {} cached / {} stale, {} unseen lights, {} unseen faces",
         r.casting_lights,
@@ -697,6 +697,7 @@ impl OverlayPainter {
         textures.clear();
         let timing = PassTiming {
             name: OVERLAY_PASS.into(),
+            pass_type: None,
             gpu_ms: None,
             gpu_trusted: true,
             cpu_ms: start.elapsed().as_secs_f64() * 1e3,
