@@ -411,7 +411,9 @@ fn normal_from_cofactor(m: glam::Mat3, c: glam::Mat3) -> glam::Mat3 {
     if largest > 0.0 && largest.is_finite() { c * (1.0 / largest) } else { c }
 }
 
-/// Per-material constants (`GpuMaterial` in `shaders/common/mesh.wgsl`).
+/// Per-material constants (`GpuMaterial` in `shaders/common/mesh.wgsl`). Over 15 fields
+/// because it mirrors the WGSL struct field for field (one uniform per material; the layout
+/// test in `tests/shaders.rs` holds the two together).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuMaterial {
@@ -515,7 +517,9 @@ pub fn shared_f32_constants() -> Vec<(&'static str, f32)> {
     ]
 }
 
-/// Cluster-grid constants (`ClusterParams` in `shaders/common/clusters.wgsl`).
+/// Cluster-grid constants (`ClusterParams` in `shaders/common/clusters.wgsl`). Over 15 fields
+/// because it mirrors the WGSL struct field for field (one uniform the whole build reads; the
+/// layout test in `tests/shaders.rs` holds the two together).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuClusterParams {

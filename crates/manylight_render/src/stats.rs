@@ -48,7 +48,11 @@ pub struct CpuPhases {
     pub submit_ms: f64,
 }
 
-/// The report of one frame.
+/// The report of one frame. Flat, over 15 fields: it is the `last_frame` object of
+/// `manylight render --stats-json` and of the page's `manylight.stats()`, whose field names
+/// scripts read; the figures that belong together are already objects of their own
+/// ([`CpuPhases`], [`crate::clusters::ClusterReport`], [`crate::settings::ShadowReport`],
+/// [`ViewReport`]).
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct FrameReport {
     /// Frame counter.

@@ -24,7 +24,8 @@ pub fn resident_kib() -> Result<u64, String> {
         .ok_or_else(|| "/proc/self/status has no readable VmRSS line".to_string())
 }
 
-/// The state after `frame` frames: one row of the CSV.
+/// The state after `frame` frames: one row of the CSV, one field a column (over 15: the soak's
+/// CSV has that many columns).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Sample {
     /// Frames (app updates) done.

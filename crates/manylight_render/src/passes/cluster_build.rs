@@ -25,7 +25,8 @@ impl PipelineKey for ClusterBuildKey {
 
 /// The compute pipelines of the build, for one workgroup size: the lights' view-space spheres
 /// (`shaders/light_spheres.wgsl`), three per level, and levels 0 and 1 from the lights' side
-/// (`light_marks`, `tile_marks` and the `_bits` steps).
+/// (`light_marks`, `tile_marks` and the `_bits` steps). One field a compute entry point (over
+/// 15): the build's steps are dispatched by name in `record`, and a map would hide a missing one.
 pub struct ClusterBuildPipelines {
     light_spheres: wgpu::ComputePipeline,
     light_marks: wgpu::ComputePipeline,
