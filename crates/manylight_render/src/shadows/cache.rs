@@ -73,10 +73,10 @@ impl ShadowResources {
             let mut entry = w.light;
             match w.state {
                 MapState::Draw => {
-                    let first_face = self.gpu_faces.len() as u32;
-                    self.gpu_faces.extend_from_slice(&self.work_faces[w.faces.clone()]);
-                    for &(slot, d) in &self.work_draws[w.draws.clone()] {
-                        self.by_mesh[slot]
+                    let first_face = self.scratch.gpu_faces.len() as u32;
+                    self.scratch.gpu_faces.extend_from_slice(&self.scratch.work_faces[w.faces.clone()]);
+                    for &(slot, d) in &self.scratch.work_draws[w.draws.clone()] {
+                        self.scratch.by_mesh[slot]
                             .1
                             .push(GpuShadowDraw { instance: d.instance, face: first_face + d.face });
                     }
@@ -111,10 +111,10 @@ impl ShadowResources {
                 }
             }
             if let ShadowCaster::Point(k) = p.caster {
-                self.gpu_lights[k as usize] = entry;
+                self.scratch.gpu_lights[k as usize] = entry;
             }
             if let Some((i, gpu)) = w.directional {
-                self.gpu_directional[i as usize] = gpu;
+                self.scratch.gpu_directional[i as usize] = gpu;
             }
         }
         std::mem::swap(&mut self.cache, &mut self.next_cache);

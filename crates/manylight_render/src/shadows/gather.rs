@@ -87,11 +87,11 @@ impl ShadowResources {
     pub(super) fn opaque_draws<'a>(&mut self, scene: &'a SceneResources) -> Vec<OpaqueDraw<'a>> {
         let mut opaque = Vec::new();
         for d in scene.draws.iter().filter(|d| !d.variant.blend) {
-            let slot = match self.by_mesh.iter().position(|(m, _)| *m == d.mesh) {
+            let slot = match self.scratch.by_mesh.iter().position(|(m, _)| *m == d.mesh) {
                 Some(i) => i,
                 None => {
-                    self.by_mesh.push((d.mesh, Vec::new()));
-                    self.by_mesh.len() - 1
+                    self.scratch.by_mesh.push((d.mesh, Vec::new()));
+                    self.scratch.by_mesh.len() - 1
                 }
             };
             let mut hash = DefaultHasher::new();
@@ -106,13 +106,13 @@ impl ShadowResources {
     /// faces and pairs go to `work_faces` and `work_draws`, each map's ranges of them to the
     /// list returned.
     pub(super) fn gather_work(&mut self, inputs: &MapInputs) -> Vec<MapWork> {
-        let mut work = std::mem::take(&mut self.work);
+        let mut work = std::mem::take(&mut self.scratch.work);
         work.clear();
-        self.work_faces.clear();
-        self.work_draws.clear();
+        self.scratch.work_faces.clear();
+        self.scratch.work_draws.clear();
         for i in 0..self.plan.placements.len() {
             let p = self.plan.placements[i];
-            let (faces, draws) = (self.work_faces.len(), self.work_draws.len());
+            let (faces, draws) = (self.scratch.work_faces.len(), self.scratch.work_draws.len());
             let mut content = DefaultHasher::new();
             let mut light_entry = GpuShadowLight::default();
             let mut directional_entry = None;
@@ -128,8 +128,8 @@ impl ShadowResources {
                 content: content.finish(),
                 light: light_entry,
                 directional: directional_entry,
-                faces: faces..self.work_faces.len(),
-                draws: draws..self.work_draws.len(),
+                faces: faces..self.scratch.work_faces.len(),
+                draws: draws..self.scratch.work_draws.len(),
                 importance: inputs.importance.get(&p.caster).copied().unwrap_or(0.0),
                 state: MapState::Draw,
             });
@@ -158,7 +158,7 @@ impl ShadowResources {
         };
         for face in 0..SHADOW_FACES {
             let (tx, ty) = tile_of(p, face);
-            self.work_faces.push(GpuShadowFace {
+            self.scratch.work_faces.push(GpuShadowFace {
                 clip_from_world: face_clip_from_world(light.position, face, near, far),
                 atlas: tile_transform(tx, ty, p.edge, inputs.atlas),
             });
@@ -176,7 +176,7 @@ impl ShadowResources {
             for face in 0..SHADOW_FACES {
                 if seen[face as usize] && box_meets_face(light.position, face, &o.draw.world_bounds) {
                     let draw = GpuShadowDraw { instance: o.draw.instance, face };
-                    self.work_draws.push((o.slot, draw));
+                    self.scratch.work_draws.push((o.slot, draw));
                     (o.content, face).hash(content);
                 }
             }
@@ -216,7 +216,7 @@ impl ShadowResources {
                 tile: [tx, ty, p.edge, inputs.settings.filter.gpu_id()],
                 params: [far, fit.texel, fit.depth_range, 0.0],
             };
-            self.work_faces.push(GpuShadowFace {
+            self.scratch.work_faces.push(GpuShadowFace {
                 clip_from_world: fit.clip_from_world,
                 atlas: tile_transform(tx, ty, p.edge, inputs.atlas),
             });
@@ -224,7 +224,7 @@ impl ShadowResources {
             for o in &inputs.opaque {
                 if box_meets_clip(&fit.clip_from_world, &o.draw.world_bounds) {
                     let draw = GpuShadowDraw { instance: o.draw.instance, face: c as u32 };
-                    self.work_draws.push((o.slot, draw));
+                    self.scratch.work_draws.push((o.slot, draw));
                     (o.content, c).hash(content);
                 }
             }

@@ -87,7 +87,7 @@ impl ShadowResources {
         frustums: &[[Vec4; 5]],
     ) {
         let settings = snapshot.settings.shadows;
-        self.requests.clear();
+        self.scratch.requests.clear();
         // The lights with a shadow, found without visiting the chunks that hold none.
         for (k, light) in snapshot.lights.shadowed().map(|(k, l)| (k as u32, l)) {
             if !light.is_valid() || light.radius <= 0.0 {
@@ -103,7 +103,7 @@ impl ShadowResources {
             let wanted = projected_radius(camera, center, radius).map(|p| p * settings.resolution_scale);
             let edge = edge_for(wanted, settings.min_face_size, settings.max_face_size);
             let importance = edge_for(wanted, 1, 1 << 30) as f32;
-            self.requests.push(ShadowRequest { caster: ShadowCaster::Point(k), edge, importance });
+            self.scratch.requests.push(ShadowRequest { caster: ShadowCaster::Point(k), edge, importance });
         }
     }
 
@@ -122,7 +122,7 @@ impl ShadowResources {
             if light.shadow.is_some() && has_view {
                 let edge = settings.cascade_size.max(settings.min_face_size).min(widest);
                 let caster = ShadowCaster::Directional(i as u32);
-                self.requests.push(ShadowRequest { caster, edge, importance: f32::MAX });
+                self.scratch.requests.push(ShadowRequest { caster, edge, importance: f32::MAX });
             }
         }
     }

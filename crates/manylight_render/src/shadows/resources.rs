@@ -35,7 +35,10 @@ pub struct ShadowMeshDraws {
     pub count: u32,
 }
 
-/// The shadow atlas and the buffers of its pass, kept across frames.
+/// The shadow atlas and the buffers of its pass, kept across frames. Over 15 fields: the atlas,
+/// the four buffers the shading and shadow passes bind, this frame's plan, report and the
+/// flags the shadow pass reads, the device's capabilities, and the maps kept from frame to
+/// frame; what a frame only builds in is its `ShadowScratch`.
 pub struct ShadowResources {
     /// The atlas (created on the first frame with a casting light, grown when a frame needs a
     /// larger one, never shrunk).
@@ -80,14 +83,31 @@ pub struct ShadowResources {
     /// The maps the atlas holds, by light.
     pub(super) cache: HashMap<ShadowCaster, CachedMap>,
     pub(super) next_cache: HashMap<ShadowCaster, CachedMap>,
-    pub(super) work: Vec<MapWork>,
-    pub(super) work_faces: Vec<GpuShadowFace>,
-    pub(super) work_draws: Vec<(usize, GpuShadowDraw)>,
+    /// The largest atlas edge the device allows (or [`ShadowResources::limit_texture_size`]).
     max_texture: u32,
+    /// What a frame builds its plan and uploads in.
+    pub(super) scratch: ShadowScratch,
+}
+
+/// What a frame builds its shadow plan and uploads in: emptied and refilled each frame, kept
+/// between frames so that a steady frame allocates nothing.
+#[derive(Default)]
+pub(super) struct ShadowScratch {
+    /// The maps to draw, with their inputs.
+    pub(super) work: Vec<MapWork>,
+    /// The faces of `work`, packed.
+    pub(super) work_faces: Vec<GpuShadowFace>,
+    /// The (mesh, draw) pairs of `work`.
+    pub(super) work_draws: Vec<(usize, GpuShadowDraw)>,
+    /// The light table, packed.
     pub(super) gpu_lights: Vec<GpuShadowLight>,
+    /// The directional lights' cascades, packed.
     pub(super) gpu_directional: Vec<GpuDirectionalShadow>,
+    /// Every placed face, packed.
     pub(super) gpu_faces: Vec<GpuShadowFace>,
+    /// The draws grouped by mesh.
     pub(super) by_mesh: Vec<(usize, Vec<GpuShadowDraw>)>,
+    /// Which lights ask for a map, and how big.
     pub(super) requests: Vec<ShadowRequest>,
 }
 
@@ -143,15 +163,11 @@ impl ShadowResources {
             allocator: BlockAllocator::new(0, 1),
             cache: HashMap::new(),
             next_cache: HashMap::new(),
-            work: Vec::new(),
-            work_faces: Vec::new(),
-            work_draws: Vec::new(),
             max_texture: gpu.max_texture_size(),
-            gpu_lights: Vec::new(),
-            gpu_directional: vec![GpuDirectionalShadow::default(); MAX_DIRECTIONAL_LIGHTS as usize],
-            gpu_faces: Vec::new(),
-            by_mesh: Vec::new(),
-            requests: Vec::new(),
+            scratch: ShadowScratch {
+                gpu_directional: vec![GpuDirectionalShadow::default(); MAX_DIRECTIONAL_LIGHTS as usize],
+                ..ShadowScratch::default()
+            },
         }
     }
 
@@ -211,8 +227,8 @@ impl ShadowResources {
         // Each light's edge from the whole frame's needs, then its place: where it was while
         // its edge holds.
         let min_edge = settings.min_face_size.min(max_atlas / SHADOW_TILE_COLUMNS).max(1);
-        let target = plan_atlas(&self.requests, max_atlas, min_edge);
-        self.report.casting_lights = self.requests.len() as u32 + self.report.unseen_lights;
+        let target = plan_atlas(&self.scratch.requests, max_atlas, min_edge);
+        self.report.casting_lights = self.scratch.requests.len() as u32 + self.report.unseen_lights;
         self.report.atlas_limited_by_device = limited;
         if target.placements.is_empty() {
             self.report.dropped_lights = target.dropped;
@@ -222,17 +238,17 @@ impl ShadowResources {
         let atlas = self.place_maps(gpu, &target, min_edge);
 
         // The light table: every light of the buffer, edge 0 where it has no map.
-        self.gpu_lights.clear();
-        self.gpu_lights.resize(scene.light_count.max(1) as usize, GpuShadowLight::default());
+        self.scratch.gpu_lights.clear();
+        self.scratch.gpu_lights.resize(scene.light_count.max(1) as usize, GpuShadowLight::default());
         let lights = &snapshot.lights;
-        self.gpu_faces.clear();
-        for list in &mut self.by_mesh {
+        self.scratch.gpu_faces.clear();
+        for list in &mut self.scratch.by_mesh {
             list.1.clear();
         }
         let opaque = self.opaque_draws(scene);
         let casters = caster_bounds(&opaque);
-        self.gpu_directional.fill(GpuDirectionalShadow::default());
-        let importance = self.requests.iter().map(|r| (r.caster, r.importance)).collect();
+        self.scratch.gpu_directional.fill(GpuDirectionalShadow::default());
+        let importance = self.scratch.requests.iter().map(|r| (r.caster, r.importance)).collect();
         let inputs =
             MapInputs { settings, atlas, lights, directional, view, frustums, opaque, casters, importance };
 
@@ -240,7 +256,7 @@ impl ShadowResources {
         self.choose_redraws(&mut work, &settings);
         self.commit_maps(&work);
         self.clears_tiles = work.iter().any(|w| w.state != MapState::Draw);
-        self.work = work;
+        self.scratch.work = work;
         self.upload(gpu, scene, atlas)
     }
 
@@ -268,7 +284,7 @@ impl ShadowResources {
         if !self.allocator.serves(atlas, min_edge) {
             self.allocator = BlockAllocator::new(atlas, min_edge);
         }
-        self.plan = place_stably(&mut self.allocator, target, &self.requests);
+        self.plan = place_stably(&mut self.allocator, target, &self.scratch.requests);
         self.report.downgraded_lights = self.plan.downgraded;
         self.report.dropped_lights = self.plan.dropped;
         atlas
@@ -278,9 +294,9 @@ impl ShadowResources {
     /// shadow tables, faces and pairs, and marks the frame's maps for drawing in an `atlas`
     /// texels wide atlas.
     fn upload(&mut self, gpu: &GpuContext, scene: &SceneResources, atlas: u32) -> Result<(), RenderError> {
-        self.by_mesh.retain(|(mesh, _)| scene.assets.mesh(*mesh).is_some());
+        self.scratch.by_mesh.retain(|(mesh, _)| scene.assets.mesh(*mesh).is_some());
         let mut all = Vec::new();
-        for (mesh, list) in &self.by_mesh {
+        for (mesh, list) in &self.scratch.by_mesh {
             if list.is_empty() {
                 continue;
             }
@@ -291,10 +307,10 @@ impl ShadowResources {
             });
             all.extend_from_slice(list);
         }
-        let mut grew = self.lights.write(gpu, bytemuck::cast_slice(&self.gpu_lights))?;
-        grew |= self.directional.write(gpu, bytemuck::cast_slice(&self.gpu_directional))?;
-        if !self.gpu_faces.is_empty() {
-            grew |= self.faces.write(gpu, bytemuck::cast_slice(&self.gpu_faces))?;
+        let mut grew = self.lights.write(gpu, bytemuck::cast_slice(&self.scratch.gpu_lights))?;
+        grew |= self.directional.write(gpu, bytemuck::cast_slice(&self.scratch.gpu_directional))?;
+        if !self.scratch.gpu_faces.is_empty() {
+            grew |= self.faces.write(gpu, bytemuck::cast_slice(&self.scratch.gpu_faces))?;
         }
         if !all.is_empty() {
             grew |= self.draws.write(gpu, bytemuck::cast_slice(&all))?;
@@ -303,7 +319,7 @@ impl ShadowResources {
             self.generation += 1;
         }
         self.active = true;
-        self.faces_drawn = self.gpu_faces.len() as u32;
+        self.faces_drawn = self.scratch.gpu_faces.len() as u32;
         self.pending_draw.store(self.faces_drawn > 0, Ordering::Relaxed);
         self.report.instance_faces = all.len() as u32;
         self.report.draw_calls = self.mesh_draws.len() as u32;
