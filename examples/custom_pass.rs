@@ -61,7 +61,7 @@ pub fn layout(size: Res<manylight::app::ViewportSize>, mut cameras: Query<&mut C
     for mut camera in &mut cameras {
         let x = camera.order.clamp(0, 1) as u32 * half.x;
         let viewport = Some(Viewport { physical_position: UVec2::new(x, 0), physical_size: half });
-        camera.set_if_neq(Camera { viewport, ..camera.clone() });
+        camera.set_if_neq(Camera { viewport, ..*camera });
     }
 }
 

@@ -46,19 +46,24 @@ fn frame_stats_list_the_passes_with_timings() {
     assert_eq!(report.light_count as usize, default_scene().lights.len() + 8);
     assert_eq!(report.instance_count as usize, default_scene().instances.len());
     assert_eq!((report.width, report.height), (SIZE.x, SIZE.y));
-    for pass in &report.passes {
-        assert!(pass.cpu_ms >= 0.0 && pass.cpu_ms.is_finite());
-        // lavapipe and every real GPU we target support timestamp queries (compute-pass figures
-        // are flagged untrusted on CPU adapters, but present).
-        let gpu_ms = pass.gpu_ms.unwrap_or_else(|| panic!("{} has no GPU time", pass.name));
-        assert!(gpu_ms >= 0.0 && gpu_ms.is_finite());
-    }
+    // lavapipe and every real GPU we target support timestamp queries (compute-pass figures
+    // are flagged untrusted on CPU adapters, but present).
+    let gpu_ms: Vec<f64> = (report.passes.iter())
+        .map(|p| p.gpu_ms.unwrap_or_else(|| panic!("{} has no GPU time", p.name)))
+        .collect();
+    assert!(gpu_ms.iter().chain(report.passes.iter().map(|p| &p.cpu_ms)).all(|ms| ms.is_finite()));
+    // The frame's GPU time is its passes' (summed in the same order: the same float).
+    assert_eq!(report.frame_gpu_ms, Some(gpu_ms.iter().sum()), "{:?}", report.passes);
     assert!(report.frame_cpu_ms > 0.0);
     // The CPU time by phase: extraction (main world), then the render side's phases, which
     // happen inside the frame's CPU time; the uploads include the lights.
     let cpu = report.cpu;
     assert!(cpu.extract_ms > 0.0 && cpu.upload_ms > 0.0 && cpu.prepare_ms > 0.0, "{cpu:?}");
     assert!(cpu.record_ms > 0.0 && cpu.submit_ms > 0.0, "{cpu:?}");
+    // Each pass's CPU time is its recording, which the record phase sums (with any recording
+    // made only to count the light lists, which no pass of the report shows).
+    let recorded: f64 = report.passes.iter().map(|p| p.cpu_ms).sum();
+    assert!(recorded <= cpu.record_ms, "passes recorded in {recorded} ms, the phase took {cpu:?}");
     let render_side = cpu.upload_ms + cpu.prepare_ms + cpu.record_ms + cpu.submit_ms;
     assert!(render_side <= report.frame_cpu_ms + 1e-6, "{cpu:?} against {} ms", report.frame_cpu_ms);
     assert!(report.light_upload_bytes > 0 && cpu.upload_bytes >= report.light_upload_bytes, "{cpu:?}");

@@ -29,6 +29,7 @@ mod codec_accuracy;
 mod culling_tests;
 mod depth_precision;
 mod direct;
+mod large_floor;
 mod plot;
 mod post;
 mod progress;
@@ -132,6 +133,21 @@ struct ReportArgs {
     /// reference (`report_shadows.csv` and its figures with `--plot`).
     #[arg(long)]
     shadows: bool,
+    /// The very-large-surfaces section instead (`report`): a floor quad with corners at ±extent
+    /// under four point lights, flat and tilted, drawn by every pipeline, G-buffer layout and
+    /// normal codec at `--size` against the same floor tessellated into rings that grow with the
+    /// distance from the camera (naive forward), and those rings against the floor shaded
+    /// analytically on the CPU: FLIP mean and p99, worst 8-bit channel and non-finite pixels,
+    /// one frame each, as a markdown table. Draws its own floor: no scene, rig lights or timing.
+    #[arg(long, conflicts_with_all = ["shadows", "plot", "scene", "lights", "frames"])]
+    large_floor: bool,
+    /// Half-sizes of the floor `--large-floor` measures (`report`).
+    #[arg(long, value_delimiter = ',', default_value = "10,1e4,1e7", requires = "large_floor",
+          value_parser = large_floor::parse_extent)]
+    floor_extents: Vec<f64>,
+    /// Far plane of `--large-floor`'s camera, or `inf` for none (`report`).
+    #[arg(long, default_value = "1e8", requires = "large_floor", value_parser = large_floor::parse_far)]
+    floor_far: f32,
 }
 
 #[derive(clap::Args)]
@@ -920,6 +936,11 @@ fn rangeless_lights_cmd(args: ReportArgs) -> Result<()> {
 }
 
 fn report_cmd(args: ReportArgs) -> Result<()> {
+    if args.large_floor {
+        let base = measure_base(&args.clusters, "default").render;
+        print!("{}", large_floor::run(&args.floor_extents, args.floor_far, args.size, base)?);
+        return Ok(());
+    }
     let scene = args.clusters.load(&args.scene)?;
     check_lights(scene.lights.len().saturating_add(args.lights), "--lights")?;
     let base = measure_base(&args.clusters, &args.scene);

@@ -430,7 +430,8 @@ fn a_scene_lit_only_by_the_sun_is_rendered_as_lit_and_measured() {
 /// on a 240 GB allocation, `--lights 18446744073709551615` panicked with "capacity overflow",
 /// `--lights 10000000` reached 2.9 GB spawning entities past lavapipe's 2 796 202-light
 /// buffer) or rendered a black image and exited 0 (`--exposure NaN`): each exits 1 or 2 with a
-/// message naming the limit, in seconds and without its resident memory reaching 256 MiB.
+/// message naming the limit, without its resident memory reaching 256 MiB (what it would have
+/// allocated is gigabytes).
 #[test]
 fn arguments_past_a_limit_exit_with_a_message_before_allocating() {
     let _gpu = GPU.lock().unwrap_or_else(|e| e.into_inner());
@@ -456,21 +457,19 @@ fn arguments_past_a_limit_exit_with_a_message_before_allocating() {
         assert!(matches!(code, Some(1 | 2)), "{flags:?}: exit {:?}\n{stderr}", run.output.status);
         assert!(stderr.contains(named), "{flags:?}: the message does not name `{named}`:\n{stderr}");
         assert!(!stderr.contains("panicked") && !stderr.contains("memory allocation"), "{flags:?}: {stderr}");
-        // Finding the adapter takes a fraction of a second on lavapipe.
-        assert!(run.seconds < 10.0, "{flags:?}: took {:.1} s", run.seconds);
         assert!(run.peak_rss < 256 << 20, "{flags:?}: resident memory reached {} MiB", run.peak_rss >> 20);
     }
 }
 
-/// A finished run of the binary with its wall time and the largest resident set seen.
+/// A finished run of the binary with the largest resident set seen.
 struct WatchedRun {
     output: Output,
-    seconds: f64,
     peak_rss: u64,
 }
 
 /// Runs the binary with `args`, reading its peak resident set (`VmHWM`) from `/proc` until it
-/// exits (0 where `/proc` cannot be read).
+/// exits (0 where `/proc` cannot be read). A run still going after 120 s fails, so a hang does
+/// not stall the suite.
 fn run_watched(args: &[&str]) -> WatchedRun {
     use std::process::Stdio;
     let start = std::time::Instant::now();
@@ -495,5 +494,5 @@ fn run_watched(args: &[&str]) -> WatchedRun {
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
     let output = child.wait_with_output().expect("output");
-    WatchedRun { output, seconds: start.elapsed().as_secs_f64(), peak_rss }
+    WatchedRun { output, peak_rss }
 }
