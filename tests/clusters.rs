@@ -6,6 +6,7 @@ mod support;
 use glam::{UVec2, Vec3};
 use manylight::app::render_world::HeadlessRenderer;
 use manylight::app::scene::extracted_light;
+use manylight::math::LightShape;
 use manylight::math::Projection;
 use manylight::math::cluster::{ClusterAssignment, CullTest, GridConfig, ZSlicing, assign_lights};
 use manylight::prelude::*;
@@ -519,7 +520,7 @@ fn spot_rig(points: &[ExtractedPointLight]) -> Vec<ExtractedPointLight> {
             let outer = [0.02, 0.3, 0.6, 1.0, std::f32::consts::FRAC_PI_2][i % 5];
             let inner = if i % 3 == 0 { outer } else { outer * 0.5 };
             ExtractedPointLight {
-                spot: Some(SpotCone { direction, inner_angle: inner, outer_angle: outer }),
+                shape: LightShape::Spot(SpotCone { direction, inner_angle: inner, outer_angle: outer }),
                 ..l.clone()
             }
         })

@@ -5,6 +5,7 @@
 mod support;
 
 use manylight::app::RenderSettings;
+use manylight::math::LightShape;
 use manylight::prelude::*;
 use manylight::scene::SceneLight;
 use support::{STRICT, Tolerance, assert_similar, asset, gpu, render_scene as render};
@@ -108,7 +109,7 @@ fn hard_light_scene(aspect: f32) -> Scene {
         color: warm,
         intensity,
         radius,
-        spot: None,
+        shape: LightShape::Point,
     };
     let half_width = (cam.projection.fov_y * 0.5).tan() * aspect;
     scene.lights.extend([
@@ -166,7 +167,7 @@ fn nonfinite_hdr_pixels_are_counted() {
         color: Vec3::splat(10.0),
         intensity: f32::MAX / 16.0,
         radius: 50.0,
-        spot: None,
+        shape: LightShape::Point,
     };
     scene.lights.push(light);
     for pipeline in [PipelineKind::NaiveForward, PipelineKind::ClusteredDeferred] {
@@ -228,7 +229,7 @@ fn light_volumes_plan_only_what_they_need() {
         color: Vec3::ONE,
         intensity: 1.0,
         radius: 2.0,
-        spot: None,
+        shape: LightShape::Point,
         shadow: None,
         animation: None,
     };

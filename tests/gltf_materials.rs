@@ -9,6 +9,7 @@ mod support;
 
 use glam::Mat4;
 use manylight::app::RenderSettings;
+use manylight::math::LightShape;
 use manylight::math::{MaterialData, Projection};
 use manylight::prelude::*;
 use manylight::scene::shapes::cuboid;
@@ -104,7 +105,7 @@ fn box_scene(sx: f32, double_sided: bool) -> Scene {
             color: Vec3::ONE,
             intensity: 8.0,
             radius: 20.0,
-            spot: None,
+            shape: LightShape::Point,
         }],
         cameras: vec![SceneCamera {
             transform: camera_looking_at(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO),

@@ -9,6 +9,7 @@ mod support;
 use glam::{Mat4, Vec3};
 use image::RgbaImage;
 use manylight::app::RenderSettings;
+use manylight::math::LightShape;
 use manylight::math::brdf::{PointLightSample, SurfaceParams, shade_directional_light, shade_point_light};
 use manylight::math::tonemap::tonemap_to_srgb8;
 use manylight::math::{MaterialData, Projection, ShadingModel, SpotCone};
@@ -43,14 +44,14 @@ fn lights() -> Vec<SceneLight> {
             color: Vec3::ONE,
             intensity: 30.0,
             radius: 40.0,
-            spot: None,
+            shape: LightShape::Point,
         },
         SceneLight {
             position: Vec3::new(-3.0, 1.0, 3.0),
             color: Vec3::new(1.0, 0.7, 0.4),
             intensity: 15.0,
             radius: 40.0,
-            spot: None,
+            shape: LightShape::Point,
         },
         // A spot from below and to the left, its cone's edge falling across the middle of
         // the grid, so both the full-strength core and the falloff show.
@@ -59,7 +60,7 @@ fn lights() -> Vec<SceneLight> {
             color: Vec3::new(0.4, 0.6, 1.0),
             intensity: 40.0,
             radius: 40.0,
-            spot: Some(SpotCone {
+            shape: LightShape::Spot(SpotCone {
                 direction: (Vec3::new(-1.0, 0.0, 0.0) - Vec3::new(-1.0, -2.5, 2.0)).normalize(),
                 inner_angle: 0.25,
                 outer_angle: 0.45,
@@ -129,9 +130,11 @@ fn cpu_twin(scene_lights: &[SceneLight]) -> RgbaImage {
     };
     let lights: Vec<PointLightSample> = scene_lights
         .iter()
-        .map(|l| match &l.spot {
-            Some(cone) => PointLightSample::spot(l.position, l.radius, l.color * l.intensity, cone),
-            None => PointLightSample::point(l.position, l.radius, l.color * l.intensity),
+        .map(|l| match &l.shape {
+            LightShape::Spot(cone) => {
+                PointLightSample::spot(l.position, l.radius, l.color * l.intensity, cone)
+            }
+            LightShape::Point => PointLightSample::point(l.position, l.radius, l.color * l.intensity),
         })
         .collect();
     RgbaImage::from_fn(SIZE.x, SIZE.y, |x, y| {
@@ -192,7 +195,8 @@ fn pbr_spheres_match_the_cpu_twin() {
     let frame = render_scene(spheres(), SIZE, 0, settings(PipelineKind::NaiveForward));
     let twin = cpu_twin(&lights());
     // The spot's cone shows: the same light shining in every direction gives another image.
-    let unbounded: Vec<SceneLight> = lights().into_iter().map(|l| SceneLight { spot: None, ..l }).collect();
+    let unbounded: Vec<SceneLight> =
+        lights().into_iter().map(|l| SceneLight { shape: LightShape::Point, ..l }).collect();
     let cone = support::flip(&twin, &cpu_twin(&unbounded));
     assert!(cone.mean > 0.01, "the spot light's cone changes little: {cone:?}");
     let _ = frame.image.save(support::output_dir().join("pbr_spheres.png"));

@@ -6,6 +6,7 @@ mod support;
 
 use glam::Mat4;
 use manylight::app::headless::{HeadlessFrame, render_headless};
+use manylight::math::LightShape;
 use manylight::math::shadow_oracle::{LightSource, OccluderSet, ShadowQuery};
 use manylight::prelude::*;
 use manylight::render::ShadowFilteringMethod;
@@ -474,7 +475,7 @@ fn many_casting_lights() -> Vec<manylight::render::ExtractedPointLight> {
             color: Vec3::ONE,
             intensity: 1.0,
             radius: 3.0,
-            spot: None,
+            shape: LightShape::Point,
             shadow: Some(manylight::render::ShadowBias::POINT),
             animation: None,
         })
@@ -557,7 +558,7 @@ fn three_lights(shift: f32) -> Vec<manylight::render::ExtractedPointLight> {
             color: Vec3::ONE,
             intensity: 4.0,
             radius: if at.y > 1.0 { 3.0 } else { 1.0 },
-            spot: None,
+            shape: LightShape::Point,
             shadow: Some(manylight::render::ShadowBias::POINT),
             animation: None,
         })
@@ -692,7 +693,7 @@ fn a_thousand_moving_shadowed_lights_are_all_accounted_for() {
                 color: Vec3::ONE,
                 intensity: 0.05,
                 radius: 2.0,
-                spot: None,
+                shape: LightShape::Point,
                 shadow: Some(manylight::render::ShadowBias::POINT),
                 animation: None,
             })

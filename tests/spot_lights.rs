@@ -5,6 +5,7 @@
 mod support;
 
 use manylight::app::RenderSettings;
+use manylight::math::LightShape;
 use manylight::math::SpotCone;
 use manylight::prelude::*;
 use manylight::scene::light_rig;
@@ -21,7 +22,7 @@ fn spot_scene(count: usize) -> Scene {
         let outer = [0.05, 0.35, 0.7, 1.2, std::f32::consts::FRAC_PI_2][i % 5];
         let mut light = manylight::scene::animated_light_at(anim, 0.0);
         light.intensity *= 3.0;
-        light.spot = Some(SpotCone {
+        light.shape = LightShape::Spot(SpotCone {
             direction: Vec3::new(a.cos(), (i % 5) as f32 / 2.0 - 1.5, a.sin()),
             inner_angle: if i % 4 == 0 { outer } else { outer * 0.6 },
             outer_angle: outer,
@@ -41,7 +42,7 @@ fn spot_lights_give_the_naive_image_in_every_pipeline() {
     let naive = render_scene(spot_scene(120), SIZE, 0, settings(PipelineKind::NaiveForward));
     // The cones show: the same lights as point lights light another image.
     let mut points = spot_scene(120);
-    points.lights.iter_mut().for_each(|l| l.spot = None);
+    points.lights.iter_mut().for_each(|l| l.shape = LightShape::Point);
     let as_points = render_scene(points, SIZE, 0, settings(PipelineKind::NaiveForward));
     assert!(flip(&naive.image, &as_points.image).mean > 0.02, "the cones change little");
     let variants = support::pipelines_besides_naive("spot", settings);
@@ -145,14 +146,14 @@ fn spot_lights_on_hard_cases_stay_finite_and_exact() {
         let eye = scene.cameras[0].transform.w_axis.truncate();
         let forward = -scene.cameras[0].transform.z_axis.truncate().normalize();
         let cone = |direction: Vec3, inner: f32, outer: f32| {
-            Some(SpotCone { direction, inner_angle: inner, outer_angle: outer })
+            LightShape::Spot(SpotCone { direction, inner_angle: inner, outer_angle: outer })
         };
-        let spot = |position: Vec3, radius: f32, spot| manylight::scene::SceneLight {
+        let spot = |position: Vec3, radius: f32, shape| manylight::scene::SceneLight {
             position,
             color: Vec3::new(1.0, 0.8, 0.6),
             intensity: 20.0,
             radius,
-            spot,
+            shape,
         };
         scene.lights.extend([
             spot(eye, 40.0, cone(forward, 0.2, 0.4)),

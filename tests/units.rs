@@ -6,6 +6,7 @@ mod support;
 
 use manylight::app::RenderSettings;
 use manylight::app::headless::render_headless;
+use manylight::math::LightShape;
 use manylight::math::lumens_from_candela;
 use manylight::prelude::*;
 use manylight::scene::SceneLight;
@@ -25,7 +26,7 @@ fn candela_lights() -> Vec<SceneLight> {
             color,
             intensity: 6.0,
             radius: 8.0,
-            spot: None,
+            shape: LightShape::Point,
         })
         .to_vec()
 }

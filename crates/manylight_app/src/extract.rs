@@ -18,7 +18,7 @@ use bevy_ecs::query::QueryData;
 use bevy_ecs::system::SystemParam;
 use bevy_time::Time;
 use glam::Mat4;
-use manylight_core::{MaterialData, SpotCone, candela_from_lumens};
+use manylight_core::{LightShape, MaterialData, SpotCone, candela_from_lumens};
 use manylight_render::{
     ExtractedCamera, ExtractedDirectionalLight, ExtractedInstance, ExtractedPointLight, ExtractedView,
     FrameSnapshot, PointLights, ViewComponents, ViewRect, ViewTarget,
@@ -292,12 +292,12 @@ fn point_light(
     if !shown(visibility) {
         return None;
     }
-    let (color, lumens, range, cone, shadow) = match (point, spot) {
-        (Some(l), _) => (linear_rgb(l.color), l.intensity, l.range, None, l.shadow()),
+    let (color, lumens, range, shape, shadow) = match (point, spot) {
+        (Some(l), _) => (linear_rgb(l.color), l.intensity, l.range, LightShape::Point, l.shadow()),
         (None, Some(l)) => {
             let direction = t.forward().into();
             let cone = SpotCone { direction, inner_angle: l.inner_angle, outer_angle: l.outer_angle };
-            (linear_rgb(l.color), l.intensity, l.range, Some(cone), l.shadow())
+            (linear_rgb(l.color), l.intensity, l.range, LightShape::Spot(cone), l.shadow())
         }
         (None, None) => return None,
     };
@@ -307,7 +307,7 @@ fn point_light(
         color: animation.map_or(color, |a| a.color),
         intensity: candela_from_lumens(lumens),
         radius: range,
-        spot: cone,
+        shape,
         shadow,
         animation: animation.map(Arc::new),
     })

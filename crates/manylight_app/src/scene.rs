@@ -7,7 +7,7 @@ use crate::components::{
 use bevy_ecs::name::Name;
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
-use manylight_core::{Aabb, LightCountError, lumens_from_candela};
+use manylight_core::{Aabb, LightCountError, LightShape, lumens_from_candela};
 use manylight_render::{
     ExtractedCamera, ExtractedDirectionalLight, ExtractedInstance, ExtractedPointLight, ExtractedView,
     FrameSettings, FrameSnapshot, ShadowBias,
@@ -124,12 +124,12 @@ fn spawn_light(commands: &mut Commands, light: &SceneLight, local: Transform, on
     // Scene lights are in candela (glTF); the components in lumens (Bevy).
     let (color, intensity, range) =
         (from_linear_rgb(light.color), lumens_from_candela(light.intensity), light.radius);
-    match &light.spot {
-        None => {
+    match &light.shape {
+        LightShape::Point => {
             let point = PointLight { color, intensity, range, radius: 0.0, ..Default::default() };
             commands.spawn((local, point, ChildOf(parent)));
         }
-        Some(cone) => {
+        LightShape::Spot(cone) => {
             let mut transform = local;
             if !on_node {
                 transform.rotation = Quat::from_rotation_arc(Vec3::NEG_Z, cone.sanitized().direction);
@@ -192,7 +192,7 @@ pub fn extracted_light(l: &SceneLight) -> ExtractedPointLight {
         color: l.color,
         intensity: l.intensity,
         radius: l.radius,
-        spot: l.spot,
+        shape: l.shape,
         shadow: None,
         animation: None,
     }
@@ -218,7 +218,7 @@ pub fn set_shadows(world: &mut World, enabled: bool) {
 
 /// `light` casting a shadow with the biases Bevy gives its kind (`shadows`), or not.
 pub fn with_shadow(mut light: ExtractedPointLight, shadows: bool) -> ExtractedPointLight {
-    light.shadow = shadows.then_some(if light.spot.is_some() { ShadowBias::SPOT } else { ShadowBias::POINT });
+    light.shadow = shadows.then_some(ShadowBias::for_shape(light.shape));
     light
 }
 

@@ -25,7 +25,6 @@ use manylight_core::AlphaMode;
 use manylight_core::cluster::ClusterAssignment;
 use manylight_core::image_metrics::{FlipStats, flip_compare};
 use manylight_core::shadow_oracle::{LightSource, OccluderSet, ShadowQuery, SurfaceHit};
-use manylight_core::spot::spot_attenuation;
 use manylight_render::shadow_probe::ShadowProbe;
 use manylight_render::{ExtractedPointLight, FrameSnapshot};
 use manylight_scene::Scene;
@@ -253,14 +252,7 @@ fn reaches(light: &ExtractedPointLight, s: &SurfaceHit) -> bool {
     if to_light.dot(s.normal) <= 0.0 {
         return false;
     }
-    match light.spot {
-        None => true,
-        Some(cone) => {
-            let (scale, offset) = cone.sanitized().scale_offset();
-            let cos = cone.direction.dot(-to_light.normalize_or_zero());
-            spot_attenuation(cos, scale, offset) > 0.0
-        }
-    }
+    light.shape.attenuation(-to_light) > 0.0
 }
 
 /// `lists` without the entries (indices into `lists.indices`, ascending) in `removed`.
@@ -317,7 +309,7 @@ mod tests {
                 color: Vec3::ONE,
                 intensity: 2.0,
                 radius: 4.0,
-                spot: None,
+                shape: manylight_core::LightShape::Point,
                 shadow: Some(ShadowBias::POINT),
                 animation: None,
             })

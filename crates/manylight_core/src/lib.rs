@@ -34,4 +34,4 @@ pub use material::{
     TextureSampler, UvChannel,
 };
 pub use mesh::{Aabb, MeshData, MeshError, Vertex};
-pub use spot::SpotCone;
+pub use spot::{LightShape, SpotCone};

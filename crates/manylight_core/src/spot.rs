@@ -10,6 +10,53 @@
 
 use glam::Vec3;
 
+/// The shape of the light a point-like light sends out: every direction, or a cone (glTF's
+/// `point` and `spot`; the sun is a light of its own type). Code that treats the shapes
+/// differently matches on it whole, so a new shape fails to compile wherever it must be
+/// handled.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum LightShape {
+    /// Light in every direction, within the light's range.
+    #[default]
+    Point,
+    /// Light inside a cone, within the light's range.
+    Spot(SpotCone),
+}
+
+impl LightShape {
+    /// The sphere `(centre, radius)` that holds every point a light of this shape at
+    /// `position` lights within `range`: the range's sphere, or the smaller one around a spot
+    /// light's cone ([`SpotCone::bounding_sphere`]).
+    pub fn bounding_sphere(&self, position: Vec3, range: f32) -> (Vec3, f32) {
+        match self {
+            LightShape::Point => (position, range),
+            LightShape::Spot(cone) => cone.bounding_sphere(position, range),
+        }
+    }
+
+    /// `(axis, scale, offset)` of the angular falloff `saturate(cos · scale + offset)²` the
+    /// shaders apply: a point light has no axis, scale 0 and offset 1 (1 in every direction).
+    pub fn falloff(&self) -> (Vec3, f32, f32) {
+        match self {
+            LightShape::Point => (Vec3::ZERO, 0.0, 1.0),
+            LightShape::Spot(cone) => {
+                let (scale, offset) = cone.scale_offset();
+                (cone.sanitized().direction, scale, offset)
+            }
+        }
+    }
+
+    /// The angular falloff towards `direction` (from the light; need not be unit): 1 for a
+    /// point light, [`spot_attenuation`] of the cone for a spot light.
+    pub fn attenuation(&self, direction: Vec3) -> f32 {
+        let (axis, scale, offset) = self.falloff();
+        match self {
+            LightShape::Point => 1.0,
+            LightShape::Spot(_) => spot_attenuation(axis.dot(direction.normalize_or_zero()), scale, offset),
+        }
+    }
+}
+
 /// The cone of a spot light.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SpotCone {

@@ -14,7 +14,7 @@
 use crate::gpu_types::{GpuDirectionalLight, GpuLightMotion, GpuPointLight, MAX_DIRECTIONAL_LIGHTS};
 use crate::settings::CascadeShadowConfig;
 use glam::Vec3;
-use manylight_core::SpotCone;
+pub use manylight_core::LightShape;
 use std::sync::Arc;
 
 /// One point light.
@@ -28,15 +28,15 @@ pub struct ExtractedPointLight {
     pub intensity: f32,
     /// Radius of influence (contribution is exactly 0 at and beyond it).
     pub radius: f32,
-    /// The cone of a spot light (`None`: a point light, lighting every direction).
-    pub spot: Option<SpotCone>,
+    /// Every direction (a point light) or a cone (a spot light).
+    pub shape: LightShape,
     /// The light casts shadows, with these biases (`None`: it lights through everything).
     pub shadow: Option<ShadowBias>,
     /// The light moves and flickers on the GPU (`None`: it stays as extracted): each frame a
     /// compute pass writes its position and colour at
     /// [`FrameSnapshot::elapsed_secs`](crate::snapshot::FrameSnapshot::elapsed_secs) into the
     /// light buffer (`shaders/light_animation.wgsl`), so its motion costs the CPU nothing.
-    /// `position` and `color` are then unused; `intensity`, `radius` and `spot` still apply.
+    /// `position` and `color` are then unused; `intensity`, `radius` and `shape` still apply.
     pub animation: Option<Arc<manylight_core::AnimatedLight>>,
 }
 
@@ -54,6 +54,14 @@ pub struct ShadowBias {
 }
 
 impl ShadowBias {
+    /// Bevy's defaults for a light of `shape` (`PointLight`'s or `SpotLight`'s).
+    pub fn for_shape(shape: LightShape) -> ShadowBias {
+        match shape {
+            LightShape::Point => ShadowBias::POINT,
+            LightShape::Spot(_) => ShadowBias::SPOT,
+        }
+    }
+
     /// Bevy's `PointLight` defaults.
     pub const POINT: ShadowBias = ShadowBias { depth: 0.08, normal: 0.6 };
     /// Bevy's `SpotLight` defaults.
@@ -76,7 +84,15 @@ impl Default for ShadowBias {
 impl ExtractedPointLight {
     /// A point light (no cone, no shadow, no animation).
     pub fn point(position: Vec3, color: Vec3, intensity: f32, radius: f32) -> ExtractedPointLight {
-        ExtractedPointLight { position, color, intensity, radius, spot: None, shadow: None, animation: None }
+        ExtractedPointLight {
+            position,
+            color,
+            intensity,
+            radius,
+            shape: LightShape::Point,
+            shadow: None,
+            animation: None,
+        }
     }
 
     /// True when every parameter is finite, the radius and intensity are not negative, and the
@@ -333,43 +349,16 @@ impl std::ops::Index<usize> for PointLights {
     }
 }
 
-/// The kinds of light the renderer draws.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum LightKind {
-    /// Light from a point in every direction, within a range.
-    Point,
-    /// Light from a point inside a cone, within a range.
-    Spot,
-    /// Light travelling one way everywhere (the sun).
-    Directional,
-}
-
-impl LightKind {
-    /// The kind of a point or spot light.
-    pub fn of(light: &ExtractedPointLight) -> LightKind {
-        if light.spot.is_some() { LightKind::Spot } else { LightKind::Point }
-    }
-}
-
 /// The sphere (centre, radius) that holds every point `light` can reach: its range around it,
-/// or the smaller sphere around a spot light's cone ([`manylight_core::SpotCone::bounding_sphere`]).
+/// or the smaller sphere around a spot light's cone ([`LightShape::bounding_sphere`]).
 pub fn bounding_sphere(light: &ExtractedPointLight) -> (Vec3, f32) {
-    match (LightKind::of(light), &light.spot) {
-        (LightKind::Spot, Some(cone)) => cone.bounding_sphere(light.position, light.radius),
-        _ => (light.position, light.radius),
-    }
+    light.shape.bounding_sphere(light.position, light.radius)
 }
 
 /// `light` as the shaders read it (`GpuPointLight` in `shaders/common/lights.wgsl`): a point
 /// light has no direction, falloff scale 0 and offset 1 (1 everywhere).
 pub fn gpu_point_light(light: &ExtractedPointLight) -> GpuPointLight {
-    let (direction, scale, offset) = match &light.spot {
-        Some(cone) => {
-            let (scale, offset) = cone.scale_offset();
-            (cone.sanitized().direction, scale, offset)
-        }
-        None => (Vec3::ZERO, 0.0, 1.0),
-    };
+    let (direction, scale, offset) = light.shape.falloff();
     GpuPointLight {
         position_radius: light.position.extend(light.radius).to_array(),
         color: (light.color * light.intensity).extend(offset).to_array(),
@@ -485,30 +474,30 @@ pub fn viewed_directional_lights(
 mod tests {
     use super::*;
 
-    fn light(spot: Option<SpotCone>) -> ExtractedPointLight {
+    fn light(shape: LightShape) -> ExtractedPointLight {
         ExtractedPointLight {
             position: Vec3::new(1.0, 2.0, 3.0),
             color: Vec3::ONE,
             intensity: 2.0,
             radius: 4.0,
-            spot,
+            shape,
             shadow: None,
             animation: None,
         }
     }
 
     #[test]
-    fn a_light_knows_its_kind_reach_and_packing() {
-        let point = light(None);
-        assert_eq!(LightKind::of(&point), LightKind::Point);
+    fn a_light_knows_its_reach_packing_and_bias_by_shape() {
+        let point = light(LightShape::Point);
         assert_eq!(bounding_sphere(&point), (point.position, 4.0));
+        assert_eq!(ShadowBias::for_shape(point.shape), ShadowBias::POINT);
         let packed = gpu_point_light(&point);
         assert_eq!(packed.position_radius, [1.0, 2.0, 3.0, 4.0]);
         assert_eq!(packed.color, [2.0, 2.0, 2.0, 1.0], "a point light's falloff offset is 1");
         assert_eq!(packed.spot, [0.0; 4]);
-        let cone = SpotCone { direction: Vec3::NEG_Y, inner_angle: 0.2, outer_angle: 0.4 };
-        let spot = light(Some(cone));
-        assert_eq!(LightKind::of(&spot), LightKind::Spot);
+        let cone = manylight_core::SpotCone { direction: Vec3::NEG_Y, inner_angle: 0.2, outer_angle: 0.4 };
+        let spot = light(LightShape::Spot(cone));
+        assert_eq!(ShadowBias::for_shape(spot.shape), ShadowBias::SPOT);
         let (_, r) = bounding_sphere(&spot);
         assert!(r < 4.0, "a narrow cone's sphere is smaller than the range: {r}");
         assert_eq!(gpu_point_light(&spot).spot[1], -1.0);
@@ -518,7 +507,7 @@ mod tests {
     fn the_reach_box_covers_every_lights_farthest_point() {
         let view =
             glam::Mat4::from_rotation_y(0.4) * glam::Mat4::from_translation(Vec3::new(-3.0, -1.0, -9.0));
-        let mut lights = vec![light(None); 3];
+        let mut lights = vec![light(LightShape::Point); 3];
         lights[1].position = Vec3::new(-5.0, 2.0, -20.0);
         lights[2].radius = 0.5;
         let mut reach = LightReach::default();
@@ -534,7 +523,7 @@ mod tests {
 
     #[test]
     fn buffers_hold_every_light_in_order() {
-        let mut lights = vec![light(None); 4];
+        let mut lights = vec![light(LightShape::Point); 4];
         lights[1].position = Vec3::NAN;
         assert_eq!(buffered_light(&lights[1]).position_radius, [0.0; 4]);
         let held: Vec<u32> = buffered_lights(&lights.into()).map(|(i, _)| i).collect();
@@ -560,7 +549,7 @@ mod tests {
             color: Vec3::ONE,
             intensity: 1.0,
             radius: 1.0,
-            spot: None,
+            shape: LightShape::Point,
             shadow: None,
             animation: None,
         };

@@ -216,7 +216,7 @@ fn add_lights(a: &mut Assembler) {
             color: Vec3::new(1.0, 0.78, 0.5),
             intensity: 80.0,
             radius: 15.0,
-            spot: None,
+            shape: manylight_core::LightShape::Point,
         });
     }
 }

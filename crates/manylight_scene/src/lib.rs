@@ -91,8 +91,8 @@ pub struct SceneLight {
     pub intensity: f32,
     /// Distance at which the light's contribution reaches exactly zero.
     pub radius: f32,
-    /// The cone of a spot light (`None`: a point light).
-    pub spot: Option<manylight_core::SpotCone>,
+    /// Every direction (a point light) or a cone (a spot light).
+    pub shape: manylight_core::LightShape,
 }
 
 /// A light travelling along one direction everywhere (the sun): not clustered, it reaches

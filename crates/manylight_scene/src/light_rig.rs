@@ -24,7 +24,7 @@ pub fn animated_light_at(light: &AnimatedLight, t: f32) -> SceneLight {
         color: light.color_at(t),
         intensity: light.intensity,
         radius: light.radius,
-        spot: None,
+        shape: manylight_core::LightShape::Point,
     }
 }
 
@@ -190,7 +190,7 @@ pub fn sphere_shell_lights(
             color: hsv(rng.f32(), rng.range(0.7, 1.0)),
             intensity: intensity_for_radius(range),
             radius: range,
-            spot: None,
+            shape: manylight_core::LightShape::Point,
         })
         .collect())
 }
@@ -219,7 +219,7 @@ pub fn studio_lights(count: usize, bounds: Aabb) -> Result<Vec<SceneLight>, Ligh
             color: Vec3::ONE,
             intensity,
             radius: 4.0 * rho,
-            spot: None,
+            shape: manylight_core::LightShape::Point,
         })
         .collect())
 }

@@ -79,7 +79,7 @@ fn hierarchy_lights_and_cameras_without_a_scene_list() {
     let spot = s.lights[1];
     assert_eq!(spot.position, Vec3::ZERO);
     assert_eq!(spot.intensity, 10.0);
-    let cone = spot.spot.expect("a spot light");
+    let manylight_core::LightShape::Spot(cone) = spot.shape else { panic!("a spot light: {spot:?}") };
     assert_eq!(cone.direction, Vec3::NEG_Z);
     assert_eq!((cone.inner_angle, cone.outer_angle), (0.0, std::f32::consts::FRAC_PI_4));
     // The directional light hangs from node 0 (no rotation): it shines down -Z.

@@ -163,7 +163,7 @@ pub fn lights() -> Vec<SceneLight> {
         color,
         intensity: 0.3,
         radius: 5.0,
-        spot: None,
+        shape: manylight_core::LightShape::Point,
     };
     vec![
         light(-1.5, 0.5, 1.0, Vec3::new(1.0, 0.8, 0.6)),

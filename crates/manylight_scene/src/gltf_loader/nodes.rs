@@ -10,7 +10,7 @@ use gltf::json::mesh::{Mode, Semantic};
 use gltf::json::validation::Checked;
 use manylight_core::attenuation::RANGELESS_LIGHT_CUTOFF;
 use manylight_core::mesh::TangentMethod;
-use manylight_core::{MeshData, Projection, SpotCone, radius_for_intensity};
+use manylight_core::{LightShape, MeshData, Projection, SpotCone, radius_for_intensity};
 use std::f32::consts::FRAC_PI_2;
 use std::sync::Arc;
 
@@ -524,8 +524,8 @@ impl Ctx<'_> {
             .map_or(&[][..], |k| &k.lights[..]);
         let l = self.lookup(lights, light, &format!("node {node}"), "light")?;
         let bad = |problem: String| SceneError::BadLight { path: self.path.to_owned(), light, problem };
-        let spot = match l.type_ {
-            Checked::Valid(LightType::Point) => None,
+        let shape = match l.type_ {
+            Checked::Valid(LightType::Point) => LightShape::Point,
             Checked::Valid(LightType::Spot) => {
                 let cone = l.spot.as_ref().ok_or_else(|| bad("a spot light needs `spot`".into()))?;
                 let (inner, outer) = (cone.inner_cone_angle, cone.outer_cone_angle);
@@ -543,7 +543,7 @@ impl Ctx<'_> {
                 let direction = world.transform_vector3(Vec3::NEG_Z).try_normalize().ok_or_else(|| {
                     bad(format!("node {node}'s transform collapses the spot light's direction"))
                 })?;
-                Some(SpotCone { direction, inner_angle: inner, outer_angle: outer })
+                LightShape::Spot(SpotCone { direction, inner_angle: inner, outer_angle: outer })
             }
             Checked::Valid(LightType::Directional) => {
                 let color = Vec3::from_array(l.color);
@@ -587,7 +587,7 @@ impl Ctx<'_> {
             color,
             intensity: l.intensity,
             radius,
-            spot,
+            shape,
         });
         Ok(())
     }
