@@ -60,8 +60,7 @@ fn uv_derivatives_give_mikktspace_frames_on_a_quad_and_its_mirror() {
     let positions = [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
     let uvs = [Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, 0.0)];
     let mirrored = uvs.map(|uv| Vec2::new(1.0 - uv.x, uv.y));
-    for (uvs, expected) in
-        [(uvs, Vec4::new(1.0, 0.0, 0.0, -1.0)), (mirrored, Vec4::new(-1.0, 0.0, 0.0, 1.0))]
+    for (uvs, expected) in [(uvs, Vec4::new(1.0, 0.0, 0.0, -1.0)), (mirrored, Vec4::new(-1.0, 0.0, 0.0, 1.0))]
     {
         let mut m = mesh(&positions, &uvs, vec![0, 1, 2, 0, 2, 3]);
         assert_eq!(m.generate_tangents(), TangentMethod::MikkTSpace);
@@ -127,9 +126,7 @@ fn hostile(mut m: MeshData, name: &str) -> MeshData {
 fn a_fan_of_100k_triangles_takes_the_fallback_without_mikktspace() {
     let m = hostile(fan(100_000), "fan");
     // The centre has a frame (+u is +x), and so do the rim vertices.
-    assert!(
-        (Vec4::from(m.vertices[0].tangent) - Vec4::new(1.0, 0.0, 0.0, -1.0)).abs().max_element() < 1e-4
-    );
+    assert!((Vec4::from(m.vertices[0].tangent) - Vec4::new(1.0, 0.0, 0.0, -1.0)).abs().max_element() < 1e-4);
     assert!(m.vertices.iter().all(|v| v.tangent[3] != 0.0));
 }
 
@@ -153,11 +150,7 @@ fn many_corners_at_one_position_with_distinct_uvs_take_the_fallback() {
     for k in 0..n {
         let a = std::f32::consts::TAU * k as f32 / n as f32;
         let b = std::f32::consts::TAU * (k + 1) as f32 / n as f32;
-        positions.extend([
-            Vec3::ZERO,
-            Vec3::new(a.cos(), a.sin(), 0.0),
-            Vec3::new(b.cos(), b.sin(), 0.0),
-        ]);
+        positions.extend([Vec3::ZERO, Vec3::new(a.cos(), a.sin(), 0.0), Vec3::new(b.cos(), b.sin(), 0.0)]);
         uvs.extend([
             Vec2::new(k as f32 / n as f32, 0.0),
             Vec2::new(a.cos(), a.sin()),
