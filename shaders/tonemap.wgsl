@@ -9,14 +9,7 @@
 // into the frame report): a renderer that promises "no NaN" has to count them, not hide them.
 @group(0) @binding(2) var<storage, read_write> nonfinite_pixels: atomic<u32>;
 
-fn aces_fitted(x: vec3<f32>) -> vec3<f32> {
-    let a = 2.51;
-    let b = 0.03;
-    let c = 2.43;
-    let d = 0.59;
-    let e = 0.14;
-    return saturate((x * (a * x + b)) / (x * (c * x + d) + e));
-}
+//!include common/tonemap_curve.wgsl
 
 @fragment
 fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {

@@ -247,15 +247,19 @@ fn hall_with_1024_lights_reaches_ready_on_webgpu() {
     let frame = &stats["last_frame"];
     assert_eq!(frame["pipeline"], "clustered-forward");
     assert_eq!(frame["nonfinite_pixels"], 0, "NaN or infinite pixels: {frame}");
-    let shot = session.screenshot();
-    // The lit hall: many distinct colours and a mean brightness well above black.
+    assert_lit(&session.screenshot(), "web_hall");
+}
+
+/// Panics unless the page's screenshot `shot` shows the lit hall: many distinct colours and a
+/// mean brightness well above black (else writes it to `target/image-tests/NAME.actual.png`).
+fn assert_lit(shot: &RgbaImage, name: &str) {
     let mut colours: Vec<[u8; 3]> = shot.pixels().map(|p| [p[0] >> 3, p[1] >> 3, p[2] >> 3]).collect();
     colours.sort_unstable();
     colours.dedup();
     let mean = shot.pixels().map(|p| u64::from(p[0]) + u64::from(p[1]) + u64::from(p[2])).sum::<u64>() as f64
         / (shot.width() * shot.height() * 3) as f64;
     if colours.len() < 200 || mean < 10.0 {
-        let path = support::output_dir().join("web_hall.actual.png");
+        let path = support::output_dir().join(format!("{name}.actual.png"));
         let _ = shot.save(&path);
         panic!("the canvas looks blank: {} colours, mean {mean:.1} ({})", colours.len(), path.display());
     }
@@ -302,6 +306,62 @@ fn page_matches(name: &str, query: &str, expected: &manylight::app::headless::He
         names(&native["last_frame"]),
         "the page ran other passes than native"
     );
+}
+
+/// With WebGPU disabled (Chromium without `--enable-unsafe-webgpu`: `navigator.gpu` gives no
+/// adapter) the page falls back to WebGL2, through ANGLE on SwiftShader: it reaches `ready`
+/// with the hall's 1,024 rig lights (1,030 with the hall's own), says `webgl2` with no NaN
+/// pixel, and its fixed-clock image of update 3 is within `CROSS_DEVICE` of the native
+/// clustered forward frame. No `present=read-back`: WebGL2 always shows its frames so.
+#[test]
+fn webgl2_fallback_with_1024_lights_matches_native() {
+    let query = "?lights=1024&size=128x128&overlay=off&clock=fixed&capture=3";
+    let options = WebOptions::from_query(query).expect("a valid query");
+    let expected = {
+        let _gpu = support::gpu();
+        manylight::app::headless::render_headless(UVec2::new(128, 128), 3, |app| {
+            manylight_web::demo::add_scene(app, &options, DemoScene::Hall, 1.0);
+        })
+        .expect("the native frame")
+    };
+    let browser = browser();
+    let session = Session::open(&browser, query, false);
+    let took = session.wait_ready();
+    println!("WebGL2: ready after {:.1} s", took.as_secs_f64());
+    let stats = session.wait_for(
+        "const s = manylight.stats(); return s && s.last_frame && s.last_frame.light_count === 1030 ? s : null;",
+        Duration::from_secs(30),
+        "a frame with 1,030 lights",
+    );
+    assert_eq!(stats["backend"], "webgl2", "{stats}");
+    let frame = &stats["last_frame"];
+    assert_eq!(frame["pipeline"], "clustered-forward", "{frame}");
+    assert_eq!(frame["nonfinite_pixels"], 0, "NaN or infinite pixels: {frame}");
+    let url = session.wait_for("return manylight.capture();", Duration::from_secs(60), "the captured image");
+    let data = url.as_str().and_then(|u| u.strip_prefix("data:image/png;base64,")).expect("a PNG data URL");
+    let actual = decode_png(data);
+    let flip = support::assert_similar("web_webgl2_hall", &expected.image, &actual, support::CROSS_DEVICE);
+    println!("web_webgl2_hall: page against native FLIP mean {:.4}, p99 {:.4}", flip.mean, flip.p99);
+}
+
+/// `backend=webgl2` renders with WebGL2 where WebGPU is there too, and the page's canvas
+/// (filling the page; WebGL2 shows its frames through read-back) shows the lit hall.
+#[test]
+fn backend_webgl2_is_chosen_over_webgpu() {
+    let browser = browser();
+    let session = Session::open(&browser, "?backend=webgl2", true);
+    let took = session.wait_ready();
+    println!("backend=webgl2: ready after {:.1} s", took.as_secs_f64());
+    let stats = session.wait_for(
+        "const s = manylight.stats(); return s && s.last_frame && s.last_frame.light_count === 1030 ? s : null;",
+        Duration::from_secs(30),
+        "a frame with 1,030 lights",
+    );
+    assert_eq!(stats["backend"], "webgl2", "{stats}");
+    assert_eq!(stats["last_frame"]["nonfinite_pixels"], 0, "{stats}");
+    // A few frames later, so that one has been read back and shown.
+    std::thread::sleep(Duration::from_secs(2));
+    assert_lit(&session.screenshot(), "web_webgl2_page");
 }
 
 #[test]

@@ -7,26 +7,7 @@
 // The light lists (group 2), bound only by the pipelines whose entry point calls
 // `add_cluster_lights`.
 //!include common/cluster_lists.wgsl
-
-struct ForwardFragment {
-    p: SurfacePoint,
-    m: MaterialSample,
-    view_dir: vec3<f32>,
-    // the radiance so far: ambient (with occlusion), emission and the directional lights
-    color: vec3<f32>,
-};
-
-// Samples the material (discarding below an alpha mask's cutoff) and sums what every light
-// list starts from.
-fn forward_fragment(in: SurfaceVertexOut, front_facing: bool) -> ForwardFragment {
-    let p = surface_point(view, in.clip_position.xy, in.camera_offset);
-    let m = sample_material(in, front_facing);
-    alpha_test(m.base_color);
-    let view_dir = direction_to_eye(view, p.world_position);
-    var color = surface_base_radiance(m.params.albedo, view.params.w, m.occlusion, m.emissive);
-    color += shade_directional_lights(m.params, p.world_position, view_dir);
-    return ForwardFragment(p, m, view_dir, color);
-}
+//!include common/forward_fragment.wgsl
 
 // `f.color` plus every point and spot light, added in order.
 fn add_every_light(f: ForwardFragment) -> vec3<f32> {

@@ -313,6 +313,14 @@ impl GpuContext {
         Self::with_instance(instance, None)
     }
 
+    /// A context on `instance` held to WebGL2's limits ([`GpuContext::request_webgl2`]),
+    /// without a surface. Blocks until the device arrives: native only (tests of the
+    /// texture-list path; an instance of `wgpu::Backends::GL` runs it through naga's GLSL).
+    #[cfg(not(target_arch = "wasm32"))]
+    pub fn webgl2_with_instance(instance: wgpu::Instance) -> Result<GpuContext, RenderError> {
+        pollster::block_on(Self::request_webgl2(instance, None))
+    }
+
     /// Creates a context on `instance` whose adapter can present to `surface` (if given).
     /// Blocks until the device arrives: native only (a browser uses [`GpuContext::request`]).
     #[cfg(not(target_arch = "wasm32"))]
@@ -334,7 +342,6 @@ impl GpuContext {
         surface: Option<&wgpu::Surface<'_>>,
     ) -> Result<GpuContext, RenderError> {
         let adapter = request_adapter(&instance, surface).await?;
-        let info = adapter.get_info();
         let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
         let mut required_features = wgpu::Features::empty();
         if timestamps {
@@ -355,6 +362,34 @@ impl GpuContext {
             required_features |= wgpu::Features::CLIP_DISTANCES;
         }
         let required_limits = required_limits(&adapter.limits());
+        Self::open(instance, adapter, required_features, required_limits).await
+    }
+
+    /// Requests an adapter and a device held to WebGL2's limits
+    /// (`wgpu::Limits::downlevel_webgl2_defaults`, with the adapter's texture sizes) and no
+    /// optional feature: the device of the texture-list path ([`crate::texture_lists`]). In a
+    /// browser `instance` has the GL backend and `surface` is a canvas's (wgpu's WebGL2 backend
+    /// finds its adapter through a surface); natively any adapter is held to those limits, so
+    /// a storage buffer or a compute shader fails wgpu's validation as it would on WebGL2.
+    pub async fn request_webgl2(
+        instance: wgpu::Instance,
+        surface: Option<&wgpu::Surface<'_>>,
+    ) -> Result<GpuContext, RenderError> {
+        let adapter = request_adapter(&instance, surface).await?;
+        let limits = wgpu::Limits::downlevel_webgl2_defaults().using_resolution(adapter.limits());
+        Self::open(instance, adapter, wgpu::Features::empty(), limits).await
+    }
+
+    /// The device and queue of `adapter` with `required_features` and `required_limits`, with
+    /// the error and device-loss callbacks installed.
+    async fn open(
+        instance: wgpu::Instance,
+        adapter: wgpu::Adapter,
+        required_features: wgpu::Features,
+        required_limits: wgpu::Limits,
+    ) -> Result<GpuContext, RenderError> {
+        let info = adapter.get_info();
+        let timestamps = required_features.contains(wgpu::Features::TIMESTAMP_QUERY);
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("manylight"),

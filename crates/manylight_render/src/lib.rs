@@ -34,6 +34,7 @@ pub mod shadow_probe;
 pub mod shadows;
 pub mod snapshot;
 pub mod stats;
+pub mod texture_lists;
 
 pub use context::{GpuContext, GpuCounts, NO_ADAPTER_HELP, RenderError};
 pub use graph::{

@@ -1,10 +1,12 @@
 //! The manylight web demo: the embedded hall lit by a thousand animated lights in a browser
-//! canvas, on WebGPU. `scripts/web.sh` builds it with wasm-bindgen and serves `web/index.html`.
+//! canvas, on WebGPU, or on WebGL2 where the browser has no WebGPU adapter. `scripts/web.sh`
+//! builds it with wasm-bindgen and serves `web/index.html`.
 //!
 //! The page contract (for people and tests):
 //! - URL query parameters ([`options::WebOptions`]): `lights`, `pipeline`, `shadows`,
 //!   `debug-view`, `scene` (`hall` or `sphere-shell`), `size`, `overlay`, `clock`, `capture`,
-//!   `present` (`canvas` or `read-back`).
+//!   `present` (`canvas` or `read-back`), `backend` (`auto`, `webgpu` or `webgl2`: without a
+//!   WebGPU adapter `auto` falls back to WebGL2, [`webgl`]).
 //!   A bad one shows its error on the page.
 //! - The camera: drag to look, W/A/S/D or the arrows to move, Q/E down and up, Shift faster
 //!   ([`controls`]).
@@ -23,3 +25,4 @@ pub mod options;
 pub mod page;
 #[cfg(target_arch = "wasm32")]
 pub mod readback_canvas;
+pub mod webgl;

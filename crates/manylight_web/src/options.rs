@@ -97,6 +97,29 @@ pub enum WebPresent {
     ReadBack,
 }
 
+/// Which GPU API the page renders with (the `backend` parameter).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WebBackend {
+    /// WebGPU when `navigator.gpu` gives an adapter, otherwise WebGL2.
+    Auto,
+    /// WebGPU only: without an adapter the page shows the error.
+    WebGpu,
+    /// WebGL2: clustered forward with CPU-built light lists in textures
+    /// (`manylight::render::texture_lists`), shown through read-back.
+    WebGl2,
+}
+
+impl WebBackend {
+    /// The value the `backend` parameter takes for it.
+    pub fn name(self) -> &'static str {
+        match self {
+            WebBackend::Auto => "auto",
+            WebBackend::WebGpu => "webgpu",
+            WebBackend::WebGl2 => "webgl2",
+        }
+    }
+}
+
 /// What the page renders, from its URL query.
 #[derive(Clone, Debug, PartialEq)]
 pub struct WebOptions {
@@ -118,8 +141,12 @@ pub struct WebOptions {
     pub clock: WebClock,
     /// `capture`: the update whose image is read back (from 1), for `manylight.capture()`.
     pub capture: Option<u64>,
-    /// `present`: `canvas` (default) or `read-back`.
+    /// `present`: `canvas` (default) or `read-back`. WebGL2 always shows its frames through
+    /// read-back.
     pub present: WebPresent,
+    /// `backend`: `auto` (default: WebGPU where the browser gives an adapter, else WebGL2),
+    /// `webgpu` or `webgl2`.
+    pub backend: WebBackend,
 }
 
 impl Default for WebOptions {
@@ -135,6 +162,7 @@ impl Default for WebOptions {
             clock: WebClock::Wall,
             capture: None,
             present: WebPresent::Canvas,
+            backend: WebBackend::Auto,
         }
     }
 }
@@ -167,7 +195,7 @@ pub enum ParamError {
 }
 
 /// The parameters the page takes.
-const KNOWN: [&str; 10] = [
+const KNOWN: [&str; 11] = [
     "lights",
     "pipeline",
     "shadows",
@@ -178,6 +206,7 @@ const KNOWN: [&str; 10] = [
     "clock",
     "capture",
     "present",
+    "backend",
 ];
 
 impl WebOptions {
@@ -237,6 +266,12 @@ impl WebOptions {
                     _ => return Err("expected canvas or read-back".into()),
                 }
             }
+            "backend" => {
+                self.backend = [WebBackend::Auto, WebBackend::WebGpu, WebBackend::WebGl2]
+                    .into_iter()
+                    .find(|b| b.name() == value)
+                    .ok_or("expected auto, webgpu or webgl2")?;
+            }
             "capture" => match value.parse::<u64>() {
                 Ok(n) if n >= 1 => self.capture = Some(n),
                 _ => return Err("expected the number of an update, from 1".into()),
@@ -265,7 +300,7 @@ mod tests {
     #[test]
     fn every_parameter_parses() {
         let o = WebOptions::from_query(
-            "?lights=100000&pipeline=clustered-deferred&shadows=on&debug-view=light-count&scene=sphere-shell&size=128x96&overlay=off&clock=fixed&capture=3&present=read-back",
+            "?lights=100000&pipeline=clustered-deferred&shadows=on&debug-view=light-count&scene=sphere-shell&size=128x96&overlay=off&clock=fixed&capture=3&present=read-back&backend=webgl2",
         )
         .unwrap();
         assert_eq!(o.lights, 100_000);
@@ -278,6 +313,9 @@ mod tests {
         assert_eq!(o.clock, WebClock::Fixed);
         assert_eq!(o.capture, Some(3));
         assert_eq!(o.present, WebPresent::ReadBack);
+        assert_eq!(o.backend, WebBackend::WebGl2);
+        assert_eq!(WebOptions::from_query("backend=webgpu").unwrap().backend, WebBackend::WebGpu);
+        assert_eq!(WebOptions::from_query("backend=auto").unwrap().backend, WebBackend::Auto);
     }
 
     #[test]
@@ -311,6 +349,7 @@ mod tests {
             ("capture=0", "`capture=0`"),
             ("clock=slow", "expected wall or fixed"),
             ("present=screen", "expected canvas or read-back"),
+            ("backend=webgl", "`backend=webgl`: expected auto, webgpu or webgl2"),
             ("debug-view=%FF", "`debug-view=\u{FFFD}`"),
         ];
         for (query, expected) in cases {

@@ -1,24 +1,30 @@
 //! The page side: starts the app in the page's canvas, and answers the page contract.
 //!
 //! 1. `start` (run when the module is initialised) parses the URL query, fetches and loads the
-//!    glTF file the `scene` parameter names (if it names one), builds the app with the
-//!    manylight plugin drawing into `<canvas id="manylight">`, and hands it to the page's event
-//!    loop. The device is requested asynchronously; the app updates once it arrives.
+//!    glTF file the `scene` parameter names (if it names one), picks the backend (WebGPU where
+//!    `navigator.gpu` gives an adapter, otherwise WebGL2, or what `backend` asks for), builds
+//!    the app with the manylight plugin drawing into `<canvas id="manylight">`, and hands it to
+//!    the page's event loop. The device is requested asynchronously; the app updates once it
+//!    arrives. WebGL2 renders with the texture-list path ([`crate::webgl`]) and shows its frames
+//!    through read-back.
 //! 2. Each update, `publish` keeps the last frame's statistics as JSON, sets
 //!    `document.title` to `manylight: ready` after the first frame, and shows a failure.
 //! 3. `stats()`, `error()` and `capture()` are what `window.manylight` calls (`index.html`).
 
 use crate::controls::{FlyInput, fly};
 use crate::demo::{DemoScene, add_scene};
-use crate::options::{AssetPath, WebOptions, WebPresent, WebScene};
+use crate::options::{AssetPath, WebBackend, WebOptions, WebPresent, WebScene};
 use crate::readback_canvas::{DisplaySlot, ReadBackSink};
+use crate::webgl::TextureListSink;
 use base64::Engine;
-use manylight::app::backend::RenderBackend;
+use manylight::app::backend::{FrameSink, RenderBackend};
 use manylight::app::render_world::HeadlessRenderer;
 use manylight::app::window::WindowConfig;
 use manylight::app::{FrameStats, HeadlessCapture, RenderFailure};
 use manylight::prelude::*;
 use manylight::render::GpuContext;
+use manylight::render::texture_lists::TextureListRenderer;
+use manylight::render::wgpu;
 use std::cell::RefCell;
 use std::rc::Rc;
 use wasm_bindgen::JsCast;
@@ -154,21 +160,36 @@ fn run() -> Result<(), String> {
         canvas.set_attribute("class", "fixed").map_err(|e| format!("cannot size the canvas: {e:?}"))?;
     }
     listen_for_input(&canvas)?;
-    match DemoScene::built_in(&options.scene) {
-        Some(scene) => start_app(options, canvas, scene),
-        None => {
-            wasm_bindgen_futures::spawn_local(async move {
-                let loaded = match &options.scene {
-                    WebScene::Gltf(path) => load_asset(path).await,
-                    _ => unreachable!("a built-in scene needs no load"),
-                };
-                let started =
-                    loaded.and_then(|scene| start_app(options, canvas, DemoScene::Loaded(Box::new(scene))));
-                if let Err(message) = started {
-                    fail(&message);
-                }
-            });
-            Ok(())
+    wasm_bindgen_futures::spawn_local(async move {
+        let started = async {
+            let scene = match (DemoScene::built_in(&options.scene), &options.scene) {
+                (Some(scene), _) => scene,
+                (None, WebScene::Gltf(path)) => DemoScene::Loaded(Box::new(load_asset(path).await?)),
+                (None, _) => unreachable!("every scene but a glTF file is built in"),
+            };
+            let webgl2 = uses_webgl2(options.backend).await;
+            start_app(options, canvas, scene, webgl2)
+        };
+        if let Err(message) = started.await {
+            fail(&message);
+        }
+    });
+    Ok(())
+}
+
+/// Whether the page renders with WebGL2: asked for, or (`auto`) the browser's `navigator.gpu`
+/// gives no WebGPU adapter.
+async fn uses_webgl2(backend: WebBackend) -> bool {
+    match backend {
+        WebBackend::WebGl2 => true,
+        WebBackend::WebGpu => false,
+        WebBackend::Auto => {
+            let instance = manylight::render::context::new_instance();
+            let webgpu = instance.request_adapter(&wgpu::RequestAdapterOptions::default()).await.is_ok();
+            if !webgpu {
+                tracing::info!("no WebGPU adapter: rendering with WebGL2");
+            }
+            !webgpu
         }
     }
 }
@@ -220,18 +241,22 @@ async fn fetch_bytes(url: &str, limit: u64) -> Result<Vec<u8>, String> {
     Ok(array.to_vec())
 }
 
-/// Builds the app for `options` showing `scene` in `canvas`, and starts it.
+/// Builds the app for `options` showing `scene` in `canvas` (on WebGL2 when `webgl2`), and
+/// starts it.
 fn start_app(
     options: WebOptions,
     canvas: web_sys::HtmlCanvasElement,
     scene: DemoScene,
+    webgl2: bool,
 ) -> Result<(), String> {
+    // WebGL2 renders offscreen and shows its frames through read-back (no overlay).
+    let present = if webgl2 { WebPresent::ReadBack } else { options.present };
     let (width, height) = match options.size {
         Some(size) => (size.x, size.y),
         None => (canvas.client_width().max(1) as u32, canvas.client_height().max(1) as u32),
     };
     let mut app = App::new();
-    match options.present {
+    match present {
         WebPresent::Canvas => {
             let config = WindowConfig {
                 title: "manylight".into(),
@@ -250,23 +275,24 @@ fn start_app(
     }
     add_scene(&mut app, &options, scene, width as f32 / height as f32);
     app.insert_resource(CaptureAt(options.capture))
-        .insert_resource(Presenting(options.present))
+        .insert_resource(Presenting(present))
         .add_systems(Update, fly_camera)
         .add_systems(First, arm_capture)
         .add_systems(Last, publish.after(ManyLightSystems::Extract));
-    match options.present {
+    match present {
         WebPresent::Canvas => {
             app.run();
         }
-        WebPresent::ReadBack => run_read_back(app, canvas)?,
+        WebPresent::ReadBack => run_read_back(app, canvas, webgl2)?,
     }
     Ok(())
 }
 
 /// Runs `app` (headless plugin) on the page's animation frames, drawing each frame that has
-/// been read back into `canvas` through its 2D context. The device is requested first; the
-/// app updates once it has arrived and only while a read-back slot is free.
-fn run_read_back(mut app: App, canvas: web_sys::HtmlCanvasElement) -> Result<(), String> {
+/// been read back into `canvas` through its 2D context. The device (WebGL2's when `webgl2`)
+/// is requested first; the app updates once it has arrived and only while a read-back slot
+/// is free.
+fn run_read_back(mut app: App, canvas: web_sys::HtmlCanvasElement, webgl2: bool) -> Result<(), String> {
     let context = canvas
         .get_context("2d")
         .ok()
@@ -283,14 +309,20 @@ fn run_read_back(mut app: App, canvas: web_sys::HtmlCanvasElement) -> Result<(),
     {
         let (app, display) = (app.clone(), display.clone());
         wasm_bindgen_futures::spawn_local(async move {
-            let instance = manylight::render::context::new_instance();
-            match GpuContext::request(instance, None).await {
-                Ok(gpu) => {
+            let sink: Result<Box<dyn FrameSink>, String> = if webgl2 {
+                webgl2_sink(display).await
+            } else {
+                let instance = manylight::render::context::new_instance();
+                GpuContext::request(instance, None).await.map_err(|e| e.to_string()).map(|gpu| {
                     let renderer = HeadlessRenderer::with_context(gpu, frames_in_flight);
-                    let sink = ReadBackSink::new(renderer, display);
-                    app.borrow_mut().insert_resource(RenderBackend::start(Box::new(sink), false));
+                    Box::new(ReadBackSink::new(renderer, display)) as Box<dyn FrameSink>
+                })
+            };
+            match sink {
+                Ok(sink) => {
+                    app.borrow_mut().insert_resource(RenderBackend::start(sink, false));
                 }
-                Err(e) => fail(&e.to_string()),
+                Err(message) => fail(&message),
             }
         });
     }
@@ -316,6 +348,28 @@ fn run_read_back(mut app: App, canvas: web_sys::HtmlCanvasElement) -> Result<(),
         request_animation_frame(closure);
     }
     Ok(())
+}
+
+/// The WebGL2 sink: the texture-list renderer on a device of wgpu's GL backend, held to
+/// WebGL2's limits. That backend finds its adapter through a canvas's `webgl2` context; the
+/// page's canvas has the 2D context the frames are shown in, so the GL context gets a canvas
+/// of its own, never shown (the frames are rendered offscreen).
+async fn webgl2_sink(display: DisplaySlot) -> Result<Box<dyn FrameSink>, String> {
+    let document = web_sys::window().and_then(|w| w.document()).ok_or("the window has no document")?;
+    let gl_canvas = document
+        .create_element("canvas")
+        .ok()
+        .and_then(|e| e.dyn_into::<web_sys::HtmlCanvasElement>().ok())
+        .ok_or("cannot create a canvas for WebGL2")?;
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+    desc.backends = wgpu::Backends::GL;
+    let instance = wgpu::Instance::new(desc);
+    let surface = instance
+        .create_surface(wgpu::SurfaceTarget::Canvas(gl_canvas))
+        .map_err(|e| format!("WebGL2 is not available: {e}"))?;
+    let gpu = GpuContext::request_webgl2(instance, Some(&surface)).await.map_err(|e| e.to_string())?;
+    let renderer = TextureListRenderer::new(gpu).map_err(|e| e.to_string())?;
+    Ok(Box::new(TextureListSink::new(renderer, Some(display)).keeping(surface)))
 }
 
 /// The animation-frame callback, which asks for the next frame with itself.

@@ -330,6 +330,34 @@ pub static DEBUG_SHADOW_LOD_GROUP: BindGroupDecl = BindGroupDecl {
 
 // ---- Which pipeline binds what ----
 
+// ---- The WebGL2 path (`texture_lists`) ----
+
+/// Group 0 of `texture_lists.wgsl`: the view uniform (`common/view_binding.wgsl`). The shadow
+/// bindings are declared for the compositions with `SHADOWS` (the directional lights' code
+/// reads them there); the path composes its shader without, as WebGL2 has no storage buffers.
+pub static TEXTURE_LISTS_VIEW_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "texture_lists_view",
+    entries: &[
+        BindingDecl::uniform(0, "view", VERTEX.union(FRAGMENT)),
+        SHADOW_BINDINGS[0].only(Presence::Shadows),
+        SHADOW_BINDINGS[1].only(Presence::Shadows),
+        SHADOW_BINDINGS[2].only(Presence::Shadows),
+        SHADOW_BINDINGS[3].only(Presence::Shadows),
+    ],
+};
+
+/// Group 2 of `texture_lists.wgsl`: the cluster grid, the lights, each cluster's range and the
+/// light indices.
+pub static TEXTURE_LISTS_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "texture_lists",
+    entries: &[
+        BindingDecl::uniform(0, "cluster_params", FRAGMENT),
+        BindingDecl::texture(1, "light_texture", UNFILTERED, FRAGMENT),
+        BindingDecl::texture(2, "cluster_range_texture", wgpu::TextureSampleType::Uint, FRAGMENT),
+        BindingDecl::texture(3, "light_index_texture", wgpu::TextureSampleType::Uint, FRAGMENT),
+    ],
+};
+
 /// Shorthand for a row of [`SHADER_BIND_GROUPS`].
 const fn row(
     shader: &'static str,
@@ -354,6 +382,7 @@ pub static SHADER_BIND_GROUPS: &[ShaderBindGroups] = &[
     row("transparent.wgsl", &["vs_main", "fs_clusters"], &[SCENE, MATERIAL, LISTS]),
     row("depth_prepass.wgsl", &[], &[SCENE, MATERIAL]),
     row("clustered_forward.wgsl", &[], &[SCENE, MATERIAL, LISTS]),
+    row("texture_lists.wgsl", &[], &[&TEXTURE_LISTS_VIEW_GROUP, MATERIAL, &TEXTURE_LISTS_GROUP]),
     row("gbuffer.wgsl", &[], &[SCENE, MATERIAL]),
     row("deferred_lighting.wgsl", &[], &[SCENE, GBUFFER, LISTS]),
     row("tiled_deferred.wgsl", &[], &[SCENE, GBUFFER, LISTS, &TILED_DEFERRED_OUTPUT_GROUP]),
