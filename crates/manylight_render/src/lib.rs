@@ -2,38 +2,70 @@
 //!
 //! It consumes a plain [`FrameSnapshot`] and knows nothing of bevy: tests and benchmarks can
 //! drive it directly. The app crate decides which passes a frame needs.
+//!
+//! The documented API is what this page lists: the types re-exported here (settings, the
+//! snapshot, the frame report, the context) and [`ext`], everything an app needs to add a
+//! pass of its own. The modules behind them are the renderer's internals: public for manylight's
+//! own crates and its benchmark CLI, hidden from these docs, and free to change between
+//! releases.
 #![warn(missing_docs)]
 
 /// The wgpu this crate renders with, for passes an app writes (the same version, no second
 /// dependency to keep in step).
 pub use wgpu;
 
+#[doc(hidden)]
 pub mod animation;
+#[doc(hidden)]
 pub mod assets;
+#[doc(hidden)]
 pub mod atlas;
+#[doc(hidden)]
 pub mod bindings;
+#[doc(hidden)]
 pub mod clusters;
+#[doc(hidden)]
 pub mod context;
 pub mod ext;
+#[doc(hidden)]
 pub mod gpu_types;
+#[doc(hidden)]
 pub mod graph;
+#[doc(hidden)]
 pub mod inflight;
+#[doc(hidden)]
 pub mod layouts;
+#[doc(hidden)]
 pub mod lights;
+#[doc(hidden)]
 pub mod passes;
+#[doc(hidden)]
 pub mod pipelines;
+#[doc(hidden)]
 pub mod plan;
+#[doc(hidden)]
 pub mod planner;
+#[doc(hidden)]
 pub mod pool;
+#[doc(hidden)]
 pub mod readback;
+#[doc(hidden)]
 pub mod renderer;
+#[doc(hidden)]
 pub mod resources;
+#[doc(hidden)]
 pub mod settings;
+#[doc(hidden)]
 pub mod shaders;
+#[doc(hidden)]
 pub mod shadow_probe;
+#[doc(hidden)]
 pub mod shadows;
+#[doc(hidden)]
 pub mod snapshot;
+#[doc(hidden)]
 pub mod stats;
+#[doc(hidden)]
 pub mod texture_lists;
 
 pub use context::{GpuContext, GpuCounts, NO_ADAPTER_HELP, RenderError};
