@@ -59,7 +59,7 @@ fn hall_matches_clustered_forward(name: &str, instance: wgpu::Instance, toleranc
     let actual = render_texture_lists(instance, &query, size, 3);
     let report = actual.stats.last.as_ref().expect("a frame report");
     assert_eq!(report.light_count, 1030, "the hall's 6 lights and the rig's 1,024");
-    assert_eq!(report.pipeline, "clustered-forward");
+    assert_eq!(report.pipeline, manylight::render::PipelineKind::ClusteredForward);
     assert_eq!(report.nonfinite_pixels, Some(0));
     assert_eq!(report.pass_names(), ["cluster_assign", "texture_lists"]);
     let clusters = report.clusters.as_ref().expect("the assignment's statistics");

@@ -166,7 +166,7 @@ pub fn assert_finite(frame: &manylight::app::headless::HeadlessFrame) {
         report.nonfinite_pixels,
         Some(0),
         "{} pipeline: pixels with a NaN or infinite HDR colour",
-        report.pipeline
+        report.pipeline.name()
     );
 }
 

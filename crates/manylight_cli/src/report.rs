@@ -388,7 +388,7 @@ fn csv(rows: &[ReportRow], scene: &str, size: UVec2, adapter: &str) -> Result<St
         let deferred = r.settings.filter(|s| s.pipeline.is_deferred());
         let mut record = crate::bench::configuration_fields(adapter, scene, size, &r.name);
         record.extend([
-            r.report.pipeline.clone(),
+            r.report.pipeline.name().to_string(),
             deferred.map_or(String::new(), |s| s.gbuffer.name().to_string()),
             deferred.map_or(String::new(), |s| s.gbuffer.bytes_per_pixel().to_string()),
             deferred

@@ -474,7 +474,7 @@ impl Renderer {
             frame_index: snapshot.frame_index,
             width: view.size.x,
             height: view.size.y,
-            pipeline: view.settings.pipeline.name().to_string(),
+            pipeline: view.settings.pipeline,
             frame_gpu_ms: None,
             passes: timings,
             light_count: self.scene.light_count - self.scene.invalid_point_lights,

@@ -62,7 +62,7 @@ pub struct FrameReport {
     /// Viewport size.
     pub height: u32,
     /// Pipeline name.
-    pub pipeline: String,
+    pub pipeline: crate::settings::PipelineKind,
     /// Passes that ran, in order.
     pub passes: Vec<PassTiming>,
     /// CPU time of the frame on the render side: uploads, cluster bounds, recording and

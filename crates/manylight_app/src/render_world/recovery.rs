@@ -209,7 +209,7 @@ fn report_without_passes(frame_index: u64, viewport: glam::UVec2, pipeline: Pipe
         frame_index,
         width: viewport.x,
         height: viewport.y,
-        pipeline: pipeline.name().to_string(),
+        pipeline,
         ..Default::default()
     }
 }

@@ -27,6 +27,13 @@ pub enum PipelineKind {
     LightVolumes,
 }
 
+/// Written as its name (`"clustered-forward"`, …), as the CLI takes it.
+impl serde::Serialize for PipelineKind {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.name())
+    }
+}
+
 impl PipelineKind {
     /// Every pipeline, in the order the CLI lists them.
     pub const ALL: [PipelineKind; 6] = [

@@ -182,7 +182,7 @@ impl TextureListRenderer {
             frame_index: snapshot.frame_index,
             width: size.x,
             height: size.y,
-            pipeline: PipelineKind::ClusteredForward.name().to_string(),
+            pipeline: PipelineKind::ClusteredForward,
             invalid_cameras,
             sanitized_cameras: snapshot.sanitized_cameras(),
             frames_in_flight: 1,
