@@ -89,6 +89,7 @@ pub trait PostPass: Send + Sync + 'static {
 /// The bind group every [`PostPass`] declares.
 static POST_PASS_GROUP: BindGroupDecl = BindGroupDecl {
     label: "post_pass",
+    index: 0,
     entries: &[
         BindingDecl::uniform(0, "params", wgpu::ShaderStages::FRAGMENT),
         BindingDecl::texture(1, "source", UNFILTERED, wgpu::ShaderStages::FRAGMENT),

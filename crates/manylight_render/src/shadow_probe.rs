@@ -111,8 +111,8 @@ pub fn probe_shadows(
                 timestamp_writes: None,
             });
             pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &shadow_group, &[]);
-            pass.set_bind_group(1, &group, &[]);
+            pass.set_bind_group(SHADOW_PROBE_SHADOWS_GROUP.index, &shadow_group, &[]);
+            pass.set_bind_group(SHADOW_PROBE_GROUP.index, &group, &[]);
             pass.dispatch_workgroups((part.len() as u32).div_ceil(WORKGROUP), 1, 1);
         }
         gpu.queue.submit([encoder.finish()]);

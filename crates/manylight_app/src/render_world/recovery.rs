@@ -205,11 +205,5 @@ pub fn empty_report(snapshot: &FrameSnapshot) -> FrameReport {
 
 /// The report of frame `frame_index` of `viewport` that ran no pass.
 fn report_without_passes(frame_index: u64, viewport: glam::UVec2, pipeline: PipelineKind) -> FrameReport {
-    FrameReport {
-        frame_index,
-        width: viewport.x,
-        height: viewport.y,
-        pipeline,
-        ..Default::default()
-    }
+    FrameReport { frame_index, width: viewport.x, height: viewport.y, pipeline, ..Default::default() }
 }

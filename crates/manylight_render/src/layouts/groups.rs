@@ -35,6 +35,7 @@ pub const SHADOW_BINDINGS: [BindingDecl; 4] = [
 /// frame whose lights cast shadows, [`SHADOW_BINDINGS`].
 pub static SCENE_GROUP: BindGroupDecl = BindGroupDecl {
     label: "scene",
+    index: 0,
     entries: &[
         BindingDecl::uniform(0, "view", EVERY_STAGE),
         BindingDecl::storage(1, "lights", EVERY_STAGE),
@@ -50,6 +51,7 @@ pub static SCENE_GROUP: BindGroupDecl = BindGroupDecl {
 /// each of its five textures followed by its sampler.
 pub static MATERIAL_GROUP: BindGroupDecl = BindGroupDecl {
     label: "material",
+    index: 1,
     entries: &[
         BindingDecl::uniform(0, "material", FRAGMENT),
         BindingDecl::texture(1, "base_color_texture", FILTERABLE, FRAGMENT),
@@ -72,6 +74,7 @@ pub static MATERIAL_GROUP: BindGroupDecl = BindGroupDecl {
 /// bounds and lists.
 pub static CLUSTER_BUILD_GROUP: BindGroupDecl = BindGroupDecl {
     label: "cluster_build",
+    index: 0,
     entries: &[
         BindingDecl::uniform(0, "params", COMPUTE),
         BindingDecl::storage(1, "bounds", COMPUTE),
@@ -90,6 +93,7 @@ pub static CLUSTER_BUILD_GROUP: BindGroupDecl = BindGroupDecl {
 /// spheres it writes.
 pub static LIGHT_SPHERES_GROUP: BindGroupDecl = BindGroupDecl {
     label: "light_spheres",
+    index: 0,
     entries: &[
         BindingDecl::uniform(0, "params", COMPUTE),
         BindingDecl::storage(1, "lights", COMPUTE),
@@ -102,6 +106,7 @@ pub static LIGHT_SPHERES_GROUP: BindGroupDecl = BindGroupDecl {
 /// the shader again), the lights' motions it reads and the light buffer it writes.
 pub static LIGHT_ANIMATION_GROUP: BindGroupDecl = BindGroupDecl {
     label: "light_animation",
+    index: 0,
     entries: &[
         BindingDecl::storage(0, "params", COMPUTE),
         BindingDecl::storage(1, "motions", COMPUTE),
@@ -113,6 +118,7 @@ pub static LIGHT_ANIMATION_GROUP: BindGroupDecl = BindGroupDecl {
 /// `tiled_deferred.wgsl`): the parameters, each cluster's range and the light indices.
 pub static CLUSTER_LISTS_GROUP: BindGroupDecl = BindGroupDecl {
     label: "cluster_lists",
+    index: 2,
     entries: &[
         BindingDecl::uniform(0, "cluster_params", SHADING),
         BindingDecl::storage(1, "cluster_ranges", SHADING),
@@ -124,6 +130,7 @@ pub static CLUSTER_LISTS_GROUP: BindGroupDecl = BindGroupDecl {
 /// ranges buffer, whose per-cluster depth ranges it writes after the cluster ranges.
 pub static CLUSTER_DEPTH_GROUP: BindGroupDecl = BindGroupDecl {
     label: "cluster_depth",
+    index: 2,
     entries: &[
         BindingDecl::storage(0, "cluster_params", COMPUTE),
         BindingDecl::storage_rw(1, "cluster_depths", COMPUTE),
@@ -134,6 +141,7 @@ pub static CLUSTER_DEPTH_GROUP: BindGroupDecl = BindGroupDecl {
 /// spheres, and the ranges and index buffers, whose refined part it writes.
 pub static LIGHT_REFINE_GROUP: BindGroupDecl = BindGroupDecl {
     label: "light_refine",
+    index: 2,
     entries: &[
         BindingDecl::storage(0, "cluster_params", COMPUTE),
         BindingDecl::storage(1, "spheres", COMPUTE),
@@ -170,6 +178,7 @@ pub const GB_EMISSIVE: BindingDecl = BindingDecl::texture(8, "gb_emissive", UNFI
 /// order), then depth and the view's clear colour.
 pub static GBUFFER_READ_GROUP: BindGroupDecl = BindGroupDecl {
     label: "gbuffer_read",
+    index: 1,
     entries: &[
         GB_POSITION,
         GB_NORMAL,
@@ -187,6 +196,7 @@ pub static GBUFFER_READ_GROUP: BindGroupDecl = BindGroupDecl {
 /// (`cs_forward` of `cluster_depth.wgsl` and `light_refine.wgsl`).
 pub static SHADING_DISTANCE_GROUP: BindGroupDecl = BindGroupDecl {
     label: "shading_distance",
+    index: 1,
     entries: &[BindingDecl::texture(9, "shading_distance", UNFILTERED, COMPUTE)],
 };
 
@@ -194,6 +204,7 @@ pub static SHADING_DISTANCE_GROUP: BindGroupDecl = BindGroupDecl {
 /// (`resources::HDR_FORMAT`, checked by `tests/shaders.rs`).
 pub static TILED_DEFERRED_OUTPUT_GROUP: BindGroupDecl = BindGroupDecl {
     label: "tiled_deferred_output",
+    index: 3,
     entries: &[BindingDecl::new(
         0,
         "hdr_out",
@@ -206,6 +217,7 @@ pub static TILED_DEFERRED_OUTPUT_GROUP: BindGroupDecl = BindGroupDecl {
 /// sum of the lights.
 pub static LIGHT_ACCUM_GROUP: BindGroupDecl = BindGroupDecl {
     label: "light_accum",
+    index: 2,
     entries: &[BindingDecl::texture(0, "light_accum", UNFILTERED, FRAGMENT)],
 };
 
@@ -215,6 +227,7 @@ pub static LIGHT_ACCUM_GROUP: BindGroupDecl = BindGroupDecl {
 /// instance's faces) and the instances.
 pub static SHADOW_MAPS_GROUP: BindGroupDecl = BindGroupDecl {
     label: "shadow_maps",
+    index: 0,
     entries: &[
         BindingDecl::storage(0, "shadow_faces", VERTEX),
         BindingDecl::storage(1, "shadow_draws", VERTEX),
@@ -225,11 +238,12 @@ pub static SHADOW_MAPS_GROUP: BindGroupDecl = BindGroupDecl {
 /// Group 0 of the shadow probe (`shaders/shadow_probe.wgsl`): [`SHADOW_BINDINGS`], as
 /// `common/shadows.wgsl` declares them.
 pub static SHADOW_PROBE_SHADOWS_GROUP: BindGroupDecl =
-    BindGroupDecl { label: "shadow_probe_shadows", entries: &SHADOW_BINDINGS };
+    BindGroupDecl { label: "shadow_probe_shadows", index: 0, entries: &SHADOW_BINDINGS };
 
 /// Group 1 of the shadow probe: the frame's lights, the probes and what it writes for each.
 pub static SHADOW_PROBE_GROUP: BindGroupDecl = BindGroupDecl {
     label: "shadow_probe",
+    index: 1,
     entries: &[
         BindingDecl::storage(0, "lights", COMPUTE),
         BindingDecl::storage(1, "probes", COMPUTE),
@@ -243,6 +257,7 @@ pub static SHADOW_PROBE_GROUP: BindGroupDecl = BindGroupDecl {
 /// image and the counter of non-finite pixels.
 pub static TONEMAP_GROUP: BindGroupDecl = BindGroupDecl {
     label: "tonemap",
+    index: 0,
     entries: &[
         BindingDecl::uniform(0, "view", FRAGMENT),
         BindingDecl::texture(1, "hdr", UNFILTERED, FRAGMENT),
@@ -254,6 +269,7 @@ pub static TONEMAP_GROUP: BindGroupDecl = BindGroupDecl {
 /// the level it reads.
 pub static BLOOM_GROUP: BindGroupDecl = BindGroupDecl {
     label: "bloom",
+    index: 0,
     entries: &[
         BindingDecl::uniform(0, "params", FRAGMENT),
         BindingDecl::new(1, "linear_sampler", FILTERING, FRAGMENT),
@@ -265,6 +281,7 @@ pub static BLOOM_GROUP: BindGroupDecl = BindGroupDecl {
 /// frame's matrices), the blur's parameters, the HDR image and depth.
 pub static MOTION_BLUR_GROUP: BindGroupDecl = BindGroupDecl {
     label: "motion_blur",
+    index: 0,
     entries: &[
         BindingDecl::uniform(0, "view", FRAGMENT),
         BindingDecl::uniform(1, "params", FRAGMENT),
@@ -281,6 +298,7 @@ const DEBUG_PARAMS: BindingDecl = BindingDecl::uniform(4, "debug", FRAGMENT);
 /// parameters, then the cluster parameters and ranges.
 pub static DEBUG_CLUSTERS_GROUP: BindGroupDecl = BindGroupDecl {
     label: "debug_view_clusters",
+    index: 0,
     entries: &[
         DEBUG_VIEW,
         DEBUG_DEPTH,
@@ -291,10 +309,11 @@ pub static DEBUG_CLUSTERS_GROUP: BindGroupDecl = BindGroupDecl {
 };
 /// The bind group of the depth debug view: view, depth and parameters.
 pub static DEBUG_DEPTH_GROUP: BindGroupDecl =
-    BindGroupDecl { label: "debug_view_depth", entries: &[DEBUG_VIEW, DEBUG_DEPTH, DEBUG_PARAMS] };
+    BindGroupDecl { label: "debug_view_depth", index: 0, entries: &[DEBUG_VIEW, DEBUG_DEPTH, DEBUG_PARAMS] };
 /// The bind group of the surface debug views: view, depth, parameters, then the Full G-buffer.
 pub static DEBUG_SURFACE_GROUP: BindGroupDecl = BindGroupDecl {
     label: "debug_view_surface",
+    index: 0,
     entries: &[
         DEBUG_VIEW,
         DEBUG_DEPTH,
@@ -308,6 +327,7 @@ pub static DEBUG_SURFACE_GROUP: BindGroupDecl = BindGroupDecl {
 /// The bind group of the shadow-atlas debug view: view, depth, parameters, then the atlas.
 pub static DEBUG_SHADOW_ATLAS_GROUP: BindGroupDecl = BindGroupDecl {
     label: "debug_view_shadow_atlas",
+    index: 0,
     entries: &[
         DEBUG_VIEW,
         DEBUG_DEPTH,
@@ -319,6 +339,7 @@ pub static DEBUG_SHADOW_ATLAS_GROUP: BindGroupDecl = BindGroupDecl {
 /// their shadow table.
 pub static DEBUG_SHADOW_LOD_GROUP: BindGroupDecl = BindGroupDecl {
     label: "debug_view_shadow_lod",
+    index: 0,
     entries: &[
         DEBUG_VIEW,
         DEBUG_DEPTH,
@@ -337,6 +358,7 @@ pub static DEBUG_SHADOW_LOD_GROUP: BindGroupDecl = BindGroupDecl {
 /// reads them there); the path composes its shader without, as WebGL2 has no storage buffers.
 pub static TEXTURE_LISTS_VIEW_GROUP: BindGroupDecl = BindGroupDecl {
     label: "texture_lists_view",
+    index: 0,
     entries: &[
         BindingDecl::uniform(0, "view", VERTEX.union(FRAGMENT)),
         SHADOW_BINDINGS[0].only(Presence::Shadows),
@@ -350,6 +372,7 @@ pub static TEXTURE_LISTS_VIEW_GROUP: BindGroupDecl = BindGroupDecl {
 /// light indices.
 pub static TEXTURE_LISTS_GROUP: BindGroupDecl = BindGroupDecl {
     label: "texture_lists",
+    index: 2,
     entries: &[
         BindingDecl::uniform(0, "cluster_params", FRAGMENT),
         BindingDecl::texture(1, "light_texture", UNFILTERED, FRAGMENT),
@@ -406,3 +429,21 @@ pub static SHADER_BIND_GROUPS: &[ShaderBindGroups] = &[
     row("debug_view.wgsl", &["fs_shadow_atlas"], &[&DEBUG_SHADOW_ATLAS_GROUP]),
     row("debug_view.wgsl", &["fs_shadow_lod"], &[&DEBUG_SHADOW_LOD_GROUP]),
 ];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_declaration_sits_at_its_own_index_in_every_pipeline() {
+        for row in SHADER_BIND_GROUPS {
+            for (at, group) in row.groups.iter().enumerate() {
+                assert_eq!(
+                    group.index, at as u32,
+                    "`{}` {:?}: group `{}` is bound at {at}, declared at {}",
+                    row.shader, row.entry_points, group.label, group.index
+                );
+            }
+        }
+    }
+}

@@ -161,6 +161,10 @@ pub const UNFILTERED: wgpu::TextureSampleType = wgpu::TextureSampleType::Float {
 pub struct BindGroupDecl {
     /// The label of its layout and groups; unique among the declarations.
     pub label: &'static str,
+    /// Its group number (`@group(index)` in the WGSL): the same in every pipeline that binds
+    /// it (checked against [`SHADER_BIND_GROUPS`]), so passes bind it with
+    /// `set_bind_group(DECL.index, …)`, never a bare number.
+    pub index: u32,
     /// Its bindings.
     pub entries: &'static [BindingDecl],
 }

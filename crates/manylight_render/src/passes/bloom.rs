@@ -218,7 +218,7 @@ fn draw(
         multiview_mask: None,
     });
     pass.set_pipeline(&pipeline.pipeline);
-    pass.set_bind_group(0, &bind_group, &[]);
+    pass.set_bind_group(BLOOM_GROUP.index, &bind_group, &[]);
     pass.draw(0..3, 0..1);
     Ok(())
 }

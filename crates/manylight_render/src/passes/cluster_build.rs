@@ -177,10 +177,14 @@ impl Pass for ClusterBuildPass {
                 timestamp_writes: timestamps,
             });
             // The lights' view-space spheres first, then the build over them.
-            pass.set_bind_group(0, &spheres_group, &[]);
+            pass.set_bind_group(crate::layouts::LIGHT_SPHERES_GROUP.index, &spheres_group, &[]);
             pass.set_pipeline(&pipelines.light_spheres);
             pass.dispatch_workgroups(light_groups[0], light_groups[1], 1);
-            pass.set_bind_group(0, &clusters.bindings.build_group, &[]);
+            pass.set_bind_group(
+                crate::layouts::CLUSTER_BUILD_GROUP.index,
+                &clusters.bindings.build_group,
+                &[],
+            );
             // The steps of the build (shaders/cluster_build.wgsl), in order; the scans run as
             // one workgroup.
             // Levels 0 and 1 per (coarse) tile, or from the lights' side where their bits fit.

@@ -83,9 +83,9 @@ impl Pass for ClusterDepthPass {
             timestamp_writes: timestamps,
         });
         pass.set_pipeline(&pipeline.pipeline);
-        pass.set_bind_group(0, &scene.view_bind_group, &[]);
-        pass.set_bind_group(1, &source, &[]);
-        pass.set_bind_group(2, &depths, &[]);
+        pass.set_bind_group(crate::layouts::SCENE_GROUP.index, &scene.view_bind_group, &[]);
+        pass.set_bind_group(pipeline.source_layout.decl().index, &source, &[]);
+        pass.set_bind_group(clusters.bindings.depth_layout.decl().index, &depths, &[]);
         pass.dispatch_workgroups(groups[0], groups[1], 1);
         Ok(())
     }

@@ -58,7 +58,7 @@ impl Pass for LightAnimationPass {
             timestamp_writes: timestamps,
         });
         pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, group, &[]);
+        pass.set_bind_group(crate::layouts::LIGHT_ANIMATION_GROUP.index, group, &[]);
         pass.dispatch_workgroups(x, y, 1);
         Ok(())
     }

@@ -90,9 +90,9 @@ impl Pass for LightRefinePass {
             timestamp_writes: timestamps,
         });
         pass.set_pipeline(&pipeline.pipeline);
-        pass.set_bind_group(0, &scene.view_bind_group, &[]);
-        pass.set_bind_group(1, &source, &[]);
-        pass.set_bind_group(2, &lists, &[]);
+        pass.set_bind_group(crate::layouts::SCENE_GROUP.index, &scene.view_bind_group, &[]);
+        pass.set_bind_group(pipeline.source_layout.decl().index, &source, &[]);
+        pass.set_bind_group(clusters.bindings.refine_layout.decl().index, &lists, &[]);
         pass.dispatch_workgroups(groups[0], groups[1], 1);
         Ok(())
     }

@@ -296,8 +296,8 @@ impl Pass for LightVolumesPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_bind_group(0, &scene.view_bind_group, &[]);
-        pass.set_bind_group(1, &gbuffer, &[]);
+        pass.set_bind_group(crate::layouts::SCENE_GROUP.index, &scene.view_bind_group, &[]);
+        pass.set_bind_group(crate::layouts::GBUFFER_READ_GROUP.index, &gbuffer, &[]);
         pass.set_pipeline(&pipeline.ambient);
         pass.draw(0..3, 0..1);
         if scene.light_count > 0 {

@@ -79,9 +79,10 @@ pub fn record_scene_pass<P: ScenePipeline>(
         occlusion_query_set: None,
         multiview_mask: None,
     });
-    pass.set_bind_group(0, &scene.view_bind_group, &[]);
+    pass.set_bind_group(crate::layouts::SCENE_GROUP.index, &scene.view_bind_group, &[]);
+    // The pass's own groups follow the material's.
     for (i, group) in extra.iter().enumerate() {
-        pass.set_bind_group(2 + i as u32, *group, &[]);
+        pass.set_bind_group(crate::layouts::MATERIAL_GROUP.index + 1 + i as u32, *group, &[]);
     }
     draw_scene(&mut pass, scene, pipelines, !clear_depth);
 }
@@ -128,7 +129,7 @@ pub fn draw_in_order<'d, P: ScenePipeline>(
             bound_variant = Some(d.variant);
         }
         if d.material != bound_material {
-            pass.set_bind_group(1, &material.bind_group, &[]);
+            pass.set_bind_group(crate::layouts::MATERIAL_GROUP.index, &material.bind_group, &[]);
             bound_material = d.material;
         }
         if d.mesh != bound_mesh {

@@ -157,7 +157,7 @@ impl Pass for ShadowMapsPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_bind_group(0, &bind_group, &[]);
+        pass.set_bind_group(SHADOW_MAPS_GROUP.index, &bind_group, &[]);
         if shadows.clears_tiles {
             pass.set_pipeline(&pipeline.clear);
             pass.draw(0..6, 0..shadows.faces_drawn);

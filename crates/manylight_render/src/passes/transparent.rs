@@ -118,9 +118,9 @@ impl Pass for TransparentPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_bind_group(0, &scene.view_bind_group, &[]);
+        pass.set_bind_group(crate::layouts::SCENE_GROUP.index, &scene.view_bind_group, &[]);
         if let Some(c) = clusters {
-            pass.set_bind_group(2, &c.bindings.lists_group, &[]);
+            pass.set_bind_group(crate::layouts::CLUSTER_LISTS_GROUP.index, &c.bindings.lists_group, &[]);
         }
         draw_in_order(&mut pass, scene, &pipelines, scene.blended.iter().map(|&i| &scene.draws[i]));
         Ok(())

@@ -312,8 +312,8 @@ impl TextureListRenderer {
                 multiview_mask: None,
             });
             if camera.is_some() {
-                pass.set_bind_group(0, &self.view_group, &[]);
-                pass.set_bind_group(2, &self.lists_group, &[]);
+                pass.set_bind_group(TEXTURE_LISTS_VIEW_GROUP.index, &self.view_group, &[]);
+                pass.set_bind_group(TEXTURE_LISTS_GROUP.index, &self.lists_group, &[]);
                 let stride = std::mem::size_of::<GpuInstance>() as u64;
                 for (i, d) in draws.iter().enumerate() {
                     let (Some(mesh), Some(material), Some(pipeline)) = (
@@ -324,7 +324,7 @@ impl TextureListRenderer {
                         continue;
                     };
                     pass.set_pipeline(pipeline);
-                    pass.set_bind_group(1, &material.bind_group, &[]);
+                    pass.set_bind_group(crate::layouts::MATERIAL_GROUP.index, &material.bind_group, &[]);
                     pass.set_vertex_buffer(0, mesh.vertices.slice(..));
                     pass.set_vertex_buffer(
                         1,
