@@ -147,6 +147,7 @@ pub(crate) struct ViewsArgs {
     pub(crate) clusters: ClusterArgs,
 }
 
+// One field a flag of `manylight bench` (over 15): clap derives the command line from it.
 #[derive(clap::Args)]
 pub(crate) struct BenchArgs {
     /// `default`, `sphere-shell` or a .gltf/.glb path.
@@ -212,6 +213,8 @@ pub(crate) struct BenchArgs {
     pub(crate) plot: Option<PathBuf>,
 }
 
+// One field a flag of `manylight render` (over 15; the cluster and shadow flags are groups of
+// their own): clap derives the command line from it.
 #[derive(clap::Args)]
 pub(crate) struct RenderArgs {
     /// `default` (embedded hall), `sphere-shell`, or a path to a .gltf/.glb file.

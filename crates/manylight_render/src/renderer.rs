@@ -156,7 +156,7 @@ impl Renderer {
             let gpu = &self.gpu;
             let clusters = self.clusters[view.index].get_or_insert_with(|| ClusterResources::new(gpu));
             let view_from_world = view.camera.map(|c| c.view_from_world()).unwrap_or_default();
-            let lights = (self.scene.light_count, &self.scene.light_reach);
+            let lights = (self.scene.lights.count, &self.scene.lights.reach);
             match &self.pixel_light_lists {
                 Some(lists) => clusters.prepare_pixel_lists(gpu, view, &view_from_world, lights, lists)?,
                 None => clusters.prepare(gpu, view, &view_from_world, lights, options)?,
@@ -188,8 +188,8 @@ impl Renderer {
         &self,
         probes: &[crate::shadow_probe::ShadowProbe],
     ) -> Result<Vec<f32>, RenderError> {
-        let lights = self.scene.lights.buffer();
-        crate::shadow_probe::probe_shadows(&self.gpu, &self.shadows, lights, self.scene.light_count, probes)
+        let lights = self.scene.lights.buffer.buffer();
+        crate::shadow_probe::probe_shadows(&self.gpu, &self.shadows, lights, self.scene.lights.count, probes)
     }
 
     /// The transient pool (tests read its allocation counts).
@@ -221,13 +221,13 @@ impl Renderer {
         let builds_clusters = has(crate::graph::is::<crate::passes::cluster_build::ClusterBuildPass>);
         let loop_limited = crate::gpu_types::has_loop_limit(&self.gpu.info);
         // Naive forward loops over every light, four per iteration.
-        let naive_iterations = u64::from(self.scene.light_count).div_ceil(4);
+        let naive_iterations = u64::from(self.scene.lights.count).div_ceil(4);
         if loop_limited
             && has(crate::graph::is::<crate::passes::forward::ForwardPass>)
             && naive_iterations > u64::from(LAVAPIPE_LOOP_LIMIT)
         {
             return Err(RenderError::LoopLimit {
-                what: format!("naive forward's loop over {} lights", self.scene.light_count),
+                what: format!("naive forward's loop over {} lights", self.scene.lights.count),
                 iterations: naive_iterations,
                 limit: LAVAPIPE_LOOP_LIMIT,
             });
@@ -354,7 +354,7 @@ impl Renderer {
         // The frame's first encoder animates the lights first, before any pass reads them.
         let animation = crate::passes::light_animation::LightAnimationPass;
         let mut with_animation = Vec::new();
-        let passes = if self.scene.motions.pending() {
+        let passes = if self.scene.lights.motions.pending() {
             with_animation.push(&animation as &dyn Pass);
             with_animation.extend_from_slice(passes);
             &with_animation[..]
@@ -362,7 +362,7 @@ impl Renderer {
             passes
         };
         let timings = self.record_passes(passes, &mut encoder, view.index, &textures, output_format)?;
-        self.scene.motions.recorded();
+        self.scene.lights.motions.recorded();
         // The view's counters go to the frame's read-back slot, after the passes wrote them.
         let clusters = self.clusters.get(view.index).and_then(Option::as_ref);
         let tonemapped = passes.iter().any(|p| crate::graph::is::<crate::passes::tonemap::TonemapPass>(*p));
@@ -477,16 +477,16 @@ impl Renderer {
             pipeline: view.settings.pipeline,
             frame_gpu_ms: None,
             passes: timings,
-            light_count: self.scene.light_count - self.scene.invalid_point_lights,
-            invalid_lights: self.scene.invalid_lights,
-            directional_lights: self.scene.directional_count,
-            dropped_directional_lights: self.scene.dropped_directional_lights,
+            light_count: self.scene.lights.count - self.scene.lights.invalid_point_lights,
+            invalid_lights: self.scene.lights.invalid_lights,
+            directional_lights: self.scene.lights.directional_count,
+            dropped_directional_lights: self.scene.lights.dropped_directional_lights,
             invalid_cameras: 0,
             sanitized_cameras: 0,
             nonfinite_pixels: None,
-            instance_count: self.scene.draws.len() as u32,
-            invalid_instances: self.scene.invalid_instances,
-            collapsed_instances: self.scene.collapsed_instances,
+            instance_count: self.scene.instances.draws.len() as u32,
+            invalid_instances: self.scene.instances.invalid_instances,
+            collapsed_instances: self.scene.instances.collapsed_instances,
             transient_textures: self.pool.live() as u32,
             transient_bytes: self.pool.frame_bytes(),
             transient_allocations: self.pool.allocations(),

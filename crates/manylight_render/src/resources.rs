@@ -191,38 +191,53 @@ impl ChunkSummary {
 /// A group 0 and the generations of the buffers (lights, instances, shadows) it was made from.
 type BoundView = ((u64, u64, u64), wgpu::BindGroup);
 
-/// Scene data on the GPU for the current frame.
+/// Scene data on the GPU for the current frame: group 0 and the view constants
+/// ([`ViewBindings`]), the lights ([`SceneLights`]), the instances and their draws
+/// ([`SceneInstances`]), the meshes and materials ([`SceneAssets`]) and the tone map's
+/// non-finite counter.
 pub struct SceneResources {
-    /// Layout of group 0 this frame ([`SCENE_GROUP`]): view uniform, lights, instances, and the
-    /// shadow bindings when [`SceneResources::shadows_active`].
-    pub view_layout: GroupLayout,
+    /// Group 0 of the scene passes and the view uniform.
+    pub view: ViewBindings,
+    /// The point, spot and directional lights as the shaders read them.
+    pub lights: SceneLights,
+    /// The instances and the frame's draws.
+    pub instances: SceneInstances,
+    /// The tone map's count of non-finite HDR pixels.
+    pub nonfinite: NonFiniteCounter,
+    /// Meshes, materials, textures and samplers on the GPU, and the material layout.
+    pub assets: SceneAssets,
+}
+
+/// Group 0 of every scene pass ([`SCENE_GROUP`]) and the view constants it holds.
+pub struct ViewBindings {
+    /// Layout of group 0 this frame: view uniform, lights, instances, and the shadow bindings
+    /// when [`ViewBindings::shadows_active`].
+    pub layout: GroupLayout,
     /// Group 0's layout without shadows.
-    plain_view_layout: GroupLayout,
+    plain_layout: GroupLayout,
     /// Group 0's layout with shadows.
-    shadowed_view_layout: GroupLayout,
+    shadowed_layout: GroupLayout,
     /// This frame's lights cast shadows: group 0 holds the shadow bindings and every shading
     /// pipeline is composed with `SHADOWS`.
     pub shadows_active: bool,
     /// Group 0 for this frame.
-    pub view_bind_group: wgpu::BindGroup,
+    pub bind_group: wgpu::BindGroup,
     /// The view uniform buffer.
-    pub view_buffer: wgpu::Buffer,
-    /// Point lights (storage; at least one element).
-    pub lights: GrowableBuffer,
-    /// Instance transforms (storage).
-    pub instances: GrowableBuffer,
-    /// Draws sorted by material then mesh.
-    pub draws: Vec<Draw>,
-    /// The distinct variants of this frame's draws, in first-drawn order: the pipelines each
-    /// mesh pass needs.
-    pub variants: Vec<SurfaceVariant>,
-    /// The blended draws (indices into `draws`) of the current view, farthest first.
-    pub blended: Vec<usize>,
+    pub buffer: wgpu::Buffer,
     /// The frame's view constants as uploaded.
-    pub view: ViewUniform,
+    pub uniform: ViewUniform,
+    /// Group 0 without (0) and with (1) the shadow bindings.
+    bound: [Option<BoundView>; 2],
+}
+
+/// The frame's lights on the GPU: the point and spot lights' buffer (written only where lights
+/// changed), the directional lights the view uniform carries, and what the frame counted.
+pub struct SceneLights {
+    /// Point lights (storage; at least one element).
+    pub buffer: GrowableBuffer,
     /// Point and spot lights in the light buffer this frame (invalid ones included: they keep
     /// their index and light nothing).
-    pub light_count: u32,
+    pub count: u32,
     /// The invalid ones among them.
     pub invalid_point_lights: u32,
     /// This frame's directional lights as every view's uniform carries them.
@@ -233,17 +248,12 @@ pub struct SceneResources {
     pub dropped_directional_lights: u32,
     /// Bytes written to the light buffer this frame (once per frame, whatever the views; only
     /// the lights that changed).
-    pub light_upload_bytes: u64,
+    pub upload_bytes: u64,
     /// Lights dropped for invalid parameters this frame.
     pub invalid_lights: u32,
-    /// Instances not drawn this frame because their transform is not finite.
-    pub invalid_instances: u32,
-    /// Instances not drawn this frame because their transform collapses the mesh to a line or
-    /// a point (a zero scale on two or three axes, on the mesh or a parent): they cover no pixel.
-    pub collapsed_instances: u32,
     /// The box around what the uploaded lights can reach (the cluster grids slice a projection
     /// without a far plane to it).
-    pub light_reach: LightReach,
+    pub reach: LightReach,
     /// The chunks of lights the light buffer holds: a frame packs and writes only the lights
     /// of chunks that are not these, and of those only the lights that differ.
     uploaded_chunks: Vec<Arc<LightChunk>>,
@@ -253,18 +263,30 @@ pub struct SceneResources {
     /// One run of changed lights, packed (kept between frames so that it is not allocated
     /// again).
     packed: Vec<GpuPointLight>,
-    /// This frame's instances as packed, and the ones the instance buffer held before (what a
-    /// frame compares with to write only the instances that changed).
-    instance_data: Vec<GpuInstance>,
-    uploaded_instances: Vec<GpuInstance>,
     /// The motions of the lights that animate on the GPU, and the pass that applies them.
     pub motions: crate::animation::LightMotions,
-    /// The tone map's count of non-finite HDR pixels.
-    pub nonfinite: NonFiniteCounter,
-    /// Meshes, materials, textures and samplers on the GPU, and the material layout.
-    pub assets: SceneAssets,
-    /// Group 0 without (0) and with (1) the shadow bindings.
-    bound: [Option<BoundView>; 2],
+}
+
+/// The frame's instances on the GPU and the draws made of them.
+pub struct SceneInstances {
+    /// Instance transforms (storage).
+    pub buffer: GrowableBuffer,
+    /// Draws sorted by material then mesh.
+    pub draws: Vec<Draw>,
+    /// The distinct variants of this frame's draws, in first-drawn order: the pipelines each
+    /// mesh pass needs.
+    pub variants: Vec<SurfaceVariant>,
+    /// The blended draws (indices into `draws`) of the current view, farthest first.
+    pub blended: Vec<usize>,
+    /// This frame's instances as packed, and the ones the instance buffer held before (what a
+    /// frame compares with to write only the instances that changed).
+    packed: Vec<GpuInstance>,
+    uploaded: Vec<GpuInstance>,
+    /// Instances not drawn this frame because their transform is not finite.
+    pub invalid_instances: u32,
+    /// Instances not drawn this frame because their transform collapses the mesh to a line or
+    /// a point (a zero scale on two or three axes, on the mesh or a parent): they cover no pixel.
+    pub collapsed_instances: u32,
 }
 
 /// A GPU counter of pixels whose HDR colour is NaN or infinite, written by the tone map and
@@ -310,37 +332,43 @@ impl SceneResources {
         let view_bind_group =
             Self::make_view_bind_group(gpu, &view_layout, &view_buffer, &lights, &instances, None);
         SceneResources {
-            plain_view_layout: view_layout.clone(),
-            view_layout,
-            shadowed_view_layout,
-            shadows_active: false,
-            view_bind_group,
-            view_buffer,
-            lights,
-            instances,
-            draws: Vec::new(),
-            variants: Vec::new(),
-            blended: Vec::new(),
-            view: ViewUniform::zeroed_default(),
-            light_count: 0,
-            directional: [GpuDirectionalLight::default(); MAX_DIRECTIONAL_LIGHTS as usize],
-            directional_count: 0,
-            dropped_directional_lights: 0,
-            light_upload_bytes: 0,
-            invalid_lights: 0,
-            invalid_instances: 0,
-            collapsed_instances: 0,
-            light_reach: LightReach::default(),
-            invalid_point_lights: 0,
-            uploaded_chunks: Vec::new(),
-            chunk_summaries: Vec::new(),
-            packed: Vec::new(),
-            instance_data: Vec::new(),
-            uploaded_instances: Vec::new(),
-            motions: Default::default(),
+            view: ViewBindings {
+                plain_layout: view_layout.clone(),
+                layout: view_layout,
+                shadowed_layout: shadowed_view_layout,
+                shadows_active: false,
+                bind_group: view_bind_group,
+                buffer: view_buffer,
+                uniform: ViewUniform::zeroed_default(),
+                bound: [None, None],
+            },
+            lights: SceneLights {
+                buffer: lights,
+                count: 0,
+                invalid_point_lights: 0,
+                directional: [GpuDirectionalLight::default(); MAX_DIRECTIONAL_LIGHTS as usize],
+                directional_count: 0,
+                dropped_directional_lights: 0,
+                upload_bytes: 0,
+                invalid_lights: 0,
+                reach: LightReach::default(),
+                uploaded_chunks: Vec::new(),
+                chunk_summaries: Vec::new(),
+                packed: Vec::new(),
+                motions: Default::default(),
+            },
+            instances: SceneInstances {
+                buffer: instances,
+                draws: Vec::new(),
+                variants: Vec::new(),
+                blended: Vec::new(),
+                packed: Vec::new(),
+                uploaded: Vec::new(),
+                invalid_instances: 0,
+                collapsed_instances: 0,
+            },
             nonfinite: NonFiniteCounter::new(gpu),
             assets: SceneAssets::new(gpu),
-            bound: [None, None],
         }
     }
 
@@ -376,28 +404,28 @@ impl SceneResources {
     pub fn bind_view(&mut self, gpu: &GpuContext, shadows: Option<ShadowBindings<'_>>) {
         let active = shadows.is_some();
         let generations = (
-            self.lights.generation(),
-            self.instances.generation(),
+            self.lights.buffer.generation(),
+            self.instances.buffer.generation(),
             shadows.as_ref().map_or(0, |s| s.generation + 1),
         );
-        let layout = if active { &self.shadowed_view_layout } else { &self.plain_view_layout };
-        let slot = &mut self.bound[usize::from(active)];
+        let layout = if active { &self.view.shadowed_layout } else { &self.view.plain_layout };
+        let slot = &mut self.view.bound[usize::from(active)];
         if slot.as_ref().is_none_or(|(g, _)| *g != generations) {
             let group = Self::make_view_bind_group(
                 gpu,
                 layout,
-                &self.view_buffer,
-                &self.lights,
-                &self.instances,
+                &self.view.buffer,
+                &self.lights.buffer,
+                &self.instances.buffer,
                 shadows.as_ref(),
             );
             *slot = Some((generations, group));
         }
         if let Some((_, group)) = slot {
-            self.view_bind_group = group.clone();
+            self.view.bind_group = group.clone();
         }
-        self.shadows_active = active;
-        self.view_layout = layout.clone();
+        self.view.shadows_active = active;
+        self.view.layout = layout.clone();
     }
 
     /// Writes the view constants of `view` (before each view's submission: the views of a
@@ -405,7 +433,7 @@ impl SceneResources {
     pub fn prepare_view(&mut self, gpu: &GpuContext, view: &RenderView) {
         let size = view.size;
         let settings = &view.settings;
-        self.view = match &view.camera {
+        self.view.uniform = match &view.camera {
             Some(cam) => {
                 let clip_from_view = cam.projection.matrix(aspect(size));
                 let view_from_world = cam.view_from_world();
@@ -421,26 +449,26 @@ impl SceneResources {
                     camera_position: cam.position().extend(1.0),
                     viewport: viewport_vec(size),
                     params: Vec4::new(p.near, p.near_over_far(), view.exposure(), settings.ambient),
-                    light_count: self.light_count,
+                    light_count: self.lights.count,
                     shading_model: settings.shading.gpu_id(),
-                    directional_count: self.directional_count,
+                    directional_count: self.lights.directional_count,
                     _pad: 0,
-                    directional: self.directional,
+                    directional: self.lights.directional,
                 }
             }
             None => ViewUniform {
                 viewport: viewport_vec(size),
-                light_count: self.light_count,
+                light_count: self.lights.count,
                 ..ViewUniform::zeroed_default()
             },
         };
-        gpu.write_buffer(&self.view_buffer, 0, bytemuck::bytes_of(&self.view));
+        gpu.write_buffer(&self.view.buffer, 0, bytemuck::bytes_of(&self.view.uniform));
         // Blended draws, farthest first along the view direction (view-space z ascending).
-        let view_from_world = self.view.view_from_world;
-        let draws = &self.draws;
-        self.blended.clear();
-        self.blended.extend((0..draws.len()).filter(|&i| draws[i].variant.blend));
-        self.blended.sort_by(|&a, &b| {
+        let view_from_world = self.view.uniform.view_from_world;
+        let draws = &self.instances.draws;
+        self.instances.blended.clear();
+        self.instances.blended.extend((0..draws.len()).filter(|&i| draws[i].variant.blend));
+        self.instances.blended.sort_by(|&a, &b| {
             let z = |i: usize| view_from_world.transform_point3(draws[i].center).z;
             z(a).total_cmp(&z(b)).then(a.cmp(&b))
         });
@@ -455,18 +483,18 @@ impl SceneResources {
         let element = std::mem::size_of::<GpuPointLight>();
         // At least one light: every pipeline binds the buffer (a new buffer is zeroed). A new
         // light or motion buffer is written whole.
-        let new_lights = self.lights.reserve(gpu, (lights.len().max(1) * element) as u64)?;
-        if self.motions.reserve(gpu, lights)? | new_lights {
-            self.uploaded_chunks.clear();
+        let new_lights = self.lights.buffer.reserve(gpu, (lights.len().max(1) * element) as u64)?;
+        if self.lights.motions.reserve(gpu, lights)? | new_lights {
+            self.lights.uploaded_chunks.clear();
         }
         let mut written = 0;
-        self.chunk_summaries.resize(lights.chunks().len(), ChunkSummary::default());
+        self.lights.chunk_summaries.resize(lights.chunks().len(), ChunkSummary::default());
         for (k, chunk) in lights.chunks().iter().enumerate() {
-            let old = self.uploaded_chunks.get(k);
+            let old = self.lights.uploaded_chunks.get(k);
             if old.is_some_and(|o| Arc::ptr_eq(o, chunk)) {
                 continue;
             }
-            self.chunk_summaries[k] = ChunkSummary::of(chunk.lights());
+            self.lights.chunk_summaries[k] = ChunkSummary::of(chunk.lights());
             let (old, new) = (old.map_or(&[][..], |o| o.lights()), chunk.lights());
             let mut i = 0;
             while i < new.len() {
@@ -478,18 +506,22 @@ impl SceneResources {
                 while i < new.len() && old.get(i) != Some(&new[i]) {
                     i += 1;
                 }
-                self.packed.clear();
-                self.packed.extend(new[start..i].iter().map(buffered_light));
+                self.lights.packed.clear();
+                self.lights.packed.extend(new[start..i].iter().map(buffered_light));
                 let offset = ((k * LIGHT_CHUNK + start) * element) as u64;
-                gpu.write_buffer(self.lights.buffer(), offset, bytemuck::cast_slice(&self.packed));
-                written += (self.packed.len() * element) as u64;
-                written += self.motions.write(gpu, k * LIGHT_CHUNK + start, &new[start..i], t);
+                gpu.write_buffer(
+                    self.lights.buffer.buffer(),
+                    offset,
+                    bytemuck::cast_slice(&self.lights.packed),
+                );
+                written += (self.lights.packed.len() * element) as u64;
+                written += self.lights.motions.write(gpu, k * LIGHT_CHUNK + start, &new[start..i], t);
             }
         }
-        written += self.motions.refresh_epochs(gpu, lights, t);
+        written += self.lights.motions.refresh_epochs(gpu, lights, t);
         // The chunks as the buffer now holds them (the Vec keeps its allocation).
-        self.uploaded_chunks.clear();
-        self.uploaded_chunks.extend(lights.chunks().iter().cloned());
+        self.lights.uploaded_chunks.clear();
+        self.lights.uploaded_chunks.extend(lights.chunks().iter().cloned());
         Ok(written)
     }
 
@@ -500,51 +532,55 @@ impl SceneResources {
 
         // Lights: invalid ones (NaN, inf, negative) keep their place as zeroed lights that
         // reach nothing, and are counted.
-        self.light_upload_bytes = self.upload_lights(gpu, &snapshot.lights, snapshot.elapsed_secs)?;
-        self.light_count = snapshot.lights.len() as u32;
+        self.lights.upload_bytes = self.upload_lights(gpu, &snapshot.lights, snapshot.elapsed_secs)?;
+        self.lights.count = snapshot.lights.len() as u32;
         // Animated lights take their place for the frame's time before any view reads them.
-        self.light_upload_bytes +=
-            self.motions.prepare(gpu, &self.lights, self.light_count, snapshot.elapsed_secs)?;
-        self.light_reach = LightReach::default();
-        self.invalid_point_lights = 0;
-        for summary in &self.chunk_summaries {
-            self.light_reach.merge(&summary.reach);
-            self.invalid_point_lights += summary.invalid;
+        self.lights.upload_bytes += self.lights.motions.prepare(
+            gpu,
+            &self.lights.buffer,
+            self.lights.count,
+            snapshot.elapsed_secs,
+        )?;
+        self.lights.reach = LightReach::default();
+        self.lights.invalid_point_lights = 0;
+        for summary in &self.lights.chunk_summaries {
+            self.lights.reach.merge(&summary.reach);
+            self.lights.invalid_point_lights += summary.invalid;
         }
-        self.invalid_lights = self.invalid_point_lights;
+        self.lights.invalid_lights = self.lights.invalid_point_lights;
         // Directional lights: the first MAX_DIRECTIONAL_LIGHTS valid ones, in the view uniform.
         let valid_count = snapshot.directional_lights.iter().filter(|l| l.is_valid()).count() as u32;
         let mut count = 0usize;
         for (i, l) in viewed_directional_lights(&snapshot.directional_lights) {
-            self.directional[i as usize] = gpu_directional_light(l);
+            self.lights.directional[i as usize] = gpu_directional_light(l);
             count += 1;
         }
-        self.invalid_lights += snapshot.directional_lights.len() as u32 - valid_count;
-        self.directional_count = count as u32;
-        self.dropped_directional_lights = valid_count - count as u32;
-        if self.dropped_directional_lights > 0 {
+        self.lights.invalid_lights += snapshot.directional_lights.len() as u32 - valid_count;
+        self.lights.directional_count = count as u32;
+        self.lights.dropped_directional_lights = valid_count - count as u32;
+        if self.lights.dropped_directional_lights > 0 {
             tracing::warn!(
                 "{} directional lights past the first {MAX_DIRECTIONAL_LIGHTS} are not drawn",
-                self.dropped_directional_lights
+                self.lights.dropped_directional_lights
             );
         }
 
         // Meshes, materials, instances.
         // Last frame's instances become the comparison; this frame's are packed into the other
         // Vec (both keep their allocations).
-        std::mem::swap(&mut self.instance_data, &mut self.uploaded_instances);
-        let mut instance_data = std::mem::take(&mut self.instance_data);
+        std::mem::swap(&mut self.instances.packed, &mut self.instances.uploaded);
+        let mut instance_data = std::mem::take(&mut self.instances.packed);
         instance_data.clear();
-        self.draws.clear();
-        (self.invalid_instances, self.collapsed_instances) = (0, 0);
+        self.instances.draws.clear();
+        (self.instances.invalid_instances, self.instances.collapsed_instances) = (0, 0);
         for inst in &snapshot.instances {
             if !inst.world_from_local.is_finite() {
                 tracing::debug!("skipping instance of `{}`: non-finite transform", inst.mesh.label);
-                self.invalid_instances += 1;
+                self.instances.invalid_instances += 1;
                 continue;
             }
             let Some(gpu_instance) = GpuInstance::drawable(inst.world_from_local) else {
-                self.collapsed_instances += 1;
+                self.instances.collapsed_instances += 1;
                 continue;
             };
             if inst.mesh.indices.is_empty() {
@@ -558,7 +594,7 @@ impl SceneResources {
             let center = inst.world_from_local.transform_point3(local_center);
             let instance = instance_data.len() as u32;
             let world_bounds = local_bounds.transformed(&inst.world_from_local);
-            self.draws.push(Draw {
+            self.instances.draws.push(Draw {
                 mesh,
                 material,
                 instance,
@@ -570,11 +606,11 @@ impl SceneResources {
             });
             instance_data.push(gpu_instance);
         }
-        self.draws.sort_by_key(|d| d.order);
-        self.variants.clear();
-        for d in &self.draws {
-            if !self.variants.contains(&d.variant) {
-                self.variants.push(d.variant);
+        self.instances.draws.sort_by_key(|d| d.order);
+        self.instances.variants.clear();
+        for d in &self.instances.draws {
+            if !self.instances.variants.contains(&d.variant) {
+                self.instances.variants.push(d.variant);
             }
         }
         if instance_data.is_empty() {
@@ -582,9 +618,14 @@ impl SceneResources {
         }
         // Only the instances that differ from the buffer's: still objects upload nothing.
         let element = std::mem::size_of::<GpuInstance>();
-        let previous = bytemuck::cast_slice(&self.uploaded_instances);
-        self.instances.write_changed(gpu, bytemuck::cast_slice(&instance_data), Some(previous), element)?;
-        self.instance_data = instance_data;
+        let previous = bytemuck::cast_slice(&self.instances.uploaded);
+        self.instances.buffer.write_changed(
+            gpu,
+            bytemuck::cast_slice(&instance_data),
+            Some(previous),
+            element,
+        )?;
+        self.instances.packed = instance_data;
 
         self.assets.evict_unused();
         Ok(())

@@ -32,7 +32,7 @@ pub struct ShadowProbe {
 
 /// The shadow test of `shadows`' last frame for each probe, in [0, 1] (1: fully lit). Every
 /// probe is 1 when that frame drew no shadow map; a probe of a light the buffer lacks is 1.
-/// `lights` is the frame's light buffer (`SceneResources::lights`), holding `light_count`
+/// `lights` is the frame's light buffer (`SceneLights::buffer`), holding `light_count`
 /// lights. Waits for the GPU.
 pub fn probe_shadows(
     gpu: &GpuContext,

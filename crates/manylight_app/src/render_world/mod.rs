@@ -220,7 +220,7 @@ impl RenderWorld {
             self.gpu().device.destroy();
         }
         self.world.resource_mut::<RendererResource>().prepare(&snapshot)?;
-        let light_upload_bytes = self.world.resource::<RendererResource>().0.scene.light_upload_bytes;
+        let light_upload_bytes = self.world.resource::<RendererResource>().0.scene.lights.upload_bytes;
         self.world.insert_resource(CurrentSnapshot(snapshot));
         let result = self.render_views(output, format);
         if self.recovery.lose_in_frame.take() == Some(DeviceLoss::InFrame) {

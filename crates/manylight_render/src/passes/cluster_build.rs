@@ -145,7 +145,7 @@ impl Pass for ClusterBuildPass {
             spheres_layout,
             &[
                 Binding::Buffer(&clusters.buffers.params),
-                Binding::Buffer(ctx.scene.lights.buffer()),
+                Binding::Buffer(ctx.scene.lights.buffer.buffer()),
                 Binding::Buffer(clusters.buffers.spheres.buffer()),
             ],
         );

@@ -57,13 +57,13 @@ impl Pass for ClusterDepthPass {
         let scene = ctx.scene;
         let device = &ctx.gpu.device;
         let pipeline = ctx.pipelines.get_or_create(
-            ClusterDepthKey { source: self.source, shadowed_view: scene.shadows_active },
+            ClusterDepthKey { source: self.source, shadowed_view: scene.view.shadows_active },
             |k| {
                 DistancePipeline::new(
                     device,
                     "cluster_depth.wgsl",
                     "cluster_depth",
-                    [&scene.view_layout, &clusters.bindings.depth_layout],
+                    [&scene.view.layout, &clusters.bindings.depth_layout],
                     k.source,
                 )
             },
@@ -83,7 +83,7 @@ impl Pass for ClusterDepthPass {
             timestamp_writes: timestamps,
         });
         pass.set_pipeline(&pipeline.pipeline);
-        pass.set_bind_group(crate::layouts::SCENE_GROUP.index, &scene.view_bind_group, &[]);
+        pass.set_bind_group(crate::layouts::SCENE_GROUP.index, &scene.view.bind_group, &[]);
         pass.set_bind_group(pipeline.source_layout.decl().index, &source, &[]);
         pass.set_bind_group(clusters.bindings.depth_layout.decl().index, &depths, &[]);
         pass.dispatch_workgroups(groups[0], groups[1], 1);

@@ -106,7 +106,7 @@ impl Pass for ClusteredForwardPass {
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
         let scene = ctx.scene;
         let clusters = ctx.require_clusters("clustered_forward")?;
-        let layouts = [&scene.view_layout, &scene.assets.material_layout, &clusters.bindings.lists_layout];
+        let layouts = [&scene.view.layout, &scene.assets.material_layout, &clusters.bindings.lists_layout];
         let after = self.after_prepass;
         let pipelines = variant_pipelines(
             ctx,

@@ -92,14 +92,14 @@ impl DebugViewPipeline {
 /// would end (as far as the lights reach, [`manylight_core::Projection::finite_for`]), or at
 /// `near × 10⁴` when there is no light.
 fn depth_view_far(scene: &crate::resources::SceneResources) -> f32 {
-    let (near, near_over_far) = (scene.view.params.x, scene.view.params.y);
+    let (near, near_over_far) = (scene.view.uniform.params.x, scene.view.uniform.params.y);
     if near_over_far > 0.0 {
         return near / near_over_far;
     }
-    if scene.light_count == 0 {
+    if scene.lights.count == 0 {
         return near * 1e4;
     }
-    let reach = scene.light_reach.farthest(&scene.view.view_from_world);
+    let reach = scene.lights.reach.farthest(&scene.view.uniform.view_from_world);
     manylight_core::Projection::infinite(1.0, near).finite_for(reach).far
 }
 
@@ -170,7 +170,7 @@ impl Pass for DebugViewPass {
         let depth_far = depth_view_far(ctx.scene);
         let params = ctx.uniform(&[self.view.gpu_id(), self.heatmap_max.max(1), depth_far.to_bits(), 0]);
         let mut bindings = vec![
-            Binding::Buffer(&ctx.scene.view_buffer),
+            Binding::Buffer(&ctx.scene.view.buffer),
             Binding::Texture(ctx.texture(DEPTH)?),
             Binding::Buffer(&params),
         ];
@@ -199,7 +199,7 @@ impl Pass for DebugViewPass {
                 let table = shadows
                     .map(|s| s.lights.buffer())
                     .ok_or_else(|| RenderError::Graph("shadow-lod: the frame has no shadow table".into()))?;
-                bindings.extend([Binding::Buffer(ctx.scene.lights.buffer()), Binding::Buffer(table)]);
+                bindings.extend([Binding::Buffer(ctx.scene.lights.buffer.buffer()), Binding::Buffer(table)]);
             }
         }
         let bind_group = ctx.bind_group(&pipeline.layout, &bindings);

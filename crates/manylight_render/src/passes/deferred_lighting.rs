@@ -101,9 +101,9 @@ impl Pass for DeferredLightingPass {
         let clusters = ctx.require_clusters("deferred_lighting")?;
         let device = &ctx.gpu.device;
         let (layout, codec) = (self.layout, self.codec);
-        let view_layout = &ctx.scene.view_layout;
+        let view_layout = &ctx.scene.view.layout;
         let pipeline = ctx.pipelines.get_or_create(
-            DeferredLightingKey { layout, codec, shadows: ctx.scene.shadows_active },
+            DeferredLightingKey { layout, codec, shadows: ctx.scene.view.shadows_active },
             |k| {
                 let defs = crate::shaders::ShaderDefs { shadows: k.shadows, ..Default::default() };
                 DeferredLightingPipeline::new(
@@ -119,7 +119,7 @@ impl Pass for DeferredLightingPass {
         let gbuffer = gbuffer_read_bind_group(ctx, &pipeline.gbuffer_layout, layout, self.clear_color)?;
         let hdr = ctx.texture(HDR)?;
         let timestamps = ctx.render_timestamps(true, true);
-        let groups = [&ctx.scene.view_bind_group, &gbuffer, &clusters.bindings.lists_group];
+        let groups = [&ctx.scene.view.bind_group, &gbuffer, &clusters.bindings.lists_group];
         draw_fullscreen(ctx.encoder, "deferred_lighting", hdr, timestamps, &pipeline.pipeline, &groups);
         Ok(())
     }

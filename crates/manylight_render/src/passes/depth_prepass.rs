@@ -44,7 +44,7 @@ impl DepthPrepassPipeline {
             &MeshPipelineDesc {
                 label: "depth_prepass",
                 shader: "depth_prepass.wgsl",
-                layouts: &[&scene.view_layout, &scene.assets.material_layout],
+                layouts: &[&scene.view.layout, &scene.assets.material_layout],
                 fragment,
                 targets,
                 depth_write: true,

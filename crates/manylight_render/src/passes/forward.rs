@@ -34,7 +34,7 @@ impl ForwardPipeline {
             &MeshPipelineDesc {
                 label: "forward",
                 shader: "forward.wgsl",
-                layouts: &[&scene.view_layout, &scene.assets.material_layout],
+                layouts: &[&scene.view.layout, &scene.assets.material_layout],
                 fragment: Some("fs_main"),
                 targets: &[HDR_FORMAT],
                 depth_write: true,

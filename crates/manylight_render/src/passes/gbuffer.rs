@@ -42,7 +42,7 @@ impl GBufferPipeline {
             &MeshPipelineDesc {
                 label: "gbuffer",
                 shader: "gbuffer.wgsl",
-                layouts: &[&scene.view_layout, &scene.assets.material_layout],
+                layouts: &[&scene.view.layout, &scene.assets.material_layout],
                 fragment: Some("fs_main"),
                 targets: &formats,
                 depth_write: true,

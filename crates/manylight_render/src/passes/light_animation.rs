@@ -42,7 +42,7 @@ impl Pass for LightAnimationPass {
     }
 
     fn record(&self, ctx: &mut PassContext<'_>) -> Result<(), RenderError> {
-        let Some((layout, group)) = ctx.scene.motions.dispatch() else {
+        let Some((layout, group)) = ctx.scene.lights.motions.dispatch() else {
             return Ok(());
         };
         let device = &ctx.gpu.device;
@@ -51,7 +51,7 @@ impl Pass for LightAnimationPass {
             compute_pipeline(device, Self::NAME, "light_animation.wgsl", &[layout], "main", &constants)
         })?;
         let max_groups = ctx.gpu.device.limits().max_compute_workgroups_per_dimension;
-        let [x, y] = dispatch_size(ctx.scene.light_count, WORKGROUP_SIZE, max_groups)?;
+        let [x, y] = dispatch_size(ctx.scene.lights.count, WORKGROUP_SIZE, max_groups)?;
         let timestamps = ctx.compute_timestamps(true, true);
         let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some(Self::NAME),

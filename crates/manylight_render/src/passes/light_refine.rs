@@ -59,13 +59,13 @@ impl Pass for LightRefinePass {
         let scene = ctx.scene;
         let device = &ctx.gpu.device;
         let pipeline = ctx.pipelines.get_or_create(
-            RefineKey { source: self.source, shadowed_view: scene.shadows_active },
+            RefineKey { source: self.source, shadowed_view: scene.view.shadows_active },
             |k| {
                 DistancePipeline::new(
                     device,
                     "light_refine.wgsl",
                     "light_refine",
-                    [&scene.view_layout, &clusters.bindings.refine_layout],
+                    [&scene.view.layout, &clusters.bindings.refine_layout],
                     k.source,
                 )
             },
@@ -90,7 +90,7 @@ impl Pass for LightRefinePass {
             timestamp_writes: timestamps,
         });
         pass.set_pipeline(&pipeline.pipeline);
-        pass.set_bind_group(crate::layouts::SCENE_GROUP.index, &scene.view_bind_group, &[]);
+        pass.set_bind_group(crate::layouts::SCENE_GROUP.index, &scene.view.bind_group, &[]);
         pass.set_bind_group(pipeline.source_layout.decl().index, &source, &[]);
         pass.set_bind_group(clusters.bindings.refine_layout.decl().index, &lists, &[]);
         pass.dispatch_workgroups(groups[0], groups[1], 1);

@@ -269,10 +269,10 @@ impl Pass for LightVolumesPass {
         let (layout, codec, accumulation) = (self.layout, self.codec, self.accumulation);
         let scene = ctx.scene;
         let gpu = ctx.gpu;
-        let key = LightVolumesKey { layout, codec, accumulation, shadows: scene.shadows_active };
+        let key = LightVolumesKey { layout, codec, accumulation, shadows: scene.view.shadows_active };
         let pipeline = ctx.pipelines.get_or_create(key, |k| {
             let defs = crate::shaders::ShaderDefs { shadows: k.shadows, ..Default::default() };
-            LightVolumesPipeline::new(gpu, &scene.view_layout, k.layout, k.codec, k.accumulation, defs)
+            LightVolumesPipeline::new(gpu, &scene.view.layout, k.layout, k.codec, k.accumulation, defs)
         })?;
         let gbuffer = gbuffer_read_bind_group(ctx, &pipeline.gbuffer_layout, layout, self.clear_color)?;
         let hdr = ctx.texture(HDR)?;
@@ -296,20 +296,20 @@ impl Pass for LightVolumesPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_bind_group(crate::layouts::SCENE_GROUP.index, &scene.view_bind_group, &[]);
+        pass.set_bind_group(crate::layouts::SCENE_GROUP.index, &scene.view.bind_group, &[]);
         pass.set_bind_group(crate::layouts::GBUFFER_READ_GROUP.index, &gbuffer, &[]);
         pass.set_pipeline(&pipeline.ambient);
         pass.draw(0..3, 0..1);
-        if scene.light_count > 0 {
+        if scene.lights.count > 0 {
             pass.set_pipeline(&pipeline.volume);
             pass.set_vertex_buffer(0, pipeline.proxy.vertices.slice(..));
             pass.set_index_buffer(pipeline.proxy.indices.slice(..), wgpu::IndexFormat::Uint16);
-            pass.draw_indexed(0..pipeline.proxy.index_count, 0, 0..scene.light_count);
+            pass.draw_indexed(0..pipeline.proxy.index_count, 0, 0..scene.lights.count);
         }
         drop(pass);
         if let Some((resolve, accum)) = resolve {
             let timestamps = ctx.render_timestamps(false, true);
-            let groups = [&scene.view_bind_group, &gbuffer, &accum];
+            let groups = [&scene.view.bind_group, &gbuffer, &accum];
             draw_fullscreen(ctx.encoder, "light_volumes_resolve", hdr, timestamps, resolve, &groups);
         }
         Ok(())

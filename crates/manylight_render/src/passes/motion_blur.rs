@@ -126,7 +126,7 @@ impl Pass for MotionBlurPass {
         let blur_group = ctx.bind_group(
             &pipeline.blur_layout,
             &[
-                Binding::Buffer(&ctx.scene.view_buffer),
+                Binding::Buffer(&ctx.scene.view.buffer),
                 Binding::Buffer(&params),
                 Binding::Texture(target.source),
                 Binding::Texture(depth),

@@ -18,7 +18,7 @@ pub trait ScenePipeline {
 pub type VariantPipelines<P> = Vec<(SurfaceVariant, Arc<P>)>;
 
 /// The pipelines of an opaque mesh pass for every opaque variant the frame draws
-/// (`SceneResources::variants`), each made by `create` on first use. Blended variants get
+/// (`SceneInstances::variants`), each made by `create` on first use. Blended variants get
 /// none, so the opaque passes skip their draws.
 pub fn variant_pipelines<K: PipelineKey>(
     ctx: &PassContext<'_>,
@@ -45,9 +45,9 @@ fn pipelines_where<K: PipelineKey>(
 ) -> Result<VariantPipelines<K::Pipeline>, RenderError> {
     // Each variant's pipeline has the view's shading model where its material has none, and
     // reads shadows when the frame's lights cast them.
-    let global = ctx.scene.view.shading_model;
-    let shadows = ctx.scene.shadows_active;
-    let variants = ctx.scene.variants.iter().filter(|v| filter(v));
+    let global = ctx.scene.view.uniform.shading_model;
+    let shadows = ctx.scene.view.shadows_active;
+    let variants = ctx.scene.instances.variants.iter().filter(|v| filter(v));
     variants
         .map(|&v| {
             Ok((v, ctx.pipelines.get_or_create(key(v.resolved(global).with_shadows(shadows)), &create)?))
@@ -79,7 +79,7 @@ pub fn record_scene_pass<P: ScenePipeline>(
         occlusion_query_set: None,
         multiview_mask: None,
     });
-    pass.set_bind_group(crate::layouts::SCENE_GROUP.index, &scene.view_bind_group, &[]);
+    pass.set_bind_group(crate::layouts::SCENE_GROUP.index, &scene.view.bind_group, &[]);
     // The pass's own groups follow the material's.
     for (i, group) in extra.iter().enumerate() {
         pass.set_bind_group(crate::layouts::MATERIAL_GROUP.index + 1 + i as u32, *group, &[]);
@@ -101,9 +101,9 @@ pub fn draw_scene<P: ScenePipeline>(
     reverse: bool,
 ) {
     if reverse {
-        draw_in_order(pass, scene, pipelines, scene.draws.iter().rev());
+        draw_in_order(pass, scene, pipelines, scene.instances.draws.iter().rev());
     } else {
-        draw_in_order(pass, scene, pipelines, scene.draws.iter());
+        draw_in_order(pass, scene, pipelines, scene.instances.draws.iter());
     }
 }
 

@@ -136,7 +136,7 @@ impl Pass for ShadowMapsPass {
             &[
                 Binding::Buffer(shadows.faces.buffer()),
                 Binding::Buffer(shadows.draws.buffer()),
-                Binding::Buffer(ctx.scene.instances.buffer()),
+                Binding::Buffer(ctx.scene.instances.buffer.buffer()),
             ],
         );
         let scene = ctx.scene;

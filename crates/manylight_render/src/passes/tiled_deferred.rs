@@ -119,9 +119,9 @@ impl Pass for TiledDeferredPass {
         }
         let device = &ctx.gpu.device;
         let (layout, codec) = (self.layout, self.codec);
-        let view_layout = &ctx.scene.view_layout;
+        let view_layout = &ctx.scene.view.layout;
         let pipeline = ctx.pipelines.get_or_create(
-            TiledDeferredKey { layout, codec, shadows: ctx.scene.shadows_active },
+            TiledDeferredKey { layout, codec, shadows: ctx.scene.view.shadows_active },
             |k| {
                 let defs = crate::shaders::ShaderDefs { shadows: k.shadows, ..Default::default() };
                 TiledDeferredPipeline::new(
@@ -142,7 +142,7 @@ impl Pass for TiledDeferredPass {
             timestamp_writes: timestamps,
         });
         pass.set_pipeline(&pipeline.pipeline);
-        for (i, group) in [&ctx.scene.view_bind_group, &gbuffer, &clusters.bindings.lists_group, &output]
+        for (i, group) in [&ctx.scene.view.bind_group, &gbuffer, &clusters.bindings.lists_group, &output]
             .into_iter()
             .enumerate()
         {

@@ -60,7 +60,7 @@ impl Pass for TonemapPass {
         let bind_group = ctx.bind_group(
             &pipeline.layout,
             &[
-                Binding::Buffer(&ctx.scene.view_buffer),
+                Binding::Buffer(&ctx.scene.view.buffer),
                 Binding::Texture(ctx.texture(HDR)?),
                 Binding::Buffer(&ctx.scene.nonfinite.counter),
             ],

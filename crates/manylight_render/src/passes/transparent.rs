@@ -94,7 +94,7 @@ impl Pass for TransparentPass {
         } else {
             None
         };
-        let mut layouts = vec![&scene.view_layout, &scene.assets.material_layout];
+        let mut layouts = vec![&scene.view.layout, &scene.assets.material_layout];
         layouts.extend(clusters.map(|c| &c.bindings.lists_layout));
         let clustered = self.clustered;
         let pipelines = blended_variant_pipelines(
@@ -118,11 +118,16 @@ impl Pass for TransparentPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_bind_group(crate::layouts::SCENE_GROUP.index, &scene.view_bind_group, &[]);
+        pass.set_bind_group(crate::layouts::SCENE_GROUP.index, &scene.view.bind_group, &[]);
         if let Some(c) = clusters {
             pass.set_bind_group(crate::layouts::CLUSTER_LISTS_GROUP.index, &c.bindings.lists_group, &[]);
         }
-        draw_in_order(&mut pass, scene, &pipelines, scene.blended.iter().map(|&i| &scene.draws[i]));
+        draw_in_order(
+            &mut pass,
+            scene,
+            &pipelines,
+            scene.instances.blended.iter().map(|&i| &scene.instances.draws[i]),
+        );
         Ok(())
     }
 }

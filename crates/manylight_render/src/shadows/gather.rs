@@ -86,7 +86,7 @@ impl ShadowResources {
     /// mesh) and a hash of what it draws (its mesh and transform), found once a frame.
     pub(super) fn opaque_draws<'a>(&mut self, scene: &'a SceneResources) -> Vec<OpaqueDraw<'a>> {
         let mut opaque = Vec::new();
-        for d in scene.draws.iter().filter(|d| !d.variant.blend) {
+        for d in scene.instances.draws.iter().filter(|d| !d.variant.blend) {
             let slot = match self.scratch.by_mesh.iter().position(|(m, _)| *m == d.mesh) {
                 Some(i) => i,
                 None => {

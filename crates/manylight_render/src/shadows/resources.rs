@@ -239,7 +239,7 @@ impl ShadowResources {
 
         // The light table: every light of the buffer, edge 0 where it has no map.
         self.scratch.gpu_lights.clear();
-        self.scratch.gpu_lights.resize(scene.light_count.max(1) as usize, GpuShadowLight::default());
+        self.scratch.gpu_lights.resize(scene.lights.count.max(1) as usize, GpuShadowLight::default());
         let lights = &snapshot.lights;
         self.scratch.gpu_faces.clear();
         for list in &mut self.scratch.by_mesh {
