@@ -431,37 +431,8 @@ impl SceneResources {
     /// Writes the view constants of `view` (before each view's submission: the views of a
     /// frame share the lights and instances that [`SceneResources::prepare`] uploaded once).
     pub fn prepare_view(&mut self, gpu: &GpuContext, view: &RenderView) {
-        let size = view.size;
-        let settings = &view.settings;
-        self.view.uniform = match &view.camera {
-            Some(cam) => {
-                let clip_from_view = cam.projection.matrix(aspect(size));
-                let view_from_world = cam.view_from_world();
-                let clip_from_world = clip_from_view * view_from_world;
-                let p = cam.projection.sanitized();
-                // near / far rather than far: 0 for an infinite projection, never infinite.
-                ViewUniform {
-                    clip_from_world,
-                    view_from_world,
-                    clip_from_view,
-                    world_from_clip: clip_from_world.inverse(),
-                    prev_clip_from_world: cam.prev_clip_from_world.unwrap_or(clip_from_world),
-                    camera_position: cam.position().extend(1.0),
-                    viewport: viewport_vec(size),
-                    params: Vec4::new(p.near, p.near_over_far(), view.exposure(), settings.ambient),
-                    light_count: self.lights.count,
-                    shading_model: settings.shading.gpu_id(),
-                    directional_count: self.lights.directional_count,
-                    _pad: 0,
-                    directional: self.lights.directional,
-                }
-            }
-            None => ViewUniform {
-                viewport: viewport_vec(size),
-                light_count: self.lights.count,
-                ..ViewUniform::zeroed_default()
-            },
-        };
+        let lights = &self.lights;
+        self.view.uniform = view_uniform(view, lights.count, lights.directional_count, lights.directional);
         gpu.write_buffer(&self.view.buffer, 0, bytemuck::bytes_of(&self.view.uniform));
         // Blended draws, farthest first along the view direction (view-space z ascending).
         let view_from_world = self.view.uniform.view_from_world;
@@ -655,6 +626,47 @@ impl ViewUniform {
             _pad: 0,
             directional: [GpuDirectionalLight::default(); MAX_DIRECTIONAL_LIGHTS as usize],
         }
+    }
+}
+
+/// The view constants of `view` (group 0's `view`, `ViewUniform` in `common/view.wgsl`), with
+/// the frame's point-light count and directional lights.
+pub(crate) fn view_uniform(
+    view: &RenderView,
+    light_count: u32,
+    directional_count: u32,
+    directional: [GpuDirectionalLight; MAX_DIRECTIONAL_LIGHTS as usize],
+) -> ViewUniform {
+    let size = view.size;
+    let settings = &view.settings;
+    match &view.camera {
+        Some(cam) => {
+            let clip_from_view = cam.projection.matrix(aspect(size));
+            let view_from_world = cam.view_from_world();
+            let clip_from_world = clip_from_view * view_from_world;
+            let p = cam.projection.sanitized();
+            // near / far rather than far: 0 for an infinite projection, never infinite.
+            ViewUniform {
+                clip_from_world,
+                view_from_world,
+                clip_from_view,
+                world_from_clip: clip_from_world.inverse(),
+                prev_clip_from_world: cam.prev_clip_from_world.unwrap_or(clip_from_world),
+                camera_position: cam.position().extend(1.0),
+                viewport: viewport_vec(size),
+                params: Vec4::new(p.near, p.near_over_far(), view.exposure(), settings.ambient),
+                light_count,
+                shading_model: settings.shading.gpu_id(),
+                directional_count,
+                _pad: 0,
+                directional,
+            }
+        }
+        None => ViewUniform {
+            viewport: viewport_vec(size),
+            light_count,
+            ..ViewUniform::zeroed_default()
+        },
     }
 }
 

@@ -41,13 +41,14 @@ use crate::gpu_types::{
 use crate::layouts::GroupLayout;
 use crate::lights::{gpu_directional_light, viewed_directional_lights};
 use crate::readback::HeadlessTarget;
+use crate::resources::view_uniform;
 use crate::resources::{DEPTH_FORMAT, SurfaceVariant};
 use crate::shaders::ShaderDefs;
 use crate::snapshot::{FrameSnapshot, PipelineKind, RenderView};
 use crate::stats::{FrameReport, PassTiming, ViewReport};
 use glam::{Mat4, UVec2, Vec3};
 use lists::{FrameLights, TEXELS_PER_LIGHT, padded};
-use pipeline::{create_pipeline, instance_buffer, lists_group, view_uniform};
+use pipeline::{create_pipeline, instance_buffer, lists_group};
 use std::collections::HashMap;
 use textures::ListTexture;
 

@@ -5,12 +5,10 @@
 use super::textures::ListTexture;
 use crate::bindings::Binding;
 use crate::context::GpuContext;
-use crate::gpu_types::{GpuDirectionalLight, GpuInstance, MAX_DIRECTIONAL_LIGHTS, ViewUniform};
+use crate::gpu_types::GpuInstance;
 use crate::layouts::GroupLayout;
 use crate::readback::HEADLESS_FORMAT;
 use crate::resources::{DEPTH_FORMAT, SurfaceVariant};
-use crate::snapshot::{RenderView, aspect};
-use glam::{UVec2, Vec4};
 
 /// The pipeline of draws of `variant`, with the path's `layout` and shader `module`.
 pub(super) fn create_pipeline(
@@ -62,39 +60,6 @@ pub(super) fn create_pipeline(
         multiview_mask: None,
         cache: None,
     })
-}
-
-/// The view uniform of `view` (as the storage-buffer passes get it).
-pub(super) fn view_uniform(
-    view: &RenderView,
-    light_count: u32,
-    directional_count: u32,
-    directional: [GpuDirectionalLight; MAX_DIRECTIONAL_LIGHTS as usize],
-) -> ViewUniform {
-    let size = view.size.max(UVec2::ONE);
-    let viewport = Vec4::new(size.x as f32, size.y as f32, 1.0 / size.x as f32, 1.0 / size.y as f32);
-    let Some(cam) = view.camera else {
-        return ViewUniform { viewport, light_count, ..ViewUniform::zeroed_default() };
-    };
-    let clip_from_view = cam.projection.matrix(aspect(size));
-    let view_from_world = cam.view_from_world();
-    let clip_from_world = clip_from_view * view_from_world;
-    let p = cam.projection.sanitized();
-    ViewUniform {
-        clip_from_world,
-        view_from_world,
-        clip_from_view,
-        world_from_clip: clip_from_world.inverse(),
-        prev_clip_from_world: cam.prev_clip_from_world.unwrap_or(clip_from_world),
-        camera_position: cam.position().extend(1.0),
-        viewport,
-        params: Vec4::new(p.near, p.near_over_far(), view.exposure(), view.settings.ambient),
-        light_count,
-        shading_model: view.settings.shading.gpu_id(),
-        directional_count,
-        _pad: 0,
-        directional,
-    }
 }
 
 pub(super) fn lists_group(
