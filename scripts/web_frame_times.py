@@ -4,12 +4,17 @@
     bash scripts/web.sh --build-only
     python3 scripts/web_frame_times.py [--lights 256,1024,16384,100000] [--size 640x360]
         [--scene sphere-shell] [--pipeline clustered-forward] [--seconds 10]
+        [--backend auto|webgpu|webgl2]
 
 Serves target/web on 127.0.0.1, opens each light count in headless Chromium through chromedriver
-(WebGPU on the machine's adapter: SwiftShader without a GPU, frames shown through read-back),
+(started with `--enable-unsafe-webgpu`; frames shown through read-back, on the machine's adapter:
+SwiftShader without a GPU), with `backend=` from `--backend` in the page's URL (`auto`, the
+default, is WebGPU where Chromium offers it, else WebGL2; `webgl2` forces WebGL2 through ANGLE),
 waits for `manylight: ready` and a warm-up, then counts the frames the page rendered in
 `--seconds` and prints a Markdown table: milliseconds a frame (wall clock), the median GPU time
-the page's stats report, and the light count they report.
+the page's stats report (— on WebGL2, which has no timestamp queries), the median CPU time of
+the `cluster_assign` pass (WebGL2's CPU-built cluster lists; — where the lists are built on the
+GPU), the light count the stats report and the backend they name.
 """
 
 import argparse
@@ -81,13 +86,16 @@ def measure(page, seconds):
     time.sleep(3)  # warm-up: the first frames size the light lists
     stats = page.eval("return manylight.stats()")
     frames0, t0 = stats["frames_rendered"], time.time()
-    gpu = []
+    gpu, assign = [], []
     while time.time() - t0 < seconds:
         time.sleep(0.5)
         stats = page.eval("return manylight.stats()")
         last = stats["last_frame"]
         if last and last.get("frame_gpu_ms") is not None:
             gpu.append(last["frame_gpu_ms"])
+        for p in (last or {}).get("passes", []):
+            if p.get("name") == "cluster_assign":
+                assign.append(p["cpu_ms"])
     frames = stats["frames_rendered"] - frames0
     elapsed = time.time() - t0
     return {
@@ -95,6 +103,7 @@ def measure(page, seconds):
         "frame_ms": elapsed * 1e3 / frames if frames else float("inf"),
         "frames": frames,
         "gpu_ms": statistics.median(gpu) if gpu else None,
+        "assign_ms": statistics.median(assign) if assign else None,
         "lights": stats["last_frame"]["light_count"],
         "backend": stats.get("backend"),
     }
@@ -107,6 +116,7 @@ def main():
     parser.add_argument("--scene", default="sphere-shell")
     parser.add_argument("--pipeline", default="clustered-forward")
     parser.add_argument("--seconds", type=float, default=10.0)
+    parser.add_argument("--backend", choices=["auto", "webgpu", "webgl2"], default="auto")
     args = parser.parse_args()
     web = os.path.join(ROOT, "target", "web")
     if not os.path.exists(os.path.join(web, "index.html")):
@@ -124,22 +134,24 @@ def main():
     try:
         wait_for_port(page_port, "the page server")
         wait_for_port(driver_port, "chromedriver")
-        print(f"| lights | ms a frame | GPU ms (median) | frames | ready after | backend |")
-        print(f"|---|---|---|---|---|---|")
+        print("| lights | ms a frame | GPU ms (median) | cluster_assign CPU ms (median) | frames "
+              "| ready after | backend |")
+        print("|---|---|---|---|---|---|---|")
         for lights in [int(n) for n in args.lights.split(",")]:
             query = (f"?scene={args.scene}&lights={lights}&pipeline={args.pipeline}&size={args.size}"
-                     f"&overlay=off&present=read-back")
+                     f"&overlay=off&present=read-back&backend={args.backend}")
             page = Page(f"http://127.0.0.1:{driver_port}", f"http://127.0.0.1:{page_port}/{query}", chromium)
             try:
                 m = measure(page, args.seconds)
             finally:
                 page.close()
             if "error" in m:
-                print(f"| {lights} | error: {m['error']} | | | | |")
+                print(f"| {lights} | error: {m['error']} | | | | | |")
                 continue
-            gpu = f"{m['gpu_ms']:.1f}" if m["gpu_ms"] is not None else "n/a"
-            print(f"| {m['lights']} | {m['frame_ms']:.1f} | {gpu} | {m['frames']} | {m['ready_s']:.1f} s "
-                  f"| {m['backend']} |", flush=True)
+            gpu = f"{m['gpu_ms']:.1f}" if m["gpu_ms"] is not None else "—"
+            assign = f"{m['assign_ms']:.1f}" if m["assign_ms"] is not None else "—"
+            print(f"| {m['lights']} | {m['frame_ms']:.1f} | {gpu} | {assign} | {m['frames']} "
+                  f"| {m['ready_s']:.1f} s | {m['backend']} |", flush=True)
     finally:
         driver.kill()
         server.kill()
