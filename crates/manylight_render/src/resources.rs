@@ -662,11 +662,7 @@ pub(crate) fn view_uniform(
                 directional,
             }
         }
-        None => ViewUniform {
-            viewport: viewport_vec(size),
-            light_count,
-            ..ViewUniform::zeroed_default()
-        },
+        None => ViewUniform { viewport: viewport_vec(size), light_count, ..ViewUniform::zeroed_default() },
     }
 }
 
