@@ -470,6 +470,31 @@ pub fn viewed_directional_lights(
         .map(|(i, l)| (i as u32, l))
 }
 
+/// A frame's directional lights as the view uniform carries them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewedDirectionalLights {
+    /// The first [`MAX_DIRECTIONAL_LIGHTS`] valid ones, packed; the rest zeroed.
+    pub packed: [GpuDirectionalLight; MAX_DIRECTIONAL_LIGHTS as usize],
+    /// How many of `packed` are lights.
+    pub count: u32,
+    /// Valid lights past [`MAX_DIRECTIONAL_LIGHTS`], not drawn.
+    pub dropped: u32,
+    /// Lights refused for invalid parameters.
+    pub invalid: u32,
+}
+
+/// `lights` packed for the view uniform ([`viewed_directional_lights`], [`gpu_directional_light`]).
+pub fn pack_directional_lights(lights: &[ExtractedDirectionalLight]) -> ViewedDirectionalLights {
+    let mut packed = [GpuDirectionalLight::default(); MAX_DIRECTIONAL_LIGHTS as usize];
+    let mut count = 0;
+    for (i, l) in viewed_directional_lights(lights) {
+        packed[i as usize] = gpu_directional_light(l);
+        count += 1;
+    }
+    let valid = lights.iter().filter(|l| l.is_valid()).count() as u32;
+    ViewedDirectionalLights { packed, count, dropped: valid - count, invalid: lights.len() as u32 - valid }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

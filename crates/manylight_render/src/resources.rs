@@ -15,7 +15,7 @@ use crate::gpu_types::{
     TEXTURE_SLOT_OCCLUSION, ViewUniform,
 };
 use crate::layouts::{GroupLayout, SCENE_GROUP};
-use crate::lights::{LightReach, buffered_light, gpu_directional_light, viewed_directional_lights};
+use crate::lights::{LightReach, buffered_light, pack_directional_lights};
 use crate::pool::GrowableBuffer;
 use crate::shaders::ShaderDefs;
 use crate::snapshot::{
@@ -520,15 +520,11 @@ impl SceneResources {
         }
         self.lights.invalid_lights = self.lights.invalid_point_lights;
         // Directional lights: the first MAX_DIRECTIONAL_LIGHTS valid ones, in the view uniform.
-        let valid_count = snapshot.directional_lights.iter().filter(|l| l.is_valid()).count() as u32;
-        let mut count = 0usize;
-        for (i, l) in viewed_directional_lights(&snapshot.directional_lights) {
-            self.lights.directional[i as usize] = gpu_directional_light(l);
-            count += 1;
-        }
-        self.lights.invalid_lights += snapshot.directional_lights.len() as u32 - valid_count;
-        self.lights.directional_count = count as u32;
-        self.lights.dropped_directional_lights = valid_count - count as u32;
+        let directional = pack_directional_lights(&snapshot.directional_lights);
+        self.lights.invalid_lights += directional.invalid;
+        self.lights.directional = directional.packed;
+        self.lights.directional_count = directional.count;
+        self.lights.dropped_directional_lights = directional.dropped;
         if self.lights.dropped_directional_lights > 0 {
             tracing::warn!(
                 "{} directional lights past the first {MAX_DIRECTIONAL_LIGHTS} are not drawn",

@@ -23,6 +23,5 @@ pub mod demo;
 pub mod options;
 #[cfg(target_arch = "wasm32")]
 pub mod page;
-#[cfg(target_arch = "wasm32")]
 pub mod readback_canvas;
 pub mod webgl;

@@ -8,6 +8,7 @@
 //! to the page's display slot (and to the app when it asked for that frame). Natively (tests)
 //! the sink waits for each frame, so reports and images come back with their own frame.
 
+use crate::readback_canvas::DisplaySlot;
 use manylight::app::backend::FrameSink;
 use manylight::app::render_world::SinkFrame;
 use manylight::render::readback::PendingImage;
@@ -16,13 +17,10 @@ use manylight::render::texture_lists::lists::take_nonfinite;
 use manylight::render::wgpu;
 use manylight::render::{FrameReport, FrameSnapshot, RenderError};
 use std::collections::VecDeque;
-use std::sync::{Arc, Mutex};
+use std::sync::Mutex;
 
 /// Frames rendered and not yet read back, at most (the app waits for [`FrameSink::ready`]).
 pub const MAX_FRAMES_IN_FLIGHT: usize = 2;
-
-/// Where the newest frame read back goes for display (the page's 2D canvas).
-pub type Display = Arc<Mutex<Option<image::RgbaImage>>>;
 
 /// A frame on its way back: its report, its image copy, and whether the app asked for it.
 struct InFlight {
@@ -42,7 +40,7 @@ struct Queue {
 /// The texture-list renderer as a frame sink (module docs).
 pub struct TextureListSink {
     renderer: TextureListRenderer,
-    display: Option<Display>,
+    display: Option<DisplaySlot>,
     queue: Mutex<Queue>,
     /// The surface whose context the device was found through (the page's WebGL2 canvas),
     /// kept as long as the device.
@@ -51,7 +49,7 @@ pub struct TextureListSink {
 
 impl TextureListSink {
     /// A sink around `renderer` that puts each frame read back into `display`, if given.
-    pub fn new(renderer: TextureListRenderer, display: Option<Display>) -> TextureListSink {
+    pub fn new(renderer: TextureListRenderer, display: Option<DisplaySlot>) -> TextureListSink {
         TextureListSink { renderer, display, queue: Mutex::new(Queue::default()), _surface: None }
     }
 

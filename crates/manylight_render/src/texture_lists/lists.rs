@@ -62,13 +62,9 @@ impl FrameLights {
     /// The light texture's texels, `lights_per_row` lights a row, the last row padded with
     /// zeros (at least one row).
     pub fn texels(&self, lights_per_row: u32) -> Vec<[f32; 4]> {
-        let rows = rows_for(self.packed.len() as u64, lights_per_row);
-        let mut texels = Vec::with_capacity((rows * lights_per_row * TEXELS_PER_LIGHT) as usize);
-        for l in &self.packed {
-            texels.extend([l.position_radius, l.color, l.spot]);
-        }
-        texels.resize(texels.capacity(), [0.0; 4]);
-        texels
+        let texels: Vec<[f32; 4]> =
+            self.packed.iter().flat_map(|l| [l.position_radius, l.color, l.spot]).collect();
+        padded(&texels, lights_per_row * TEXELS_PER_LIGHT, [0.0; 4])
     }
 
     /// The cluster lists of a view of `grid` from `view_from_world`, by the CPU assignment
@@ -93,10 +89,11 @@ pub fn rows_for(entries: u64, width: u32) -> u32 {
 
 /// `data` padded with `fill` to whole rows of `width` (at least one row).
 pub fn padded<T: Copy>(data: &[T], width: u32, fill: T) -> Vec<T> {
-    let rows = rows_for(data.len() as u64, width);
-    let mut out = Vec::with_capacity((rows * width) as usize);
+    // A Vec may hold more than it was asked for: the length is the rows', not the capacity.
+    let len = rows_for(data.len() as u64, width) as usize * width.max(1) as usize;
+    let mut out = Vec::with_capacity(len);
     out.extend_from_slice(data);
-    out.resize(out.capacity(), fill);
+    out.resize(len, fill);
     out
 }
 

@@ -35,11 +35,9 @@ use crate::layouts::{TEXTURE_LISTS_GROUP, TEXTURE_LISTS_VIEW_GROUP};
 use crate::assets::SceneAssets;
 use crate::bindings::Binding;
 use crate::context::{GpuContext, RenderError};
-use crate::gpu_types::{
-    GpuClusterParams, GpuDirectionalLight, GpuInstance, MAX_DIRECTIONAL_LIGHTS, ViewUniform,
-};
+use crate::gpu_types::{GpuClusterParams, GpuInstance, ViewUniform};
 use crate::layouts::GroupLayout;
-use crate::lights::{gpu_directional_light, viewed_directional_lights};
+use crate::lights::pack_directional_lights;
 use crate::readback::HeadlessTarget;
 use crate::resources::view_uniform;
 use crate::resources::{DEPTH_FORMAT, SurfaceVariant};
@@ -201,17 +199,10 @@ impl TextureListRenderer {
         let mut rebind = self.lights.write(&self.gpu, bytemuck::cast_slice(&texels))?;
         report.light_upload_bytes =
             (lights.packed.len() * std::mem::size_of::<crate::gpu_types::GpuPointLight>()) as u64;
-        let mut directional = [GpuDirectionalLight::default(); MAX_DIRECTIONAL_LIGHTS as usize];
-        let mut directional_count = 0;
-        for (i, l) in viewed_directional_lights(&snapshot.directional_lights) {
-            directional[i as usize] = gpu_directional_light(l);
-            directional_count += 1;
-        }
-        let valid_directional = snapshot.directional_lights.iter().filter(|l| l.is_valid()).count() as u32;
-        report.directional_lights = directional_count;
-        report.dropped_directional_lights = valid_directional - directional_count;
-        report.invalid_lights = (snapshot.lights.len() as u32 - lights.valid)
-            + (snapshot.directional_lights.len() as u32 - valid_directional);
+        let directional = pack_directional_lights(&snapshot.directional_lights);
+        report.directional_lights = directional.count;
+        report.dropped_directional_lights = directional.dropped;
+        report.invalid_lights = (snapshot.lights.len() as u32 - lights.valid) + directional.invalid;
         let (draws, instances) = self.prepare_draws(snapshot, &view, &mut report)?;
         report.cpu.upload_ms = ms_since(upload_start);
 
@@ -279,7 +270,7 @@ impl TextureListRenderer {
 
         // 3. The draw.
         let record_start = web_time::Instant::now();
-        let uniform = view_uniform(&view, lights.packed.len() as u32, directional_count, directional);
+        let uniform = view_uniform(&view, lights.packed.len() as u32, directional.count, directional.packed);
         self.gpu.write_buffer(&self.view_buffer, 0, bytemuck::bytes_of(&uniform));
         let bytes = bytemuck::cast_slice::<GpuInstance, u8>(&instances);
         if self.instances.size() < bytes.len() as u64 {
