@@ -11,6 +11,7 @@ pub mod camera;
 pub mod cluster;
 pub mod codec;
 pub mod efficiency;
+pub mod environment;
 pub mod icosphere;
 #[cfg(not(target_arch = "wasm32"))]
 pub mod image_metrics;
