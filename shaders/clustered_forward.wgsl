@@ -4,5 +4,5 @@
 
 @fragment
 fn fs_main(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
-    return vec4<f32>(add_cluster_lights(forward_fragment(in, front_facing), in.clip_position.xy), 1.0);
+    return vec4<f32>(add_cluster_lights(environment_fragment(in, front_facing), in.clip_position.xy), 1.0);
 }

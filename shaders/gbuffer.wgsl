@@ -10,20 +10,26 @@
 //   z = the two material parameters as f16 (`material_slots`: shininess | specular, or
 //   roughness | metallic for PBR), w = the reverse-Z depth of the shading position
 //   (f32 bits); the lighting pass rebuilds the position from that depth.
-// Every layout adds an rgba16f target: the emitted radiance (rgb, clamped to f16's largest
-// value) and the ambient occlusion (a).
+// Every layout adds an rgba16f target: the emitted radiance plus, with ENVIRONMENT, the light
+// of the view's environment (rgb, clamped to f16's largest value; the environment is summed
+// here, as forward passes sum it per fragment, so the G-buffer stores no more for it) and the
+// ambient occlusion (a).
 // Every layout stores the shading position of `surface_point` (common/surface.wgsl), not the
 // rasteriser's interpolation or depth, which drift on triangles much larger than their
 // distance from the camera.
 //!include common/mesh_pass.wgsl
 //!include common/gbuffer_codec.wgsl
+//!include common/environment.wgsl
 
 // The fragment stage writes the layout the shader is composed for (the define GBUFFER_FULL,
 // GBUFFER_PACKED or GBUFFER_COMPACT): one `GBufferOut` and one `fs_main`.
 
-// The emissive target's texel: emitted radiance and occlusion.
-fn emissive_texel(m: MaterialSample) -> vec4<f32> {
-    return vec4<f32>(min(m.emissive, vec3<f32>(65504.0)), m.occlusion);
+// The emissive target's texel at shading point `p`: emitted radiance with the environment's
+// light, and occlusion.
+fn emissive_texel(m: MaterialSample, p: SurfacePoint) -> vec4<f32> {
+    let view_dir = direction_to_eye(view, p.world_position);
+    let radiance = m.emissive + environment_light(m.params, view_dir, m.occlusion);
+    return vec4<f32>(min(radiance, vec3<f32>(65504.0)), m.occlusion);
 }
 
 //!if GBUFFER_FULL
@@ -45,7 +51,7 @@ fn fs_main(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> G
     let slots = material_slots(s);
     out.normal = vec4<f32>(s.normal, slots.x);
     out.albedo = vec4<f32>(s.albedo, saturate(slots.y));
-    out.emissive = emissive_texel(m);
+    out.emissive = emissive_texel(m, p);
     return out;
 }
 //!endif
@@ -67,7 +73,7 @@ fn fs_main(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> G
     var out: GBufferOut;
     out.albedo = vec4<f32>(gbuffer_pack_albedo_params(s), n.x);
     out.position = vec4<f32>(p.world_position, n.y);
-    out.emissive = emissive_texel(m);
+    out.emissive = emissive_texel(m, p);
     return out;
 }
 //!endif
@@ -92,7 +98,7 @@ fn fs_main(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> G
         pack2x16float(material_slots(s)),
         bitcast<u32>(clip.z / clip.w),
     );
-    out.emissive = emissive_texel(m);
+    out.emissive = emissive_texel(m, p);
     return out;
 }
 //!endif

@@ -6,12 +6,12 @@
 
 @fragment
 fn fs_every_light(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
-    let f = forward_fragment(in, front_facing);
+    let f = environment_fragment(in, front_facing);
     return vec4<f32>(add_every_light(f), saturate(f.m.base_color.a));
 }
 
 @fragment
 fn fs_clusters(in: SurfaceVertexOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
-    let f = forward_fragment(in, front_facing);
+    let f = environment_fragment(in, front_facing);
     return vec4<f32>(add_cluster_lights(f, in.clip_position.xy), saturate(f.m.base_color.a));
 }

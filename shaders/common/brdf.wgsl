@@ -91,7 +91,7 @@ fn toon_point_light(s: SurfaceParams, n_dot_l: f32, view_dir: vec3<f32>, l: vec3
 }
 
 // glTF 2.0 metallic-roughness (Appendix B) times n.l, for a light in direction `l` with
-// n_dot_l > 0: GGX distribution, height-correlated Smith visibility, Schlick Fresnel, Lambert
+// n_dot_l > 0: GGX distribution, separable Smith visibility, Schlick Fresnel, Lambert
 // diffuse, split by metallic.
 fn pbr_point_light(s: SurfaceParams, n_dot_l: f32, view_dir: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
     let metallic = clamp(s.metallic, 0.0, 1.0);

@@ -10,6 +10,7 @@ struct ForwardFragment {
     m: MaterialSample,
     view_dir: vec3<f32>,
     // the radiance so far: ambient (with occlusion), emission and the directional lights
+    // (and the environment, `common/light_lists.wgsl`'s `environment_fragment`)
     color: vec3<f32>,
 };
 

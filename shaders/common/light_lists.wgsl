@@ -1,6 +1,7 @@
 // What the passes that shade meshes forward share (naive, tiled and clustered forward, and the
-// transparent pass): the fragment's surface with its ambient, emission and directional lights,
-// then the point and spot lights it sums, either every light or its cluster's list.
+// transparent pass): the fragment's surface with its ambient, emission, environment and
+// directional lights, then the point and spot lights it sums, either every light or its
+// cluster's list.
 //!include common/mesh_pass.wgsl
 //!include common/brdf.wgsl
 //!include common/directional_lights.wgsl
@@ -8,6 +9,15 @@
 // `add_cluster_lights`.
 //!include common/cluster_lists.wgsl
 //!include common/forward_fragment.wgsl
+//!include common/environment.wgsl
+
+// `forward_fragment` with the light of the view's environment added (with ENVIRONMENT; the
+// G-buffer pass adds the same term to its emissive target).
+fn environment_fragment(in: SurfaceVertexOut, front_facing: bool) -> ForwardFragment {
+    var f = forward_fragment(in, front_facing);
+    f.color += environment_light(f.m.params, f.view_dir, f.m.occlusion);
+    return f;
+}
 
 // `f.color` plus every point and spot light, added in order.
 fn add_every_light(f: ForwardFragment) -> vec3<f32> {

@@ -20,6 +20,13 @@ struct ViewUniform {
     viewport: vec4<f32>,
     // x: near, y: near / far (0 without a far plane), z: exposure, w: ambient intensity
     params: vec4<f32>,
+    // the environment's axes from world axes (`common/environment.wgsl`)
+    env_from_world: mat4x4<f32>,
+    // the skybox's axes from world axes (`skybox.wgsl`)
+    sky_from_world: mat4x4<f32>,
+    // x: environment intensity, y: the specular cube's largest mip level, z: skybox
+    // brightness, w: unused
+    environment: vec4<f32>,
     light_count: u32,
     shading_model: u32,
     directional_count: u32,

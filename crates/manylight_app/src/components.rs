@@ -453,6 +453,16 @@ pub type Bloom = manylight_render::BloomSettings;
 /// `RenderSettings::exposure` (a multiplier, 1 by default).
 pub type Exposure = manylight_render::Exposure;
 
+/// Image-based lighting on what the camera sees, Bevy's `EnvironmentMapLight`: the render
+/// crate's [`EnvironmentMapLight`](manylight_render::EnvironmentMapLight) itself, a component.
+/// A camera without it gets no environment bindings and no prefiltering.
+pub type EnvironmentMapLight = manylight_render::EnvironmentMapLight;
+
+/// A panorama behind the camera's geometry, Bevy's `Skybox`: the render crate's
+/// [`Skybox`](manylight_render::Skybox) itself, a component. A camera without it shows the
+/// clear colour.
+pub type Skybox = manylight_render::Skybox;
+
 /// Camera-motion blur on the camera: the render crate's
 /// [`MotionBlurSettings`](manylight_render::MotionBlurSettings) itself, a component. A camera
 /// without it gets no motion-blur pass.

@@ -3,12 +3,14 @@
 
 use crate::backend::{RenderBackend, record_results};
 use crate::components::{
-    Bloom, Camera, Camera3d, CameraDebugView, CameraShadows, CascadeShadowConfig, DirectionalLight, Exposure,
-    GlobalTransform, InheritedVisibility, LightAnimation, Material, Mesh3d, MotionBlur, PointLight,
-    Projection, RenderTarget, SpotLight, Transform, from_linear_rgb, linear_rgb,
+    Bloom, Camera, Camera3d, CameraDebugView, CameraShadows, CascadeShadowConfig, DirectionalLight,
+    EnvironmentMapLight, Exposure, GlobalTransform, InheritedVisibility, LightAnimation, Material, Mesh3d,
+    MotionBlur, PointLight, Projection, RenderTarget, Skybox, SpotLight, Transform, from_linear_rgb,
+    linear_rgb,
 };
 use crate::resources::{
-    DebugView, HeadlessCapture, LightAnimationMode, RenderFailure, RenderSettings, ViewportSize,
+    DebugView, EnvironmentImages, HeadlessCapture, LightAnimationMode, RenderFailure, RenderSettings,
+    ViewportSize,
 };
 use crate::stages::{ExtractedCameraComponents, RenderStages};
 use bevy_app::AppExit;
@@ -97,6 +99,10 @@ pub struct CameraItem {
     pub debug_view: Option<&'static CameraDebugView>,
     /// Its exposure.
     pub exposure: Option<&'static Exposure>,
+    /// The environment that lights what it sees.
+    pub environment: Option<&'static EnvironmentMapLight>,
+    /// The panorama behind its geometry.
+    pub skybox: Option<&'static Skybox>,
     /// Its shadows checkbox (shadows shown without one).
     pub shadows: Option<&'static CameraShadows>,
 }
@@ -162,6 +168,7 @@ pub struct ExtractInputs<'w, 's> {
     removed_points: RemovedComponents<'w, 's, PointLight>,
     removed_spots: RemovedComponents<'w, 's, SpotLight>,
     directional_lights: Query<'w, 's, DirectionalItem, (Without<PointLight>, Without<SpotLight>)>,
+    environments: Option<Res<'w, EnvironmentImages>>,
 }
 
 /// Builds the frame's snapshot from the world; the components an app extracts per camera are
@@ -178,6 +185,7 @@ pub fn build_snapshot(
     let snapshot = FrameSnapshot {
         frame_index: state.frame_index,
         viewport,
+        environments: used_environments(&views, world.environments.as_deref()),
         views,
         instances,
         // Shares every chunk no light of which changed with the frames before.
@@ -190,6 +198,23 @@ pub fn build_snapshot(
     };
     state.frame_index += 1;
     snapshot
+}
+
+/// The panoramas the views' environments and skyboxes name (none, and no allocation, when no
+/// camera has either).
+fn used_environments(views: &[ExtractedView], images: Option<&EnvironmentImages>) -> EnvironmentImages {
+    let mut used = EnvironmentImages::default();
+    let Some(images) = images else { return used };
+    for (handle, image) in images.iter() {
+        let named = views.iter().any(|v| {
+            v.camera.environment.is_some_and(|e| e.image == handle)
+                || v.camera.skybox.is_some_and(|s| s.image == handle)
+        });
+        if named {
+            used.insert(handle, image.clone());
+        }
+    }
+    used
 }
 
 /// One view per active camera, lowest order first, each with its last frame's matrix (kept in
@@ -229,6 +254,8 @@ fn extract_views(
                 bloom: item.bloom.copied(),
                 motion_blur: item.motion_blur.copied(),
                 exposure: item.exposure.copied(),
+                environment: item.environment.copied(),
+                skybox: item.skybox.copied(),
             },
             target,
             rect,

@@ -29,14 +29,15 @@ pub mod window;
 pub use backend::RenderFailed;
 pub use components::{
     Bloom, Camera, Camera3d, CameraDebugView, CameraShadows, CascadeShadowConfig, CascadeShadowConfigBuilder,
-    Color, DirectionalLight, Exposure, GlobalTransform, InheritedVisibility, LightAnimation, Material,
-    Mesh3d, MotionBlur, OrthographicProjection, PerspectiveProjection, PointLight, Projection, RenderImage,
-    RenderTarget, SpotLight, Transform, Viewport, Visibility, from_linear_rgb, linear_rgb,
+    Color, DirectionalLight, EnvironmentMapLight, Exposure, GlobalTransform, InheritedVisibility,
+    LightAnimation, Material, Mesh3d, MotionBlur, OrthographicProjection, PerspectiveProjection, PointLight,
+    Projection, RenderImage, RenderTarget, Skybox, SpotLight, Transform, Viewport, Visibility,
+    from_linear_rgb, linear_rgb,
 };
 pub use plugin::{HEADLESS_TIME_STEP, HeadlessConfig, ManyLightPlugin, ManyLightSystems, OutputMode};
 pub use resources::{
-    DebugView, FrameStats, FrameTotals, FramesInFlight, HeadlessCapture, LightAnimationMode, LightControls,
-    RenderFailure, RenderSettings, RenderedImages, ViewportSize,
+    DebugView, EnvironmentImages, FrameStats, FrameTotals, FramesInFlight, HeadlessCapture,
+    LightAnimationMode, LightControls, RenderFailure, RenderSettings, RenderedImages, ViewportSize,
 };
 pub use window::{Overlay, PressedKeys, WindowConfig, WindowRequests};
 
@@ -49,14 +50,15 @@ pub mod prelude {
 
     pub use crate::components::{
         Bloom, Camera, Camera3d, CameraDebugView, CameraShadows, CascadeShadowConfig,
-        CascadeShadowConfigBuilder, Color, DirectionalLight, Exposure, GlobalTransform, InheritedVisibility,
-        LightAnimation, Material, Mesh3d, MotionBlur, OrthographicProjection, PerspectiveProjection,
-        PointLight, Projection, RenderImage, RenderTarget, SpotLight, Transform, Viewport, Visibility,
+        CascadeShadowConfigBuilder, Color, DirectionalLight, EnvironmentMapLight, Exposure, GlobalTransform,
+        InheritedVisibility, LightAnimation, Material, Mesh3d, MotionBlur, OrthographicProjection,
+        PerspectiveProjection, PointLight, Projection, RenderImage, RenderTarget, Skybox, SpotLight,
+        Transform, Viewport, Visibility,
     };
     pub use crate::plugin::{ManyLightPlugin, ManyLightSystems};
     pub use crate::resources::{
-        DebugView, FrameStats, HeadlessCapture, LightAnimationMode, LightControls, RenderSettings,
-        RenderedImages,
+        DebugView, EnvironmentImages, FrameStats, HeadlessCapture, LightAnimationMode, LightControls,
+        RenderSettings, RenderedImages,
     };
     pub use crate::scene::{spawn_light_rig, spawn_scene};
     pub use crate::stages::{ExtractCameraComponentPlugin, ManyLightAppExt, RenderStages};

@@ -4,6 +4,9 @@ use bevy_ecs::prelude::*;
 use glam::UVec2;
 use manylight_render::{DebugViewMode, FrameReport, FrameSettings};
 
+/// The panoramas cameras' [`EnvironmentMapLight`](crate::EnvironmentMapLight)s and
+/// [`Skybox`](crate::Skybox)es name: the render crate's type itself, a resource.
+pub use manylight_render::EnvironmentImages;
 pub use manylight_render::RenderSettings;
 
 /// What views are rendered with: `settings` and the debug view of `debug` (a camera's

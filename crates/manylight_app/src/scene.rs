@@ -255,6 +255,8 @@ pub fn scene_snapshot(
             bloom: None,
             motion_blur: None,
             exposure: None,
+            environment: None,
+            skybox: None,
         })],
         instances: scene
             .instances
@@ -270,5 +272,6 @@ pub fn scene_snapshot(
         lights: lights.into(),
         settings,
         pixel_light_lists: None,
+        environments: Default::default(),
     }
 }

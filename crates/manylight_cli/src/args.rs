@@ -295,6 +295,34 @@ pub(crate) struct RenderArgs {
     pub(crate) shadow_reference: Option<PathBuf>,
     #[command(flatten)]
     pub(crate) post: PostArgs,
+    #[command(flatten)]
+    pub(crate) environment: EnvironmentArgs,
+}
+
+/// Image-based lighting of `render`: an HDR panorama that lights the scene and, by default,
+/// shows behind it.
+#[derive(clap::Args, Clone, Debug)]
+pub(crate) struct EnvironmentArgs {
+    /// An equirectangular HDR panorama (.hdr or .exr) that lights the scene (split-sum
+    /// image-based lighting in every pipeline), e.g. assets/environments/studio_small_03.hdr.
+    #[arg(long)]
+    pub(crate) environment: Option<PathBuf>,
+    /// Multiplies the panorama's radiance where it lights the scene.
+    #[arg(long, default_value_t = 1.0, requires = "environment", value_parser = parse_environment_intensity)]
+    pub(crate) environment_intensity: f32,
+    /// `on` (default) draws the panorama behind the geometry, `off` keeps the clear colour.
+    #[arg(long, default_value = "on", requires = "environment", value_parser = parse_on_off, action = clap::ArgAction::Set)]
+    pub(crate) skybox: bool,
+}
+
+/// A finite, non-negative multiplier.
+fn parse_environment_intensity(s: &str) -> Result<f32, String> {
+    let value: f32 = s.parse().map_err(|e| format!("environment intensity `{s}`: {e}"))?;
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(format!("environment intensity `{s}`: a finite number of at least 0"))
+    }
 }
 
 /// Opt-in post stages of `render`.

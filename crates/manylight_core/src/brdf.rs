@@ -2,8 +2,9 @@
 //! operations in the same order, for tests and CPU reference images.
 //!
 //! [`ShadingModel::Pbr`] is glTF 2.0 metallic-roughness (the specification's Appendix B):
-//! Trowbridge-Reitz (GGX) distribution, height-correlated Smith visibility, Schlick Fresnel and a
-//! Lambert diffuse lobe, with the energy split by metallic:
+//! Trowbridge-Reitz (GGX) distribution, separable Smith visibility (G1(l) G1(v) / (4 n.l n.v),
+//! as the specification writes it), Schlick Fresnel and a Lambert diffuse lobe, with the energy
+//! split by metallic:
 //!
 //! ```text
 //! c_diff = lerp(base, 0, metallic)         f0 = lerp(0.04, base, metallic)    a = roughness^2

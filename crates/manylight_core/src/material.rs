@@ -14,7 +14,7 @@ pub enum ShadingModel {
     /// Cel shading: each light's diffuse term in [`TOON_BANDS`] flat bands, plus a rim light
     /// on silhouettes the light reaches (`shade_reached_light` in `shaders/common/brdf.wgsl`).
     Toon,
-    /// glTF 2.0 metallic-roughness: GGX distribution, height-correlated Smith visibility,
+    /// glTF 2.0 metallic-roughness: GGX distribution, separable Smith visibility,
     /// Schlick Fresnel and Lambert diffuse, split by metallic ([`crate::brdf`]).
     #[default]
     Pbr,

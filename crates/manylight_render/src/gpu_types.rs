@@ -181,6 +181,13 @@ pub struct ViewUniform {
     pub viewport: Vec4,
     /// near, near / far (0 without a far plane), exposure, ambient.
     pub params: Vec4,
+    /// The environment's axes from world axes (its `EnvironmentMapLight::rotation`, inverted).
+    pub env_from_world: Mat4,
+    /// The skybox's axes from world axes (its `Skybox::rotation`, inverted).
+    pub sky_from_world: Mat4,
+    /// x: environment intensity, y: the specular cube's largest mip level, z: skybox
+    /// brightness, w: unused.
+    pub environment: Vec4,
     /// Number of lights in the light buffer.
     pub light_count: u32,
     /// Global shading model id.

@@ -174,6 +174,8 @@ pub struct PassContext<'a> {
     pub clusters: Option<&'a crate::clusters::ClusterResources>,
     /// The shadow atlas and its pass's buffers (`None` outside a renderer).
     pub shadows: Option<&'a crate::shadows::ShadowResources>,
+    /// The prefiltered environments (`None` outside a renderer).
+    pub environments: Option<&'a crate::environment::EnvironmentMaps>,
     /// Bind groups and uniform buffers kept across frames (record creates none in steady
     /// state).
     pub bindings: &'a crate::bindings::BindingCache,

@@ -26,6 +26,8 @@ pub mod bindings;
 pub mod clusters;
 #[doc(hidden)]
 pub mod context;
+#[doc(hidden)]
+pub mod environment;
 pub mod ext;
 #[doc(hidden)]
 pub mod gpu_types;
@@ -81,9 +83,9 @@ pub use settings::{CameraShadows, CascadeShadowConfig, CascadeShadowConfigBuilde
 pub use shadows::{ShadowReport, ShadowSettings};
 pub use snapshot::{
     BloomChain, BloomSettings, ClusterSettings, DEFAULT_COARSE_TILES, DebugViewMode, DirectionalShadow,
-    Exposure, ExtractedCamera, ExtractedDirectionalLight, ExtractedInstance, ExtractedPointLight,
-    ExtractedView, FrameSettings, FrameSnapshot, GBufferLayout, LIGHT_CHUNK, LightChunk, MotionBlurSettings,
-    PipelineKind, PointLights, RenderSettings, RenderTextureId, RenderView, ShadowBias, ViewComponents,
-    ViewRect, ViewTarget,
+    EnvironmentFilter, EnvironmentHandle, EnvironmentImages, EnvironmentMapLight, Exposure, ExtractedCamera,
+    ExtractedDirectionalLight, ExtractedInstance, ExtractedPointLight, ExtractedView, FrameSettings,
+    FrameSnapshot, GBufferLayout, LIGHT_CHUNK, LightChunk, MotionBlurSettings, PipelineKind, PointLights,
+    RenderSettings, RenderTextureId, RenderView, ShadowBias, Skybox, ViewComponents, ViewRect, ViewTarget,
 };
 pub use stats::{CpuPhases, FrameReport, PassTiming, ViewReport};

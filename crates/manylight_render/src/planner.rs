@@ -65,6 +65,7 @@ pub fn builtin_stages() -> Vec<Stage> {
         Stage::new::<DeferredLightingPass>(deferred_lighting::plan),
         Stage::new::<TiledDeferredPass>(tiled_deferred::plan),
         Stage::new::<LightVolumesPass>(light_volumes::plan),
+        Stage::new::<SkyboxPass>(skybox::plan),
         Stage::new::<TransparentPass>(transparent::plan),
         Stage::new::<MotionBlurPass>(motion_blur::plan),
         Stage::new::<BloomBrightPass>(bloom::plan),

@@ -30,6 +30,8 @@ pub struct Renderer {
     pub scene: SceneResources,
     /// The shadow atlas and its pass's buffers.
     pub shadows: crate::shadows::ShadowResources,
+    /// The prefiltered environment maps the views name.
+    pub environments: crate::environment::EnvironmentMaps,
     /// Pipelines created so far.
     pub pipelines: PipelineCache,
     /// Cluster buffers of each view (by its position in the frame's views), created the first
@@ -63,6 +65,7 @@ impl Renderer {
         Renderer {
             scene: SceneResources::new(&gpu),
             shadows: crate::shadows::ShadowResources::new(&gpu),
+            environments: crate::environment::EnvironmentMaps::new(),
             pipelines: PipelineCache::default(),
             clusters: Vec::new(),
             pool: TransientPool::default(),
@@ -113,7 +116,8 @@ impl Renderer {
         self.bindings.begin_frame();
         self.scene.prepare(&self.gpu, snapshot)?;
         self.shadows.prepare(&self.gpu, &self.scene, snapshot)?;
-        self.scene.bind_view(&self.gpu, self.shadows.bindings());
+        self.environments.prepare(&self.gpu, snapshot)?;
+        self.scene.bind_view(&self.gpu, self.shadows.bindings(), None);
         self.pixel_light_lists = snapshot.pixel_light_lists.clone();
         // Views that went away free their cluster buffers.
         self.clusters.truncate(snapshot.views.len().max(1));
@@ -148,7 +152,10 @@ impl Renderer {
         self.scene.prepare_view(&self.gpu, view);
         // A view whose camera's shadows checkbox is off binds and shades without shadows.
         let shadows = self.shadows.bindings().filter(|_| view.settings.render.shadows.enabled);
-        self.scene.bind_view(&self.gpu, shadows);
+        let filter = view.settings.render.environment_filter;
+        let environment =
+            view.camera.and_then(|c| c.environment).and_then(|e| self.environments.bindings(e.image, filter));
+        self.scene.bind_view(&self.gpu, shadows, environment);
         if view.needs_clusters(has_lights) {
             if self.clusters.len() <= view.index {
                 self.clusters.resize_with(view.index + 1, || None);
@@ -435,6 +442,7 @@ impl Renderer {
                 pipelines: &self.pipelines,
                 clusters,
                 shadows: Some(&self.shadows),
+                environments: Some(&self.environments),
                 bindings: &self.bindings,
                 encoder,
                 output_format,

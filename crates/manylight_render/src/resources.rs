@@ -9,6 +9,7 @@
 use crate::assets::SceneAssets;
 use crate::bindings::Binding;
 use crate::context::{GpuContext, RenderError};
+use crate::environment::EnvironmentBindings;
 use crate::gpu_types::{
     GpuDirectionalLight, GpuInstance, GpuPointLight, MAX_DIRECTIONAL_LIGHTS, SHADING_GLOBAL,
     TEXTURE_SLOT_BASE_COLOR, TEXTURE_SLOT_EMISSIVE, TEXTURE_SLOT_METALLIC_ROUGHNESS, TEXTURE_SLOT_NORMAL,
@@ -62,8 +63,11 @@ pub struct SurfaceVariant {
     /// branch on the material's model).
     pub shading: u32,
     /// The frame's lights cast shadows: the shaders are composed with `SHADOWS` and group 0
-    /// has the shadow bindings (set per frame by [`SurfaceVariant::with_shadows`]).
+    /// has the shadow bindings (set per view by [`SurfaceVariant::with_view`]).
     pub shadows: bool,
+    /// The view has an environment: the shaders are composed with `ENVIRONMENT` and group 0
+    /// has its maps (set per view by [`SurfaceVariant::with_view`]).
+    pub environment: bool,
 }
 
 impl SurfaceVariant {
@@ -83,17 +87,23 @@ impl SurfaceVariant {
                 .fold(0, |bits, (slot, _)| bits | 1 << slot),
             shading: material.shading.map_or(SHADING_GLOBAL, |s| s.gpu_id()),
             shadows: false,
+            environment: false,
         }
     }
 
-    /// The variant in a frame whose lights cast shadows (`shadows`) or not.
-    pub fn with_shadows(self, shadows: bool) -> SurfaceVariant {
-        SurfaceVariant { shadows, ..self }
+    /// The variant for a view whose group 0 is composed with `view` (its `SHADOWS` and
+    /// `ENVIRONMENT`).
+    pub fn with_view(self, view: ShaderDefs) -> SurfaceVariant {
+        SurfaceVariant { shadows: view.shadows, environment: view.environment, ..self }
     }
 
     /// The shader defines of the variant.
     pub fn defs(self) -> crate::shaders::ShaderDefs {
-        crate::shaders::ShaderDefs { shadows: self.shadows, ..Default::default() }
+        crate::shaders::ShaderDefs {
+            shadows: self.shadows,
+            environment: self.environment,
+            ..Default::default()
+        }
     }
 
     /// The variant with the view's model `global` (`ShadingModel::gpu_id`) where the material
@@ -188,8 +198,9 @@ impl ChunkSummary {
     }
 }
 
-/// A group 0 and the generations of the buffers (lights, instances, shadows) it was made from.
-type BoundView = ((u64, u64, u64), wgpu::BindGroup);
+/// A group 0 and the generations of the buffers (lights, instances, shadows, environment) it
+/// was made from.
+type BoundView = ((u64, u64, u64, u64), wgpu::BindGroup);
 
 /// Scene data on the GPU for the current frame: group 0 and the view constants
 /// ([`ViewBindings`]), the lights ([`SceneLights`]), the instances and their draws
@@ -210,24 +221,43 @@ pub struct SceneResources {
 
 /// Group 0 of every scene pass ([`SCENE_GROUP`]) and the view constants it holds.
 pub struct ViewBindings {
-    /// Layout of group 0 this frame: view uniform, lights, instances, and the shadow bindings
-    /// when [`ViewBindings::shadows_active`].
+    /// Layout of group 0 for this view: view uniform, lights, instances, the shadow bindings
+    /// when [`ViewBindings::shadows_active`] and the environment's when
+    /// [`ViewBindings::environment_active`].
     pub layout: GroupLayout,
-    /// Group 0's layout without shadows.
-    plain_layout: GroupLayout,
-    /// Group 0's layout with shadows.
-    shadowed_layout: GroupLayout,
+    /// Group 0's layouts, by [`flavor`]: without and with shadows, without and with an
+    /// environment.
+    layouts: [GroupLayout; 4],
     /// This frame's lights cast shadows: group 0 holds the shadow bindings and every shading
     /// pipeline is composed with `SHADOWS`.
     pub shadows_active: bool,
+    /// The view has an environment: group 0 holds its maps and the surface pipelines are
+    /// composed with `ENVIRONMENT`.
+    pub environment_active: bool,
     /// Group 0 for this frame.
     pub bind_group: wgpu::BindGroup,
     /// The view uniform buffer.
     pub buffer: wgpu::Buffer,
     /// The frame's view constants as uploaded.
     pub uniform: ViewUniform,
-    /// Group 0 without (0) and with (1) the shadow bindings.
-    bound: [Option<BoundView>; 2],
+    /// Group 0 of each [`flavor`], as last made.
+    bound: [Option<BoundView>; 4],
+}
+
+/// The index of a group 0 layout: shadows in bit 0, an environment in bit 1.
+fn flavor(shadows: bool, environment: bool) -> usize {
+    usize::from(shadows) | usize::from(environment) << 1
+}
+
+impl ViewBindings {
+    /// The defines group 0's bindings this view are composed with (`SHADOWS`, `ENVIRONMENT`).
+    pub fn defs(&self) -> ShaderDefs {
+        ShaderDefs {
+            shadows: self.shadows_active,
+            environment: self.environment_active,
+            ..Default::default()
+        }
+    }
 }
 
 /// The frame's lights on the GPU: the point and spot lights' buffer (written only where lights
@@ -315,9 +345,11 @@ impl SceneResources {
     /// Creates the layouts and empty buffers.
     pub fn new(gpu: &GpuContext) -> SceneResources {
         let device = &gpu.device;
-        let view_layout = SCENE_GROUP.create_layout(device, ShaderDefs::default());
-        let shadowed_view_layout =
-            SCENE_GROUP.create_layout(device, ShaderDefs { shadows: true, ..Default::default() });
+        let layouts =
+            [(false, false), (true, false), (false, true), (true, true)].map(|(shadows, environment)| {
+                SCENE_GROUP.create_layout(device, ShaderDefs { shadows, environment, ..Default::default() })
+            });
+        let view_layout = layouts[flavor(false, false)].clone();
         let view_buffer = gpu.create_buffer(&wgpu::BufferDescriptor {
             label: Some("view_uniform"),
             size: std::mem::size_of::<ViewUniform>() as u64,
@@ -330,17 +362,17 @@ impl SceneResources {
         let lights = GrowableBuffer::new(gpu, "point_lights", storage_usage, light_bytes);
         let instances = GrowableBuffer::new(gpu, "instances", storage_usage, 64 * 128);
         let view_bind_group =
-            Self::make_view_bind_group(gpu, &view_layout, &view_buffer, &lights, &instances, None);
+            Self::make_view_bind_group(gpu, &view_layout, &view_buffer, &lights, &instances, None, None);
         SceneResources {
             view: ViewBindings {
-                plain_layout: view_layout.clone(),
                 layout: view_layout,
-                shadowed_layout: shadowed_view_layout,
+                layouts,
                 shadows_active: false,
+                environment_active: false,
                 bind_group: view_bind_group,
                 buffer: view_buffer,
                 uniform: ViewUniform::zeroed_default(),
-                bound: [None, None],
+                bound: [None, None, None, None],
             },
             lights: SceneLights {
                 buffer: lights,
@@ -379,6 +411,7 @@ impl SceneResources {
         lights: &GrowableBuffer,
         instances: &GrowableBuffer,
         shadows: Option<&ShadowBindings<'_>>,
+        environment: Option<&EnvironmentBindings<'_>>,
     ) -> wgpu::BindGroup {
         let mut resources = vec![
             Binding::Buffer(view),
@@ -393,23 +426,38 @@ impl SceneResources {
                 Binding::Buffer(shadows.directional),
             ]);
         }
+        if let Some(environment) = environment {
+            resources.extend([
+                Binding::Texture(environment.specular),
+                Binding::Texture(environment.irradiance),
+                Binding::Texture(environment.lut),
+                Binding::Sampler(environment.sampler),
+            ]);
+        }
         layout.create_bind_group(gpu, &resources)
     }
 
-    /// Binds group 0 for a view (after [`SceneResources::prepare`] and the shadows'
-    /// `prepare`): with the shadow atlas, its sampler and light table when `shadows` is given,
-    /// else without them. A group with and one without are kept, so views that differ only in
-    /// their shadows checkbox switch between them; each is re-created only when a buffer or
-    /// the atlas changed.
-    pub fn bind_view(&mut self, gpu: &GpuContext, shadows: Option<ShadowBindings<'_>>) {
-        let active = shadows.is_some();
+    /// Binds group 0 for a view (after [`SceneResources::prepare`], the shadows' and the
+    /// environments' `prepare`): with the shadow atlas, its sampler and light table when
+    /// `shadows` is given, with the environment's maps when `environment` is, else without
+    /// them. One group of each combination is kept, so views that differ only in their
+    /// shadows checkbox or environment switch between them; each is re-created only when a
+    /// buffer, the atlas or the environment changed.
+    pub fn bind_view(
+        &mut self,
+        gpu: &GpuContext,
+        shadows: Option<ShadowBindings<'_>>,
+        environment: Option<EnvironmentBindings<'_>>,
+    ) {
+        let index = flavor(shadows.is_some(), environment.is_some());
         let generations = (
             self.lights.buffer.generation(),
             self.instances.buffer.generation(),
             shadows.as_ref().map_or(0, |s| s.generation + 1),
+            environment.as_ref().map_or(0, |e| e.generation + 1),
         );
-        let layout = if active { &self.view.shadowed_layout } else { &self.view.plain_layout };
-        let slot = &mut self.view.bound[usize::from(active)];
+        let layout = &self.view.layouts[index];
+        let slot = &mut self.view.bound[index];
         if slot.as_ref().is_none_or(|(g, _)| *g != generations) {
             let group = Self::make_view_bind_group(
                 gpu,
@@ -418,13 +466,15 @@ impl SceneResources {
                 &self.lights.buffer,
                 &self.instances.buffer,
                 shadows.as_ref(),
+                environment.as_ref(),
             );
             *slot = Some((generations, group));
         }
         if let Some((_, group)) = slot {
             self.view.bind_group = group.clone();
         }
-        self.view.shadows_active = active;
+        self.view.shadows_active = shadows.is_some();
+        self.view.environment_active = environment.is_some();
         self.view.layout = layout.clone();
     }
 
@@ -616,6 +666,9 @@ impl ViewUniform {
             camera_position: Vec4::W,
             viewport: Vec4::ONE,
             params: Vec4::new(0.1, 1000.0, 1.0, 0.0),
+            env_from_world: Mat4::IDENTITY,
+            sky_from_world: Mat4::IDENTITY,
+            environment: Vec4::ZERO,
             light_count: 0,
             shading_model: 0,
             directional_count: 0,
@@ -651,6 +704,18 @@ pub(crate) fn view_uniform(
                 camera_position: cam.position().extend(1.0),
                 viewport: viewport_vec(size),
                 params: Vec4::new(p.near, p.near_over_far(), view.exposure(), settings.ambient),
+                env_from_world: Mat4::from_quat(
+                    cam.environment.map_or(glam::Quat::IDENTITY, |e| e.rotation).inverse(),
+                ),
+                sky_from_world: Mat4::from_quat(
+                    cam.skybox.map_or(glam::Quat::IDENTITY, |s| s.rotation).inverse(),
+                ),
+                environment: Vec4::new(
+                    cam.environment.map_or(0.0, |e| e.intensity),
+                    (settings.environment_filter.specular_mips() - 1) as f32,
+                    cam.skybox.map_or(0.0, |s| s.brightness),
+                    0.0,
+                ),
                 light_count,
                 shading_model: settings.shading.gpu_id(),
                 directional_count,

@@ -34,6 +34,10 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("common/point_lights.wgsl", include_str!("../shaders/common/point_lights.wgsl")),
     ("common/shadow_types.wgsl", include_str!("../shaders/common/shadow_types.wgsl")),
     ("common/shadows.wgsl", include_str!("../shaders/common/shadows.wgsl")),
+    ("common/environment_map.wgsl", include_str!("../shaders/common/environment_map.wgsl")),
+    ("common/environment.wgsl", include_str!("../shaders/common/environment.wgsl")),
+    ("environment_prefilter.wgsl", include_str!("../shaders/environment_prefilter.wgsl")),
+    ("skybox.wgsl", include_str!("../shaders/skybox.wgsl")),
     ("shadow_maps.wgsl", include_str!("../shaders/shadow_maps.wgsl")),
     ("shadow_probe.wgsl", include_str!("../shaders/shadow_probe.wgsl")),
     ("light_volumes.wgsl", include_str!("../shaders/light_volumes.wgsl")),
@@ -88,6 +92,10 @@ pub struct ShaderDefs {
     /// (`common/gbuffer_read.wgsl` gives it `gbuffer_read`, `gbuffer.wgsl` its `GBufferOut`), so
     /// each pass has one entry point whatever the layout.
     pub gbuffer: Option<crate::snapshot::GBufferLayout>,
+    /// `ENVIRONMENT`: surfaces add the light of the view's environment map
+    /// (`common/environment.wgsl`): its prefiltered cubes, lookup table and sampler are bound
+    /// in group 0.
+    pub environment: bool,
 }
 
 impl ShaderDefs {
@@ -97,10 +105,11 @@ impl ShaderDefs {
     }
 
     /// The defines a shader can test, with their state.
-    fn flags(self) -> [(&'static str, bool); 6] {
+    fn flags(self) -> [(&'static str, bool); 7] {
         use crate::snapshot::GBufferLayout;
         [
             ("SHADOWS", self.shadows),
+            ("ENVIRONMENT", self.environment),
             ("CLIP_DISTANCES", self.clip_distances),
             ("GBUFFER", self.gbuffer.is_some()),
             ("GBUFFER_FULL", self.gbuffer == Some(GBufferLayout::Full)),

@@ -14,8 +14,9 @@ pub use crate::lights::{
     ShadowBias,
 };
 pub use crate::settings::{
-    BloomChain, BloomSettings, ClusterSettings, DEFAULT_COARSE_TILES, DebugViewMode, Exposure, FrameSettings,
-    GBufferLayout, MotionBlurSettings, PipelineKind, RenderSettings,
+    BloomChain, BloomSettings, ClusterSettings, DEFAULT_COARSE_TILES, DebugViewMode, EnvironmentFilter,
+    EnvironmentHandle, EnvironmentImages, EnvironmentMapLight, Exposure, FrameSettings, GBufferLayout,
+    MotionBlurSettings, PipelineKind, RenderSettings, Skybox,
 };
 
 /// The camera as the render side sees it.
@@ -34,6 +35,10 @@ pub struct ExtractedCamera {
     pub motion_blur: Option<MotionBlurSettings>,
     /// The camera's exposure, when it has one (else `RenderSettings::exposure`).
     pub exposure: Option<Exposure>,
+    /// The environment that lights what the camera sees, when it has one.
+    pub environment: Option<EnvironmentMapLight>,
+    /// The panorama behind the geometry, when the camera has one (else the clear colour).
+    pub skybox: Option<Skybox>,
 }
 
 impl ExtractedCamera {
@@ -279,6 +284,9 @@ pub struct FrameSnapshot {
     /// [`FrameSnapshot::lights`]). For a single view. `None` (the default): the cluster build
     /// makes the lists.
     pub pixel_light_lists: Option<Arc<manylight_core::cluster::ClusterAssignment>>,
+    /// The panoramas the views' environments and skyboxes name (at least those; the renderer
+    /// prefilters each handle once and frees its maps when no view names it).
+    pub environments: EnvironmentImages,
     /// CPU time the main world took to extract this snapshot, in milliseconds (0 for a snapshot
     /// made without an app); reported as `CpuPhases::extract_ms`.
     pub extract_cpu_ms: f64,

@@ -38,7 +38,9 @@ fn all_defs() -> Vec<ShaderDefs> {
     for shadows in [false, true] {
         for clip_distances in [false, true] {
             for gbuffer in GBUFFER_CHOICES {
-                out.push(ShaderDefs { shadows, clip_distances, gbuffer });
+                for environment in [false, true] {
+                    out.push(ShaderDefs { shadows, clip_distances, gbuffer, environment });
+                }
             }
         }
     }
@@ -263,6 +265,9 @@ fn shared_structs_match_rust() {
             ("camera_position", offset_of!(ViewUniform, camera_position)),
             ("viewport", offset_of!(ViewUniform, viewport)),
             ("params", offset_of!(ViewUniform, params)),
+            ("env_from_world", offset_of!(ViewUniform, env_from_world)),
+            ("sky_from_world", offset_of!(ViewUniform, sky_from_world)),
+            ("environment", offset_of!(ViewUniform, environment)),
             ("light_count", offset_of!(ViewUniform, light_count)),
             ("shading_model", offset_of!(ViewUniform, shading_model)),
             ("directional_count", offset_of!(ViewUniform, directional_count)),
@@ -503,12 +508,28 @@ fn kind_matches(kind: BindingKind, module: &naga::Module, var: &naga::GlobalVari
                 }
         }
         (
+            BindingKind::Cube(wgpu::TextureSampleType::Float { .. }),
+            AddressSpace::Handle,
+            TypeInner::Image { dim, arrayed, class: ImageClass::Sampled { kind, multi } },
+        ) => *dim == ImageDimension::Cube && !arrayed && *kind == ScalarKind::Float && !multi,
+        (
             BindingKind::StorageTexture(format),
             AddressSpace::Handle,
-            TypeInner::Image { class: ImageClass::Storage { format: naga_format, access }, .. },
+            TypeInner::Image { dim, arrayed, class: ImageClass::Storage { format: naga_format, access } },
         ) => {
-            format == wgpu::TextureFormat::Rgba16Float
-                && *naga_format == naga::StorageFormat::Rgba16Float
+            *dim == ImageDimension::D2
+                && !arrayed
+                && storage_format_matches(format, *naga_format)
+                && *access == naga::StorageAccess::STORE
+        }
+        (
+            BindingKind::StorageTextureArray(format),
+            AddressSpace::Handle,
+            TypeInner::Image { dim, arrayed, class: ImageClass::Storage { format: naga_format, access } },
+        ) => {
+            *dim == ImageDimension::D2
+                && *arrayed
+                && storage_format_matches(format, *naga_format)
                 && *access == naga::StorageAccess::STORE
         }
         (BindingKind::Sampler(ty), AddressSpace::Handle, TypeInner::Sampler { comparison }) => {
@@ -516,6 +537,15 @@ fn kind_matches(kind: BindingKind, module: &naga::Module, var: &naga::GlobalVari
         }
         _ => false,
     }
+}
+
+/// Whether a storage texture's WGSL format is the one its Rust declaration names.
+fn storage_format_matches(format: wgpu::TextureFormat, naga_format: naga::StorageFormat) -> bool {
+    matches!(
+        (format, naga_format),
+        (wgpu::TextureFormat::Rgba16Float, naga::StorageFormat::Rgba16Float)
+            | (wgpu::TextureFormat::Rgba32Float, naga::StorageFormat::Rgba32Float)
+    )
 }
 
 /// The stage of an entry point as wgpu names it.

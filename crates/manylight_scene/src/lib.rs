@@ -5,6 +5,7 @@
 #![warn(missing_docs)]
 
 mod default_scene;
+pub mod environment;
 mod error;
 mod gltf_loader;
 mod light_rig;
@@ -13,6 +14,9 @@ pub mod shapes;
 mod textures;
 
 pub use default_scene::default_scene;
+#[cfg(not(target_arch = "wasm32"))]
+pub use environment::load_environment;
+pub use environment::{DecodedEnvironment, EnvironmentBudget, EnvironmentError, decode_environment};
 pub use error::SceneError;
 pub use gltf_loader::{
     FetchedFiles, LoadOptions, MAX_DOWNSCALED_SOURCE, OversizedTextures, ReferencedFile,

@@ -15,8 +15,8 @@
 //! F1 (or [`Overlay::visible`]) hides it: no UI is built and no pass runs. Headless there is no
 //! overlay at all: no window, no events, no pass.
 
-use crate::components::{Bloom, Camera3d, MotionBlur};
-use crate::resources::{DebugView, FrameStats, LightControls, RenderSettings};
+use crate::components::{Bloom, Camera3d, EnvironmentMapLight, MotionBlur, Skybox};
+use crate::resources::{DebugView, EnvironmentImages, FrameStats, LightControls, RenderSettings};
 use bevy_ecs::prelude::*;
 use egui::epaint::textures::TexturesDelta;
 use egui::{ClippedPrimitive, Color32, Pos2, Stroke, Vec2};
@@ -24,7 +24,9 @@ use glam::{UVec2, UVec3};
 use manylight_core::ShadingModel;
 use manylight_core::cluster::{CullTest, ZSlicing};
 use manylight_core::codec::NormalCodec;
-use manylight_render::{DebugViewMode, GBufferLayout, GpuContext, PassTiming, PipelineKind};
+use manylight_render::{
+    DebugViewMode, EnvironmentHandle, GBufferLayout, GpuContext, PassTiming, PipelineKind,
+};
 use std::collections::VecDeque;
 use std::sync::{Arc, Mutex};
 use web_time::Instant;
@@ -206,6 +208,7 @@ fn panel(
             .show(ui, |ui| lights_ui(ui, world, pending_lights));
     }
     egui::CollapsingHeader::new("Shadows").default_open(true).show(ui, |ui| shadows_ui(ui, world));
+    egui::CollapsingHeader::new("Environment").default_open(true).show(ui, |ui| environment_ui(ui, world));
     egui::CollapsingHeader::new("Post effects").default_open(true).show(ui, |ui| effects_ui(ui, world));
     egui::CollapsingHeader::new("Cluster grid").default_open(false).show(ui, |ui| clusters_ui(ui, world));
     egui::CollapsingHeader::new("Timings")
@@ -326,6 +329,62 @@ fn effects_ui(ui: &mut egui::Ui, world: &mut World) {
         if m != old {
             world.entity_mut(camera).insert(m);
         }
+    }
+}
+
+/// The first camera's environment: which panorama of [`EnvironmentImages`] lights it (or
+/// none), its intensity, and whether it is the skybox too.
+fn environment_ui(ui: &mut egui::Ui, world: &mut World) {
+    let Some(camera) = first_camera(world) else {
+        ui.label("no camera");
+        return;
+    };
+    let choices: Vec<(EnvironmentHandle, String)> = match world.get_resource::<EnvironmentImages>() {
+        Some(images) => images
+            .iter()
+            .map(|(h, _)| (h, images.name(h).map_or_else(|| format!("panorama {h:?}"), str::to_string)))
+            .collect(),
+        None => Vec::new(),
+    };
+    if choices.is_empty() {
+        ui.label("no panorama loaded");
+        return;
+    }
+    let old = world.get::<EnvironmentMapLight>(camera).copied();
+    let mut chosen = old.map(|e| e.image);
+    let name = |h: Option<EnvironmentHandle>| {
+        h.and_then(|h| choices.iter().find(|(c, _)| *c == h)).map_or("none".to_string(), |(_, n)| n.clone())
+    };
+    egui::ComboBox::from_label("environment").selected_text(name(chosen)).show_ui(ui, |ui| {
+        ui.selectable_value(&mut chosen, None, "none");
+        for (h, n) in &choices {
+            ui.selectable_value(&mut chosen, Some(*h), n);
+        }
+    });
+    let mut light = old;
+    let mut skybox = world.get::<Skybox>(camera).is_some();
+    if chosen != old.map(|e| e.image) {
+        light = chosen
+            .map(|image| EnvironmentMapLight { image, ..old.unwrap_or(EnvironmentMapLight::new(image)) });
+        skybox = chosen.is_some();
+    }
+    if let Some(l) = &mut light {
+        ui.add(egui::Slider::new(&mut l.intensity, 0.0..=4.0).text("intensity"));
+        ui.checkbox(&mut skybox, "skybox");
+    }
+    let mut entity = world.entity_mut(camera);
+    if light != old {
+        match light {
+            Some(l) => entity.insert(l),
+            None => entity.remove::<EnvironmentMapLight>(),
+        };
+    }
+    let sky = light.filter(|_| skybox).map(|l| l.image);
+    if sky != entity.get::<Skybox>().map(|s| s.image) {
+        match sky {
+            Some(image) => entity.insert(Skybox::new(image)),
+            None => entity.remove::<Skybox>(),
+        };
     }
 }
 

@@ -10,14 +10,25 @@ use manylight_app::scene::{spawn_light_rig, spawn_scene};
 use manylight_app::{FrameStats, RenderSettings};
 use manylight_scene::Scene;
 
-/// What `render_scene` adds beyond the scene: post stages on the camera and the debug view.
-#[derive(Clone, Copy, Debug, Default)]
+/// What `render_scene` adds beyond the scene: post stages and an environment on the camera,
+/// and the debug view.
+#[derive(Clone, Debug, Default)]
 pub(crate) struct Extras {
     pub(crate) bloom: Option<manylight_app::Bloom>,
     pub(crate) motion_blur: Option<manylight_app::MotionBlur>,
     pub(crate) debug: manylight_app::DebugView,
     /// Every light casts a shadow.
     pub(crate) shadows: bool,
+    /// The panorama that lights the camera's view, and whether it shows behind it.
+    pub(crate) environment: Option<CameraEnvironment>,
+}
+
+/// An environment on the camera: the panorama, its intensity and whether it is the skybox too.
+#[derive(Clone, Debug)]
+pub(crate) struct CameraEnvironment {
+    pub(crate) image: std::sync::Arc<manylight_core::environment::EquirectImage>,
+    pub(crate) intensity: f32,
+    pub(crate) skybox: bool,
 }
 
 /// Camera turn per frame under `--motion-blur` (about 20 px of motion at 1280 px wide).
@@ -38,6 +49,9 @@ pub(crate) fn render_scene(
     let aspect = size.x as f32 / size.y as f32;
     let bounds = scene.bounds();
     let frame = render_headless(size, frames, move |app| {
+        let mut images = manylight_app::EnvironmentImages::default();
+        let environment = extras.environment.clone().map(|e| (images.add(e.image), e.intensity, e.skybox));
+        app.insert_resource(images);
         app.insert_resource(settings).insert_resource(extras.debug).add_systems(
             Startup,
             move |mut commands: Commands| {
@@ -59,6 +73,15 @@ pub(crate) fn render_scene(
                     }
                     if let Some(motion_blur) = extras.motion_blur {
                         camera.insert(motion_blur);
+                    }
+                    if let Some((image, intensity, skybox)) = environment {
+                        camera.insert(manylight_app::EnvironmentMapLight {
+                            intensity,
+                            ..manylight_app::EnvironmentMapLight::new(image)
+                        });
+                        if skybox {
+                            camera.insert(manylight_app::Skybox::new(image));
+                        }
                     }
                 }
             },

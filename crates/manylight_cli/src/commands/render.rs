@@ -4,7 +4,7 @@
 
 mod measure;
 
-use super::headless::{Extras, render_scene};
+use super::headless::{CameraEnvironment, Extras, render_scene};
 use super::shared::check_lights;
 use crate::args::RenderArgs;
 use anyhow::{Context, Result, bail};
@@ -45,8 +45,8 @@ pub(crate) fn run(args: RenderArgs) -> Result<()> {
     };
     let settings = app_settings(&args, ambient, shadow_settings);
     let frames = if args.post.motion_blur { args.frames.max(2) } else { args.frames };
-    let (image, stats) =
-        render_scene(scene, args.size, frames, lit.rig, args.seed, settings, render_extras(&args))?;
+    let extras = render_extras(&args)?;
+    let (image, stats) = render_scene(scene, args.size, frames, lit.rig, args.seed, settings, extras)?;
     save_png(&image, &args.out).map_err(anyhow::Error::msg)?;
     if let Some(path) = &args.stats_json {
         let json = render_stats_json(&stats, oracle, shadow_accuracy.as_ref(), culling);
@@ -135,9 +135,28 @@ fn app_settings(
     }
 }
 
-/// The post stages, debug view and shadows `render` adds to the scene.
-fn render_extras(args: &RenderArgs) -> Extras {
-    Extras {
+/// The post stages, environment, debug view and shadows `render` adds to the scene.
+fn render_extras(args: &RenderArgs) -> Result<Extras> {
+    let environment = match &args.environment.environment {
+        Some(path) => {
+            let budget = manylight_scene::EnvironmentBudget::default();
+            let decoded = manylight_scene::load_environment(path, &budget).context("--environment")?;
+            if decoded.clamped_texels > 0 {
+                println!(
+                    "{}: {} texels not finite, negative or above f16's range, clamped",
+                    path.display(),
+                    decoded.clamped_texels
+                );
+            }
+            Some(CameraEnvironment {
+                image: std::sync::Arc::new(decoded.image),
+                intensity: args.environment.environment_intensity,
+                skybox: args.environment.skybox,
+            })
+        }
+        None => None,
+    };
+    Ok(Extras {
         bloom: args.post.bloom.then(|| manylight_app::Bloom {
             chain: args.post.bloom_chain,
             ..manylight_app::Bloom::default()
@@ -145,7 +164,8 @@ fn render_extras(args: &RenderArgs) -> Extras {
         motion_blur: args.post.motion_blur.then(manylight_app::MotionBlur::default),
         debug: manylight_app::DebugView::new(args.clusters.debug_view),
         shadows: args.shadows,
-    }
+        environment,
+    })
 }
 
 /// Prints what `render` wrote to `out`: the last frame's size, lights, instances and passes.

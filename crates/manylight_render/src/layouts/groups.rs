@@ -30,9 +30,19 @@ pub const SHADOW_BINDINGS: [BindingDecl; 4] = [
     BindingDecl::storage(6, "directional_shadows", SHADING),
 ];
 
+/// The environment bindings of group 0 (`shaders/common/environment.wgsl`): the prefiltered
+/// specular cube, the irradiance cube, the split-sum lookup table and their sampler.
+pub const ENVIRONMENT_BINDINGS: [BindingDecl; 4] = [
+    BindingDecl::new(7, "env_specular", BindingKind::Cube(FILTERABLE), SHADING),
+    BindingDecl::new(8, "env_irradiance", BindingKind::Cube(FILTERABLE), SHADING),
+    BindingDecl::texture(9, "env_brdf_lut", FILTERABLE, SHADING),
+    BindingDecl::new(10, "env_sampler", FILTERING, SHADING),
+];
+
 /// Group 0 of every scene pass: the view uniform (`common/view_binding.wgsl`), the point and
-/// spot lights (`common/point_lights.wgsl`), the instances (`common/mesh_pass.wgsl`) and, in a
-/// frame whose lights cast shadows, [`SHADOW_BINDINGS`].
+/// spot lights (`common/point_lights.wgsl`), the instances (`common/mesh_pass.wgsl`), in a
+/// frame whose lights cast shadows [`SHADOW_BINDINGS`], and for a view with an environment
+/// [`ENVIRONMENT_BINDINGS`].
 pub static SCENE_GROUP: BindGroupDecl = BindGroupDecl {
     label: "scene",
     index: 0,
@@ -44,6 +54,71 @@ pub static SCENE_GROUP: BindGroupDecl = BindGroupDecl {
         SHADOW_BINDINGS[1].only(Presence::Shadows),
         SHADOW_BINDINGS[2].only(Presence::Shadows),
         SHADOW_BINDINGS[3].only(Presence::Shadows),
+        ENVIRONMENT_BINDINGS[0].only(Presence::Environment),
+        ENVIRONMENT_BINDINGS[1].only(Presence::Environment),
+        ENVIRONMENT_BINDINGS[2].only(Presence::Environment),
+        ENVIRONMENT_BINDINGS[3].only(Presence::Environment),
+    ],
+};
+
+// ---- Environment prefiltering and the skybox ----
+
+const ENV_OUT: BindingDecl = BindingDecl::new(
+    3,
+    "out_cube",
+    BindingKind::StorageTextureArray(wgpu::TextureFormat::Rgba16Float),
+    COMPUTE,
+);
+
+/// Group 0 of `cs_from_equirect` (`shaders/environment_prefilter.wgsl`): the parameters, the
+/// panorama (rgba32f) and the source cube's mip 0 it writes.
+pub static ENV_FROM_EQUIRECT_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "env_from_equirect",
+    index: 0,
+    entries: &[
+        BindingDecl::uniform(0, "params", COMPUTE),
+        BindingDecl::texture(1, "equirect", UNFILTERED, COMPUTE),
+        ENV_OUT,
+    ],
+};
+
+/// Group 0 of `cs_downsample`, `cs_specular` and `cs_irradiance`: the parameters, the cube
+/// they read with its sampler, and the cube mip they write.
+pub static ENV_FILTER_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "env_filter",
+    index: 0,
+    entries: &[
+        BindingDecl::uniform(0, "params", COMPUTE),
+        BindingDecl::new(2, "source", BindingKind::Cube(FILTERABLE), COMPUTE),
+        BindingDecl::new(4, "source_sampler", FILTERING, COMPUTE),
+        ENV_OUT,
+    ],
+};
+
+/// Group 0 of `cs_brdf_lut`: the parameters and the split-sum lookup table it writes.
+pub static ENV_LUT_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "env_lut",
+    index: 0,
+    entries: &[
+        BindingDecl::uniform(0, "params", COMPUTE),
+        BindingDecl::new(
+            5,
+            "out_lut",
+            BindingKind::StorageTexture(wgpu::TextureFormat::Rgba16Float),
+            COMPUTE,
+        ),
+    ],
+};
+
+/// Group 0 of the skybox pass (`shaders/skybox.wgsl`): the view uniform, the environment's
+/// cube and its sampler.
+pub static SKYBOX_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "skybox",
+    index: 0,
+    entries: &[
+        BindingDecl::uniform(0, "view", FRAGMENT),
+        BindingDecl::new(1, "sky", BindingKind::Cube(FILTERABLE), FRAGMENT),
+        BindingDecl::new(2, "sky_sampler", FILTERING, FRAGMENT),
     ],
 };
 
@@ -401,6 +476,14 @@ const GBUFFER: &BindGroupDecl = &GBUFFER_READ_GROUP;
 /// binds anything has a row (`tests/shaders.rs`).
 pub static SHADER_BIND_GROUPS: &[ShaderBindGroups] = &[
     row("forward.wgsl", &[], &[SCENE, MATERIAL]),
+    row("environment_prefilter.wgsl", &["cs_from_equirect"], &[&ENV_FROM_EQUIRECT_GROUP]),
+    row(
+        "environment_prefilter.wgsl",
+        &["cs_downsample", "cs_specular", "cs_irradiance"],
+        &[&ENV_FILTER_GROUP],
+    ),
+    row("environment_prefilter.wgsl", &["cs_brdf_lut"], &[&ENV_LUT_GROUP]),
+    row("skybox.wgsl", &[], &[&SKYBOX_GROUP]),
     row("transparent.wgsl", &["vs_main", "fs_every_light"], &[SCENE, MATERIAL]),
     row("transparent.wgsl", &["vs_main", "fs_clusters"], &[SCENE, MATERIAL, LISTS]),
     row("depth_prepass.wgsl", &[], &[SCENE, MATERIAL]),

@@ -32,8 +32,13 @@ pub enum BindingKind {
     /// A 2D texture: `texture_2d<f32>` (filterable or not), `texture_2d<u32>` or
     /// `texture_depth_2d`.
     Texture(wgpu::TextureSampleType),
+    /// A cube texture, `texture_cube<f32>`.
+    Cube(wgpu::TextureSampleType),
     /// A write-only 2D storage texture, `texture_storage_2d<format, write>`.
     StorageTexture(wgpu::TextureFormat),
+    /// A write-only array of 2D storage textures, `texture_storage_2d_array<format, write>`
+    /// (the six faces of one mip level of a cube).
+    StorageTextureArray(wgpu::TextureFormat),
     /// `sampler` (filtering or not) or `sampler_comparison`.
     Sampler(wgpu::SamplerBindingType),
 }
@@ -50,10 +55,20 @@ impl BindingKind {
                 view_dimension: wgpu::TextureViewDimension::D2,
                 multisampled: false,
             },
+            BindingKind::Cube(sample_type) => wgpu::BindingType::Texture {
+                sample_type,
+                view_dimension: wgpu::TextureViewDimension::Cube,
+                multisampled: false,
+            },
             BindingKind::StorageTexture(format) => wgpu::BindingType::StorageTexture {
                 access: wgpu::StorageTextureAccess::WriteOnly,
                 format,
                 view_dimension: wgpu::TextureViewDimension::D2,
+            },
+            BindingKind::StorageTextureArray(format) => wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::WriteOnly,
+                format,
+                view_dimension: wgpu::TextureViewDimension::D2Array,
             },
             BindingKind::Sampler(ty) => wgpu::BindingType::Sampler(ty),
         }
@@ -68,6 +83,8 @@ pub enum Presence {
     Always,
     /// With `SHADOWS` ([`ShaderDefs::shadows`]).
     Shadows,
+    /// With `ENVIRONMENT` ([`ShaderDefs::environment`]).
+    Environment,
     /// With this G-buffer layout ([`ShaderDefs::gbuffer`]).
     GBuffer(GBufferLayout),
 }
@@ -78,6 +95,7 @@ impl Presence {
         match self {
             Presence::Always => true,
             Presence::Shadows => defs.shadows,
+            Presence::Environment => defs.environment,
             Presence::GBuffer(layout) => defs.gbuffer == Some(layout),
         }
     }

@@ -12,14 +12,14 @@ use crate::graph::{NamedPass, Pass, PassContext, ResourceName};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 
-/// The pipeline key of [`ClusterDepthPass`]: where it reads the shading distances, and whether
-/// group 0 (the view, which it shares with the shading passes) has the shadow bindings.
+/// The pipeline key of [`ClusterDepthPass`]: where it reads the shading distances, and which
+/// bindings group 0 (the view, which it shares with the shading passes) has.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ClusterDepthKey {
     /// Where the shading distances come from.
     pub source: DistanceSource,
-    /// The view layout is the shadowed one.
-    pub shadowed_view: bool,
+    /// The defines of the view's group 0 (`SHADOWS`, `ENVIRONMENT`).
+    pub view: crate::shaders::ShaderDefs,
 }
 
 impl PipelineKey for ClusterDepthKey {
@@ -57,7 +57,7 @@ impl Pass for ClusterDepthPass {
         let scene = ctx.scene;
         let device = &ctx.gpu.device;
         let pipeline = ctx.pipelines.get_or_create(
-            ClusterDepthKey { source: self.source, shadowed_view: scene.view.shadows_active },
+            ClusterDepthKey { source: self.source, view: scene.view.defs() },
             |k| {
                 DistancePipeline::new(
                     device,

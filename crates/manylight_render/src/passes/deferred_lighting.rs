@@ -20,8 +20,8 @@ pub struct DeferredLightingKey {
     pub layout: GBufferLayout,
     /// Its normal codec.
     pub codec: NormalCodec,
-    /// Composed with `SHADOWS` (group 0 has the shadow bindings).
-    pub shadows: bool,
+    /// The defines of the view's group 0 (`SHADOWS`, `ENVIRONMENT`): its bindings.
+    pub view: crate::shaders::ShaderDefs,
 }
 
 impl PipelineKey for DeferredLightingKey {
@@ -103,9 +103,9 @@ impl Pass for DeferredLightingPass {
         let (layout, codec) = (self.layout, self.codec);
         let view_layout = &ctx.scene.view.layout;
         let pipeline = ctx.pipelines.get_or_create(
-            DeferredLightingKey { layout, codec, shadows: ctx.scene.view.shadows_active },
+            DeferredLightingKey { layout, codec, view: ctx.scene.view.defs() },
             |k| {
-                let defs = crate::shaders::ShaderDefs { shadows: k.shadows, ..Default::default() };
+                let defs = k.view;
                 DeferredLightingPipeline::new(
                     device,
                     view_layout,

@@ -13,14 +13,14 @@ use crate::graph::{NamedPass, Pass, PassContext, ResourceName};
 use crate::pipelines::PipelineKey;
 use crate::plan::PlanInputs;
 
-/// The pipeline key of [`LightRefinePass`]: where it reads the shading distances, and whether
-/// group 0 (the view, which it shares with the shading passes) has the shadow bindings.
+/// The pipeline key of [`LightRefinePass`]: where it reads the shading distances, and which
+/// bindings group 0 (the view, which it shares with the shading passes) has.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct RefineKey {
     /// Where the shading distances come from.
     pub source: DistanceSource,
-    /// The view layout is the shadowed one.
-    pub shadowed_view: bool,
+    /// The defines of the view's group 0 (`SHADOWS`, `ENVIRONMENT`).
+    pub view: crate::shaders::ShaderDefs,
 }
 
 impl PipelineKey for RefineKey {
@@ -58,9 +58,8 @@ impl Pass for LightRefinePass {
         let clusters = ctx.require_clusters("light_refine")?;
         let scene = ctx.scene;
         let device = &ctx.gpu.device;
-        let pipeline = ctx.pipelines.get_or_create(
-            RefineKey { source: self.source, shadowed_view: scene.view.shadows_active },
-            |k| {
+        let pipeline =
+            ctx.pipelines.get_or_create(RefineKey { source: self.source, view: scene.view.defs() }, |k| {
                 DistancePipeline::new(
                     device,
                     "light_refine.wgsl",
@@ -68,8 +67,7 @@ impl Pass for LightRefinePass {
                     [&scene.view.layout, &clusters.bindings.refine_layout],
                     k.source,
                 )
-            },
-        )?;
+            })?;
         let source = self.source.bind_group(ctx, &pipeline.source_layout, self.clear_color)?;
         let lists = ctx.bind_group(
             &clusters.bindings.refine_layout,

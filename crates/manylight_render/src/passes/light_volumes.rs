@@ -30,8 +30,8 @@ pub struct LightVolumesKey {
     pub codec: NormalCodec,
     /// Where the lights are summed.
     pub accumulation: wgpu::TextureFormat,
-    /// Composed with `SHADOWS` (group 0 has the shadow bindings).
-    pub shadows: bool,
+    /// The defines of the view's group 0 (`SHADOWS`, `ENVIRONMENT`): its bindings.
+    pub view: crate::shaders::ShaderDefs,
 }
 
 impl PipelineKey for LightVolumesKey {
@@ -269,9 +269,9 @@ impl Pass for LightVolumesPass {
         let (layout, codec, accumulation) = (self.layout, self.codec, self.accumulation);
         let scene = ctx.scene;
         let gpu = ctx.gpu;
-        let key = LightVolumesKey { layout, codec, accumulation, shadows: scene.view.shadows_active };
+        let key = LightVolumesKey { layout, codec, accumulation, view: scene.view.defs() };
         let pipeline = ctx.pipelines.get_or_create(key, |k| {
-            let defs = crate::shaders::ShaderDefs { shadows: k.shadows, ..Default::default() };
+            let defs = k.view;
             LightVolumesPipeline::new(gpu, &scene.view.layout, k.layout, k.codec, k.accumulation, defs)
         })?;
         let gbuffer = gbuffer_read_bind_group(ctx, &pipeline.gbuffer_layout, layout, self.clear_color)?;

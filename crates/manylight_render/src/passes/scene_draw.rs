@@ -44,14 +44,12 @@ fn pipelines_where<K: PipelineKey>(
     create: impl Fn(&K) -> Result<K::Pipeline, RenderError>,
 ) -> Result<VariantPipelines<K::Pipeline>, RenderError> {
     // Each variant's pipeline has the view's shading model where its material has none, and
-    // reads shadows when the frame's lights cast them.
+    // reads shadows when the frame's lights cast them and the environment when the view has one.
     let global = ctx.scene.view.uniform.shading_model;
-    let shadows = ctx.scene.view.shadows_active;
+    let view = ctx.scene.view.defs();
     let variants = ctx.scene.instances.variants.iter().filter(|v| filter(v));
     variants
-        .map(|&v| {
-            Ok((v, ctx.pipelines.get_or_create(key(v.resolved(global).with_shadows(shadows)), &create)?))
-        })
+        .map(|&v| Ok((v, ctx.pipelines.get_or_create(key(v.resolved(global).with_view(view)), &create)?)))
         .collect()
 }
 

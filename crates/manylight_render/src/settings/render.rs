@@ -1,7 +1,7 @@
 //! What a frame is rendered with: the [`RenderSettings`] an app sets, and the
 //! [`FrameSettings`] a view draws with (those settings and its debug view).
 
-use super::{ClusterSettings, DebugViewMode, GBufferLayout, PipelineKind, ShadowSettings};
+use super::{ClusterSettings, DebugViewMode, EnvironmentFilter, GBufferLayout, PipelineKind, ShadowSettings};
 use manylight_core::ShadingModel;
 use manylight_core::codec::NormalCodec;
 
@@ -30,6 +30,8 @@ pub struct RenderSettings {
     pub normal_codec: NormalCodec,
     /// Shadow atlas and face sizes, and whether casting lights cast.
     pub shadows: ShadowSettings,
+    /// How finely the cameras' environments are prefiltered.
+    pub environment_filter: EnvironmentFilter,
 }
 
 impl RenderSettings {
@@ -46,7 +48,8 @@ impl RenderSettings {
         if !self.clear_color.iter().all(|c| c.is_finite() && *c >= 0.0) {
             return Err(format!("clear_color {:?} must be finite and non-negative", self.clear_color));
         }
-        self.shadows.check_values()
+        self.shadows.check_values()?;
+        self.environment_filter.check_values()
     }
 }
 
@@ -62,6 +65,7 @@ impl Default for RenderSettings {
             gbuffer: GBufferLayout::Full,
             normal_codec: NormalCodec::Octa16,
             shadows: ShadowSettings::default(),
+            environment_filter: EnvironmentFilter::default(),
         }
     }
 }

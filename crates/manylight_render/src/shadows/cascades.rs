@@ -107,6 +107,8 @@ mod tests {
             bloom: None,
             motion_blur: None,
             exposure: None,
+            environment: None,
+            skybox: None,
         };
         let direction = Vec3::new(0.3, -1.0, 0.2).normalize();
         let casters = Aabb { min: Vec3::new(-50.0, -1.0, -50.0), max: Vec3::new(50.0, 30.0, 50.0) };

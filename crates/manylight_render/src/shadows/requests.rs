@@ -143,6 +143,8 @@ mod tests {
             bloom: None,
             motion_blur: None,
             exposure: None,
+            environment: None,
+            skybox: None,
         };
         let size = UVec2::new(1280, 720);
         let near = requested_edge(&settings, Some((&camera, size)), Vec3::new(0.0, 0.0, -5.0), 1.0);
