@@ -1,9 +1,11 @@
 //! Views a glTF/GLB file: its meshes and lights, seen through its first camera (or one that
-//! frames the whole scene), with an optional rig of animated lights. A file without lights is
-//! lit by a dome of studio lights around it, as a model viewer does.
+//! frames the whole scene), with an optional rig of animated lights, lit by an HDR panorama (the
+//! bundled Venice Sunset by default; the overlay picks another bundled one or none) shown as
+//! its skybox, as a model viewer does. Without an environment, a file without lights is lit by a
+//! dome of studio lights around it.
 //!
 //! ```text
-//! cargo run --example gltf_viewer -- PATH [--lights N] [--fit] [--headless OUT.png]
+//! cargo run --example gltf_viewer -- PATH [--lights N] [--fit] [--environment PATH.hdr | --no-environment] [--headless OUT.png]
 //! ```
 //!
 //! A file that cannot be loaded prints the loader's error (naming the file and the problem)
@@ -17,8 +19,14 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Studio lights (`manylight::scene::studio_lights`) around a file that brings no lights when
-/// `--lights` is not given.
+/// neither `--lights` nor an environment is given.
 const STUDIO_LIGHTS: usize = 32;
+
+/// The bundled panoramas, offered by the overlay's environment picker; the first is the default.
+const BUNDLED_ENVIRONMENTS: [&str; 2] = [
+    concat!(env!("CARGO_MANIFEST_DIR"), "/assets/environments/venice_sunset.hdr"),
+    concat!(env!("CARGO_MANIFEST_DIR"), "/assets/environments/studio_small_03.hdr"),
+];
 
 #[derive(Parser)]
 #[command(about = "View a glTF/GLB file with manylight")]
@@ -32,6 +40,13 @@ struct Args {
     /// Frame the whole scene instead of looking through the file's first camera.
     #[arg(long)]
     fit: bool,
+    /// An equirectangular HDR panorama (.hdr or .exr) that lights the scene and shows behind
+    /// it (default: the bundled Venice Sunset).
+    #[arg(long, value_name = "PATH.hdr", conflicts_with = "no_environment")]
+    environment: Option<PathBuf>,
+    /// No environment: the file's lights only (studio lights for a file without any).
+    #[arg(long)]
+    no_environment: bool,
     /// Render one 1280x720 frame to this PNG instead of opening a window.
     #[arg(long, value_name = "OUT.png")]
     headless: Option<PathBuf>,
@@ -50,7 +65,15 @@ fn main() -> ExitCode {
     if args.fit {
         scene.cameras.clear();
     }
-    if scene.lights.is_empty() && args.lights.is_none() {
+    let environments = match load_environments(&args) {
+        Ok(e) => e,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let lit_by = environments.iter().next().map(|(handle, _)| handle);
+    if scene.lights.is_empty() && args.lights.is_none() && lit_by.is_none() {
         let studio =
             manylight::scene::studio_lights(STUDIO_LIGHTS, scene.bounds()).expect("the studio's lights fit");
         scene.lights.extend(studio);
@@ -83,6 +106,14 @@ fn main() -> ExitCode {
     let aspect = size.x as f32 / size.y as f32;
     let exit = App::new()
         .add_plugins(plugin)
+        .insert_resource(environments)
+        .add_systems(PostStartup, move |mut commands: Commands, cameras: Query<Entity, With<Camera3d>>| {
+            for camera in &cameras {
+                if let Some(image) = lit_by {
+                    commands.entity(camera).insert((EnvironmentMapLight::new(image), Skybox::new(image)));
+                }
+            }
+        })
         .add_systems(Startup, move |mut commands: Commands| {
             spawn_scene(&mut commands, &scene, true, aspect);
             if lights > 0 {
@@ -102,4 +133,23 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// The panoramas the viewer offers: the one `--environment` names (or the bundled default)
+/// first, then the other bundled ones; none with `--no-environment`.
+fn load_environments(args: &Args) -> Result<EnvironmentImages, manylight::scene::EnvironmentError> {
+    let mut images = EnvironmentImages::default();
+    if args.no_environment {
+        return Ok(images);
+    }
+    let budget = manylight::scene::EnvironmentBudget::default();
+    let chosen = args.environment.clone().unwrap_or_else(|| PathBuf::from(BUNDLED_ENVIRONMENTS[0]));
+    let others = BUNDLED_ENVIRONMENTS.iter().map(PathBuf::from).filter(|p| *p != chosen);
+    for path in std::iter::once(chosen.clone()).chain(others) {
+        let decoded = manylight::scene::load_environment(&path, &budget)?;
+        let name =
+            path.file_stem().map_or_else(|| path.display().to_string(), |s| s.to_string_lossy().into_owned());
+        images.add_named(name, decoded.image);
+    }
+    Ok(images)
 }

@@ -1,6 +1,6 @@
 // The skybox: behind the geometry (where the depth buffer holds the reverse-Z far plane, 0),
 // the environment the pixel's ray looks at, times the skybox's brightness. A full-screen
-// triangle at depth 0 with the test "equal" touches only those pixels.
+// triangle at depth 0 with the test "greater or equal" touches only those pixels.
 //!include common/view.wgsl
 //!include common/fullscreen.wgsl
 //!include common/environment_map.wgsl

@@ -219,6 +219,10 @@ fn only_a_camera_with_an_environment_gets_its_passes() {
     let light = render(settings(PipelineKind::ClusteredForward), Environment::Light);
     let sky = render(settings(PipelineKind::ClusteredForward), Environment::LightAndSkybox);
     assert_eq!(pass_names(&plain), pass_names(&light));
+    let report = |f: &HeadlessFrame| f.stats.last.as_ref().expect("a report").environment;
+    assert_eq!(report(&plain), None, "a frame without an environment reports none");
+    let named = report(&light).expect("the environment's report");
+    assert_eq!((named.prefiltered, named.missing, named.resident), (1, 0, 1));
     let skybox = "skybox".to_string();
     assert!(!pass_names(&light).contains(&skybox));
     let with_sky: Vec<_> = pass_names(&sky).into_iter().filter(|p| *p != skybox).collect();
@@ -294,4 +298,37 @@ fn gpu_split_sum_matches_its_cpu_twin() {
         support::Tolerance { mean: 0.02, p99: 0.15 },
     );
     eprintln!("split-sum against its CPU twin: {stats:?}");
+}
+
+/// A camera naming a panorama no `EnvironmentImages` holds (removed, or never added) draws
+/// without it, and the frame counts it: no error, no NaN.
+#[test]
+fn a_missing_panorama_is_counted_and_drawn_without() {
+    let _gpu = gpu();
+    let scene = spheres();
+    let aspect = SIZE.x as f32 / SIZE.y as f32;
+    let frame = render_headless(SIZE, 1, move |app| {
+        let mut images = EnvironmentImages::default();
+        let gone = images.add(panorama());
+        images.remove(gone);
+        app.insert_resource(images).insert_resource(settings(PipelineKind::ClusteredDeferred)).add_systems(
+            Startup,
+            move |mut commands: Commands| {
+                spawn_scene(&mut commands, &scene, true, aspect);
+            },
+        );
+        app.add_systems(
+            PostStartup,
+            move |mut commands: Commands, cameras: Query<Entity, With<Camera3d>>| {
+                for camera in &cameras {
+                    commands.entity(camera).insert((EnvironmentMapLight::new(gone), Skybox::new(gone)));
+                }
+            },
+        );
+    })
+    .unwrap_or_else(|e| panic!("render failed: {e}"));
+    assert_finite(&frame);
+    let report = frame.stats.last.as_ref().expect("a report").environment.expect("the environment's report");
+    assert_eq!((report.prefiltered, report.resident), (0, 0));
+    assert!(report.missing >= 1, "{report:?}");
 }

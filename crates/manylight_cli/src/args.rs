@@ -53,6 +53,17 @@ pub(crate) enum Command {
     /// count keep changing; exit 1 if memory or the transient pool grows, a frame fails or a
     /// pixel is NaN.
     Soak(soak::SoakArgs),
+    /// FLIP between two PNGs of one size (mean, 95th and 99th percentile, max), e.g. a render
+    /// against a glTF sample's screenshot; optionally writes the error map.
+    Compare {
+        /// The reference image.
+        reference: PathBuf,
+        /// The image compared with it.
+        test: PathBuf,
+        /// Write the FLIP error map here (PNG, magma colours).
+        #[arg(long)]
+        error_map: Option<PathBuf>,
+    },
     /// Draw the figures of a CSV that `bench`, `report` or `post` wrote.
     Plot {
         /// The CSV file.

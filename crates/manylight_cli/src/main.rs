@@ -44,6 +44,9 @@ fn main() -> ExitCode {
         Command::Post(args) => commands::post::run(args),
         Command::Views(args) => commands::views::run(args),
         Command::Plot { csv, out } => commands::plot::run(csv, out),
+        Command::Compare { reference, test, error_map } => {
+            commands::compare::run(&reference, &test, error_map.as_deref())
+        }
         Command::Soak(args) => soak::run(args),
         Command::DepthPrecision { samples } => commands::cpu_tables::depth_precision(samples),
         Command::CodecAccuracy { samples } => commands::cpu_tables::codec_accuracy(samples),

@@ -81,8 +81,8 @@ struct FilterPipelines {
     lut_layout: GroupLayout,
 }
 
-/// What prefiltering took this frame.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// What the frame's environments took.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct EnvironmentReport {
     /// Panoramas prefiltered this frame.
     pub prefiltered: u32,
@@ -91,6 +91,10 @@ pub struct EnvironmentReport {
     pub prefilter_cpu_ms: f64,
     /// Views that named a panorama the frame's snapshot does not hold: drawn without it.
     pub missing: u32,
+    /// Prefiltered environments on the GPU after the frame.
+    pub resident: u32,
+    /// Whether any view named a panorama this frame.
+    pub named: bool,
 }
 
 /// The prefiltered environments and their shared lookup table and sampler.
@@ -135,6 +139,7 @@ impl EnvironmentMaps {
         for view in &snapshot.views {
             let named = [view.camera.environment.map(|e| e.image), view.camera.skybox.map(|s| s.image)];
             for handle in named.into_iter().flatten() {
+                self.report.named = true;
                 if let Some(map) = self.maps.iter_mut().find(|m| m.handle == handle && m.filter == filter) {
                     map.last_used = self.frame;
                     continue;
@@ -156,6 +161,7 @@ impl EnvironmentMaps {
             // Nothing names an environment: keep no table either.
             self.lut = None;
         }
+        self.report.resident = self.maps.len() as u32;
         Ok(())
     }
 

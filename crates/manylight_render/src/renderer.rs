@@ -504,6 +504,7 @@ impl Renderer {
             light_upload_bytes: 0,
             device_recoveries: 0,
             shadows: (self.shadows.report.casting_lights > 0).then_some(self.shadows.report),
+            environment: self.environments.report.named.then_some(self.environments.report),
             ..Default::default()
         }
     }

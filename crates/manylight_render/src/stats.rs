@@ -109,6 +109,9 @@ pub struct FrameReport {
     pub clusters: Option<crate::clusters::ClusterReport>,
     /// What the shadows took, when a light asked to cast one.
     pub shadows: Option<crate::settings::ShadowReport>,
+    /// What the environments took, when a view named one: panoramas prefiltered this frame,
+    /// views drawn without theirs, prefiltered environments on the GPU.
+    pub environment: Option<crate::environment::EnvironmentReport>,
     /// The views the frame rendered, in order (the passes of each are in [`FrameReport::passes`],
     /// one view after the other).
     pub views: Vec<ViewReport>,

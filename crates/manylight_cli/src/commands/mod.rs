@@ -5,6 +5,7 @@
 
 pub(crate) mod bench;
 pub(crate) mod check;
+pub(crate) mod compare;
 pub(crate) mod cpu_tables;
 mod headless;
 pub(crate) mod plot;

@@ -38,12 +38,13 @@ impl SkyboxPipeline {
                 fragment: "fs_main",
                 output: HDR_FORMAT,
                 blend: None,
-                // The triangle lies on the far plane (reverse-Z 0): only pixels no surface
-                // covered pass "equal".
+                // The triangle lies on the far plane (reverse-Z 0): "0 >= stored" holds only
+                // where no surface was drawn (stored 0). Exact for a constant 0, unlike "equal",
+                // which needs the vertex positions to be invariant.
                 depth: Some(wgpu::DepthStencilState {
                     format: DEPTH_FORMAT,
                     depth_write_enabled: Some(false),
-                    depth_compare: Some(wgpu::CompareFunction::Equal),
+                    depth_compare: Some(wgpu::CompareFunction::GreaterEqual),
                     stencil: Default::default(),
                     bias: Default::default(),
                 }),
