@@ -95,6 +95,7 @@ fn run_window(lights: usize, shadows: bool, settings: RenderSettings) -> ExitCod
     let exit = App::new()
         .add_plugins(ManyLightPlugin::window(config))
         .insert_resource(settings)
+        .insert_resource(bundled_environments())
         .add_systems(Startup, scene_setup(lights, shadows))
         .add_systems(Update, print_fps)
         .run();
@@ -104,6 +105,23 @@ fn run_window(lights: usize, shadows: bool, settings: RenderSettings) -> ExitCod
         eprintln!("error: the demo failed (see the log above); `--headless` renders without a window");
         ExitCode::FAILURE
     }
+}
+
+/// The bundled panoramas, for the overlay's environment picker (the hall is lit by its lights
+/// alone until one is picked). One that cannot be read is left out, with a warning.
+fn bundled_environments() -> EnvironmentImages {
+    let mut images = EnvironmentImages::default();
+    for name in ["venice_sunset", "studio_small_03"] {
+        let path =
+            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/environments").join(format!("{name}.hdr"));
+        match manylight::scene::load_environment(&path, &Default::default()) {
+            Ok(decoded) => {
+                images.add_named(name, decoded.image);
+            }
+            Err(e) => eprintln!("warning: {e}"),
+        }
+    }
+    images
 }
 
 fn run_headless(
