@@ -110,6 +110,46 @@ fn render_writes_png_and_stats_json() {
     assert_eq!(stats["frames_rendered"].as_u64(), Some(2));
 }
 
+/// `--environment` lights the scene from a bundled panorama: the skybox pass runs, the
+/// environment report says one panorama was prefiltered, and the background is the sky.
+#[test]
+fn render_takes_an_environment() {
+    let _gpu = GPU.lock().unwrap_or_else(|e| e.into_inner());
+    let dir = root().join("target/cli-tests");
+    std::fs::create_dir_all(&dir).expect("mkdir");
+    let png = dir.join("environment.png");
+    let json = dir.join("environment.json");
+    let sky = root().join("assets/environments/venice_sunset.hdr");
+    let spheres = root().join("assets/MetalRoughSpheresNoTextures/MetalRoughSpheresNoTextures.gltf");
+    let out = manylight(&[
+        "render",
+        "--scene",
+        spheres.to_str().expect("utf-8"),
+        "--environment",
+        sky.to_str().expect("utf-8"),
+        "--studio-lights",
+        "0",
+        "--size",
+        "96x96",
+        "--out",
+        png.to_str().expect("utf-8"),
+        "--stats-json",
+        json.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).expect("json")).expect("valid");
+    let last = &stats["last_frame"];
+    let names: Vec<&str> =
+        last["passes"].as_array().expect("passes").iter().map(|p| p["name"].as_str().unwrap_or("")).collect();
+    assert!(names.contains(&"skybox"), "{names:?}");
+    assert_eq!(last["environment"]["prefiltered"].as_u64(), Some(1));
+    assert_eq!(last["nonfinite_pixels"].as_u64(), Some(0));
+    let img = image::open(&png).expect("png").to_rgba8();
+    let corner = img.get_pixel(1, 1);
+    assert!(corner[0] > 60 && corner[2] > 60, "the corner shows the sky: {corner:?}");
+}
+
 #[test]
 fn bad_arguments_are_refused_with_a_message() {
     for args in [
@@ -117,6 +157,12 @@ fn bad_arguments_are_refused_with_a_message() {
         &["render", "--out", "x.png", "--pipeline", "magic"],
         &["render", "--out", "x.png", "--scene", "/nonexistent/scene.gltf"],
         &["check", "/nonexistent/file.glb"],
+        &["render", "--out", "x.png", "--environment", "/nonexistent/sky.hdr"],
+        &["render", "--out", "x.png", "--environment", "Cargo.toml"],
+        &["render", "--out", "x.png", "--environment", "sky.hdr", "--skybox", "maybe"],
+        &["render", "--out", "x.png", "--environment", "sky.hdr", "--environment-intensity", "nan"],
+        &["render", "--out", "x.png", "--skybox", "on"],
+        &["compare", "Cargo.toml", "Cargo.toml"],
         &["soak", "--frames", "100", "--warmup", "100"],
         &["soak", "--sizes", "0x10"],
     ] {
