@@ -137,7 +137,6 @@ impl Plugin for ManyLightPlugin {
         app.insert_resource(FramesInFlight(self.frames_in_flight));
         app.init_resource::<RenderSettings>()
             .init_resource::<DebugView>()
-            .init_resource::<crate::resources::EnvironmentImages>()
             .init_resource::<crate::resources::LightAnimationMode>()
             .init_resource::<FrameStats>()
             .init_resource::<crate::resources::RenderedImages>()

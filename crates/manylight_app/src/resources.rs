@@ -5,7 +5,8 @@ use glam::UVec2;
 use manylight_render::{DebugViewMode, FrameReport, FrameSettings};
 
 /// The panoramas cameras' [`EnvironmentMapLight`](crate::EnvironmentMapLight)s and
-/// [`Skybox`](crate::Skybox)es name: the render crate's type itself, a resource.
+/// [`Skybox`](crate::Skybox)es name: the render crate's type itself, a resource the app inserts
+/// when it has panoramas (the plugin adds none).
 pub use manylight_render::EnvironmentImages;
 pub use manylight_render::RenderSettings;
 

@@ -49,9 +49,14 @@ pub(crate) fn render_scene(
     let aspect = size.x as f32 / size.y as f32;
     let bounds = scene.bounds();
     let frame = render_headless(size, frames, move |app| {
-        let mut images = manylight_app::EnvironmentImages::default();
-        let environment = extras.environment.clone().map(|e| (images.add(e.image), e.intensity, e.skybox));
-        app.insert_resource(images);
+        // The panorama's resource only when there is one: an app without an environment is
+        // the app it was before environments existed, entity for entity.
+        let environment = extras.environment.clone().map(|e| {
+            let mut images = manylight_app::EnvironmentImages::default();
+            let handle = images.add(e.image);
+            app.insert_resource(images);
+            (handle, e.intensity, e.skybox)
+        });
         app.insert_resource(settings).insert_resource(extras.debug).add_systems(
             Startup,
             move |mut commands: Commands| {
