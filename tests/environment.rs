@@ -142,10 +142,28 @@ fn render_with(
     settings: RenderSettings,
     environment: Environment,
 ) -> HeadlessFrame {
+    let mut images = EnvironmentImages::default();
+    let image = images.add(panorama);
+    render_camera(scene, images, settings, move |camera| {
+        if environment != Environment::None {
+            camera.insert(EnvironmentMapLight::new(image));
+        }
+        if environment == Environment::LightAndSkybox {
+            camera.insert(Skybox::new(image));
+        }
+    })
+}
+
+/// Renders `scene` through its camera, with `images` as the app's panoramas and what `camera`
+/// puts on the camera entity; panics on failure or a NaN pixel.
+fn render_camera(
+    scene: Scene,
+    images: EnvironmentImages,
+    settings: RenderSettings,
+    camera: impl Fn(&mut EntityCommands) + Send + Sync + 'static,
+) -> HeadlessFrame {
     let aspect = SIZE.x as f32 / SIZE.y as f32;
     let frame = render_headless(SIZE, 1, move |app| {
-        let mut images = EnvironmentImages::default();
-        let image = images.add(panorama);
         app.insert_resource(images).insert_resource(settings).add_systems(
             Startup,
             move |mut commands: Commands| {
@@ -155,14 +173,8 @@ fn render_with(
         app.add_systems(
             PostStartup,
             move |mut commands: Commands, cameras: Query<Entity, With<Camera3d>>| {
-                for camera in &cameras {
-                    let mut camera = commands.entity(camera);
-                    if environment != Environment::None {
-                        camera.insert(EnvironmentMapLight::new(image));
-                    }
-                    if environment == Environment::LightAndSkybox {
-                        camera.insert(Skybox::new(image));
-                    }
+                for entity in &cameras {
+                    camera(&mut commands.entity(entity));
                 }
             },
         );
@@ -305,29 +317,12 @@ fn gpu_split_sum_matches_its_cpu_twin() {
 #[test]
 fn a_missing_panorama_is_counted_and_drawn_without() {
     let _gpu = gpu();
-    let scene = spheres();
-    let aspect = SIZE.x as f32 / SIZE.y as f32;
-    let frame = render_headless(SIZE, 1, move |app| {
-        let mut images = EnvironmentImages::default();
-        let gone = images.add(panorama());
-        images.remove(gone);
-        app.insert_resource(images).insert_resource(settings(PipelineKind::ClusteredDeferred)).add_systems(
-            Startup,
-            move |mut commands: Commands| {
-                spawn_scene(&mut commands, &scene, true, aspect);
-            },
-        );
-        app.add_systems(
-            PostStartup,
-            move |mut commands: Commands, cameras: Query<Entity, With<Camera3d>>| {
-                for camera in &cameras {
-                    commands.entity(camera).insert((EnvironmentMapLight::new(gone), Skybox::new(gone)));
-                }
-            },
-        );
-    })
-    .unwrap_or_else(|e| panic!("render failed: {e}"));
-    assert_finite(&frame);
+    let mut images = EnvironmentImages::default();
+    let gone = images.add(panorama());
+    images.remove(gone);
+    let frame = render_camera(spheres(), images, settings(PipelineKind::ClusteredDeferred), move |camera| {
+        camera.insert((EnvironmentMapLight::new(gone), Skybox::new(gone)));
+    });
     let report = frame.stats.last.as_ref().expect("a report").environment.expect("the environment's report");
     assert_eq!((report.prefiltered, report.resident), (0, 0));
     assert!(report.missing >= 1, "{report:?}");
