@@ -4,16 +4,15 @@
 
 mod support;
 
-use glam::{Mat4, Vec3};
+use glam::Vec3;
 use manylight::app::RenderSettings;
 use manylight::app::headless::{HeadlessFrame, render_headless};
 use manylight::math::environment::EquirectImage;
-use manylight::math::{MaterialData, Projection, ShadingModel};
+use manylight::math::{Projection, ShadingModel};
 use manylight::prelude::*;
 use manylight::render::EnvironmentFilter;
-use manylight::scene::shapes::uv_sphere;
-use manylight::scene::{SceneCamera, SceneInstance, SceneLight, camera_looking_at};
-use std::sync::Arc;
+use manylight::scene::shapes::SphereGrid;
+use manylight::scene::{SceneCamera, SceneLight, camera_looking_at};
 use support::{STRICT, assert_finite, assert_similar, gpu};
 
 const SIZE: UVec2 = UVec2::new(192, 96);
@@ -57,8 +56,19 @@ const EYE: Vec3 = Vec3::new(0.0, 0.0, 6.0);
 const FOV_Y: f32 = 0.5;
 const ALBEDO: Vec3 = Vec3::new(0.9, 0.7, 0.5);
 
+fn grid() -> SphereGrid {
+    SphereGrid {
+        radius: RADIUS,
+        rings: 48,
+        segments: 96,
+        albedo: ALBEDO,
+        metallic: METALLIC.to_vec(),
+        roughness: ROUGHNESS.to_vec(),
+    }
+}
+
 fn centre(row: usize, column: usize) -> Vec3 {
-    Vec3::new(column as f32 - 1.5, 0.5 - row as f32, 0.0)
+    grid().centre(row, column)
 }
 
 /// A panorama of broad features only (sky gradient, ground, coloured quadrants), so the
@@ -80,24 +90,7 @@ fn smooth_panorama() -> EquirectImage {
 /// Eight spheres: metals on the top row, dielectrics below, roughness rising to the right,
 /// one weak point light, nothing else.
 fn spheres() -> Scene {
-    let mut scene = Scene { name: "environment spheres".into(), ..Scene::default() };
-    scene.meshes.push(Arc::new(uv_sphere("sphere", RADIUS, 48, 96, false)));
-    for (row, metallic) in METALLIC.into_iter().enumerate() {
-        for (column, roughness) in ROUGHNESS.into_iter().enumerate() {
-            scene.materials.push(Arc::new(MaterialData {
-                label: format!("metallic {metallic} roughness {roughness}"),
-                base_color: Color::linear_rgb(ALBEDO.x, ALBEDO.y, ALBEDO.z),
-                metallic,
-                roughness,
-                ..MaterialData::default()
-            }));
-            scene.instances.push(SceneInstance {
-                mesh: 0,
-                material: scene.materials.len() - 1,
-                transform: Mat4::from_translation(centre(row, column)),
-            });
-        }
-    }
+    let mut scene = grid().scene("environment spheres");
     scene.lights.push(SceneLight {
         position: Vec3::new(2.0, 2.0, 3.0),
         color: Vec3::ONE,

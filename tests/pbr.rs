@@ -6,17 +6,16 @@
 
 mod support;
 
-use glam::{Mat4, Vec3};
+use glam::Vec3;
 use image::RgbaImage;
 use manylight::app::RenderSettings;
 use manylight::math::LightShape;
 use manylight::math::brdf::{PointLightSample, SurfaceParams, shade_directional_light, shade_point_light};
 use manylight::math::tonemap::tonemap_to_srgb8;
-use manylight::math::{MaterialData, Projection, ShadingModel, SpotCone};
+use manylight::math::{Projection, ShadingModel, SpotCone};
 use manylight::prelude::*;
-use manylight::scene::shapes::uv_sphere;
-use manylight::scene::{SceneCamera, SceneDirectionalLight, SceneInstance, SceneLight, camera_looking_at};
-use std::sync::Arc;
+use manylight::scene::shapes::SphereGrid;
+use manylight::scene::{SceneCamera, SceneDirectionalLight, SceneLight, camera_looking_at};
 use support::{STRICT, Tolerance, assert_similar, gpu, render_scene};
 
 const SIZE: UVec2 = UVec2::new(256, 128);
@@ -33,8 +32,19 @@ const FOV_Y: f32 = 0.5;
 /// circle).
 const TWIN: Tolerance = Tolerance { mean: 0.01, p99: 0.05 };
 
+fn grid() -> SphereGrid {
+    SphereGrid {
+        radius: SPHERE_RADIUS,
+        rings: 96,
+        segments: 192,
+        albedo: BASE_COLOR,
+        metallic: METALLIC.to_vec(),
+        roughness: ROUGHNESS.to_vec(),
+    }
+}
+
 fn centre(row: usize, column: usize) -> Vec3 {
-    Vec3::new((column as f32 - 2.0) * 1.0, 0.5 - row as f32, 0.0)
+    grid().centre(row, column)
 }
 
 fn lights() -> Vec<SceneLight> {
@@ -80,24 +90,7 @@ fn sun() -> SceneDirectionalLight {
 
 /// Ten spheres: metals on the top row, dielectrics below, roughness rising to the right.
 fn spheres() -> Scene {
-    let mut scene = Scene { name: "pbr spheres".into(), ..Scene::default() };
-    scene.meshes.push(Arc::new(uv_sphere("sphere", SPHERE_RADIUS, 96, 192, false)));
-    for (row, metallic) in METALLIC.into_iter().enumerate() {
-        for (column, roughness) in ROUGHNESS.into_iter().enumerate() {
-            scene.materials.push(Arc::new(MaterialData {
-                label: format!("metallic {metallic} roughness {roughness}"),
-                base_color: Color::linear_rgb(BASE_COLOR.x, BASE_COLOR.y, BASE_COLOR.z),
-                metallic,
-                roughness,
-                ..MaterialData::default()
-            }));
-            scene.instances.push(SceneInstance {
-                mesh: 0,
-                material: scene.materials.len() - 1,
-                transform: Mat4::from_translation(centre(row, column)),
-            });
-        }
-    }
+    let mut scene = grid().scene("pbr spheres");
     scene.lights = lights();
     scene.directional_lights = vec![sun()];
     scene.cameras.push(SceneCamera {

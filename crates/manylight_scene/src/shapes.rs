@@ -206,3 +206,58 @@ mod tests {
         }
     }
 }
+
+/// A grid of metallic-roughness spheres, one material each: a row per metalness, a column per
+/// roughness, one unit apart and centred on the origin (the first row on top), facing +Z. Tests
+/// and measurements that compare shading with a reference ray-cast the same spheres
+/// ([`SphereGrid::centre`], [`SphereGrid::radius`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SphereGrid {
+    /// Sphere radius (below 0.5 leaves gaps between them).
+    pub radius: f32,
+    /// Latitude rings and longitude segments of each sphere's mesh.
+    pub rings: u32,
+    /// See `rings`.
+    pub segments: u32,
+    /// Linear base colour of every sphere.
+    pub albedo: Vec3,
+    /// Metalness of each row, top first.
+    pub metallic: Vec<f32>,
+    /// Perceptual roughness of each column, left first.
+    pub roughness: Vec<f32>,
+}
+
+impl SphereGrid {
+    /// Centre of the sphere at `row`, `column`.
+    pub fn centre(&self, row: usize, column: usize) -> Vec3 {
+        let half_w = (self.roughness.len() as f32 - 1.0) * 0.5;
+        let half_h = (self.metallic.len() as f32 - 1.0) * 0.5;
+        Vec3::new(column as f32 - half_w, half_h - row as f32, 0.0)
+    }
+
+    /// The spheres as a scene (no camera, no light): one mesh, a material per sphere named by
+    /// its parameters.
+    pub fn scene(&self, name: &str) -> crate::Scene {
+        use manylight_core::{Color, MaterialData};
+        use std::sync::Arc;
+        let mut scene = crate::Scene { name: name.into(), ..crate::Scene::default() };
+        scene.meshes.push(Arc::new(uv_sphere("sphere", self.radius, self.rings, self.segments, false)));
+        for (row, &metallic) in self.metallic.iter().enumerate() {
+            for (column, &roughness) in self.roughness.iter().enumerate() {
+                scene.materials.push(Arc::new(MaterialData {
+                    label: format!("metallic {metallic} roughness {roughness}"),
+                    base_color: Color::linear_rgb(self.albedo.x, self.albedo.y, self.albedo.z),
+                    metallic,
+                    roughness,
+                    ..MaterialData::default()
+                }));
+                scene.instances.push(crate::SceneInstance {
+                    mesh: 0,
+                    material: scene.materials.len() - 1,
+                    transform: glam::Mat4::from_translation(self.centre(row, column)),
+                });
+            }
+        }
+        scene
+    }
+}
