@@ -64,6 +64,10 @@ pub(crate) enum Command {
         #[arg(long)]
         error_map: Option<PathBuf>,
     },
+    /// How far split-sum image-based lighting is from a Monte-Carlo reference on a grid of
+    /// spheres, for prefilter samples, cube sizes and lookup-table sizes, with each setting's
+    /// prefilter time and per-frame cost, as markdown tables.
+    EnvironmentAccuracy(EnvironmentAccuracyArgs),
     /// Draw the figures of a CSV that `bench`, `report` or `post` wrote.
     Plot {
         /// The CSV file.
@@ -96,6 +100,29 @@ pub(crate) enum Command {
         #[arg(long, default_value_t = 4_000_000)]
         samples: usize,
     },
+}
+
+#[derive(clap::Args)]
+pub(crate) struct EnvironmentAccuracyArgs {
+    /// The panorama (.hdr or .exr) that lights the spheres.
+    #[arg(long, default_value = "assets/environments/studio_small_03.hdr")]
+    pub(crate) environment: PathBuf,
+    /// Image size, WxH.
+    #[arg(long, default_value = "320x128", value_parser = parse_size)]
+    pub(crate) size: UVec2,
+    /// Samples per pixel of each of the two Monte-Carlo references (each sample draws a GGX,
+    /// a cosine-distributed and an environment direction).
+    #[arg(long, default_value_t = 4096)]
+    pub(crate) reference_samples: u32,
+    /// Timed frames per setting, with and without the environment (medians).
+    #[arg(long, default_value_t = 9)]
+    pub(crate) frames: u32,
+    /// Also write the results as CSV here.
+    #[arg(long)]
+    pub(crate) csv: Option<PathBuf>,
+    /// Draw error against prefilter time (PNG) here.
+    #[arg(long)]
+    pub(crate) figure: Option<PathBuf>,
 }
 
 #[derive(clap::Args)]

@@ -16,6 +16,7 @@ mod commands;
 mod culling_tests;
 mod depth_precision;
 mod direct;
+mod environment_accuracy;
 mod large_floor;
 mod plot;
 mod post;
@@ -43,6 +44,7 @@ fn main() -> ExitCode {
         Command::RangelessLights(args) => commands::report::rangeless_lights(args),
         Command::Post(args) => commands::post::run(args),
         Command::Views(args) => commands::views::run(args),
+        Command::EnvironmentAccuracy(args) => commands::environment_accuracy::run(args),
         Command::Plot { csv, out } => commands::plot::run(csv, out),
         Command::Compare { reference, test, error_map } => {
             commands::compare::run(&reference, &test, error_map.as_deref())

@@ -7,6 +7,7 @@ pub(crate) mod bench;
 pub(crate) mod check;
 pub(crate) mod compare;
 pub(crate) mod cpu_tables;
+pub(crate) mod environment_accuracy;
 mod headless;
 pub(crate) mod plot;
 pub(crate) mod post;
