@@ -312,7 +312,7 @@ impl FilterPipelines {
         let filter_layout = ENV_FILTER_GROUP.create_layout(device, defs);
         let lut_layout = ENV_LUT_GROUP.create_layout(device, defs);
         let make = |entry: &str, layout: &GroupLayout| {
-            crate::passes::common::compute_pipeline(
+            crate::layouts::compute_pipeline(
                 device,
                 entry,
                 "environment_prefilter.wgsl",

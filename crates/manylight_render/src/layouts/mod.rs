@@ -316,3 +316,39 @@ pub fn pipeline_layout(device: &wgpu::Device, label: &str, layouts: &[&GroupLayo
         immediate_size: 0,
     })
 }
+
+/// The compute pipeline of `shader`'s `entry` over the bind groups `layouts` (group 0 first),
+/// with its `override` constants (`label` names the layout and the pipeline).
+pub fn compute_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    shader: &str,
+    layouts: &[&GroupLayout],
+    entry: &str,
+    constants: &[(&str, f64)],
+) -> Result<wgpu::ComputePipeline, crate::context::RenderError> {
+    compute_pipeline_with_defs(device, label, shader, layouts, entry, constants, Default::default())
+}
+
+/// [`compute_pipeline`] with its shader composed with `defs`.
+pub fn compute_pipeline_with_defs(
+    device: &wgpu::Device,
+    label: &str,
+    shader: &str,
+    layouts: &[&GroupLayout],
+    entry: &str,
+    constants: &[(&str, f64)],
+    defs: crate::shaders::ShaderDefs,
+) -> Result<wgpu::ComputePipeline, crate::context::RenderError> {
+    check_pipeline(shader, &[entry], layouts)?;
+    let module = crate::shaders::create_module_with(device, shader, defs)?;
+    let layout = pipeline_layout(device, label, layouts);
+    Ok(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(label),
+        layout: Some(&layout),
+        module: &module,
+        entry_point: Some(entry),
+        compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
+        cache: None,
+    }))
+}
