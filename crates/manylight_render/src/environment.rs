@@ -436,7 +436,7 @@ impl Recorder<'_> {
             view_formats: &[],
         });
         let texels: Vec<[f32; 4]> = image.texels.iter().map(|&[r, g, b]| [r, g, b, 1.0]).collect();
-        gpu.queue.write_texture(
+        gpu.write_texture(
             equirect.as_image_copy(),
             bytemuck::cast_slice(&texels),
             wgpu::TexelCopyBufferLayout {
