@@ -249,6 +249,7 @@ fn split_sum_twin(panorama: &EquirectImage) -> image::RgbaImage {
         * camera_looking_at(EYE, Vec3::ZERO).inverse())
     .inverse();
     let samples = SplitSumSamples { lut: 256, specular: 256, irradiance: 256 };
+    let spheres = grid();
     image::RgbaImage::from_fn(SIZE.x, SIZE.y, |x, y| {
         let ndc = Vec3::new(
             (x as f32 + 0.5) / SIZE.x as f32 * 2.0 - 1.0,
@@ -257,18 +258,7 @@ fn split_sum_twin(panorama: &EquirectImage) -> image::RgbaImage {
         );
         let p = world_from_clip * ndc.extend(1.0);
         let dir = (p.truncate() / p.w - EYE).normalize();
-        let mut hit: Option<(f32, usize, usize)> = None;
-        for row in 0..METALLIC.len() {
-            for column in 0..ROUGHNESS.len() {
-                let oc = EYE - centre(row, column);
-                let b = oc.dot(dir);
-                let disc = b * b - (oc.length_squared() - RADIUS * RADIUS);
-                let t = -b - disc.max(0.0).sqrt();
-                if disc >= 0.0 && t > 0.0 && hit.is_none_or(|(best, _, _)| t < best) {
-                    hit = Some((t, row, column));
-                }
-            }
-        }
+        let hit = spheres.hit(EYE, dir);
         let hdr = match hit {
             None => sample_equirect(panorama, dir),
             Some((t, row, column)) => {

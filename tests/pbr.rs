@@ -130,6 +130,7 @@ fn cpu_twin(scene_lights: &[SceneLight]) -> RgbaImage {
             LightShape::Point => PointLightSample::point(l.position, l.radius, l.color * l.intensity),
         })
         .collect();
+    let spheres = grid();
     RgbaImage::from_fn(SIZE.x, SIZE.y, |x, y| {
         let ndc = Vec3::new(
             (x as f32 + 0.5) / SIZE.x as f32 * 2.0 - 1.0,
@@ -137,21 +138,7 @@ fn cpu_twin(scene_lights: &[SceneLight]) -> RgbaImage {
             0.5,
         );
         let dir = (unproject(ndc) - EYE).normalize();
-        let mut hit: Option<(f32, usize, usize)> = None;
-        for row in 0..METALLIC.len() {
-            for column in 0..ROUGHNESS.len() {
-                let oc = EYE - centre(row, column);
-                let b = oc.dot(dir);
-                let disc = b * b - (oc.length_squared() - SPHERE_RADIUS * SPHERE_RADIUS);
-                if disc < 0.0 {
-                    continue;
-                }
-                let t = -b - disc.sqrt();
-                if t > 0.0 && hit.is_none_or(|(best, _, _)| t < best) {
-                    hit = Some((t, row, column));
-                }
-            }
-        }
+        let hit = spheres.hit(EYE, dir);
         let hdr = match hit {
             None => Vec3::ZERO,
             Some((t, row, column)) => {

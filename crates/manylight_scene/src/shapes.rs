@@ -235,6 +235,28 @@ impl SphereGrid {
         Vec3::new(column as f32 - half_w, half_h - row as f32, 0.0)
     }
 
+    /// The nearest sphere the ray from `origin` along unit `dir` enters in front of `origin`:
+    /// the distance along the ray, and the sphere's row and column (the analytic spheres the
+    /// meshes of [`SphereGrid::scene`] approximate).
+    pub fn hit(&self, origin: Vec3, dir: Vec3) -> Option<(f32, usize, usize)> {
+        let mut hit: Option<(f32, usize, usize)> = None;
+        for row in 0..self.metallic.len() {
+            for column in 0..self.roughness.len() {
+                let oc = origin - self.centre(row, column);
+                let b = oc.dot(dir);
+                let disc = b * b - (oc.length_squared() - self.radius * self.radius);
+                if disc < 0.0 {
+                    continue;
+                }
+                let t = -b - disc.sqrt();
+                if t > 0.0 && hit.is_none_or(|(best, _, _)| t < best) {
+                    hit = Some((t, row, column));
+                }
+            }
+        }
+        hit
+    }
+
     /// The spheres as a scene (no camera, no light): one mesh, a material per sphere named by
     /// its parameters.
     pub fn scene(&self, name: &str) -> crate::Scene {
