@@ -6,7 +6,7 @@
 // - cs_downsample: each further mip of the source cube, the mean of the four texels below it
 //   (one bilinear read at their shared corner);
 // - cs_specular: one mip of the specular cube, the source convolved with GGX at that mip's
-//   roughness, with n = v = r (Karis 2013), importance sampled; each sample reads the source's
+//   roughness (params.roughness), with n = v = r (Karis 2013), importance sampled; each sample reads the source's
 //   mip whose texels cover the sample's solid angle (filtered importance sampling, Colbert and
 //   Krivanek 2007), so a few hundred samples do not sparkle;
 // - cs_irradiance: the irradiance cube, (1 / pi) x the cosine-weighted integral, cosine
@@ -24,7 +24,9 @@ struct GpuEnvironmentFilter {
     // samples per texel (cs_specular, cs_irradiance, cs_brdf_lut) or reads per axis
     // (cs_from_equirect)
     samples: u32,
-    // GGX perceptual roughness of the mip cs_specular writes
+    // GGX perceptual roughness of the mip cs_specular writes: (mip / (mips - 1))^2 (Rust:
+    // `EnvironmentFilter::specular_mip_roughness`), which `environment_specular_lod` in
+    // `common/environment.wgsl` maps back to the mip
     roughness: f32,
     // the source cube's mip-0 face size in texels
     source_size: f32,

@@ -5,6 +5,9 @@
 //!if SHADOWS
 //!include common/shadows.wgsl
 //!endif
+//!if RAYS
+//!include common/ray_shadows.wgsl
+//!endif
 
 // Radiance the view's directional lights add to a surface at `position` seen from
 // `view_dir` (each times its shadow test where it casts one).
@@ -24,6 +27,11 @@ fn shade_directional_lights(s: SurfaceParams, position: vec3<f32>, view_dir: vec
 //!if SHADOWS
         if any(radiance > vec3<f32>(0.0)) {
             radiance *= directional_shadow_visibility(i, light.direction.xyz, position, s.normal, view_distance);
+        }
+//!endif
+//!if RAYS
+        if any(radiance > vec3<f32>(0.0)) {
+            radiance *= ray_directional_visibility(view.rays, light.direction, position, s.normal);
         }
 //!endif
         color += radiance;

@@ -9,7 +9,8 @@
 
 //!if ENVIRONMENT
 // The specular cube: mip m is the environment prefiltered with GGX at perceptual roughness
-// m / (mips - 1) (view.environment.y is mips - 1).
+// (m / (mips - 1))^2 (Rust: `EnvironmentFilter::specular_mip_roughness`; view.environment.y
+// is mips - 1), read at `environment_specular_lod`.
 @group(0) @binding(7) var env_specular: texture_cube<f32>;
 // The diffuse irradiance cube: (1 / pi) x the cosine-weighted integral of the environment.
 @group(0) @binding(8) var env_irradiance: texture_cube<f32>;
@@ -27,8 +28,15 @@ fn environment_irradiance(n: vec3<f32>) -> vec3<f32> {
     return textureSampleLevel(env_irradiance, env_sampler, environment_direction(n), 0.0).rgb;
 }
 
+// The specular mip of perceptual `roughness`: sqrt(roughness) x (mips - 1), the inverse of the
+// prefilter's (m / (mips - 1))^2 (Rust: `EnvironmentFilter::specular_lod` and
+// `specular_mip_roughness`, which set each mip's roughness for `cs_specular`).
+fn environment_specular_lod(roughness: f32) -> f32 {
+    return sqrt(clamp(roughness, 0.0, 1.0)) * view.environment.y;
+}
+
 fn environment_specular(r: vec3<f32>, roughness: f32) -> vec3<f32> {
-    let lod = roughness * view.environment.y;
+    let lod = environment_specular_lod(roughness);
     return textureSampleLevel(env_specular, env_sampler, environment_direction(r), lod).rgb;
 }
 

@@ -5,6 +5,10 @@
 //!if SHADOWS
 //!include common/shadows.wgsl
 //!endif
+//!if RAYS
+//!include common/view_binding.wgsl
+//!include common/ray_shadows.wgsl
+//!endif
 
 @group(0) @binding(1) var<storage, read> lights: array<GpuPointLight>;
 
@@ -23,6 +27,12 @@ fn shade_light(s: SurfaceParams, position: vec3<f32>, view_dir: vec3<f32>, k: u3
     // map lookup.
     if any(radiance > vec3<f32>(0.0)) {
         return radiance * shadow_visibility(k, position, s.normal);
+    }
+//!endif
+//!if RAYS
+    // Only a light that adds something pays for its ray.
+    if any(radiance > vec3<f32>(0.0)) {
+        return radiance * ray_light_visibility(view.rays, k, lights[k].position_radius.xyz, position, s.normal);
     }
 //!endif
     return radiance;

@@ -27,6 +27,10 @@ struct ViewUniform {
     // x: environment intensity, y: the specular cube's largest mip level, z: skybox
     // brightness, w: unused
     environment: vec4<f32>,
+    // the shadow rays' geometry (`common/ray_bvh.wgsl`): x the instance level's root
+    // (RAY_NO_NODE: no ray), y the first `ray_prims` entry of the instances, z that of the
+    // casting lights' bits
+    rays: vec4<u32>,
     light_count: u32,
     shading_model: u32,
     directional_count: u32,

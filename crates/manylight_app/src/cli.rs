@@ -45,6 +45,52 @@ pub fn parse_on_off(s: &str) -> Result<bool, String> {
     }
 }
 
+/// What `--shadows` asks for: no shadow, shadow maps (`on` or `maps`) or shadow rays.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ShadowChoice {
+    /// No light casts.
+    #[default]
+    Off,
+    /// Every light casts, into shadow maps ([`manylight_render::ShadowMethod::Maps`]).
+    Maps,
+    /// Every light casts, found with rays ([`manylight_render::ShadowMethod::Rays`]).
+    Rays,
+}
+
+impl ShadowChoice {
+    /// True when lights cast.
+    pub fn casts(self) -> bool {
+        self != ShadowChoice::Off
+    }
+
+    /// How shadows are found (maps when off: nothing casts then).
+    pub fn method(self) -> manylight_render::ShadowMethod {
+        match self {
+            ShadowChoice::Rays => manylight_render::ShadowMethod::Rays,
+            ShadowChoice::Off | ShadowChoice::Maps => manylight_render::ShadowMethod::Maps,
+        }
+    }
+
+    /// The name `--shadows` takes (`maps` for `on`).
+    pub fn name(self) -> &'static str {
+        match self {
+            ShadowChoice::Off => "off",
+            ShadowChoice::Maps => "maps",
+            ShadowChoice::Rays => "rays",
+        }
+    }
+}
+
+/// `off`, `on` (shadow maps), `maps` or `rays`.
+pub fn parse_shadows(s: &str) -> Result<ShadowChoice, String> {
+    match s {
+        "off" => Ok(ShadowChoice::Off),
+        "on" | "maps" => Ok(ShadowChoice::Maps),
+        "rays" => Ok(ShadowChoice::Rays),
+        _ => Err(format!("`{s}`: expected off, on, maps or rays")),
+    }
+}
+
 /// `hardware2x2` or `gaussian`.
 pub fn parse_shadow_filter(s: &str) -> Result<manylight_render::ShadowFilteringMethod, String> {
     named(

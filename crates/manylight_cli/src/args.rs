@@ -68,6 +68,10 @@ pub(crate) enum Command {
     /// spheres, for prefilter samples, cube sizes and lookup-table sizes, with each setting's
     /// prefilter time and per-frame cost, as markdown tables.
     EnvironmentAccuracy(EnvironmentAccuracyArgs),
+    /// What shadow rays cost: building the scene's two-level BVH (time, bytes, depth) and
+    /// tracing each pixel's rays to the lights that reach its surface, on the GPU, on the
+    /// traversal's CPU twin and on the CPU oracle, as markdown tables.
+    ShadowRays(ShadowRaysArgs),
     /// Draw the figures of a CSV that `bench`, `report` or `post` wrote.
     Plot {
         /// The CSV file.
@@ -100,6 +104,28 @@ pub(crate) enum Command {
         #[arg(long, default_value_t = 4_000_000)]
         samples: usize,
     },
+}
+
+#[derive(clap::Args)]
+pub(crate) struct ShadowRaysArgs {
+    /// The scene: `default`, `sphere-shell` or a .gltf/.glb path.
+    #[arg(long, default_value = "default")]
+    pub(crate) scene: String,
+    /// Lights of the animated rig (as `bench --lights`), where they are at time 0.
+    #[arg(long, default_value_t = 100_000)]
+    pub(crate) lights: usize,
+    /// Pixels, WxH.
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    pub(crate) size: UVec2,
+    /// Rays a pixel, one row each (comma-separated).
+    #[arg(long, value_delimiter = ',', default_value = "1,2,4,8")]
+    pub(crate) rays_per_pixel: Vec<u32>,
+    /// Seed of the light rig.
+    #[arg(long, default_value_t = 1)]
+    pub(crate) seed: u64,
+    /// Timed GPU traces and instance-level builds per row (medians).
+    #[arg(long, default_value_t = 3)]
+    pub(crate) repeats: u32,
 }
 
 #[derive(clap::Args)]
@@ -226,14 +252,17 @@ pub(crate) struct BenchArgs {
     /// light-volumes).
     #[arg(long, value_delimiter = ',', default_value = "full,compact", value_parser = parse_gbuffer)]
     pub(crate) gbuffers: Vec<GBufferLayout>,
-    /// Comma-separated shadow settings swept: `off` (no light casts), `on` (every light of the
-    /// scene and the rig casts).
-    #[arg(long, value_delimiter = ',', default_value = "off", value_parser = parse_on_off, action = clap::ArgAction::Set)]
-    pub(crate) shadows: Vec<bool>,
+    /// Comma-separated shadow settings swept: `off` (no light casts), `on` or `maps` (every
+    /// light of the scene and the rig casts into the shadow atlas), `rays` (every light casts,
+    /// found with rays through the scene's BVH).
+    #[arg(long, value_delimiter = ',', default_value = "off", value_parser = manylight_app::cli::parse_shadows)]
+    pub(crate) shadows: Vec<manylight_app::cli::ShadowChoice>,
     /// Also measure each pipeline row's last frame against exact visibility: the CSV columns
     /// `visibility_error` (mean |shadow test - exact| over the light-pixel pairs the light
-    /// reaches) and `flip_vs_shadow_reference` (FLIP mean against naive forward with exact
-    /// visibility). Not timed.
+    /// reaches), `flip_vs_shadow_reference` (FLIP mean against naive forward with exact
+    /// visibility), `light_error` (sum of |HDR luminance - the reference's| over the sum of the
+    /// unshadowed frame's) and `flicker` (mean |next still frame - frame| over the mean, HDR
+    /// luminance). Not timed.
     #[arg(long)]
     pub(crate) shadow_oracle: bool,
     #[command(flatten)]
@@ -298,13 +327,16 @@ pub(crate) struct RenderArgs {
     #[arg(long, default_value_t = 1)]
     pub(crate) seed: u64,
     /// Camera: `scene` (the file's first camera, else a fitted one), `fit` (frame the whole
-    /// scene), or the index of one of the file's cameras.
+    /// scene), the index of one of the file's cameras, `look-at:EX,EY,EZ:TX,TY,TZ:FOV_DEG` (a
+    /// perspective camera at the eye looking at the target, +Y up, FOV_DEG degrees tall) or
+    /// `ortho:EX,EY,EZ:TX,TY,TZ:HEIGHT` (orthographic, HEIGHT world units tall).
     #[arg(long, default_value = "scene")]
     pub(crate) camera: String,
-    /// Shadows: `on` makes every light of the scene and of `--lights` cast one (glTF has no
-    /// shadow flag), `off` (default) none.
-    #[arg(long, default_value = "off", value_parser = parse_on_off, action = clap::ArgAction::Set)]
-    pub(crate) shadows: bool,
+    /// Shadows: `on` or `maps` makes every light of the scene and of `--lights` cast one into
+    /// the shadow atlas (glTF has no shadow flag), `rays` finds every light's shadow with rays
+    /// traced through the scene's BVH, `off` (default) none.
+    #[arg(long, default_value = "off", value_parser = manylight_app::cli::parse_shadows)]
+    pub(crate) shadows: manylight_app::cli::ShadowChoice,
     #[command(flatten)]
     pub(crate) shadow: ShadowArgs,
     /// Output PNG.
@@ -324,8 +356,10 @@ pub(crate) struct RenderArgs {
     pub(crate) oracle: bool,
     /// Also measure the last frame's shadows against exact visibility (a ray cast from every
     /// pixel's surface to each light that reaches it): prints the visibility error (mean
-    /// |shadow test - exact| over those pairs) and FLIP against the shadow reference (the
-    /// oracle's lists without the blocked pairs: naive forward with exact visibility).
+    /// |shadow test - exact| over those pairs), FLIP against the shadow reference (the
+    /// oracle's lists without the blocked pairs: naive forward with exact visibility), the
+    /// light error (sum of |HDR luminance - the reference's| over the sum of the unshadowed
+    /// frame's) and the flicker (mean |next still frame - frame| over the mean, HDR luminance).
     #[arg(long)]
     pub(crate) shadow_oracle: bool,
     /// Where `--shadow-oracle` writes the shadow reference image (PNG).
@@ -412,8 +446,12 @@ pub(crate) struct ShadowArgs {
 }
 
 impl ShadowArgs {
-    /// The settings, refused with the flag's problem when no atlas can be planned with them.
-    pub(crate) fn settings(&self) -> Result<manylight_render::ShadowSettings> {
+    /// The settings, finding shadows by `method`, refused with the flag's problem when no
+    /// atlas can be planned with them.
+    pub(crate) fn settings(
+        &self,
+        method: manylight_render::ShadowMethod,
+    ) -> Result<manylight_render::ShadowSettings> {
         let s = manylight_render::ShadowSettings {
             enabled: true,
             atlas_size: self.shadow_atlas,
@@ -424,6 +462,7 @@ impl ShadowArgs {
             cache_maps: self.shadow_cache_maps,
             max_redrawn_maps: self.shadow_max_redrawn_maps.0,
             filter: self.shadow_filter,
+            method,
         };
         s.check_values()
             .map_err(|e| anyhow::anyhow!("--{}", e.replace("shadows.", "shadow-").replace('_', "-")))?;

@@ -6,6 +6,7 @@ use crate::progress::Progress;
 use crate::shadow_error::{measure_shadows, occluders};
 use anyhow::{Context, Result};
 use glam::UVec2;
+use manylight_app::cli::ShadowChoice;
 use manylight_app::render_world::HeadlessRenderer;
 use manylight_core::shadow_oracle::OccluderSet;
 use manylight_render::passes::{
@@ -36,7 +37,7 @@ pub struct Row {
     /// (the forward oracle) or clustered deferred (the deferred oracle, per G-buffer layout).
     oracle: bool,
     /// Every light casts a shadow.
-    shadows: bool,
+    shadows: ShadowChoice,
     /// The last frame's shadows against exact visibility (`--shadow-oracle`).
     shadow_accuracy: Option<ShadowFigures>,
 }
@@ -46,6 +47,8 @@ pub struct Row {
 struct ShadowFigures {
     visibility_error: f64,
     flip_vs_reference: f32,
+    light_error: f64,
+    flicker: f64,
 }
 
 impl Row {
@@ -146,8 +149,8 @@ pub struct Sweep {
     pub shell_lattice: bool,
     /// G-buffer layouts swept for the deferred pipeline.
     pub gbuffers: Vec<GBufferLayout>,
-    /// Shadow settings swept: every light casts (`true`) or none does.
-    pub shadows: Vec<bool>,
+    /// Shadow settings swept: no light casts, or every light casts into maps or with rays.
+    pub shadows: Vec<ShadowChoice>,
     /// Also measure each pipeline row's last frame against exact visibility (visibility error
     /// and FLIP against the shadow reference).
     pub shadow_oracle: bool,
@@ -159,8 +162,8 @@ pub struct Sweep {
 pub fn run(scene: &Scene, scene_name: &str, sweep: &Sweep) -> Result<String> {
     let mut renderer = HeadlessRenderer::new()?;
     let adapter = renderer.render_world.gpu().info.name.clone();
-    let shadow_settings: Vec<bool> =
-        if sweep.shadows.is_empty() { vec![false] } else { sweep.shadows.clone() };
+    let shadow_settings: Vec<ShadowChoice> =
+        if sweep.shadows.is_empty() { vec![ShadowChoice::Off] } else { sweep.shadows.clone() };
     let configs = configurations(sweep, &shadow_settings);
     let oracles = oracle_configurations(sweep, &shadow_settings);
     let occluders = sweep.shadow_oracle.then(|| occluders(scene));
@@ -186,8 +189,8 @@ struct Config {
     /// The G-buffer layout of a deferred pipeline.
     gbuffer: Option<GBufferLayout>,
     lights: usize,
-    /// Every light casts a shadow.
-    shadows: bool,
+    /// Every light casts a shadow, into maps or with rays, or none does.
+    shadows: ShadowChoice,
     /// An oracle's run (see [`Row::oracle`]).
     oracle: bool,
 }
@@ -202,14 +205,14 @@ impl Config {
             (false, Some(g)) => format!("{} ({} G-buffer), {lights} lights", self.pipeline.name(), g.name()),
             (false, None) => format!("{}, {lights} lights", self.pipeline.name()),
         };
-        if self.shadows { format!("{label}, shadows") } else { label }
+        if self.shadows.casts() { format!("{label}, shadows {}", self.shadows.name()) } else { label }
     }
 }
 
 /// The sweep's pipeline configurations, by light count, pipeline, G-buffer layout (deferred
 /// pipelines) and shadow setting (of `shadows`); naive forward only up to
 /// `sweep.naive_max_lights` lights.
-fn configurations(sweep: &Sweep, shadows: &[bool]) -> Vec<Config> {
+fn configurations(sweep: &Sweep, shadows: &[ShadowChoice]) -> Vec<Config> {
     sweep
         .lights
         .iter()
@@ -238,7 +241,7 @@ fn configurations(sweep: &Sweep, shadows: &[bool]) -> Vec<Config> {
 /// The oracles of `--oracle` (none without it): one forward oracle per light count, and a
 /// deferred one per G-buffer layout when the sweep has deferred pipelines, each with every
 /// shadow setting of `shadows`.
-fn oracle_configurations(sweep: &Sweep, shadows: &[bool]) -> Vec<Config> {
+fn oracle_configurations(sweep: &Sweep, shadows: &[ShadowChoice]) -> Vec<Config> {
     if !sweep.oracle {
         return Vec::new();
     }
@@ -276,7 +279,7 @@ fn measure_config(
 ) -> Result<Row> {
     let Config { pipeline, gbuffer, lights, shadows, oracle } = config;
     let (lit, rig) = lights_of(scene, sweep.shell_lattice, lights)?;
-    let settings = FrameSettings {
+    let mut settings = FrameSettings {
         render: RenderSettings {
             pipeline,
             gbuffer: gbuffer.unwrap_or(sweep.settings.gbuffer),
@@ -284,8 +287,9 @@ fn measure_config(
         },
         ..sweep.settings
     };
+    settings.render.shadows.method = shadows.method();
     let (frame_ms, last, oracle_culling) =
-        timed_frames(renderer, &lit, &rig, sweep, settings, oracle, shadows)?;
+        timed_frames(renderer, &lit, &rig, sweep, settings, oracle, shadows.casts())?;
     let (culling, depth_bounded, zbinned) = if oracle {
         (oracle_culling, None, None)
     } else if sweep.culling_efficiency && pipeline.uses_clusters() && lights > 0 {
@@ -299,11 +303,16 @@ fn measure_config(
         Some(occluders) if !oracle => {
             let t = (sweep.warmup + sweep.frames).saturating_sub(1);
             let mut snap = snapshot(&lit, &rig, t as f32 / 60.0, sweep.size, settings, u64::from(t));
-            if shadows {
+            if shadows.casts() {
                 crate::direct::cast_every_shadow(&mut snap);
             }
             let a = measure_shadows(renderer, snap, occluders)?;
-            Some(ShadowFigures { visibility_error: a.visibility_error, flip_vs_reference: a.flip.mean })
+            Some(ShadowFigures {
+                visibility_error: a.visibility_error,
+                flip_vs_reference: a.flip.mean,
+                light_error: a.light_error,
+                flicker: a.flicker,
+            })
         }
         _ => None,
     };
@@ -454,7 +463,7 @@ fn csv(rows: &[Row], scene: &str, size: UVec2, adapter: &str) -> String {
          list_capacity,tile_entries,tile_capacity,fallback_clusters,shading_ms,shading_vs_oracle,\
          coarse_tiles,coarse_entries,depth_bounded_ratio,cluster_depth_gpu_ms,light_refine_gpu_ms,\
          zbinned_ratio,shadows,shadow_maps_rendered,shadow_maps_cached,shadow_maps_stale,shadow_atlas_bytes,shadow_gpu_ms,\
-         visibility_error,flip_vs_shadow_reference,frame_ms_min,frame_ms_max,cpu_frame_ms,cpu_upload_ms,\
+         visibility_error,flip_vs_shadow_reference,light_error,flicker,frame_ms_min,frame_ms_max,cpu_frame_ms,cpu_upload_ms,\
          cpu_prepare_ms,cpu_record_ms,cpu_submit_ms,upload_bytes\n",
     );
     for r in rows {
@@ -564,12 +573,12 @@ impl Row {
         ]
     }
 
-    /// `shadows` to `flip_vs_shadow_reference`: the shadow maps and their accuracy.
+    /// `shadows` to `flicker`: the shadow maps and their accuracy.
     fn shadow_fields(&self) -> Vec<String> {
         let s = self.last.shadows;
         let a = self.shadow_accuracy;
         vec![
-            if self.shadows { "on" } else { "off" }.to_string(),
+            self.shadows.name().to_string(),
             s.map_or(0, |s| s.maps_rendered).to_string(),
             s.map_or(0, |s| s.maps_cached).to_string(),
             s.map_or(0, |s| s.maps_stale).to_string(),
@@ -577,6 +586,8 @@ impl Row {
             pass_ms::<ShadowMapsPass>(&self.last),
             a.map_or(String::new(), |a| format!("{:.5}", a.visibility_error)),
             a.map_or(String::new(), |a| format!("{:.5}", a.flip_vs_reference)),
+            a.map_or(String::new(), |a| format!("{:.6}", a.light_error)),
+            a.map_or(String::new(), |a| format!("{:.6}", a.flicker)),
         ]
     }
 

@@ -11,6 +11,7 @@ use std::process::ExitCode;
 
 mod args;
 mod bench;
+mod camera_spec;
 mod codec_accuracy;
 mod commands;
 mod culling_tests;
@@ -21,6 +22,7 @@ mod large_floor;
 mod plot;
 mod post;
 mod progress;
+mod ray_cost;
 mod report;
 mod shadow_error;
 mod soak;
@@ -45,6 +47,7 @@ fn main() -> ExitCode {
         Command::Post(args) => commands::post::run(args),
         Command::Views(args) => commands::views::run(args),
         Command::EnvironmentAccuracy(args) => commands::environment_accuracy::run(args),
+        Command::ShadowRays(args) => commands::shadow_rays::run(args),
         Command::Plot { csv, out } => commands::plot::run(csv, out),
         Command::Compare { reference, test, error_map } => {
             commands::compare::run(&reference, &test, error_map.as_deref())

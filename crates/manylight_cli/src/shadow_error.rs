@@ -16,6 +16,17 @@
 //!    visibility. The frame is compared with it by FLIP. Directional lights are not measured:
 //!    the reference keeps the frame's cascades, and a scene lit only by directional lights
 //!    has no pairs to measure (its error is 0 over 0 pairs).
+//! 6. The **light error** is `Σ |shadowed − reference| / Σ unshadowed` over the pixels' Rec. 709
+//!    luminance in HDR (linear radiance before exposure and tone mapping;
+//!    [`manylight_core::image_metrics::light_error`]): the measured frame, the shadow
+//!    reference, and the frame with shadows disabled (the render the oracle's lists come from).
+//!    Unlike the visibility error it weighs each pair by the light it carries and needs nothing
+//!    of the technique but its image, so it measures any shadow technique alike.
+//! 7. The **flicker** is the renderer's next frame of the same still scene (camera, lights and
+//!    the animation clock unchanged, the frame index one on) against the measured frame:
+//!    `mean |next − measured| / mean next` of their HDR luminance
+//!    ([`manylight_core::image_metrics::flicker`]). Shadow maps are deterministic (0); a
+//!    stochastic technique's noise that changes from frame to frame shows here.
 
 use crate::direct::oracle_snapshot;
 use anyhow::{Context, Result};
@@ -23,7 +34,7 @@ use glam::{Mat4, UVec2, Vec2};
 use manylight_app::render_world::HeadlessRenderer;
 use manylight_core::AlphaMode;
 use manylight_core::cluster::ClusterAssignment;
-use manylight_core::image_metrics::{FlipStats, flip_compare};
+use manylight_core::image_metrics::{FlipStats, flicker, flip_compare, light_error, luminance_rgba_f16};
 use manylight_core::shadow_oracle::{LightSource, OccluderSet, ShadowQuery, SurfaceHit};
 use manylight_render::shadow_probe::ShadowProbe;
 use manylight_render::{ExtractedPointLight, FrameSnapshot};
@@ -54,6 +65,13 @@ pub struct ShadowAccuracy {
     pub light_leak: f64,
     /// FLIP of the frame against the shadow reference.
     pub flip: FlipStats,
+    /// `Σ |shadowed − reference| / Σ unshadowed` of the HDR luminance (see the module's
+    /// step 6): 0 is exact visibility; infinite only when the unshadowed frame is black and the
+    /// frame is not.
+    pub light_error: f64,
+    /// `mean |next frame − frame| / mean next frame` of the HDR luminance with nothing moving
+    /// (step 7): 0 for a deterministic technique.
+    pub flicker: f64,
     /// The shadow reference image.
     pub reference: image::RgbaImage,
 }
@@ -77,6 +95,31 @@ pub fn measure_shadows(
     snapshot: FrameSnapshot,
     occluders: &OccluderSet,
 ) -> Result<ShadowAccuracy> {
+    // The measuring frames keep their HDR images readable; the renderer's frames after them
+    // are ordinary again, whether the measurement succeeded or not.
+    renderer.render_world.renderer_mut().set_hdr_readback(true);
+    let measured = measure_with_hdr(renderer, snapshot, occluders);
+    renderer.render_world.renderer_mut().set_hdr_readback(false);
+    measured
+}
+
+/// The per-pixel HDR luminance of the renderer's last frame (rendered with its HDR read-back
+/// on).
+fn hdr_luminance(renderer: &HeadlessRenderer, what: &str) -> Result<Vec<f32>> {
+    let (_, _, rgba) = renderer
+        .render_world
+        .renderer()
+        .read_hdr()?
+        .with_context(|| format!("the {what} has no HDR image to measure"))?;
+    Ok(luminance_rgba_f16(&rgba)?)
+}
+
+/// [`measure_shadows`] on a renderer whose frames keep their HDR images readable.
+fn measure_with_hdr(
+    renderer: &mut HeadlessRenderer,
+    snapshot: FrameSnapshot,
+    occluders: &OccluderSet,
+) -> Result<ShadowAccuracy> {
     let camera = *snapshot.camera().context("the frame has no camera to measure")?;
     let size = snapshot.viewport.max(UVec2::ONE);
     // The oracle's lists come from a render without shadows (its depth is the same), so the
@@ -84,9 +127,18 @@ pub fn measure_shadows(
     // renderer's last one, as the caching and the redraw budget left it.
     let mut unshadowed = snapshot.clone();
     unshadowed.settings.shadows.enabled = false;
-    let (oracle, _) = oracle_snapshot(renderer, unshadowed)?;
+    // `oracle_snapshot` renders the unshadowed frame (by the oracle's pipeline: clustered
+    // forward or deferred) when it has a point or spot light to list; without one it renders
+    // nothing, and the unshadowed frame is rendered here.
+    let lists_rendered = manylight_render::lights::buffered_lights(&unshadowed.lights).next().is_some();
+    let (oracle, _) = oracle_snapshot(renderer, unshadowed.clone())?;
+    if !lists_rendered {
+        renderer.render(unshadowed, false)?;
+    }
+    let unshadowed_light = hdr_luminance(renderer, "unshadowed frame")?;
     let (_, frame) = renderer.render(snapshot.clone(), true)?;
     let image = frame.context("the frame was not read back")?;
+    let shadowed_light = hdr_luminance(renderer, "frame")?;
     let lists = oracle.pixel_light_lists.clone().context("the oracle made no lists")?;
     let lights: Vec<&ExtractedPointLight> =
         manylight_render::lights::buffered_lights(&snapshot.lights).map(|(_, l)| l).collect();
@@ -108,6 +160,12 @@ pub fn measure_shadows(
         })
         .collect();
     let tested = renderer.render_world.renderer().probe_shadows(&probe_inputs)?;
+    // The renderer's next frame, right after the measured one (the probes above read the
+    // measured frame's atlas): the same still scene, the animation clock unchanged.
+    let mut next = snapshot.clone();
+    next.frame_index += 1;
+    renderer.render(next, false)?;
+    let flicker = flicker(&hdr_luminance(renderer, "next frame")?, &shadowed_light)?;
     let exact: Vec<bool> =
         pairs.entries.iter().zip(&visible).filter(|((_, reaches), _)| *reaches).map(|(_, &v)| v).collect();
     let errors = test_errors(&tested, &exact);
@@ -116,6 +174,8 @@ pub fn measure_shadows(
 
     let reference =
         shadow_reference(renderer, oracle, snapshot.settings.shadows, &lists, &pairs.entries, &visible)?;
+    let light_error =
+        light_error(&shadowed_light, &hdr_luminance(renderer, "shadow reference")?, &unshadowed_light)?;
     let (flip, _) =
         flip_compare(reference.dimensions(), reference.as_raw(), image.dimensions(), image.as_raw())?;
     let per_pair = |sum: f64| if contributing_pairs == 0 { 0.0 } else { sum / contributing_pairs as f64 };
@@ -129,6 +189,8 @@ pub fn measure_shadows(
         false_shadow: per_pair(errors.false_shadow),
         light_leak: per_pair(errors.light_leak),
         flip,
+        light_error,
+        flicker,
         reference,
     })
 }
@@ -335,7 +397,45 @@ mod tests {
             assert_eq!(a.blocked_pairs, 0, "shadows {shadows}");
             assert!(a.visibility_error < 1e-3, "shadows {shadows}: {}", a.visibility_error);
             assert!(a.flip.mean < 0.002, "shadows {shadows}: FLIP {}", a.flip.mean);
+            assert!(a.light_error < 1e-3, "shadows {shadows}: light error {}", a.light_error);
+            // Deterministic frames (0 on lavapipe); light lists in another order on another
+            // device round sums differently, far below this.
+            assert!(a.flicker < 1e-4, "shadows {shadows}: flicker {}", a.flicker);
         }
+    }
+
+    /// The HDR image the measures read is the one the tone map shows: tone mapped on the CPU
+    /// it is the read-back frame within the rounding of the sRGB encoding; an ordinary frame's
+    /// HDR image cannot be read.
+    #[test]
+    fn the_hdr_read_back_is_what_the_tone_map_shows() {
+        let (scene, lights) = open_floor();
+        let size = UVec2::new(128, 96);
+        let snapshot =
+            manylight_app::scene::scene_snapshot(&scene, lights, size, FrameSettings::default(), 0);
+        let exposure = snapshot.render_view(0).exposure();
+        let mut renderer = HeadlessRenderer::new().expect("a GPU adapter (lavapipe in CI)");
+        renderer.render_world.renderer_mut().set_hdr_readback(true);
+        let (_, image) = renderer.render(snapshot.clone(), true).expect("rendered");
+        let image = image.expect("read back");
+        let (w, h, rgba) = renderer.render_world.renderer().read_hdr().expect("read").expect("an HDR image");
+        assert_eq!((w, h), size.into());
+        let mut worst = 0u8;
+        for (hdr, ldr) in rgba.chunks_exact(4).zip(image.pixels()) {
+            let [r, g, b, _] =
+                [hdr[0], hdr[1], hdr[2], hdr[3]].map(manylight_core::image_metrics::f16_to_f32);
+            let shown = manylight_core::tonemap::tonemap_to_srgb8(Vec3::new(r, g, b), exposure);
+            for c in 0..3 {
+                worst = worst.max(shown[c].abs_diff(ldr[c]));
+            }
+        }
+        assert!(worst <= 1, "the CPU tone map of the HDR image is {worst} steps from the frame");
+        let lit = luminance_rgba_f16(&rgba).expect("RGBA").iter().filter(|&&l| l > 0.01).count();
+        assert!(lit > (w * h / 2) as usize, "{lit} lit pixels of {}", w * h);
+
+        renderer.render_world.renderer_mut().set_hdr_readback(false);
+        renderer.render(snapshot, false).expect("rendered");
+        assert!(renderer.render_world.renderer().read_hdr().is_err(), "an ordinary frame's HDR image");
     }
 
     #[test]

@@ -18,6 +18,7 @@ pub mod image_metrics;
 pub mod light_count;
 pub mod material;
 pub mod mesh;
+pub mod ray_bvh;
 pub mod shadow_oracle;
 pub mod spot;
 pub mod tonemap;

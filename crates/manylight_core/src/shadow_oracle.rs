@@ -47,12 +47,15 @@ pub struct ShadowQuery {
     pub light: LightSource,
 }
 
+/// [`surface_offset`] per unit of a point's largest coordinate: 64 float steps.
+pub const SURFACE_OFFSET_STEPS: f32 = 64.0 * f32::EPSILON;
+
 /// How far a ray starts off the surface (and ends before a point light) at `point`: 64 float
 /// steps of the point's largest coordinate (`f32` positions near `p` are spaced about
 /// `|p| · 1.2·10⁻⁷` apart), and never less than 64 steps of 1: 7.6·10⁻⁶ near the origin, 0.076
 /// at 10⁴.
 pub fn surface_offset(point: Vec3) -> f32 {
-    64.0 * f32::EPSILON * point.abs().max_element().max(1.0)
+    SURFACE_OFFSET_STEPS * point.abs().max_element().max(1.0)
 }
 
 /// Where a ray first meets the scene (see [`OccluderSet::first_hit`]).
@@ -145,32 +148,43 @@ impl OccluderSet {
         queries.par_iter().map(|q| self.visible(q)).collect()
     }
 
-    /// The ray of a query; `None` when the point coincides with the light or an input is not
-    /// finite (nothing to block).
+    /// The ray of a query ([`ShadowQuery::segment`]).
     fn ray(&self, query: &ShadowQuery) -> Option<Ray> {
-        let offset = surface_offset(query.point);
-        let normal = query.normal.try_normalize().unwrap_or(Vec3::ZERO);
-        let (direction, length) = match query.light {
+        let (origin, direction, length) = query.segment()?;
+        Some(Ray::new(Vec3A::from(origin), Vec3A::from(direction), 0.0, length))
+    }
+}
+
+impl ShadowQuery {
+    /// The segment a shadow ray tests for this pair (see the module's steps): its origin, off
+    /// the surface along the normal by [`surface_offset`]; its unit direction towards the
+    /// light; and its length (infinite for a directional light). `None` when the point
+    /// coincides with the light or an input is not finite (nothing to block). Every tracer of
+    /// shadow rays (this oracle, [`crate::ray_bvh`], the shaders) casts this segment.
+    pub fn segment(&self) -> Option<(Vec3, Vec3, f32)> {
+        let offset = surface_offset(self.point);
+        let normal = self.normal.try_normalize().unwrap_or(Vec3::ZERO);
+        let (direction, length) = match self.light {
             LightSource::At(position) => {
-                let to = position - query.point;
+                let to = position - self.point;
                 (to.try_normalize()?, to.length() - offset)
             }
             LightSource::Travelling(direction) => (-direction.try_normalize()?, f32::INFINITY),
         };
         // Off the surface along its normal: a light behind the surface is then blocked by the
         // surface itself, as shading (which gives it no contribution there) agrees.
-        let origin = query.point + normal * offset;
+        let origin = self.point + normal * offset;
         if !origin.is_finite() || length <= 0.0 {
             return None;
         }
-        Some(Ray::new(Vec3A::from(origin), Vec3A::from(direction), 0.0, length))
+        Some((origin, direction, length))
     }
 }
 
 /// How far outside a triangle, in barycentric units, a hit still counts: a ray through the
 /// edge two triangles share hits both (the plain Möller–Trumbore test can miss both there, and
 /// light would leak through the diagonal of a closed box).
-const EDGE_TOLERANCE: f32 = 1e-6;
+pub const EDGE_TOLERANCE: f32 = 1e-6;
 
 /// Distance along `ray` to where it crosses `tri` (either side) within `[tmin, tmax]`, edges
 /// included ([`EDGE_TOLERANCE`]); infinity where it does not (Möller–Trumbore).

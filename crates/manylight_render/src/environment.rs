@@ -32,7 +32,8 @@ pub struct GpuEnvironmentFilter {
     pub size: u32,
     /// Samples per texel, or reads per axis for `cs_from_equirect`.
     pub samples: u32,
-    /// GGX perceptual roughness of the specular mip written.
+    /// GGX perceptual roughness of the specular mip written
+    /// ([`EnvironmentFilter::specular_mip_roughness`]).
     pub roughness: f32,
     /// The source cube's mip-0 face size.
     pub source_size: f32,
@@ -485,7 +486,8 @@ impl Recorder<'_> {
     }
 
     /// The specular cube: mip 0 the source's (roughness 0 reflects the panorama itself), mip m
-    /// the source convolved with GGX at roughness m / (mips - 1).
+    /// the source convolved with GGX at [`EnvironmentFilter::specular_mip_roughness`],
+    /// `(m / (mips - 1))²`, the roughness the shading passes' lod maps back to.
     fn specular_cube(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -511,7 +513,7 @@ impl Recorder<'_> {
             let params = GpuEnvironmentFilter {
                 size: size >> level,
                 samples: filter.samples,
-                roughness: level as f32 / (mips - 1) as f32,
+                roughness: filter.specular_mip_roughness(level),
                 source_size: size as f32,
                 source_max_lod: (source.mip_level_count() - 1) as f32,
                 ..Default::default()

@@ -104,6 +104,7 @@ pub const CULL_BOTH: u32 = 2;
 pub fn shared_u32_constants() -> Vec<(&'static str, u32)> {
     use crate::settings::DebugViewMode as DebugView;
     use manylight_core::cluster::ZSlicing;
+    use manylight_core::ray_bvh;
     vec![
         ("MAX_DIRECTIONAL_LIGHTS", MAX_DIRECTIONAL_LIGHTS),
         ("SHADOW_FACES", SHADOW_FACES),
@@ -158,6 +159,13 @@ pub fn shared_u32_constants() -> Vec<(&'static str, u32)> {
         ("DEBUG_ROUGHNESS", DebugView::Roughness.gpu_id()),
         ("DEBUG_EMISSIVE", DebugView::Emissive.gpu_id()),
         ("DEBUG_OCCLUSION", DebugView::Occlusion.gpu_id()),
+        ("RAY_STACK_SIZE", ray_bvh::RAY_STACK_SIZE),
+        ("RAY_MAX_STEPS", ray_bvh::RAY_MAX_STEPS),
+        ("RAY_NO_NODE", ray_bvh::RAY_NO_NODE),
+        ("RAY_VISIBLE", ray_bvh::RayOutcome::Visible.code()),
+        ("RAY_BLOCKED", ray_bvh::RayOutcome::Blocked.code()),
+        ("RAY_EXHAUSTED", ray_bvh::RayOutcome::Exhausted.code()),
+        ("RAY_STACK_FULL", ray_bvh::RayOutcome::StackFull.code()),
     ]
 }
 
@@ -188,6 +196,10 @@ pub struct ViewUniform {
     /// x: environment intensity, y: the specular cube's largest mip level, z: skybox
     /// brightness, w: unused.
     pub environment: Vec4,
+    /// The shadow rays' geometry (`shaders/common/ray_bvh.wgsl`): x the instance level's root
+    /// (`manylight_core::ray_bvh::RAY_NO_NODE` when the frame traces no ray), y the first
+    /// `ray_prims` entry of the instances, z that of the casting lights' bits, w unused.
+    pub rays: [u32; 4],
     /// Number of lights in the light buffer.
     pub light_count: u32,
     /// Global shading model id.
@@ -209,7 +221,7 @@ pub const MAX_DIRECTIONAL_LIGHTS: u32 = 8;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuDirectionalLight {
-    /// xyz: unit direction the light travels, w: unused.
+    /// xyz: unit direction the light travels, w: 1 when the light casts a shadow, else 0.
     pub direction: [f32; 4],
     /// rgb: colour × illuminance, a: unused.
     pub color: [f32; 4],
@@ -521,6 +533,10 @@ pub fn shared_f32_constants() -> Vec<(&'static str, f32)> {
         ("PBR_DIELECTRIC_F0", manylight_core::brdf::PBR_DIELECTRIC_F0),
         ("BRDF_PI", std::f32::consts::PI),
         ("BRDF_FRAC_1_PI", std::f32::consts::FRAC_1_PI),
+        ("RAY_MISS", manylight_core::ray_bvh::RAY_MISS),
+        ("RAY_FAR", manylight_core::ray_bvh::RAY_FAR),
+        ("RAY_EDGE_TOLERANCE", manylight_core::shadow_oracle::EDGE_TOLERANCE),
+        ("RAY_SURFACE_OFFSET", manylight_core::shadow_oracle::SURFACE_OFFSET_STEPS),
     ]
 }
 

@@ -50,6 +50,8 @@ pub mod planner;
 #[doc(hidden)]
 pub mod pool;
 #[doc(hidden)]
+pub mod ray_geometry;
+#[doc(hidden)]
 pub mod readback;
 #[doc(hidden)]
 pub mod renderer;
@@ -79,7 +81,9 @@ pub use plan::PlanInputs;
 pub use planner::{FramePlanner, Stage, StageError, StageId, builtin_stages};
 pub use readback::{HEADLESS_FORMAT, HeadlessTarget};
 pub use renderer::Renderer;
-pub use settings::{CameraShadows, CascadeShadowConfig, CascadeShadowConfigBuilder, ShadowFilteringMethod};
+pub use settings::{
+    CameraShadows, CascadeShadowConfig, CascadeShadowConfigBuilder, ShadowFilteringMethod, ShadowMethod,
+};
 pub use shadows::{ShadowReport, ShadowSettings};
 pub use snapshot::{
     BloomChain, BloomSettings, ClusterSettings, DEFAULT_COARSE_TILES, DebugViewMode, DirectionalShadow,

@@ -396,7 +396,12 @@ pub fn gpu_light_motion(light: &ExtractedPointLight, epoch: f32) -> GpuLightMoti
 /// `light` as the view uniform holds it.
 pub fn gpu_directional_light(light: &ExtractedDirectionalLight) -> GpuDirectionalLight {
     GpuDirectionalLight {
-        direction: light.direction.normalize().extend(0.0).to_array(),
+        // w: whether it casts, read by the shadow rays (the maps have their own table).
+        direction: light
+            .direction
+            .normalize()
+            .extend(if light.shadow.is_some() { 1.0 } else { 0.0 })
+            .to_array(),
         color: (light.color * light.illuminance).extend(0.0).to_array(),
     }
 }

@@ -12,7 +12,7 @@ use crate::bindings::BindingCache;
 use crate::clusters::ClusterResources;
 use crate::context::{GpuContext, GpuCounts, RenderError};
 use crate::gpu_types::{GpuClusterCounters, LAVAPIPE_LOOP_LIMIT};
-use crate::graph::{OUTPUT, Pass, PassContext, RenderGraph, ResourceName};
+use crate::graph::{HDR, HDR_SWAP, OUTPUT, Pass, PassContext, RenderGraph, ResourceName};
 use crate::inflight::{DEFAULT_FRAMES_IN_FLIGHT, FrameRing};
 use crate::pipelines::PipelineCache;
 use crate::pool::{TextureKey, TransientPool};
@@ -30,6 +30,8 @@ pub struct Renderer {
     pub scene: SceneResources,
     /// The shadow atlas and its pass's buffers.
     pub shadows: crate::shadows::ShadowResources,
+    /// The shadow rays' geometry and casting lights, when the frame traces rays.
+    pub rays: crate::ray_geometry::ShadowRays,
     /// The prefiltered environment maps the views name.
     pub environments: crate::environment::EnvironmentMaps,
     /// Pipelines created so far.
@@ -46,6 +48,12 @@ pub struct Renderer {
     counts_at_begin: GpuCounts,
     cpu_adapter: bool,
     last_textures: HashMap<crate::graph::ResourceName, wgpu::TextureView>,
+    /// Whether the last frame's HDR image ended in [`HDR_SWAP`] (an odd number of
+    /// post-processing passes swapped it there).
+    last_hdr_swapped: bool,
+    /// Whether frames make their HDR textures copyable, for [`Renderer::read_hdr`]
+    /// ([`Renderer::set_hdr_readback`]; off for ordinary frames).
+    hdr_readback: bool,
     /// This frame's `FrameSnapshot::pixel_light_lists`.
     pixel_light_lists: Option<std::sync::Arc<manylight_core::cluster::ClusterAssignment>>,
     /// This frame's CPU time by phase so far.
@@ -65,6 +73,7 @@ impl Renderer {
         Renderer {
             scene: SceneResources::new(&gpu),
             shadows: crate::shadows::ShadowResources::new(&gpu),
+            rays: Default::default(),
             environments: crate::environment::EnvironmentMaps::new(),
             pipelines: PipelineCache::default(),
             clusters: Vec::new(),
@@ -75,6 +84,8 @@ impl Renderer {
             counts_at_begin: gpu.counts(),
             cpu_adapter,
             last_textures: HashMap::new(),
+            last_hdr_swapped: false,
+            hdr_readback: false,
             pixel_light_lists: None,
             phases: CpuPhases::default(),
             gpu,
@@ -116,8 +127,9 @@ impl Renderer {
         self.bindings.begin_frame();
         self.scene.prepare(&self.gpu, snapshot)?;
         self.shadows.prepare(&self.gpu, &self.scene, snapshot)?;
+        self.rays.prepare(&self.gpu, snapshot);
         self.environments.prepare(&self.gpu, snapshot)?;
-        self.scene.bind_view(&self.gpu, self.shadows.bindings(), None);
+        self.scene.bind_view(&self.gpu, self.shadows.bindings(), None, self.rays.bindings());
         self.pixel_light_lists = snapshot.pixel_light_lists.clone();
         // Views that went away free their cluster buffers.
         self.clusters.truncate(snapshot.views.len().max(1));
@@ -149,13 +161,15 @@ impl Renderer {
         has_lights: bool,
         options: crate::clusters::ListOptions,
     ) -> Result<(), RenderError> {
-        self.scene.prepare_view(&self.gpu, view);
         // A view whose camera's shadows checkbox is off binds and shades without shadows.
         let shadows = self.shadows.bindings().filter(|_| view.settings.render.shadows.enabled);
+        let rays = self.rays.bindings().filter(|_| view.settings.render.shadows.enabled);
         let filter = view.settings.render.environment_filter;
         let environment =
             view.camera.and_then(|c| c.environment).and_then(|e| self.environments.bindings(e.image, filter));
-        self.scene.bind_view(&self.gpu, shadows, environment);
+        self.scene.bind_view(&self.gpu, shadows, environment, rays);
+        // After binding: the view uniform carries the shadow rays' root.
+        self.scene.prepare_view(&self.gpu, view);
         if view.needs_clusters(has_lights) {
             if self.clusters.len() <= view.index {
                 self.clusters.resize_with(view.index + 1, || None);
@@ -189,6 +203,43 @@ impl Renderer {
         Ok(Some((w, h, depth)))
     }
 
+    /// Makes the HDR textures of the frames that follow copyable (`keep`), so that
+    /// [`Renderer::read_hdr`] can read the image the tone map reads; or not, as ordinary frames
+    /// are. While it is set the frames take their HDR textures from the pool under their own key
+    /// (an extra usage), so ordinary frames never pay for it.
+    pub fn set_hdr_readback(&mut self, keep: bool) {
+        self.hdr_readback = keep;
+    }
+
+    /// The last frame's HDR image as the tone map read it (linear radiance before exposure and
+    /// tone mapping, after any post-processing), as the bits of its `Rgba16Float` texels, row
+    /// by row: `(width, height, rgba)`. `None` when the frame had no HDR image (a debug view
+    /// replaced it); an error when the frame was not rendered after
+    /// [`Renderer::set_hdr_readback`]`(true)`. Waits for the GPU.
+    pub fn read_hdr(&self) -> Result<Option<(u32, u32, Vec<u16>)>, RenderError> {
+        let name = if self.last_hdr_swapped { HDR_SWAP } else { HDR };
+        let Some(view) = self.last_textures.get(&name) else {
+            return Ok(None);
+        };
+        let texture = view.texture();
+        if !texture.usage().contains(wgpu::TextureUsages::COPY_SRC) {
+            return Err(RenderError::Readback(
+                "the frame's HDR image cannot be copied: render it after set_hdr_readback(true)".into(),
+            ));
+        }
+        if texture.format() != crate::resources::HDR_FORMAT {
+            return Err(RenderError::Readback(format!(
+                "the frame's HDR image is {:?}, not {:?}",
+                texture.format(),
+                crate::resources::HDR_FORMAT
+            )));
+        }
+        // Rgba16Float: four 2-byte channels per texel.
+        let bytes = crate::readback::read_texture(&self.gpu, texture, wgpu::TextureAspect::All, 8)?;
+        let rgba = bytemuck::pod_collect_to_vec::<u8, u16>(&bytes);
+        Ok(Some((texture.width(), texture.height(), rgba)))
+    }
+
     /// The shadow test the last frame's shading made at each of `probes`, in [0, 1]
     /// ([`crate::shadow_probe::probe_shadows`]; waits for the GPU).
     pub fn probe_shadows(
@@ -196,6 +247,15 @@ impl Renderer {
         probes: &[crate::shadow_probe::ShadowProbe],
     ) -> Result<Vec<f32>, RenderError> {
         let lights = self.scene.lights.buffer.buffer();
+        if self.rays.bindings().is_some() {
+            return crate::ray_geometry::probe_lights(
+                &self.gpu,
+                &self.rays,
+                lights,
+                self.scene.lights.count,
+                probes,
+            );
+        }
         crate::shadow_probe::probe_shadows(&self.gpu, &self.shadows, lights, self.scene.lights.count, probes)
     }
 
@@ -409,12 +469,14 @@ impl Renderer {
                     continue;
                 }
                 let scaled = |v: u32| ((v as f32 * spec.scale).round() as u32).max(1);
-                let key = TextureKey {
-                    width: scaled(size.x),
-                    height: scaled(size.y),
-                    format: spec.format,
-                    usage: spec.usage,
+                // HDR images to be read back (`set_hdr_readback`) must be copyable.
+                let usage = if self.hdr_readback && (spec.name == HDR || spec.name == HDR_SWAP) {
+                    spec.usage | wgpu::TextureUsages::COPY_SRC
+                } else {
+                    spec.usage
                 };
+                let key =
+                    TextureKey { width: scaled(size.x), height: scaled(size.y), format: spec.format, usage };
                 textures.insert(spec.name, self.pool.acquire(&self.gpu.device, key, spec.name.name()));
             }
         }
@@ -467,6 +529,7 @@ impl Renderer {
                 cpu_ms,
             });
         }
+        self.last_hdr_swapped = hdr_swapped.get();
         Ok(timings)
     }
 

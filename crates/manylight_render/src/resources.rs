@@ -68,6 +68,9 @@ pub struct SurfaceVariant {
     /// The view has an environment: the shaders are composed with `ENVIRONMENT` and group 0
     /// has its maps (set per view by [`SurfaceVariant::with_view`]).
     pub environment: bool,
+    /// The frame traces shadow rays: the shaders are composed with `RAYS` and group 0 has the
+    /// BVH (set per view by [`SurfaceVariant::with_view`]).
+    pub rays: bool,
 }
 
 impl SurfaceVariant {
@@ -88,13 +91,14 @@ impl SurfaceVariant {
             shading: material.shading.map_or(SHADING_GLOBAL, |s| s.gpu_id()),
             shadows: false,
             environment: false,
+            rays: false,
         }
     }
 
-    /// The variant for a view whose group 0 is composed with `view` (its `SHADOWS` and
-    /// `ENVIRONMENT`).
+    /// The variant for a view whose group 0 is composed with `view` (its `SHADOWS`,
+    /// `ENVIRONMENT` and `RAYS`).
     pub fn with_view(self, view: ShaderDefs) -> SurfaceVariant {
-        SurfaceVariant { shadows: view.shadows, environment: view.environment, ..self }
+        SurfaceVariant { shadows: view.shadows, environment: view.environment, rays: view.rays, ..self }
     }
 
     /// The shader defines of the variant.
@@ -102,6 +106,7 @@ impl SurfaceVariant {
         crate::shaders::ShaderDefs {
             shadows: self.shadows,
             environment: self.environment,
+            rays: self.rays,
             ..Default::default()
         }
     }
@@ -176,6 +181,18 @@ pub struct ShadowBindings<'a> {
     pub generation: u64,
 }
 
+/// The shadow rays' buffers group 0 binds ([`crate::ray_geometry::ShadowRays::bindings`]).
+pub struct RayBindings<'a> {
+    /// The BVH's nodes (both levels).
+    pub nodes: &'a wgpu::Buffer,
+    /// The triangles, the instances and the casting lights' bits.
+    pub prims: &'a wgpu::Buffer,
+    /// The instance level's root and the offsets in `prims` (the view uniform's `rays`).
+    pub view: [u32; 4],
+    /// Changes whenever one of the buffers is re-created.
+    pub generation: u64,
+}
+
 /// What a frame needs to know of a chunk of lights without visiting them again: how many are
 /// invalid, and the box of what the valid ones reach.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -198,9 +215,9 @@ impl ChunkSummary {
     }
 }
 
-/// A group 0 and the generations of the buffers (lights, instances, shadows, environment) it
-/// was made from.
-type BoundView = ((u64, u64, u64, u64), wgpu::BindGroup);
+/// A group 0 and the generations of the buffers (lights, instances, shadows, environment, rays)
+/// it was made from.
+type BoundView = ((u64, u64, u64, u64, u64), wgpu::BindGroup);
 
 /// Scene data on the GPU for the current frame: group 0 and the view constants
 /// ([`ViewBindings`]), the lights ([`SceneLights`]), the instances and their draws
@@ -225,15 +242,20 @@ pub struct ViewBindings {
     /// when [`ViewBindings::shadows_active`] and the environment's when
     /// [`ViewBindings::environment_active`].
     pub layout: GroupLayout,
-    /// Group 0's layouts, by [`flavor`]: without and with shadows, without and with an
-    /// environment.
-    layouts: [GroupLayout; 4],
+    /// Group 0's layouts, by [`flavor`]: without and with shadow maps, without and with an
+    /// environment, without and with shadow rays.
+    layouts: [GroupLayout; FLAVORS],
     /// This frame's lights cast shadows: group 0 holds the shadow bindings and every shading
     /// pipeline is composed with `SHADOWS`.
     pub shadows_active: bool,
     /// The view has an environment: group 0 holds its maps and the surface pipelines are
     /// composed with `ENVIRONMENT`.
     pub environment_active: bool,
+    /// This frame traces shadow rays: group 0 holds the BVH and the casting lights' bits and
+    /// every shading pipeline is composed with `RAYS`.
+    pub rays_active: bool,
+    /// The shadow rays' root and offsets the view uniform carries (`ViewUniform::rays`).
+    pub rays: [u32; 4],
     /// Group 0 for this frame.
     pub bind_group: wgpu::BindGroup,
     /// The view uniform buffer.
@@ -241,12 +263,16 @@ pub struct ViewBindings {
     /// The frame's view constants as uploaded.
     pub uniform: ViewUniform,
     /// Group 0 of each [`flavor`], as last made.
-    bound: [Option<BoundView>; 4],
+    bound: [Option<BoundView>; FLAVORS],
 }
 
-/// The index of a group 0 layout: shadows in bit 0, an environment in bit 1.
-fn flavor(shadows: bool, environment: bool) -> usize {
-    usize::from(shadows) | usize::from(environment) << 1
+/// Group 0's layouts: each combination of shadow maps, an environment and shadow rays.
+const FLAVORS: usize = 8;
+
+/// The index of a group 0 layout: shadow maps in bit 0, an environment in bit 1, shadow rays in
+/// bit 2.
+fn flavor(shadows: bool, environment: bool, rays: bool) -> usize {
+    usize::from(shadows) | usize::from(environment) << 1 | usize::from(rays) << 2
 }
 
 impl ViewBindings {
@@ -255,6 +281,7 @@ impl ViewBindings {
         ShaderDefs {
             shadows: self.shadows_active,
             environment: self.environment_active,
+            rays: self.rays_active,
             ..Default::default()
         }
     }
@@ -345,11 +372,11 @@ impl SceneResources {
     /// Creates the layouts and empty buffers.
     pub fn new(gpu: &GpuContext) -> SceneResources {
         let device = &gpu.device;
-        let layouts =
-            [(false, false), (true, false), (false, true), (true, true)].map(|(shadows, environment)| {
-                SCENE_GROUP.create_layout(device, ShaderDefs { shadows, environment, ..Default::default() })
-            });
-        let view_layout = layouts[flavor(false, false)].clone();
+        let layouts: [GroupLayout; FLAVORS] = std::array::from_fn(|i| {
+            let (shadows, environment, rays) = (i & 1 != 0, i & 2 != 0, i & 4 != 0);
+            SCENE_GROUP.create_layout(device, ShaderDefs { shadows, environment, rays, ..Default::default() })
+        });
+        let view_layout = layouts[flavor(false, false, false)].clone();
         let view_buffer = gpu.create_buffer(&wgpu::BufferDescriptor {
             label: Some("view_uniform"),
             size: std::mem::size_of::<ViewUniform>() as u64,
@@ -361,18 +388,26 @@ impl SceneResources {
         let light_bytes = std::mem::size_of::<GpuPointLight>() as u64;
         let lights = GrowableBuffer::new(gpu, "point_lights", storage_usage, light_bytes);
         let instances = GrowableBuffer::new(gpu, "instances", storage_usage, 64 * 128);
-        let view_bind_group =
-            Self::make_view_bind_group(gpu, &view_layout, &view_buffer, &lights, &instances, None, None);
+        let view_bind_group = Self::make_view_bind_group(
+            gpu,
+            &view_layout,
+            [&view_buffer, lights.buffer(), instances.buffer()],
+            None,
+            None,
+            None,
+        );
         SceneResources {
             view: ViewBindings {
                 layout: view_layout,
                 layouts,
                 shadows_active: false,
                 environment_active: false,
+                rays_active: false,
+                rays: [manylight_core::ray_bvh::RAY_NO_NODE, 0, 0, 0],
                 bind_group: view_bind_group,
                 buffer: view_buffer,
                 uniform: ViewUniform::zeroed_default(),
-                bound: [None, None, None, None],
+                bound: Default::default(),
             },
             lights: SceneLights {
                 buffer: lights,
@@ -404,20 +439,17 @@ impl SceneResources {
         }
     }
 
+    /// Group 0 of `layout`: `base` (the view uniform, the lights and the instances), then the
+    /// shadow maps', the environment's and the shadow rays' bindings that are given.
     fn make_view_bind_group(
         gpu: &GpuContext,
         layout: &GroupLayout,
-        view: &wgpu::Buffer,
-        lights: &GrowableBuffer,
-        instances: &GrowableBuffer,
+        base: [&wgpu::Buffer; 3],
         shadows: Option<&ShadowBindings<'_>>,
         environment: Option<&EnvironmentBindings<'_>>,
+        rays: Option<&RayBindings<'_>>,
     ) -> wgpu::BindGroup {
-        let mut resources = vec![
-            Binding::Buffer(view),
-            Binding::Buffer(lights.buffer()),
-            Binding::Buffer(instances.buffer()),
-        ];
+        let mut resources = base.map(Binding::Buffer).to_vec();
         if let Some(shadows) = shadows {
             resources.extend([
                 Binding::Texture(shadows.atlas),
@@ -434,27 +466,33 @@ impl SceneResources {
                 Binding::Sampler(environment.sampler),
             ]);
         }
+        if let Some(rays) = rays {
+            resources.extend([Binding::Buffer(rays.nodes), Binding::Buffer(rays.prims)]);
+        }
         layout.create_bind_group(gpu, &resources)
     }
 
     /// Binds group 0 for a view (after [`SceneResources::prepare`], the shadows' and the
     /// environments' `prepare`): with the shadow atlas, its sampler and light table when
     /// `shadows` is given, with the environment's maps when `environment` is, else without
-    /// them. One group of each combination is kept, so views that differ only in their
-    /// shadows checkbox or environment switch between them; each is re-created only when a
-    /// buffer, the atlas or the environment changed.
+    /// them, and with the shadow rays' buffers when `rays` is. One group of each combination
+    /// is kept, so views that differ only in their shadows checkbox or environment switch
+    /// between them; each is re-created only when a buffer, the atlas or the environment
+    /// changed.
     pub fn bind_view(
         &mut self,
         gpu: &GpuContext,
         shadows: Option<ShadowBindings<'_>>,
         environment: Option<EnvironmentBindings<'_>>,
+        rays: Option<RayBindings<'_>>,
     ) {
-        let index = flavor(shadows.is_some(), environment.is_some());
+        let index = flavor(shadows.is_some(), environment.is_some(), rays.is_some());
         let generations = (
             self.lights.buffer.generation(),
             self.instances.buffer.generation(),
             shadows.as_ref().map_or(0, |s| s.generation + 1),
             environment.as_ref().map_or(0, |e| e.generation + 1),
+            rays.as_ref().map_or(0, |r| r.generation + 1),
         );
         let layout = &self.view.layouts[index];
         let slot = &mut self.view.bound[index];
@@ -462,11 +500,10 @@ impl SceneResources {
             let group = Self::make_view_bind_group(
                 gpu,
                 layout,
-                &self.view.buffer,
-                &self.lights.buffer,
-                &self.instances.buffer,
+                [&self.view.buffer, self.lights.buffer.buffer(), self.instances.buffer.buffer()],
                 shadows.as_ref(),
                 environment.as_ref(),
+                rays.as_ref(),
             );
             *slot = Some((generations, group));
         }
@@ -475,6 +512,8 @@ impl SceneResources {
         }
         self.view.shadows_active = shadows.is_some();
         self.view.environment_active = environment.is_some();
+        self.view.rays_active = rays.is_some();
+        self.view.rays = rays.map_or([manylight_core::ray_bvh::RAY_NO_NODE, 0, 0, 0], |r| r.view);
         self.view.layout = layout.clone();
     }
 
@@ -483,6 +522,7 @@ impl SceneResources {
     pub fn prepare_view(&mut self, gpu: &GpuContext, view: &RenderView) {
         let lights = &self.lights;
         self.view.uniform = view_uniform(view, lights.count, lights.directional_count, lights.directional);
+        self.view.uniform.rays = self.view.rays;
         gpu.write_buffer(&self.view.buffer, 0, bytemuck::bytes_of(&self.view.uniform));
         // Blended draws, farthest first along the view direction (view-space z ascending).
         let view_from_world = self.view.uniform.view_from_world;
@@ -669,6 +709,7 @@ impl ViewUniform {
             env_from_world: Mat4::IDENTITY,
             sky_from_world: Mat4::IDENTITY,
             environment: Vec4::ZERO,
+            rays: [manylight_core::ray_bvh::RAY_NO_NODE, 0, 0, 0],
             light_count: 0,
             shading_model: 0,
             directional_count: 0,
@@ -716,6 +757,7 @@ pub(crate) fn view_uniform(
                     cam.skybox.map_or(0.0, |s| s.brightness),
                     0.0,
                 ),
+                rays: [manylight_core::ray_bvh::RAY_NO_NODE, 0, 0, 0],
                 light_count,
                 shading_model: settings.shading.gpu_id(),
                 directional_count,

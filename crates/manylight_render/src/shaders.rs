@@ -40,6 +40,9 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("skybox.wgsl", include_str!("../shaders/skybox.wgsl")),
     ("shadow_maps.wgsl", include_str!("../shaders/shadow_maps.wgsl")),
     ("shadow_probe.wgsl", include_str!("../shaders/shadow_probe.wgsl")),
+    ("common/ray_bvh.wgsl", include_str!("../shaders/common/ray_bvh.wgsl")),
+    ("common/ray_shadows.wgsl", include_str!("../shaders/common/ray_shadows.wgsl")),
+    ("ray_probe.wgsl", include_str!("../shaders/ray_probe.wgsl")),
     ("light_volumes.wgsl", include_str!("../shaders/light_volumes.wgsl")),
     ("forward.wgsl", include_str!("../shaders/forward.wgsl")),
     ("depth_prepass.wgsl", include_str!("../shaders/depth_prepass.wgsl")),
@@ -96,6 +99,10 @@ pub struct ShaderDefs {
     /// (`common/environment.wgsl`): its prefiltered cubes, lookup table and sampler are bound
     /// in group 0.
     pub environment: bool,
+    /// `RAYS`: point, spot and directional lights that cast test their visibility with a
+    /// shadow ray through the scene's BVH (`common/ray_shadows.wgsl`): the BVH's three
+    /// buffers and the casting lights' bits are bound in group 0.
+    pub rays: bool,
 }
 
 impl ShaderDefs {
@@ -105,10 +112,11 @@ impl ShaderDefs {
     }
 
     /// The defines a shader can test, with their state.
-    fn flags(self) -> [(&'static str, bool); 7] {
+    fn flags(self) -> [(&'static str, bool); 8] {
         use crate::snapshot::GBufferLayout;
         [
             ("SHADOWS", self.shadows),
+            ("RAYS", self.rays),
             ("ENVIRONMENT", self.environment),
             ("CLIP_DISTANCES", self.clip_distances),
             ("GBUFFER", self.gbuffer.is_some()),

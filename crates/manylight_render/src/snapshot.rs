@@ -371,8 +371,20 @@ impl FrameSnapshot {
         self.lights.iter().any(|l| l.is_valid())
     }
 
-    /// True when the frame draws shadow maps: shadows are enabled, a view shows them, and a
-    /// valid point or spot light with a range, or a valid directional light, casts one.
+    /// True when the frame draws shadow maps: a light casts ([`FrameSnapshot::casts_shadows`])
+    /// and shadows are found with maps ([`crate::settings::ShadowMethod::Maps`]).
+    pub fn draws_shadow_maps(&self) -> bool {
+        self.settings.shadows.method == crate::settings::ShadowMethod::Maps && self.casts_shadows()
+    }
+
+    /// True when the frame traces shadow rays: a light casts ([`FrameSnapshot::casts_shadows`])
+    /// and shadows are found with rays ([`crate::settings::ShadowMethod::Rays`]).
+    pub fn traces_shadow_rays(&self) -> bool {
+        self.settings.shadows.method == crate::settings::ShadowMethod::Rays && self.casts_shadows()
+    }
+
+    /// True when the frame has shadows: shadows are enabled, a view shows them, and a valid
+    /// point or spot light with a range, or a valid directional light, casts one.
     pub fn casts_shadows(&self) -> bool {
         self.settings.shadows.enabled
             && self.views.iter().any(|v| v.shadows)

@@ -1,6 +1,7 @@
 //! Every WGSL file parses and validates with naga, and the structs shared with Rust have the
 //! same size and field offsets on both sides. No GPU needed.
 
+use manylight_core::ray_bvh::{BvhNode, RayInstance, RayTriangle};
 use manylight_render::GBufferLayout;
 use manylight_render::gpu_types::{
     GpuCascade, GpuDirectionalShadow, GpuShadowDraw, GpuShadowFace, GpuShadowLight, GpuShadowProbe,
@@ -10,6 +11,7 @@ use manylight_render::gpu_types::{
     GpuLightAnimationParams, GpuLightMotion, GpuMaterial, GpuPointLight, GpuTextureUv, ViewUniform,
 };
 use manylight_render::layouts::{BindingKind, Presence, SHADER_BIND_GROUPS, shader_bind_groups};
+use manylight_render::ray_geometry::{GpuRayProbeParams, GpuRaySegment};
 use manylight_render::resources::SurfaceVariant;
 use manylight_render::shaders::{SOURCES, ShaderDefs, compose, compose_with};
 use std::mem::{offset_of, size_of};
@@ -39,7 +41,9 @@ fn all_defs() -> Vec<ShaderDefs> {
         for clip_distances in [false, true] {
             for gbuffer in GBUFFER_CHOICES {
                 for environment in [false, true] {
-                    out.push(ShaderDefs { shadows, clip_distances, gbuffer, environment });
+                    for rays in [false, true] {
+                        out.push(ShaderDefs { shadows, clip_distances, gbuffer, environment, rays });
+                    }
                 }
             }
         }
@@ -251,6 +255,56 @@ fn shared_structs_match_rust() {
             ("normal", offset_of!(GpuShadowProbe, normal)),
         ],
     );
+    let rays = validate("ray_probe.wgsl");
+    offsets(
+        &rays,
+        "RayNode",
+        size_of::<BvhNode>(),
+        &[
+            ("min", offset_of!(BvhNode, min)),
+            ("count", offset_of!(BvhNode, count)),
+            ("max", offset_of!(BvhNode, max)),
+            ("first", offset_of!(BvhNode, first)),
+        ],
+    );
+    offsets(
+        &rays,
+        "RayTriangle",
+        size_of::<RayTriangle>(),
+        &[
+            ("v0", offset_of!(RayTriangle, v0)),
+            ("e1", offset_of!(RayTriangle, e1)),
+            ("e2", offset_of!(RayTriangle, e2)),
+        ],
+    );
+    offsets(
+        &rays,
+        "RayInstance",
+        size_of::<RayInstance>(),
+        &[
+            ("local_from_world", offset_of!(RayInstance, local_from_world)),
+            ("root", offset_of!(RayInstance, root)),
+        ],
+    );
+    offsets(
+        &rays,
+        "GpuRaySegment",
+        size_of::<GpuRaySegment>(),
+        &[
+            ("origin", offset_of!(GpuRaySegment, origin)),
+            ("t_max", offset_of!(GpuRaySegment, t_max)),
+            ("direction", offset_of!(GpuRaySegment, direction)),
+        ],
+    );
+    offsets(
+        &rays,
+        "GpuRayProbeParams",
+        size_of::<GpuRayProbeParams>(),
+        &[
+            ("geometry", offset_of!(GpuRayProbeParams, geometry)),
+            ("count", offset_of!(GpuRayProbeParams, count)),
+        ],
+    );
     let forward = validate("forward.wgsl");
     offsets(
         &forward,
@@ -268,6 +322,7 @@ fn shared_structs_match_rust() {
             ("env_from_world", offset_of!(ViewUniform, env_from_world)),
             ("sky_from_world", offset_of!(ViewUniform, sky_from_world)),
             ("environment", offset_of!(ViewUniform, environment)),
+            ("rays", offset_of!(ViewUniform, rays)),
             ("light_count", offset_of!(ViewUniform, light_count)),
             ("shading_model", offset_of!(ViewUniform, shading_model)),
             ("directional_count", offset_of!(ViewUniform, directional_count)),

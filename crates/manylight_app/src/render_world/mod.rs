@@ -59,7 +59,7 @@ pub struct CurrentView {
     pub has_blended: bool,
     /// The frame brings its own per-pixel light lists (`FrameSnapshot::pixel_light_lists`).
     pub has_pixel_lists: bool,
-    /// The frame draws shadow maps (`FrameSnapshot::casts_shadows`) and this view shows them.
+    /// The frame draws shadow maps (`FrameSnapshot::draws_shadow_maps`) and this view shows them.
     pub casts_shadows: bool,
     /// Components an app extracted from the view's camera for its own passes.
     pub components: ViewComponents,
@@ -70,7 +70,7 @@ impl CurrentView {
     pub fn of(snapshot: &FrameSnapshot, index: usize) -> CurrentView {
         let view = snapshot.render_view(index);
         CurrentView {
-            casts_shadows: snapshot.casts_shadows() && view.settings.render.shadows.enabled,
+            casts_shadows: snapshot.draws_shadow_maps() && view.settings.render.shadows.enabled,
             view,
             has_lights: snapshot.has_lights(),
             has_blended: snapshot.has_blended(),

@@ -31,7 +31,7 @@ pub(crate) fn run(args: BenchArgs) -> Result<()> {
                 gbuffer: args.clusters.gbuffer,
                 normal_codec: args.clusters.normal_codec,
                 shading: args.shading,
-                shadows: args.shadow.settings()?,
+                shadows: args.shadow.settings(manylight_render::ShadowMethod::Maps)?,
                 ..Default::default()
             },
             ..Default::default()

@@ -13,5 +13,6 @@ pub(crate) mod plot;
 pub(crate) mod post;
 pub(crate) mod render;
 pub(crate) mod report;
+pub(crate) mod shadow_rays;
 mod shared;
 pub(crate) mod views;

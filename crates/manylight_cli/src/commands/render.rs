@@ -7,6 +7,7 @@ mod measure;
 use super::headless::{CameraEnvironment, Extras, render_scene};
 use super::shared::check_lights;
 use crate::args::RenderArgs;
+use crate::camera_spec::CameraSpec;
 use anyhow::{Context, Result, bail};
 use manylight_app::RenderSettings;
 use manylight_app::headless::save_png;
@@ -22,7 +23,7 @@ pub(crate) fn run(args: RenderArgs) -> Result<()> {
     select_camera(&mut scene, &args.camera)?;
     let lit = add_render_lights(&mut scene, &args)?;
     let ambient = args.ambient.unwrap_or(if lit.unlit { 0.2 } else { RenderSettings::default().ambient });
-    let shadow_settings = args.shadow.settings()?;
+    let shadow_settings = args.shadow.settings(args.shadows.method())?;
     let measured = measured_snapshot(&args, &scene, lit.rig, shadow_settings)?;
     let culling = match &measured {
         Some(snap) if args.culling_efficiency => Some(measure_culling_efficiency(snap.clone())?),
@@ -98,19 +99,24 @@ fn add_render_lights(scene: &mut Scene, args: &RenderArgs) -> Result<RenderLight
     Ok(RenderLights { rig: lights, unlit })
 }
 
-/// Reorders or clears the scene's cameras so the chosen one comes first.
+/// Reorders or clears the scene's cameras, or puts an explicit one (`look-at:…`, `ortho:…`)
+/// before them, so the chosen one comes first.
 fn select_camera(scene: &mut Scene, choice: &str) -> Result<()> {
-    match choice {
-        "scene" => {}
-        "fit" => scene.cameras.clear(),
-        index => {
-            let i: usize = index
-                .parse()
-                .with_context(|| format!("--camera `{index}`: expected scene, fit or a number"))?;
+    let spec: CameraSpec = choice.parse()?;
+    match spec {
+        CameraSpec::Scene => {}
+        CameraSpec::Fit => scene.cameras.clear(),
+        CameraSpec::Index(i) => {
             if i >= scene.cameras.len() {
                 bail!("--camera {i}: the scene has {} cameras", scene.cameras.len());
             }
             scene.cameras.swap(0, i);
+        }
+        // An explicit placement goes first, so it is the one the app renders through.
+        CameraSpec::LookAt { .. } | CameraSpec::Ortho { .. } => {
+            if let Some(camera) = spec.explicit_camera(scene.bounds()) {
+                scene.cameras.insert(0, camera);
+            }
         }
     }
     Ok(())
@@ -163,7 +169,7 @@ fn render_extras(args: &RenderArgs) -> Result<Extras> {
         }),
         motion_blur: args.post.motion_blur.then(manylight_app::MotionBlur::default),
         debug: manylight_app::DebugView::new(args.clusters.debug_view),
-        shadows: args.shadows,
+        shadows: args.shadows.casts(),
         environment,
     })
 }

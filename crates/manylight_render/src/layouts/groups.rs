@@ -39,6 +39,13 @@ pub const ENVIRONMENT_BINDINGS: [BindingDecl; 4] = [
     BindingDecl::new(10, "env_sampler", FILTERING, SHADING),
 ];
 
+/// The shadow rays' bindings of group 0 (`shaders/common/ray_bvh.wgsl`): the scene's two-level
+/// BVH's nodes, and its triangles, instances and casting lights' bits in one buffer
+/// (`ray_geometry::RayGeometry`; two storage buffers, as many as the shadow maps' table and
+/// cascades, so every pipeline stays within WebGPU's 8 a stage).
+pub const RAY_GEOMETRY_BINDINGS: [BindingDecl; 2] =
+    [BindingDecl::storage(11, "ray_nodes", SHADING), BindingDecl::storage(12, "ray_prims", SHADING)];
+
 /// Group 0 of every scene pass: the view uniform (`common/view_binding.wgsl`), the point and
 /// spot lights (`common/point_lights.wgsl`), the instances (`common/mesh_pass.wgsl`), in a
 /// frame whose lights cast shadows [`SHADOW_BINDINGS`], and for a view with an environment
@@ -58,6 +65,8 @@ pub static SCENE_GROUP: BindGroupDecl = BindGroupDecl {
         ENVIRONMENT_BINDINGS[1].only(Presence::Environment),
         ENVIRONMENT_BINDINGS[2].only(Presence::Environment),
         ENVIRONMENT_BINDINGS[3].only(Presence::Environment),
+        RAY_GEOMETRY_BINDINGS[0].only(Presence::Rays),
+        RAY_GEOMETRY_BINDINGS[1].only(Presence::Rays),
     ],
 };
 
@@ -326,6 +335,35 @@ pub static SHADOW_PROBE_GROUP: BindGroupDecl = BindGroupDecl {
     ],
 };
 
+/// Group 0 of the ray probe (`shaders/ray_probe.wgsl`): [`RAY_GEOMETRY_BINDINGS`], as
+/// `common/ray_bvh.wgsl` declares them.
+pub static RAY_SHADOW_GROUP: BindGroupDecl =
+    BindGroupDecl { label: "ray_shadows", index: 0, entries: &RAY_GEOMETRY_BINDINGS };
+
+/// Group 1 of the ray probe's `main`: its parameters, the segments and what it writes for each.
+pub static RAY_PROBE_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "ray_probe",
+    index: 1,
+    entries: &[
+        BindingDecl::uniform(0, "params", COMPUTE),
+        BindingDecl::storage(1, "segments", COMPUTE),
+        BindingDecl::storage_rw(2, "traced", COMPUTE),
+    ],
+};
+
+/// Group 1 of the ray probe's `probe_lights`: its parameters, the frame's lights, the
+/// light–point pairs and the visibility it writes for each.
+pub static RAY_LIGHT_PROBE_GROUP: BindGroupDecl = BindGroupDecl {
+    label: "ray_light_probe",
+    index: 1,
+    entries: &[
+        BindingDecl::uniform(0, "params", COMPUTE),
+        BindingDecl::storage(3, "lights", COMPUTE),
+        BindingDecl::storage(4, "probes", COMPUTE),
+        BindingDecl::storage_rw(5, "probed", COMPUTE),
+    ],
+};
+
 // ---- Post and debug ----
 
 /// The tone map's bind group (`shaders/tonemap.wgsl`): the view uniform (exposure), the HDR
@@ -429,8 +467,9 @@ pub static DEBUG_SHADOW_LOD_GROUP: BindGroupDecl = BindGroupDecl {
 // ---- The WebGL2 path (`texture_lists`) ----
 
 /// Group 0 of `texture_lists.wgsl`: the view uniform (`common/view_binding.wgsl`). The shadow
-/// bindings are declared for the compositions with `SHADOWS` (the directional lights' code
-/// reads them there); the path composes its shader without, as WebGL2 has no storage buffers.
+/// maps' and rays' bindings are declared for the compositions with `SHADOWS` and `RAYS` (the
+/// directional lights' code reads them there); the path composes its shader without either,
+/// as WebGL2 has no storage buffers.
 pub static TEXTURE_LISTS_VIEW_GROUP: BindGroupDecl = BindGroupDecl {
     label: "texture_lists_view",
     index: 0,
@@ -440,6 +479,8 @@ pub static TEXTURE_LISTS_VIEW_GROUP: BindGroupDecl = BindGroupDecl {
         SHADOW_BINDINGS[1].only(Presence::Shadows),
         SHADOW_BINDINGS[2].only(Presence::Shadows),
         SHADOW_BINDINGS[3].only(Presence::Shadows),
+        RAY_GEOMETRY_BINDINGS[0].only(Presence::Rays),
+        RAY_GEOMETRY_BINDINGS[1].only(Presence::Rays),
     ],
 };
 
@@ -503,6 +544,8 @@ pub static SHADER_BIND_GROUPS: &[ShaderBindGroups] = &[
     row("light_refine.wgsl", &["cs_gbuffer"], &[SCENE, GBUFFER, &LIGHT_REFINE_GROUP]),
     row("shadow_maps.wgsl", &[], &[&SHADOW_MAPS_GROUP]),
     row("shadow_probe.wgsl", &[], &[&SHADOW_PROBE_SHADOWS_GROUP, &SHADOW_PROBE_GROUP]),
+    row("ray_probe.wgsl", &["main"], &[&RAY_SHADOW_GROUP, &RAY_PROBE_GROUP]),
+    row("ray_probe.wgsl", &["probe_lights"], &[&RAY_SHADOW_GROUP, &RAY_LIGHT_PROBE_GROUP]),
     row("bloom.wgsl", &[], &[&BLOOM_GROUP]),
     row("motion_blur.wgsl", &[], &[&MOTION_BLUR_GROUP]),
     row("tonemap.wgsl", &[], &[&TONEMAP_GROUP]),

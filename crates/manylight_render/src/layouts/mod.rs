@@ -85,6 +85,8 @@ pub enum Presence {
     Shadows,
     /// With `ENVIRONMENT` ([`ShaderDefs::environment`]).
     Environment,
+    /// With `RAYS` ([`ShaderDefs::rays`]).
+    Rays,
     /// With this G-buffer layout ([`ShaderDefs::gbuffer`]).
     GBuffer(GBufferLayout),
 }
@@ -96,6 +98,7 @@ impl Presence {
             Presence::Always => true,
             Presence::Shadows => defs.shadows,
             Presence::Environment => defs.environment,
+            Presence::Rays => defs.rays,
             Presence::GBuffer(layout) => defs.gbuffer == Some(layout),
         }
     }

@@ -134,8 +134,9 @@ pub struct EnvironmentFilter {
     pub lut_size: u32,
 }
 
-/// Specular mips of a cube: roughness 0 to 1 in this many steps, at most one per level.
-pub const ENVIRONMENT_SPECULAR_MIPS: u32 = 6;
+/// Specular mips of a cube: roughness 0 to 1 in this many steps, at most one per level
+/// ([`EnvironmentFilter::specular_mip_roughness`] spaces them).
+pub const ENVIRONMENT_SPECULAR_MIPS: u32 = 8;
 
 impl Default for EnvironmentFilter {
     /// 256² faces and 1 024 samples a texel, as the glTF Sample Viewer prefilters; fewer
@@ -170,5 +171,46 @@ impl EnvironmentFilter {
     /// (its last face at least 4 texels).
     pub fn specular_mips(&self) -> u32 {
         ENVIRONMENT_SPECULAR_MIPS.min(self.cube_size.ilog2() - 1)
+    }
+
+    /// GGX perceptual roughness the specular cube's mip `level` is prefiltered at:
+    /// `(level / (mips - 1))²`, so the mips crowd at low roughness, where the lobe's width
+    /// changes fastest and a mirror-like surface would otherwise read a much blurrier mip
+    /// between its two neighbours (Filament and Unreal space them alike). The shading passes
+    /// read the inverse, `environment_specular_lod` in `shaders/common/environment.wgsl`, as
+    /// [`EnvironmentFilter::specular_lod`] does here.
+    pub fn specular_mip_roughness(&self, level: u32) -> f32 {
+        let last = self.specular_mips().saturating_sub(1).max(1) as f32;
+        (level as f32 / last).powi(2)
+    }
+
+    /// The specular cube's mip level a surface of perceptual `roughness` reads:
+    /// `sqrt(roughness) (mips - 1)`, the inverse of
+    /// [`EnvironmentFilter::specular_mip_roughness`]. `environment_specular_lod` in
+    /// `shaders/common/environment.wgsl` computes the same from `mips - 1` in the view's
+    /// `environment.y`.
+    pub fn specular_lod(&self, roughness: f32) -> f32 {
+        roughness.clamp(0.0, 1.0).sqrt() * self.specular_mips().saturating_sub(1) as f32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every mip's roughness reads back that mip, from mirror (mip 0) to roughness 1 (the
+    /// last), for every cube size.
+    #[test]
+    fn specular_lod_inverts_the_mip_roughness() {
+        for cube_size in [16, 64, 256, 2048] {
+            let filter = EnvironmentFilter { cube_size, ..EnvironmentFilter::default() };
+            let mips = filter.specular_mips();
+            assert_eq!(filter.specular_mip_roughness(0), 0.0);
+            assert_eq!(filter.specular_mip_roughness(mips - 1), 1.0);
+            for level in 0..mips {
+                let lod = filter.specular_lod(filter.specular_mip_roughness(level));
+                assert!((lod - level as f32).abs() < 1e-4, "cube {cube_size}, mip {level}: lod {lod}");
+            }
+        }
     }
 }

@@ -30,5 +30,5 @@ pub use pipeline::{ClusterSettings, DEFAULT_COARSE_TILES, GBufferLayout, Pipelin
 pub use render::{FrameSettings, RenderSettings};
 pub use shadows::{
     CascadeConfigError, CascadeShadowConfig, CascadeShadowConfigBuilder, MAX_CASCADES, SHADOW_FACES,
-    SHADOW_TILE_COLUMNS, ShadowFilteringMethod, ShadowReport, ShadowSettings,
+    SHADOW_TILE_COLUMNS, ShadowFilteringMethod, ShadowMethod, ShadowReport, ShadowSettings,
 };

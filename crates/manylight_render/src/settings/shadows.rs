@@ -39,6 +39,9 @@ pub struct ShadowSettings {
     pub max_redrawn_maps: Option<u32>,
     /// The filter of every lookup.
     pub filter: ShadowFilteringMethod,
+    /// How a casting light's visibility is found: shadow maps in an atlas (the default), or
+    /// rays traced through the scene's BVH.
+    pub method: ShadowMethod,
 }
 
 impl Default for ShadowSettings {
@@ -53,6 +56,7 @@ impl Default for ShadowSettings {
             cache_maps: true,
             max_redrawn_maps: Some(256),
             filter: ShadowFilteringMethod::Hardware2x2,
+            method: ShadowMethod::Maps,
         }
     }
 }
@@ -94,6 +98,33 @@ impl ShadowSettings {
             return Err("shadows.max_redrawn_maps must be at least 1 (None draws every changed map)".into());
         }
         Ok(())
+    }
+}
+
+/// How a casting light's visibility is found (part of [`ShadowSettings`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum ShadowMethod {
+    /// A shadow map per light in one atlas, drawn by the shadow pass and read with the
+    /// [`ShadowSettings::filter`] in shading. The atlas and face settings apply.
+    #[default]
+    Maps,
+    /// A ray from every shaded point to every casting light that reaches it, traced in the
+    /// shading pass through a two-level BVH of the scene's opaque meshes (built when a light
+    /// casts, the instance level again when an instance moves): exact visibility, hard
+    /// shadows, no atlas and no shadow pass. Its cost grows with pixels × lights a pixel.
+    Rays,
+}
+
+impl ShadowMethod {
+    /// Every method.
+    pub const ALL: [ShadowMethod; 2] = [ShadowMethod::Maps, ShadowMethod::Rays];
+
+    /// Name used on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            ShadowMethod::Maps => "maps",
+            ShadowMethod::Rays => "rays",
+        }
     }
 }
 

@@ -209,7 +209,7 @@ impl ShadowResources {
     ) -> Result<(), RenderError> {
         let settings = snapshot.settings.shadows;
         self.start_frame();
-        if !snapshot.casts_shadows() {
+        if !snapshot.draws_shadow_maps() {
             self.plan = AtlasPlan::default();
             return Ok(());
         }

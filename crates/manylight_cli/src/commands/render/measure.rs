@@ -37,7 +37,7 @@ pub(super) fn measured_snapshot(
         ..Default::default()
     };
     let mut snapshot = direct::snapshot(scene, &rig, t, args.size, settings, 0);
-    if args.shadows {
+    if args.shadows.casts() {
         direct::cast_every_shadow(&mut snapshot);
     }
     Ok(Some(snapshot))
@@ -118,7 +118,9 @@ pub(super) fn measure_shadow_accuracy(
     println!(
         "shadow oracle: visibility error {:.4} (false shadow {:.4}, light leak {:.4}) over {} \
          contributing light-pixel pairs ({} blocked, {} tested on the wrong side); FLIP against \
-         the shadow reference: mean {:.4}, p99 {:.4}; the oracle cast {} rays in {:.0} ms",
+         the shadow reference: mean {:.4}, p99 {:.4}; light error {:.5} (HDR luminance against \
+         the shadow reference, of the unshadowed light); flicker {:.5} (the next still frame's \
+         change); the oracle cast {} rays in {:.0} ms",
         a.visibility_error,
         a.false_shadow,
         a.light_leak,
@@ -127,6 +129,8 @@ pub(super) fn measure_shadow_accuracy(
         a.wrong_pairs,
         a.flip.mean,
         a.flip.p99,
+        a.light_error,
+        a.flicker,
         a.rays,
         a.ray_cast_ms
     );
@@ -165,6 +169,8 @@ pub(super) fn render_stats_json(
             "light_leak": a.light_leak,
             "flip_vs_shadow_reference": a.flip.mean,
             "flip_vs_shadow_reference_p99": a.flip.p99,
+            "light_error": a.light_error,
+            "flicker": a.flicker,
             "rays": a.rays,
             "ray_cast_ms": a.ray_cast_ms,
         });
