@@ -7,6 +7,7 @@
 //   oracle (`render --shadow-oracle`).
 //!include common/ray_shadows.wgsl
 //!include common/lights.wgsl
+//!include common/shadow_types.wgsl
 
 // Rust: `GpuRaySegment`.
 struct GpuRaySegment {
@@ -26,14 +27,6 @@ struct GpuRayProbeParams {
     pad0: u32,
     pad1: u32,
     pad2: u32,
-};
-
-// Rust: `GpuShadowProbe` (as shadow_probe.wgsl reads it).
-struct GpuShadowProbe {
-    position: vec3<f32>,
-    light: u32,
-    normal: vec3<f32>,
-    pad: f32,
 };
 
 @group(1) @binding(0) var<uniform> params: GpuRayProbeParams;

@@ -3,17 +3,6 @@
 // `shadow_probe::probe_shadows`). Not part of a frame.
 //!include common/shadows.wgsl
 
-// Rust: `GpuShadowProbe`.
-struct GpuShadowProbe {
-    // The surface point (world).
-    position: vec3<f32>,
-    // The light's index in the light buffer.
-    light: u32,
-    // The surface's normal (any length).
-    normal: vec3<f32>,
-    pad: f32,
-};
-
 @group(1) @binding(0) var<storage, read> lights: array<GpuPointLight>;
 @group(1) @binding(1) var<storage, read> probes: array<GpuShadowProbe>;
 @group(1) @binding(2) var<storage, read_write> probed: array<f32>;

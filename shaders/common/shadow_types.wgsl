@@ -1,5 +1,5 @@
-// The shadow tables' structs (Rust: `GpuShadowLight`, `GpuCascade`, `GpuDirectionalShadow`),
-// apart from their bindings: the shading passes bind them in group 0 (common/shadows.wgsl),
+// The shadow tables' structs (Rust: `GpuShadowLight`, `GpuCascade`, `GpuDirectionalShadow`)
+// and the probes' pairs (`GpuShadowProbe`), apart from their bindings: the shading passes bind them in group 0 (common/shadows.wgsl),
 // the debug views in their own group.
 
 // Rust: `GpuShadowLight`.
@@ -33,4 +33,16 @@ struct GpuDirectionalShadow {
     count: vec4<u32>,
     // x: depth bias (world units), y: normal bias (texels of the cascade)
     bias: vec4<f32>,
+};
+
+// One light-point pair whose shadow test a probe reads back (Rust: `GpuShadowProbe`;
+// shadow_probe.wgsl for the maps, ray_probe.wgsl for the rays).
+struct GpuShadowProbe {
+    // The surface point (world).
+    position: vec3<f32>,
+    // The light's index in the light buffer.
+    light: u32,
+    // The surface's normal (any length).
+    normal: vec3<f32>,
+    pad: f32,
 };

@@ -81,14 +81,18 @@ impl ShadowChoice {
     }
 }
 
-/// `off`, `on` (shadow maps), `maps` or `rays`.
+/// `off`, `on` (shadow maps, as before maps and rays were told apart), `maps` or `rays`.
 pub fn parse_shadows(s: &str) -> Result<ShadowChoice, String> {
-    match s {
-        "off" => Ok(ShadowChoice::Off),
-        "on" | "maps" => Ok(ShadowChoice::Maps),
-        "rays" => Ok(ShadowChoice::Rays),
-        _ => Err(format!("`{s}`: expected off, on, maps or rays")),
+    if s == "on" {
+        return Ok(ShadowChoice::Maps);
     }
+    named(
+        "shadow setting",
+        s,
+        &[ShadowChoice::Off, ShadowChoice::Maps, ShadowChoice::Rays],
+        ShadowChoice::name,
+    )
+    .map_err(|e| e.replace("(expected one of: off,", "(expected one of: off, on,"))
 }
 
 /// `hardware2x2` or `gaussian`.

@@ -393,7 +393,7 @@ fn shadow_measurements_come_out_of_render_bench_and_report() {
         "--warmup",
         "0",
         "--shadows",
-        "off,on",
+        "off,on,rays",
         "--shadow-oracle",
         "--out",
         csv.to_str().expect("utf-8"),
@@ -404,12 +404,24 @@ fn shadow_measurements_come_out_of_render_bench_and_report() {
     let header = rows.headers().expect("header").clone();
     let at = |name: &str| header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no {name}"));
     let records: Vec<csv::StringRecord> = rows.records().map(|r| r.expect("row")).collect();
-    assert_eq!(records.len(), 2, "{text}");
-    let errors: Vec<f64> =
-        records.iter().map(|r| r[at("visibility_error")].parse().expect("a number")).collect();
+    assert_eq!(records.len(), 3, "{text}");
+    let number = |r: &csv::StringRecord, name: &str| -> f64 {
+        r[at(name)].parse().unwrap_or_else(|_| panic!("`{name}` is not a number in {text}"))
+    };
+    let errors: Vec<f64> = records.iter().map(|r| number(r, "visibility_error")).collect();
     assert!(errors.iter().all(|e| (0.0..=1.0).contains(e)), "{errors:?}");
-    assert_eq!(&records[1][at("shadows")], "on");
+    let shadows: Vec<&str> = records.iter().map(|r| &r[at("shadows")]).collect();
+    assert_eq!(shadows, ["off", "maps", "rays"]);
     assert!(records[1][at("flip_vs_shadow_reference")].parse::<f64>().is_ok());
+    // The shadow measures of every technique: the light error and, still, no flicker.
+    for r in &records {
+        assert!((0.0..1.0).contains(&number(r, "light_error")), "{text}");
+        assert!((0.0..1e-4).contains(&number(r, "flicker")), "{text}");
+    }
+    assert!(number(&records[1], "light_error") < 0.02, "maps: {text}");
+    // Rays are exact: every reached pair agrees with the oracle.
+    assert_eq!(errors[2], 0.0, "rays: {text}");
+    assert!(number(&records[2], "light_error") < 1e-3, "rays: {text}");
 
     let plots = dir.join("report-shadow-plots");
     let _ = std::fs::remove_dir_all(&plots);

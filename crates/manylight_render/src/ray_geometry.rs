@@ -13,7 +13,7 @@
 use crate::bindings::Binding;
 use crate::context::{GpuContext, RenderError};
 use crate::layouts::{RAY_LIGHT_PROBE_GROUP, RAY_PROBE_GROUP, RAY_SHADOW_GROUP, compute_pipeline};
-use crate::readback::read_buffer;
+use crate::readback::dispatch_and_read;
 use crate::shaders::ShaderDefs;
 use crate::snapshot::FrameSnapshot;
 use bytemuck::{Pod, Zeroable};
@@ -385,20 +385,9 @@ pub fn trace_segments(
         gpu.queue.submit([]);
         gpu.wait_idle()?;
         let start = Instant::now();
-        let mut encoder =
-            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("ray_probe") });
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("ray_probe"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(RAY_SHADOW_GROUP.index, &geometry_group, &[]);
-            pass.set_bind_group(RAY_PROBE_GROUP.index, &group, &[]);
-            pass.dispatch_workgroups((part.len() as u32).div_ceil(WORKGROUP), 1, 1);
-        }
-        gpu.queue.submit([encoder.finish()]);
-        let bytes = read_buffer(gpu, &output, 0, result_bytes)?;
+        let groups = [&geometry_group, &group];
+        let size = (part.len() as u32, WORKGROUP);
+        let bytes = dispatch_and_read(gpu, "ray_probe", &pipeline, &groups, size, &output, result_bytes)?;
         gpu_time += start.elapsed();
         let words = bytemuck::pod_collect_to_vec::<u8, u32>(&bytes);
         for pair in words.chunks_exact(2).take(part.len()) {
@@ -570,21 +559,10 @@ pub fn probe_lights(
                 Binding::Buffer(&output),
             ],
         );
-        let mut encoder = gpu
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("ray_light_probe") });
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("ray_light_probe"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(RAY_SHADOW_GROUP.index, &geometry_group, &[]);
-            pass.set_bind_group(RAY_LIGHT_PROBE_GROUP.index, &group, &[]);
-            pass.dispatch_workgroups((part.len() as u32).div_ceil(WORKGROUP), 1, 1);
-        }
-        gpu.queue.submit([encoder.finish()]);
-        let bytes = read_buffer(gpu, &output, 0, result_bytes)?;
+        let groups = [&geometry_group, &group];
+        let size = (part.len() as u32, WORKGROUP);
+        let bytes =
+            dispatch_and_read(gpu, "ray_light_probe", &pipeline, &groups, size, &output, result_bytes)?;
         out.extend_from_slice(&bytemuck::pod_collect_to_vec::<u8, f32>(&bytes)[..part.len()]);
     }
     Ok(out)

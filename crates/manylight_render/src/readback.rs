@@ -87,6 +87,33 @@ pub fn read_texture(
     Ok(out)
 }
 
+/// Runs the compute `pipeline` once per element of `count`, in workgroups of `workgroup`, with
+/// `groups` bound at their indices, and reads back the first `bytes` of `output` (a measurement:
+/// waits for the GPU).
+pub fn dispatch_and_read(
+    gpu: &GpuContext,
+    label: &str,
+    pipeline: &wgpu::ComputePipeline,
+    groups: &[&wgpu::BindGroup],
+    (count, workgroup): (u32, u32),
+    output: &wgpu::Buffer,
+    bytes: u64,
+) -> Result<Vec<u8>, RenderError> {
+    let mut encoder =
+        gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+    {
+        let mut pass = encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes: None });
+        pass.set_pipeline(pipeline);
+        for (index, group) in groups.iter().enumerate() {
+            pass.set_bind_group(index as u32, *group, &[]);
+        }
+        pass.dispatch_workgroups(count.div_ceil(workgroup), 1, 1);
+    }
+    gpu.queue.submit([encoder.finish()]);
+    read_buffer(gpu, output, 0, bytes)
+}
+
 /// Copies `size` bytes of `buffer` from `offset` to the CPU (waits for the GPU).
 pub fn read_buffer(
     gpu: &GpuContext,

@@ -8,7 +8,7 @@ use crate::bindings::Binding;
 use crate::context::{GpuContext, RenderError};
 use crate::gpu_types::{GpuPointLight, GpuShadowProbe};
 use crate::layouts::{SHADOW_PROBE_GROUP, SHADOW_PROBE_SHADOWS_GROUP, check_pipeline, pipeline_layout};
-use crate::readback::read_buffer;
+use crate::readback::dispatch_and_read;
 use crate::shaders::ShaderDefs;
 use crate::shadows::ShadowResources;
 use glam::Vec3;
@@ -102,21 +102,10 @@ pub fn probe_shadows(
             gpu,
             &[Binding::BufferPrefix(lights, light_bytes), Binding::Buffer(&input), Binding::Buffer(&output)],
         );
-        let mut encoder = gpu
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("shadow_probe") });
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("shadow_probe"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(SHADOW_PROBE_SHADOWS_GROUP.index, &shadow_group, &[]);
-            pass.set_bind_group(SHADOW_PROBE_GROUP.index, &group, &[]);
-            pass.dispatch_workgroups((part.len() as u32).div_ceil(WORKGROUP), 1, 1);
-        }
-        gpu.queue.submit([encoder.finish()]);
-        let bytes = read_buffer(gpu, &output, 0, result_bytes)?;
+        // Groups in index order: SHADOW_PROBE_SHADOWS_GROUP (0), SHADOW_PROBE_GROUP (1).
+        let groups = [&shadow_group, &group];
+        let size = (part.len() as u32, WORKGROUP);
+        let bytes = dispatch_and_read(gpu, "shadow_probe", &pipeline, &groups, size, &output, result_bytes)?;
         out.extend_from_slice(&bytemuck::pod_collect_to_vec::<u8, f32>(&bytes)[..part.len()]);
     }
     Ok(out)
