@@ -430,8 +430,8 @@ struct ShadowConfiguration {
 }
 
 /// The shadow settings `report --shadows` compares: none, then the atlas sizes and resolution
-/// policies and redraw budgets (at the default atlas) with moving lights, then caching with
-/// still lights; every light of the scene and the rig casting.
+/// policies and redraw budgets (at the default atlas) and shadow rays with moving lights, then
+/// caching and rays with still lights; every light of the scene and the rig casting.
 fn shadow_configurations(base: FrameSettings) -> Vec<ShadowConfiguration> {
     let with = |name: &str, still: bool, f: &dyn Fn(&mut manylight_render::ShadowSettings)| {
         let mut settings = base;
@@ -451,18 +451,22 @@ fn shadow_configurations(base: FrameSettings) -> Vec<ShadowConfiguration> {
         }),
         with("every changed map redrawn", false, &|s| s.max_redrawn_maps = None),
         with("at most 64 maps redrawn", false, &|s| s.max_redrawn_maps = Some(64)),
+        with("rays (exact)", false, &|s| s.method = manylight_render::ShadowMethod::Rays),
         with("still lights, shadows off", true, &|s| s.enabled = false),
         with("still lights, maps cached (default)", true, &|_| {}),
         with("still lights, no caching", true, &|s| {
             s.cache_maps = false;
             s.max_redrawn_maps = None;
         }),
+        with("still lights, rays (exact)", true, &|s| s.method = manylight_render::ShadowMethod::Rays),
     ]
 }
 
 /// One shadow setting's result.
 struct ShadowRow {
     name: String,
+    /// Shadows are off: the rows after it are timed against it (× off).
+    off: bool,
     frame_ms: f64,
     report: FrameReport,
     accuracy: crate::shadow_error::ShadowAccuracy,
@@ -509,7 +513,7 @@ pub fn shadows(
             crate::shadow_error::measure_shadows(&mut renderer, casting(u64::from(frames) + 1), &occluders)?;
         progress
             .step(|| format!("{name}: {frame_ms:.0} ms, visibility error {:.4}", accuracy.visibility_error));
-        rows.push(ShadowRow { name, frame_ms, report, accuracy });
+        rows.push(ShadowRow { name, off: !settings.render.shadows.enabled, frame_ms, report, accuracy });
     }
     progress.finish();
     let context = format!(
@@ -529,12 +533,12 @@ fn shadow_markdown(rows: &[ShadowRow], context: &str) -> String {
     let _ = writeln!(out, "{context}\n");
     let _ = writeln!(
         out,
-        "| setting | frame ms | × off | shadow pass ms | atlas MiB | maps drawn / cached / stale | smaller than asked / none | visibility error | false shadow | light leak | FLIP vs shadow reference |"
+        "| setting | frame ms | × off | shadow pass ms | atlas MiB | maps drawn / cached / stale | smaller than asked / none | visibility error | false shadow | light leak | FLIP vs shadow reference | light error | flicker |"
     );
-    let _ = writeln!(out, "|---|---:|---:|---:|---:|---|---|---:|---:|---:|---:|");
+    let _ = writeln!(out, "|---|---:|---:|---:|---:|---|---|---:|---:|---:|---:|---:|---:|");
     let mut off_ms = f64::NAN;
     for r in rows {
-        if r.report.shadows.is_none_or(|s| s.casting_lights == 0) {
+        if r.off {
             off_ms = r.frame_ms;
         }
         let s = r.report.shadows.unwrap_or_default();
@@ -542,7 +546,7 @@ fn shadow_markdown(rows: &[ShadowRow], context: &str) -> String {
         let a = &r.accuracy;
         let _ = writeln!(
             out,
-            "| {} | {:.0} | {:.2}× | {} | {:.0} | {} / {} / {} | {} / {} | {:.4} | {:.4} | {:.4} | {:.4} |",
+            "| {} | {:.0} | {:.2}× | {} | {:.0} | {} / {} / {} | {} / {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.5} | {:.5} |",
             r.name,
             r.frame_ms,
             r.frame_ms / off_ms,
@@ -556,7 +560,9 @@ fn shadow_markdown(rows: &[ShadowRow], context: &str) -> String {
             a.visibility_error,
             a.false_shadow,
             a.light_leak,
-            a.flip.mean
+            a.flip.mean,
+            a.light_error,
+            a.flicker
         );
     }
     out
@@ -575,6 +581,8 @@ fn shadow_csv(rows: &[ShadowRow], scene: &str, size: UVec2, adapter: &str) -> Re
             "visibility_error",
             "false_shadow",
             "light_leak",
+            "light_error",
+            "flicker",
             "shadow_maps_rendered",
             "shadow_maps_cached",
             "shadow_maps_stale",
@@ -597,6 +605,8 @@ fn shadow_csv(rows: &[ShadowRow], scene: &str, size: UVec2, adapter: &str) -> Re
             format!("{:.6}", a.visibility_error),
             format!("{:.6}", a.false_shadow),
             format!("{:.6}", a.light_leak),
+            format!("{:.6}", a.light_error),
+            format!("{:.6}", a.flicker),
             s.maps_rendered.to_string(),
             s.maps_cached.to_string(),
             s.maps_stale.to_string(),

@@ -444,6 +444,20 @@ fn shadow_measurements_come_out_of_render_bench_and_report() {
     let text = std::fs::read_to_string(plots.join("report_shadows.csv")).expect("report_shadows.csv");
     assert_eq!(text.lines().count() - 1, table_rows, "{text}\n{shadows}");
     assert!(text.lines().nth(1).is_some_and(|l| l.contains("shadows off")), "{text}");
+    // Shadow rays are a row of their own, exact: no pair on the wrong side.
+    let mut report_rows = csv::Reader::from_reader(text.as_bytes());
+    let header = report_rows.headers().expect("header").clone();
+    let column = |name: &str| header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no {name}"));
+    let rays: Vec<csv::StringRecord> = report_rows
+        .records()
+        .map(|r| r.expect("row"))
+        .filter(|r| r.iter().any(|f| f.contains("rays (exact)")))
+        .collect();
+    assert_eq!(rays.len(), 2, "{text}");
+    for r in &rays {
+        assert_eq!(r[column("visibility_error")].parse::<f64>().expect("a number"), 0.0, "{text}");
+        assert!(r[column("light_error")].parse::<f64>().is_ok_and(|e| (0.0..1e-3).contains(&e)), "{text}");
+    }
     assert_figures(&plots, &["report_shadows_accuracy_vs_time", "report_shadows_passes"]);
 }
 
