@@ -46,9 +46,10 @@ pub const RAY_MAX_STEPS: u32 = 4096;
 pub const RAY_LEAF_TRIANGLES: u32 = 4;
 /// [`InstanceLevel::root`] value meaning "no node": nothing to trace.
 pub const RAY_NO_NODE: u32 = u32::MAX;
-/// What the box test returns for a box the ray misses (the largest finite `f32`: shaders have
-/// no infinity literal).
-pub const RAY_MISS: f32 = f32::MAX;
+/// What the box test returns for a box the ray misses: far past [`RAY_FAR`], and written as a
+/// literal every WGSL compiler takes (shaders have no infinity, and Tint refuses `f32::MAX`'s
+/// shortest decimal, 3.4028235e38, which lies just above it).
+pub const RAY_MISS: f32 = 1e38;
 /// Where every segment ends at the latest: a directional light's (infinite) segment is traced
 /// this far.
 pub const RAY_FAR: f32 = 1e30;
@@ -414,7 +415,7 @@ fn triangle_hit(tri: &RayTriangle, ray: &TraversalRay, t_max: f32) -> bool {
     let p = ray.direction.cross(e2);
     let det = e1.dot(p);
     if !(det.abs() > 0.0 && det.abs() <= RAY_MISS) {
-        return false; // parallel, degenerate or not finite
+        return false; // parallel, degenerate, or past RAY_MISS (not finite)
     }
     let inv = 1.0 / det;
     let s = ray.origin - v0;

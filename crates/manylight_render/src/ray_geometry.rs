@@ -453,8 +453,8 @@ impl ShadowRays {
             }
             state.scratch.push((key, instance.world_from_local));
         }
-        if state.scratch != state.placed || state.geometry.root() == RAY_NO_NODE && !state.scratch.is_empty()
-        {
+        // A new mesh comes with a new instance list, so the instance level is built after it.
+        if state.scratch != state.placed {
             let slots = &state.slots;
             state.geometry.place(state.scratch.iter().map(|(key, t)| (slots[key].1, *t)));
             std::mem::swap(&mut state.placed, &mut state.scratch);

@@ -168,6 +168,18 @@ fn offsets(module: &naga::Module, name: &str, size: usize, rust: &[(&str, usize)
     }
 }
 
+/// Every `f32` constant of the preamble, as written (`{:?}`), is a finite `f32` when read back
+/// exactly: Tint (Chromium's WGSL compiler) refuses a literal past `f32::MAX` where naga rounds
+/// it, so `f32::MAX` written as 3.4028235e38 fails in a browser only.
+#[test]
+fn every_shared_float_constant_is_written_within_f32_range() {
+    for (name, value) in manylight_render::gpu_types::shared_f32_constants() {
+        let written = format!("{value:?}");
+        let exact: f64 = written.parse().expect("a decimal");
+        assert!(exact.abs() <= f64::from(f32::MAX), "{name} is written {written}, past f32::MAX");
+    }
+}
+
 #[test]
 fn shared_structs_match_rust() {
     let shadowed = validate_with("forward.wgsl", ShaderDefs { shadows: true, ..Default::default() });
