@@ -13,15 +13,15 @@
 //!    sample (all of them when fewer reach it): the segments of `ShadowQuery::segment`, as the
 //!    oracle casts them.
 
-use crate::shadow_error::occluders;
+use crate::bench::median;
+use crate::shadow_error::{occluders, pixel_surface};
 use anyhow::{Context, Result, bail};
-use glam::{IVec3, Mat4, UVec2, Vec2, Vec3};
+use glam::{IVec3, Mat4, UVec2, Vec3};
 use manylight_core::ray_bvh::{self, MeshSlot, RayOutcome, Traced};
 use manylight_core::shadow_oracle::{LightSource, OccluderSet, ShadowQuery, SurfaceHit};
 use manylight_render::GpuContext;
 use manylight_render::ray_geometry::{RayGeometry, RayGeometryReport, RaySegment, trace_segments};
-use manylight_scene::Scene;
-use manylight_scene::light_rig;
+use manylight_scene::{Scene, SplitMix64, light_rig};
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::time::Instant;
@@ -109,13 +109,13 @@ pub fn measure(options: &Options) -> Result<Measurement> {
     let placed = placement(&scene, &slots);
     geometry.place(placed.iter().copied());
     geometry.upload(&gpu);
-    let mut rebuilds: Vec<f64> = (0..options.repeats.max(1))
+    let rebuilds: Vec<f64> = (0..options.repeats.max(1))
         .map(|_| {
             geometry.place(placed.iter().copied());
             geometry.report().instance_build_ms
         })
         .collect();
-    let instance_rebuild_ms = median(&mut rebuilds);
+    let instance_rebuild_ms = median(&rebuilds);
     let mut nodes = Vec::new();
     let mut rows = Vec::new();
     for &k in &options.rays_per_pixel {
@@ -145,7 +145,7 @@ pub fn measure(options: &Options) -> Result<Measurement> {
         rows.push(Row {
             rays_per_pixel: k,
             segments: segments.len(),
-            gpu_ms: median(&mut times),
+            gpu_ms: median(&times),
             twin_ms,
             oracle_ms,
             mean_steps: traced.iter().map(|t| f64::from(t.steps)).sum::<f64>() / traced.len().max(1) as f64,
@@ -195,14 +195,7 @@ fn pixel_surfaces(scene: &Scene, size: UVec2, occluders: &OccluderSet) -> Vec<Op
     let world_from_clip = camera.transform * camera.projection.matrix(aspect).inverse();
     (0..size.x * size.y)
         .into_par_iter()
-        .map(|i| {
-            let pixel = Vec2::new((i % size.x) as f32 + 0.5, (i / size.x) as f32 + 0.5);
-            let ndc = Vec2::new(pixel.x / size.x as f32 * 2.0 - 1.0, 1.0 - pixel.y / size.y as f32 * 2.0);
-            // Reverse-Z: 1 is the near plane.
-            let near = world_from_clip.project_point3(ndc.extend(1.0));
-            let further = world_from_clip.project_point3(ndc.extend(0.5));
-            occluders.first_hit(near, further - near)
-        })
+        .map(|i| pixel_surface(&world_from_clip, size, i, occluders))
         .collect()
 }
 
@@ -225,7 +218,7 @@ fn pixel_queries(
             let index = if picks == list.len() {
                 sample
             } else {
-                (hash((pixel as u64) << 8 | sample as u64) % list.len() as u64) as usize
+                (SplitMix64((pixel as u64) << 8 | sample as u64).next_u64() % list.len() as u64) as usize
             };
             let (position, _) = lights[list[index] as usize];
             out.push(ShadowQuery {
@@ -236,14 +229,6 @@ fn pixel_queries(
         }
     }
     out
-}
-
-/// splitmix64's finaliser: a well-mixed 64-bit hash.
-fn hash(x: u64) -> u64 {
-    let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
 }
 
 /// Lights in a uniform grid of cells one largest diameter wide: a light's sphere touches at
@@ -285,11 +270,6 @@ impl LightGrid {
             })
             .collect()
     }
-}
-
-fn median(values: &mut [f64]) -> f64 {
-    values.sort_by(f64::total_cmp);
-    values.get(values.len() / 2).copied().unwrap_or(0.0)
 }
 
 /// The measurement as markdown: the geometry, then one row a rays-per-pixel setting.

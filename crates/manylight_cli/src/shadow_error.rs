@@ -210,17 +210,26 @@ fn pixel_surfaces(
             if count == 0 {
                 return None;
             }
-            let (x, y) = (i % size.x, i / size.x);
-            let ndc = Vec2::new(
-                (x as f32 + 0.5) / size.x as f32 * 2.0 - 1.0,
-                1.0 - (y as f32 + 0.5) / size.y as f32 * 2.0,
-            );
-            // Reverse-Z: 1 is the near plane.
-            let near = world_from_clip.project_point3(ndc.extend(1.0));
-            let further = world_from_clip.project_point3(ndc.extend(0.5));
-            occluders.first_hit(near, further - near)
+            pixel_surface(world_from_clip, size, i, occluders)
         })
         .collect()
+}
+
+/// The surface under pixel `i` (row-major) of a `size` frame: the first hit of the camera ray
+/// through its centre (through `world_from_clip`) in `occluders`.
+pub(crate) fn pixel_surface(
+    world_from_clip: &Mat4,
+    size: UVec2,
+    i: u32,
+    occluders: &OccluderSet,
+) -> Option<SurfaceHit> {
+    let (x, y) = (i % size.x, i / size.x);
+    let ndc =
+        Vec2::new((x as f32 + 0.5) / size.x as f32 * 2.0 - 1.0, 1.0 - (y as f32 + 0.5) / size.y as f32 * 2.0);
+    // Reverse-Z: 1 is the near plane.
+    let near = world_from_clip.project_point3(ndc.extend(1.0));
+    let further = world_from_clip.project_point3(ndc.extend(0.5));
+    occluders.first_hit(near, further - near)
 }
 
 /// The (pixel, light) entries of the oracle's lists whose pixel has a surface.

@@ -250,7 +250,7 @@ impl InstanceLevel {
             if !local_from_world.is_finite() || world_from_local.determinant() == 0.0 {
                 continue;
             }
-            let world = transformed_box(&slot.bounds, &world_from_local);
+            let world = slot.bounds.transformed(&world_from_local);
             if !(world.min.is_finite() && world.max.is_finite()) {
                 continue;
             }
@@ -464,21 +464,6 @@ fn depth(bvh: &Bvh2) -> u32 {
         }
     }
     deepest
-}
-
-/// The world box of a local box under `world_from_local` (its eight corners' box).
-fn transformed_box(local: &crate::Aabb, world_from_local: &Mat4) -> crate::Aabb {
-    let mut world = crate::Aabb::EMPTY;
-    for i in 0..8 {
-        let pick = |bit: usize, lo: f32, hi: f32| if i & bit == 0 { lo } else { hi };
-        let corner = Vec3::new(
-            pick(1, local.min.x, local.max.x),
-            pick(2, local.min.y, local.max.y),
-            pick(4, local.min.z, local.max.z),
-        );
-        world.extend(world_from_local.transform_point3(corner));
-    }
-    world
 }
 
 #[cfg(test)]

@@ -13,7 +13,7 @@
 use crate::bindings::Binding;
 use crate::context::{GpuContext, RenderError};
 use crate::layouts::{RAY_LIGHT_PROBE_GROUP, RAY_PROBE_GROUP, RAY_SHADOW_GROUP, compute_pipeline};
-use crate::readback::dispatch_and_read;
+use crate::readback::{dispatch_and_read, readback_output};
 use crate::shaders::ShaderDefs;
 use crate::snapshot::FrameSnapshot;
 use bytemuck::{Pod, Zeroable};
@@ -371,12 +371,7 @@ pub fn trace_segments(
             usage: wgpu::BufferUsages::STORAGE,
         });
         let result_bytes = (part.len() * 8) as u64;
-        let output = gpu.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("ray_traced"),
-            size: result_bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
+        let output = readback_output(gpu, "ray_traced", result_bytes);
         let group = probe_layout.create_bind_group(
             gpu,
             &[Binding::Buffer(&params), Binding::Buffer(&input), Binding::Buffer(&output)],
@@ -523,15 +518,8 @@ pub fn probe_lights(
         .create_bind_group(gpu, &[Binding::Buffer(bindings.nodes), Binding::Buffer(bindings.prims)]);
     let mut out = Vec::with_capacity(probes.len());
     for part in probes.chunks(crate::shadow_probe::PROBES_PER_DISPATCH) {
-        let gpu_probes: Vec<crate::gpu_types::GpuShadowProbe> = part
-            .iter()
-            .map(|p| crate::gpu_types::GpuShadowProbe {
-                position: p.position.to_array(),
-                light: p.light,
-                normal: p.normal.to_array(),
-                pad: 0.0,
-            })
-            .collect();
+        let gpu_probes: Vec<crate::gpu_types::GpuShadowProbe> =
+            part.iter().map(crate::gpu_types::GpuShadowProbe::from).collect();
         let params = GpuRayProbeParams { geometry: bindings.view, count: part.len() as u32, pad: [0; 3] };
         let params = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("ray_light_probe_params"),
@@ -544,12 +532,7 @@ pub fn probe_lights(
             usage: wgpu::BufferUsages::STORAGE,
         });
         let result_bytes = (part.len() * 4) as u64;
-        let output = gpu.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("ray_light_probed"),
-            size: result_bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
+        let output = readback_output(gpu, "ray_light_probed", result_bytes);
         let group = probe_layout.create_bind_group(
             gpu,
             &[

@@ -87,6 +87,16 @@ pub fn read_texture(
     Ok(out)
 }
 
+/// A storage buffer of `bytes` a compute pass writes and [`dispatch_and_read`] reads back.
+pub fn readback_output(gpu: &GpuContext, label: &str, bytes: u64) -> wgpu::Buffer {
+    gpu.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    })
+}
+
 /// Runs the compute `pipeline` once per element of `count`, in workgroups of `workgroup`, with
 /// `groups` bound at their indices, and reads back the first `bytes` of `output` (a measurement:
 /// waits for the GPU).

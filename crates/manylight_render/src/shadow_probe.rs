@@ -8,7 +8,7 @@ use crate::bindings::Binding;
 use crate::context::{GpuContext, RenderError};
 use crate::gpu_types::{GpuPointLight, GpuShadowProbe};
 use crate::layouts::{SHADOW_PROBE_GROUP, SHADOW_PROBE_SHADOWS_GROUP, check_pipeline, pipeline_layout};
-use crate::readback::dispatch_and_read;
+use crate::readback::{dispatch_and_read, readback_output};
 use crate::shaders::ShaderDefs;
 use crate::shadows::ShadowResources;
 use glam::Vec3;
@@ -28,6 +28,17 @@ pub struct ShadowProbe {
     pub normal: Vec3,
     /// The light's index in the frame's light buffer (its valid lights, in order).
     pub light: u32,
+}
+
+impl From<&ShadowProbe> for GpuShadowProbe {
+    fn from(p: &ShadowProbe) -> GpuShadowProbe {
+        GpuShadowProbe {
+            position: p.position.to_array(),
+            light: p.light,
+            normal: p.normal.to_array(),
+            pad: 0.0,
+        }
+    }
 }
 
 /// The shadow test of `shadows`' last frame for each probe, in [0, 1] (1: fully lit). Every
@@ -77,27 +88,14 @@ pub fn probe_shadows(
     };
     let mut out = Vec::with_capacity(probes.len());
     for part in probes.chunks(PROBES_PER_DISPATCH) {
-        let gpu_probes: Vec<GpuShadowProbe> = part
-            .iter()
-            .map(|p| GpuShadowProbe {
-                position: p.position.to_array(),
-                light: p.light,
-                normal: p.normal.to_array(),
-                pad: 0.0,
-            })
-            .collect();
+        let gpu_probes: Vec<GpuShadowProbe> = part.iter().map(GpuShadowProbe::from).collect();
         let input = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("shadow_probes"),
             contents: bytemuck::cast_slice(&gpu_probes),
             usage: wgpu::BufferUsages::STORAGE,
         });
         let result_bytes = (part.len() * 4) as u64;
-        let output = gpu.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("shadow_probed"),
-            size: result_bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
+        let output = readback_output(gpu, "shadow_probed", result_bytes);
         let group = probe_layout.create_bind_group(
             gpu,
             &[Binding::BufferPrefix(lights, light_bytes), Binding::Buffer(&input), Binding::Buffer(&output)],
